@@ -1,0 +1,370 @@
+//! Bake a [`HairMesh`] into the five textures of paper 003, Table 1.
+//!
+//! | texture | dims | Vulkan format | bytes/texel | content |
+//! |---|---|---|---|---|
+//! | hair mesh texture | `W x H x (4(L-1)+1)` | `R16G16B16A16_UNORM` | 8 | positions and quadratic Bezier control points, decoded `origin + extent * t` |
+//! | uv-texture | `W x H` | `R16G16_UNORM` | 4 | root `uv`, decoded `origin + extent * t` |
+//! | w-texture | `W x H x L` | `R16_UNORM` | 2 | `w`, decoded `w_scale * t` |
+//! | u-texture | `W x H x L` | `R16G16B16A16_SNORM` | 8 | unit styling direction `u` (eq. 1-3) |
+//! | v-texture | `W x H x L` | `R16G16B16A16_SNORM` | 8 | unit styling direction `v` (eq. 1-3) |
+//!
+//! 16-bit normalised formats: linear filtering is supported for them on lavapipe and the desktop
+//! GPUs we target (checked at device creation), filtering is exact on the decoded values because
+//! decoding is affine, and over a bounding box they keep a uniform `extent / 65535` precision
+//! (15 micrometres on a 1 m model) where half floats lose precision away from the origin; they
+//! take half the memory of 32-bit floats.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat2, Vec2, Vec3};
+
+use crate::curve::column_control_points;
+use crate::error::{HairError, Result};
+use crate::hair_mesh::{HairMesh, bounds, corner_triangle};
+use crate::layout::{EMPTY_TEXEL, RootLayout, layout_root_slice};
+use crate::style::HairStyle;
+
+/// Texture decode constants and sizes, shared with GLSL as `MeshInfo` (std430, 64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct MeshInfo {
+    /// xyz: position of texel value 0; w: scale of the w-texture.
+    pub pos_origin: [f32; 4],
+    /// xyz: position extent (texel value 1 maps to origin + extent); w: unused (0).
+    pub pos_extent: [f32; 4],
+    /// xy: uv origin; zw: uv extent.
+    pub uv_origin_extent: [f32; 4],
+    /// Root slice width and height in texels.
+    pub root_size: [u32; 2],
+    /// Number of layers `L`.
+    pub layers: u32,
+    /// Number of bundles.
+    pub bundle_count: u32,
+}
+
+impl MeshInfo {
+    /// Field offsets (mirrors `glsl/hair_types.glsl`).
+    pub fn field_offsets() -> Vec<(&'static str, usize)> {
+        crate::field_offsets!(MeshInfo; pos_origin, pos_extent, uv_origin_extent, root_size,
+            layers, bundle_count)
+    }
+
+    /// Depth of the hair mesh texture: root/layer slices plus three intermediate slices each.
+    pub fn position_depth(&self) -> u32 {
+        4 * (self.layers - 1) + 1
+    }
+
+    /// Texels in one root slice.
+    pub fn slice_texels(&self) -> usize {
+        self.root_size[0] as usize * self.root_size[1] as usize
+    }
+}
+
+/// Per-bundle record shared with GLSL as `BundleDesc` (std430, 32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct BundleDesc {
+    /// Root-slice texel of the cell's corner `(0, 0)`.
+    pub origin: [u32; 2],
+    /// Bit 0: triangle bundle.
+    pub flags: u32,
+    /// `h` of eq. 7: longest root edge at rest.
+    pub rest_size: f32,
+    /// Root area divided by the mean root area (strand density weight).
+    pub density: f32,
+    /// Padding to 32 bytes.
+    pub _pad: [u32; 3],
+}
+
+/// `BundleDesc::flags` bit of triangle bundles.
+pub const BUNDLE_TRIANGLE: u32 = 1;
+
+impl BundleDesc {
+    /// Field offsets (mirrors `glsl/hair_types.glsl`).
+    pub fn field_offsets() -> Vec<(&'static str, usize)> {
+        crate::field_offsets!(BundleDesc; origin, flags, rest_size, density, _pad)
+    }
+
+    /// Whether this is a triangle bundle.
+    pub fn is_triangle(&self) -> bool {
+        self.flags & BUNDLE_TRIANGLE != 0
+    }
+}
+
+/// One texture of the bake: its name, Vulkan format and encoded bytes.
+pub struct TextureView<'a> {
+    /// Name as in Table 1.
+    pub name: &'static str,
+    /// Vulkan format name.
+    pub format: &'static str,
+    /// `[width, height, depth]` (depth 1 for 2D).
+    pub extent: [u32; 3],
+    /// Encoded texel bytes, x fastest, then y, then z.
+    pub bytes: &'a [u8],
+}
+
+/// The five textures of a hair mesh plus its bundle table and style.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakedHairMesh {
+    /// Sizes and decode constants.
+    pub info: MeshInfo,
+    /// Style the mesh was baked with (renderers may override it).
+    pub style: HairStyle,
+    /// One record per bundle.
+    pub bundles: Vec<BundleDesc>,
+    /// Hair mesh texture, `R16G16B16A16_UNORM`.
+    pub position: Vec<[u16; 4]>,
+    /// uv-texture, `R16G16_UNORM`.
+    pub uv: Vec<[u16; 2]>,
+    /// w-texture, `R16_UNORM`.
+    pub w: Vec<u16>,
+    /// u-texture, `R16G16B16A16_SNORM`.
+    pub u_dir: Vec<[i16; 4]>,
+    /// v-texture, `R16G16B16A16_SNORM`.
+    pub v_dir: Vec<[i16; 4]>,
+}
+
+impl BakedHairMesh {
+    /// The five textures in Table 1 order.
+    pub fn textures(&self) -> [TextureView<'_>; 5] {
+        let [w, h] = self.info.root_size;
+        let l = self.info.layers;
+        [
+            TextureView {
+                name: "hair mesh texture",
+                format: "R16G16B16A16_UNORM",
+                extent: [w, h, self.info.position_depth()],
+                bytes: bytemuck::cast_slice(&self.position),
+            },
+            TextureView {
+                name: "uv-texture",
+                format: "R16G16_UNORM",
+                extent: [w, h, 1],
+                bytes: bytemuck::cast_slice(&self.uv),
+            },
+            TextureView {
+                name: "w-texture",
+                format: "R16_UNORM",
+                extent: [w, h, l],
+                bytes: bytemuck::cast_slice(&self.w),
+            },
+            TextureView {
+                name: "u-texture",
+                format: "R16G16B16A16_SNORM",
+                extent: [w, h, l],
+                bytes: bytemuck::cast_slice(&self.u_dir),
+            },
+            TextureView {
+                name: "v-texture",
+                format: "R16G16B16A16_SNORM",
+                extent: [w, h, l],
+                bytes: bytemuck::cast_slice(&self.v_dir),
+            },
+        ]
+    }
+
+    /// Total bytes of the five textures.
+    pub fn texture_bytes(&self) -> usize {
+        self.textures().iter().map(|t| t.bytes.len()).sum()
+    }
+}
+
+/// Options of [`bake`].
+#[derive(Clone, Copy, Debug)]
+pub struct BakeOptions {
+    /// Pack grid-like regions as shared-vertex charts (else one 2x2 block per face).
+    pub charts: bool,
+}
+
+impl Default for BakeOptions {
+    fn default() -> Self {
+        BakeOptions { charts: true }
+    }
+}
+
+/// Largest texture side accepted (Vulkan guarantees 2048 for 3D images).
+pub const MAX_TEXTURE_SIDE: u32 = 2048;
+
+/// Per-vertex styling directions `u`, `v` of one layer (eq. 1-3): the texture-space-area-weighted
+/// average of each corner triangle's linear map of the uv axes, normalised. Shared by every
+/// bundle meeting at the vertex, so styling has no seams between bundles.
+pub fn styling_directions(mesh: &HairMesh, layer: usize) -> (Vec<Vec3>, Vec<Vec3>) {
+    let n = mesh.vertices_per_layer();
+    let p = &mesh.layers[layer];
+    let mut su = vec![Vec3::ZERO; n];
+    let mut sv = vec![Vec3::ZERO; n];
+    let mut sa = vec![0.0f32; n];
+    for face in &mesh.faces {
+        let v = face.vertices();
+        for c in 0..v.len() {
+            let [i0, i1, i2] = corner_triangle(v, c);
+            let (uv0, uv1, uv2) = (mesh.uv[i0], mesh.uv[i1], mesh.uv[i2]);
+            // Eq. 2: T_i = [uv1 - uv0, uv2 - uv0] as columns.
+            let t = Mat2::from_cols(uv1 - uv0, uv2 - uv0);
+            let det = t.determinant();
+            if det.abs() < 1e-20 {
+                continue; // validated meshes have none; stay robust for deformed ones
+            }
+            let inv = t.inverse();
+            // Eq. 3: [u_i v_i] = [p1 - p0, p2 - p0] T_i^-1.
+            let (e1, e2) = (p[i1] - p[i0], p[i2] - p[i0]);
+            let ui = e1 * inv.x_axis.x + e2 * inv.x_axis.y;
+            let vi = e1 * inv.y_axis.x + e2 * inv.y_axis.y;
+            let area = 0.5 * det.abs();
+            su[i0] += ui * area;
+            sv[i0] += vi * area;
+            sa[i0] += area;
+        }
+    }
+    // Eq. 1: area-weighted mean, normalised (the division by sum A_i cancels in the normalisation).
+    let u = su
+        .iter()
+        .map(|x| x.try_normalize().unwrap_or(Vec3::X))
+        .collect();
+    let v = sv
+        .iter()
+        .map(|x| x.try_normalize().unwrap_or(Vec3::Y))
+        .collect();
+    (u, v)
+}
+
+/// Quantise `x` in `[0, 1]` to UNORM16.
+pub fn to_unorm16(x: f32) -> u16 {
+    (x.clamp(0.0, 1.0) * 65535.0).round() as u16
+}
+
+/// Quantise `x` in `[-1, 1]` to SNORM16.
+pub fn to_snorm16(x: f32) -> i16 {
+    (x.clamp(-1.0, 1.0) * 32767.0).round() as i16
+}
+
+fn safe_extent(e: Vec3) -> Vec3 {
+    Vec3::select(e.cmpgt(Vec3::splat(1e-12)), e, Vec3::ONE)
+}
+
+/// Bake `mesh` with `style` into the five textures; `progress(done, total)` is called per layer.
+pub fn bake(
+    mesh: &HairMesh,
+    style: &HairStyle,
+    options: BakeOptions,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<BakedHairMesh> {
+    mesh.validate()?;
+    style.validate(&mesh.name)?;
+    let layout: RootLayout = layout_root_slice(mesh, options.charts);
+    let layers = mesh.layer_count();
+    let depth = 4 * (layers - 1) + 1;
+    if layout.width > MAX_TEXTURE_SIDE
+        || layout.height > MAX_TEXTURE_SIDE
+        || depth as u32 > MAX_TEXTURE_SIDE
+    {
+        return Err(HairError::invalid(
+            &mesh.name,
+            format!(
+                "too large to bake: root slice {}x{} with {depth} slices exceeds {MAX_TEXTURE_SIDE} texels per side",
+                layout.width, layout.height
+            ),
+        ));
+    }
+    let n = mesh.vertices_per_layer();
+    let total_steps = n + layers;
+
+    // Control points of every vertex column along r*.
+    let mut ctrl: Vec<Vec<Vec3>> = Vec::with_capacity(n);
+    for i in 0..n {
+        let column: Vec<Vec3> = mesh.layers.iter().map(|l| l[i]).collect();
+        ctrl.push(column_control_points(&column));
+        if i % 4096 == 0 {
+            progress(i, total_steps);
+        }
+    }
+    let (lo, hi) = bounds(ctrl.iter().flatten().copied());
+    let extent = safe_extent(hi - lo);
+    let (uv_lo, uv_hi) = bounds(mesh.uv.iter().map(|uv| uv.extend(0.0)));
+    let uv_extent = safe_extent(uv_hi - uv_lo).truncate();
+    let w_scale = mesh
+        .w
+        .iter()
+        .flatten()
+        .fold(0.0f32, |a, &b| a.max(b))
+        .max(1e-12);
+
+    let slice = layout.texels.len();
+    let mut position = vec![[0u16; 4]; slice * depth];
+    let mut uv = vec![[0u16; 2]; slice];
+    let mut w = vec![0u16; slice * layers];
+    let mut u_dir = vec![[0i16; 4]; slice * layers];
+    let mut v_dir = vec![[0i16; 4]; slice * layers];
+
+    for (t, &vert) in layout.texels.iter().enumerate() {
+        if vert == EMPTY_TEXEL {
+            continue;
+        }
+        let vi = vert as usize;
+        for (z, p) in ctrl[vi].iter().enumerate() {
+            let q = (*p - lo) / extent;
+            position[z * slice + t] = [to_unorm16(q.x), to_unorm16(q.y), to_unorm16(q.z), 0];
+        }
+        let q = (mesh.uv[vi] - uv_lo.truncate()) / uv_extent;
+        uv[t] = [to_unorm16(q.x), to_unorm16(q.y)];
+        for k in 0..layers {
+            w[k * slice + t] = to_unorm16(mesh.w[k][vi] / w_scale);
+        }
+    }
+    for k in 0..layers {
+        let (us, vs) = styling_directions(mesh, k);
+        for (t, &vert) in layout.texels.iter().enumerate() {
+            if vert == EMPTY_TEXEL {
+                continue;
+            }
+            let (a, b) = (us[vert as usize], vs[vert as usize]);
+            u_dir[k * slice + t] = [to_snorm16(a.x), to_snorm16(a.y), to_snorm16(a.z), 0];
+            v_dir[k * slice + t] = [to_snorm16(b.x), to_snorm16(b.y), to_snorm16(b.z), 0];
+        }
+        progress(n + k + 1, total_steps);
+    }
+
+    let sizes = mesh.bundle_sizes();
+    let areas = mesh.bundle_areas();
+    let mean_area = areas.iter().sum::<f32>() / areas.len() as f32;
+    let bundles = layout
+        .bundles
+        .iter()
+        .enumerate()
+        .map(|(f, b)| BundleDesc {
+            origin: b.origin,
+            flags: if b.triangle { BUNDLE_TRIANGLE } else { 0 },
+            rest_size: sizes[f],
+            density: areas[f] / mean_area,
+            _pad: [0; 3],
+        })
+        .collect();
+
+    Ok(BakedHairMesh {
+        info: MeshInfo {
+            pos_origin: [lo.x, lo.y, lo.z, w_scale],
+            pos_extent: [extent.x, extent.y, extent.z, 0.0],
+            uv_origin_extent: [uv_lo.x, uv_lo.y, uv_extent.x, uv_extent.y],
+            root_size: [layout.width, layout.height],
+            layers: layers as u32,
+            bundle_count: mesh.faces.len() as u32,
+        },
+        style: *style,
+        bundles,
+        position,
+        uv,
+        w,
+        u_dir,
+        v_dir,
+    })
+}
+
+/// Root-slice statistics of a bake, for reports.
+pub fn texels_per_face(baked: &BakedHairMesh) -> f32 {
+    baked.info.slice_texels() as f32 / baked.bundles.len().max(1) as f32
+}
+
+/// Convenience: the uv extent as a vector (decode of the uv-texture).
+pub fn uv_decode(info: &MeshInfo) -> (Vec2, Vec2) {
+    let e = info.uv_origin_extent;
+    (Vec2::new(e[0], e[1]), Vec2::new(e[2], e[3]))
+}

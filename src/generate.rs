@@ -1,0 +1,405 @@
+//! CPU reference generator: the oracle the GPU paths are tested against.
+//!
+//! It reads only the baked textures and emulates what a shader does with them: normalised
+//! texture coordinates, clamp-to-edge linear filtering of the decoded texel values (the texture
+//! unit's two trilinear fetches per quadratic Bezier), one software lerp (paper 003, section 3.1),
+//! root placement from the shared blue-noise sets (section 3.3), styling in the `u v w` frame
+//! (section 3.4) and tangents by eq. 5-6 (section 3.5). `glsl/strand_eval.glsl` is the GPU twin.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use crate::bake::{BakedHairMesh, BundleDesc, MeshInfo};
+use crate::blue_noise::{MAX_STRANDS_PER_BUNDLE, quad_samples, triangle_samples};
+use crate::rng::{hash_f32, hash_u32};
+use crate::style::HairStyle;
+
+/// A decoded texture sampled like a GPU texture unit: normalised coordinates, linear filter,
+/// clamp to edge. Texels are stored decoded as `Vec4` (unused channels 0).
+#[derive(Clone, Debug)]
+pub struct SampledTexture {
+    size: [usize; 3],
+    texels: Vec<Vec4>,
+}
+
+/// Bilinear footprint in the xy plane: four texel offsets and weights.
+#[derive(Clone, Copy, Debug)]
+pub struct Footprint {
+    offsets: [usize; 4],
+    weights: [f32; 4],
+}
+
+/// One axis of linear filtering with clamp-to-edge: `(i0, i1, frac)` for normalised `u`.
+fn axis(u: f32, size: usize) -> (usize, usize, f32) {
+    let x = u * size as f32 - 0.5;
+    let f = x.floor();
+    let frac = x - f;
+    let last = size as i64 - 1;
+    let i0 = (f as i64).clamp(0, last) as usize;
+    let i1 = (f as i64 + 1).clamp(0, last) as usize;
+    (i0, i1, frac)
+}
+
+impl SampledTexture {
+    /// Decode texels with `decode` into a texture of `size` (x fastest).
+    pub fn new<T: Copy>(size: [u32; 3], data: &[T], decode: impl Fn(T) -> Vec4) -> Self {
+        SampledTexture {
+            size: size.map(|s| s as usize),
+            texels: data.iter().map(|&t| decode(t)).collect(),
+        }
+    }
+
+    /// Bilinear footprint of normalised `(u, v)`; shared by every slice of this texture.
+    pub fn footprint(&self, uv: Vec2) -> Footprint {
+        let (x0, x1, fx) = axis(uv.x, self.size[0]);
+        let (y0, y1, fy) = axis(uv.y, self.size[1]);
+        let w = self.size[0];
+        Footprint {
+            offsets: [y0 * w + x0, y0 * w + x1, y1 * w + x0, y1 * w + x1],
+            weights: [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy],
+        }
+    }
+
+    fn bilinear(&self, fp: &Footprint, slice: usize) -> Vec4 {
+        let base = slice * self.size[0] * self.size[1];
+        let t = &self.texels;
+        t[base + fp.offsets[0]] * fp.weights[0]
+            + t[base + fp.offsets[1]] * fp.weights[1]
+            + t[base + fp.offsets[2]] * fp.weights[2]
+            + t[base + fp.offsets[3]] * fp.weights[3]
+    }
+
+    /// Trilinear sample at footprint `fp` and normalised depth `w`.
+    pub fn sample_3d(&self, fp: &Footprint, w: f32) -> Vec4 {
+        let (z0, z1, fz) = axis(w, self.size[2]);
+        self.bilinear(fp, z0).lerp(self.bilinear(fp, z1), fz)
+    }
+
+    /// Bilinear sample of a 2D texture.
+    pub fn sample_2d(&self, fp: &Footprint) -> Vec4 {
+        self.bilinear(fp, 0)
+    }
+
+    /// Depth in texels.
+    pub fn depth(&self) -> usize {
+        self.size[2]
+    }
+}
+
+/// Decoded textures of one baked hair mesh, ready for sampling.
+pub struct HairTextures {
+    /// Decode constants and sizes.
+    pub info: MeshInfo,
+    /// Bundle table.
+    pub bundles: Vec<BundleDesc>,
+    position: SampledTexture,
+    uv: SampledTexture,
+    w: SampledTexture,
+    u_dir: SampledTexture,
+    v_dir: SampledTexture,
+}
+
+fn unorm(x: u16) -> f32 {
+    x as f32 / 65535.0
+}
+
+fn snorm(x: i16) -> f32 {
+    (x as f32 / 32767.0).max(-1.0)
+}
+
+impl HairTextures {
+    /// Decode the textures of `baked` exactly as the GPU's UNORM/SNORM conversion does.
+    pub fn new(baked: &BakedHairMesh) -> Self {
+        let info = baked.info;
+        let [wd, ht] = info.root_size;
+        let l = info.layers;
+        let o = Vec3::from_slice(&info.pos_origin[..3]);
+        let e = Vec3::from_slice(&info.pos_extent[..3]);
+        let [uo0, uo1, ue0, ue1] = info.uv_origin_extent;
+        let w_scale = info.pos_origin[3];
+        HairTextures {
+            info,
+            bundles: baked.bundles.clone(),
+            position: SampledTexture::new([wd, ht, info.position_depth()], &baked.position, |t| {
+                (o + e * Vec3::new(unorm(t[0]), unorm(t[1]), unorm(t[2]))).extend(0.0)
+            }),
+            uv: SampledTexture::new([wd, ht, 1], &baked.uv, |t| {
+                Vec4::new(uo0 + ue0 * unorm(t[0]), uo1 + ue1 * unorm(t[1]), 0.0, 0.0)
+            }),
+            w: SampledTexture::new([wd, ht, l], &baked.w, |t| Vec4::new(w_scale * unorm(t), 0.0, 0.0, 0.0)),
+            u_dir: SampledTexture::new([wd, ht, l], &baked.u_dir, |t| {
+                Vec4::new(snorm(t[0]), snorm(t[1]), snorm(t[2]), 0.0)
+            }),
+            v_dir: SampledTexture::new([wd, ht, l], &baked.v_dir, |t| {
+                Vec4::new(snorm(t[0]), snorm(t[1]), snorm(t[2]), 0.0)
+            }),
+        }
+    }
+
+    /// Normalised root-slice coordinate of root sample `xi` in bundle `b` (section 3.3).
+    /// Triangles map `xi` (with `xi.x + xi.y < 1`) to the quad layout by
+    /// `(xi.x / (1 - xi.y), xi.y)`: bilinear weights then equal barycentrics, with `xi.y` the
+    /// weight of the duplicated vertex. (The paper prints `xi_s (1 - xi_t)`, the inverse map.)
+    pub fn root_coord(&self, b: &BundleDesc, xi: Vec2) -> Vec2 {
+        let local = if b.is_triangle() {
+            Vec2::new(xi.x / (1.0 - xi.y).max(1e-6), xi.y)
+        } else {
+            xi
+        }
+        .clamp(Vec2::ZERO, Vec2::ONE);
+        let [w, h] = self.info.root_size;
+        Vec2::new(
+            (b.origin[0] as f32 + 0.5 + local.x) / w as f32,
+            (b.origin[1] as f32 + 0.5 + local.y) / h as f32,
+        )
+    }
+
+    /// Object-space curve point at curve parameter `r` in `[0, L-1]` for footprint `fp`:
+    /// two trilinear fetches and one lerp (section 3.1).
+    pub fn curve_point(&self, fp: &Footprint, r: f32) -> Vec3 {
+        let (slice, t) = crate::curve::quadratic_slice(r, self.info.layers as usize);
+        let depth = self.position.depth() as f32;
+        let a = self.position.sample_3d(fp, (slice as f32 + 0.5 + t) / depth);
+        let b = self.position.sample_3d(fp, (slice as f32 + 1.5 + t) / depth);
+        a.lerp(b, t).truncate()
+    }
+
+    /// Root position (single root-slice lookup, no styling).
+    pub fn root_point(&self, fp: &Footprint) -> Vec3 {
+        self.position
+            .sample_3d(fp, 0.5 / self.position.depth() as f32)
+            .truncate()
+    }
+
+    /// Styling frame `(u, v, w)` at curve parameter `r` (eq. 4 for `w`), and the `w` coordinate.
+    pub fn frame(&self, fp: &Footprint, r: f32) -> ([Vec3; 3], f32) {
+        let z = (r + 0.5) / self.info.layers as f32;
+        let u = self.u_dir.sample_3d(fp, z).truncate().normalize_or(Vec3::X);
+        let v = self.v_dir.sample_3d(fp, z).truncate().normalize_or(Vec3::Y);
+        let w = u.cross(v).normalize_or(Vec3::Z);
+        ([u, v, w], self.w.sample_3d(fp, z).x)
+    }
+
+    /// Root `uv` styling coordinate.
+    pub fn root_uv(&self, fp: &Footprint) -> Vec2 {
+        self.uv.sample_2d(fp).truncate().truncate()
+    }
+
+    /// Bilinear footprint of a normalised root coordinate (valid for every texture).
+    pub fn footprint(&self, coord: Vec2) -> Footprint {
+        self.position.footprint(coord)
+    }
+}
+
+/// Per-strand random key from the style seed, bundle and strand index (GLSL: `strand_key`).
+pub fn strand_key(seed: u32, bundle: u32, strand: u32) -> u32 {
+    hash_u32(hash_u32(bundle ^ hash_u32(seed)).wrapping_add(strand))
+}
+
+/// Random value `slot` of a strand in `[0, 1)` (GLSL: `strand_rand`).
+pub fn strand_rand(key: u32, slot: u32) -> f32 {
+    hash_f32(key.wrapping_add(slot.wrapping_mul(0x9E37_79B9)))
+}
+
+/// Smooth 1D value noise in `[-1, 1]`, `x >= 0` (GLSL: `value_noise`).
+pub fn value_noise(key: u32, x: f32) -> f32 {
+    let i = x.floor();
+    let f = x - i;
+    let i = i as u32;
+    let a = hash_f32(key.wrapping_add(hash_u32(i)));
+    let b = hash_f32(key.wrapping_add(hash_u32(i.wrapping_add(1))));
+    let s = f * f * (3.0 - 2.0 * f);
+    (a + (b - a) * s) * 2.0 - 1.0
+}
+
+fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    if e1 <= e0 {
+        return if x >= e1 { 1.0 } else { 0.0 };
+    }
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// Root sample of strand `strand` in bundle `index`: the shared progressive blue-noise set,
+/// shifted toroidally per quad bundle (a shift keeps a periodic blue-noise set blue).
+pub fn root_sample(b: &BundleDesc, index: u32, strand: u32) -> Vec2 {
+    let s = strand as usize % MAX_STRANDS_PER_BUNDLE;
+    if b.is_triangle() {
+        triangle_samples()[s]
+    } else {
+        let h = hash_u32(index ^ 0x51ed_270b);
+        let shift = Vec2::new(hash_f32(h), hash_f32(h.wrapping_add(1)));
+        (quad_samples()[s] + shift).fract()
+    }
+}
+
+/// Strands generated for bundle `b` given `n` strands per (average) bundle.
+pub fn strands_in_bundle(b: &BundleDesc, style: &HairStyle, n: u32) -> u32 {
+    let count = if style.density_by_area != 0 {
+        (n as f32 * b.density).round() as u32
+    } else {
+        n
+    };
+    count.clamp(1, MAX_STRANDS_PER_BUNDLE as u32)
+}
+
+/// Styled offset of a vertex in the `u v w` frame (object units), section 3.4.
+/// `s` is the normalised position along the strand, `w` the styling coordinate.
+pub fn styling_offset(style: &HairStyle, key: u32, s: f32, w: f32) -> Vec3 {
+    use std::f32::consts::TAU;
+    let ramp = smoothstep(0.0, style.root_ramp, w);
+    let mut off = Vec3::ZERO;
+    let curl_phase = TAU * (style.curl_frequency * w + style.curl_phase_jitter * strand_rand(key, 1));
+    off += Vec3::new(curl_phase.cos(), curl_phase.sin(), 0.0) * (style.curl_radius * ramp);
+    let wave_phase = TAU * (style.wave_frequency * w + style.wave_phase_jitter * strand_rand(key, 2));
+    let wave_dir = Vec3::new(style.wave_angle.cos(), style.wave_angle.sin(), 0.0);
+    off += wave_dir * (style.wave_amplitude * ramp * wave_phase.sin());
+    let frizz = style.frizz_amplitude * s.powf(style.frizz_power);
+    let x = w * style.frizz_frequency;
+    let fk = hash_u32(key ^ 0x7f4a_7c15);
+    off += Vec3::new(
+        value_noise(fk, x),
+        value_noise(fk.wrapping_add(0x68bc_21eb), x),
+        value_noise(fk.wrapping_add(0x02e5_be93), x),
+    ) * frizz;
+    off
+}
+
+/// Strand width at normalised position `s` (before LoD thickness compensation).
+pub fn strand_width(style: &HairStyle, s: f32) -> f32 {
+    let taper = s.powf(style.taper_power);
+    style.strand_width * (1.0 + (style.tip_width_ratio - 1.0) * taper)
+}
+
+/// Generated strands, strand-major: strand `i` owns vertices `i * verts .. (i + 1) * verts`.
+#[derive(Clone, Debug, Default)]
+pub struct StrandSet {
+    /// Vertices per strand (`2^e + 1`).
+    pub verts_per_strand: usize,
+    /// Object-space positions.
+    pub positions: Vec<Vec3>,
+    /// Unit tangents (eq. 5-6).
+    pub tangents: Vec<Vec3>,
+    /// Widths, object units.
+    pub widths: Vec<f32>,
+    /// Bundle of each strand.
+    pub strand_bundle: Vec<u32>,
+}
+
+impl StrandSet {
+    /// Number of strands.
+    pub fn strand_count(&self) -> usize {
+        self.strand_bundle.len()
+    }
+}
+
+/// Tangents of a polyline by section 3.5: central differences inside, eq. 5 and 6 at the ends.
+pub fn strand_tangents(p: &[Vec3], out: &mut [Vec3]) {
+    let m = p.len() - 1;
+    if m == 0 {
+        out[0] = Vec3::Y;
+        return;
+    }
+    if m == 1 {
+        let d = (p[1] - p[0]).normalize_or(Vec3::Y);
+        out[0] = d;
+        out[1] = d;
+        return;
+    }
+    for k in 1..m {
+        out[k] = (p[k + 1] - p[k - 1]).normalize_or(Vec3::Y);
+    }
+    // Eq. 5: mirror t_{m-1} about the last segment direction q_m.
+    let q = (p[m] - p[m - 1]).normalize_or(out[m - 1]);
+    out[m] = (q * (2.0 * out[m - 1].dot(q)) - out[m - 1]).normalize_or(q);
+    // Eq. 6: mirror t_1 about the first segment direction q_1.
+    let q = (p[1] - p[0]).normalize_or(out[1]);
+    out[0] = (q * (2.0 * out[1].dot(q)) - out[1]).normalize_or(q);
+}
+
+/// The CPU reference generator over one baked mesh and style.
+pub struct CpuGenerator {
+    /// Decoded textures.
+    pub tex: HairTextures,
+    /// Style in use.
+    pub style: HairStyle,
+}
+
+impl CpuGenerator {
+    /// Prepare `baked` for generation with `style`.
+    pub fn new(baked: &BakedHairMesh, style: HairStyle) -> Self {
+        CpuGenerator {
+            tex: HairTextures::new(baked),
+            style,
+        }
+    }
+
+    /// Generate strand `strand` of bundle `bundle` with `segments` segments into the outputs
+    /// (each of length `segments + 1`).
+    pub fn strand(&self, bundle: u32, strand: u32, segments: u32, pos: &mut [Vec3], tan: &mut [Vec3], width: &mut [f32]) {
+        let b = &self.tex.bundles[bundle as usize];
+        let style = &self.style;
+        let key = strand_key(style.seed, bundle, strand);
+        let fp = self.tex.footprint(self.tex.root_coord(b, root_sample(b, bundle, strand)));
+        let centre_xi = if b.is_triangle() {
+            Vec2::new(1.0 / 3.0, 1.0 / 3.0)
+        } else {
+            Vec2::splat(0.5)
+        };
+        let centre_fp = self.tex.footprint(self.tex.root_coord(b, centre_xi));
+        let length = 1.0 - style.length_variation * strand_rand(key, 0);
+        let span = (self.tex.info.layers - 1) as f32 * length;
+        pos[0] = self.tex.root_point(&fp);
+        width[0] = strand_width(style, 0.0);
+        for k in 1..=segments as usize {
+            let s = k as f32 / segments as f32;
+            let r = s * span;
+            let mut p = self.tex.curve_point(&fp, r);
+            if style.clump_strength > 0.0 {
+                let c = self.tex.curve_point(&centre_fp, r);
+                p += (c - p) * (style.clump_strength * s.powf(style.clump_power));
+            }
+            let ([fu, fv, fw], w) = self.tex.frame(&fp, r);
+            let off = styling_offset(style, key, s, w);
+            pos[k] = p + fu * off.x + fv * off.y + fw * off.z;
+            width[k] = strand_width(style, s);
+        }
+        strand_tangents(pos, tan);
+    }
+
+    /// Generate every strand with `n` strands per average bundle and `2^e + 1` vertices each.
+    pub fn generate(&self, n: u32, e: u32) -> StrandSet {
+        let segments = 1u32 << e;
+        let verts = segments as usize + 1;
+        let counts: Vec<u32> = self
+            .tex
+            .bundles
+            .iter()
+            .map(|b| strands_in_bundle(b, &self.style, n))
+            .collect();
+        let total: usize = counts.iter().map(|&c| c as usize).sum();
+        let mut set = StrandSet {
+            verts_per_strand: verts,
+            positions: vec![Vec3::ZERO; total * verts],
+            tangents: vec![Vec3::ZERO; total * verts],
+            widths: vec![0.0; total * verts],
+            strand_bundle: Vec::with_capacity(total),
+        };
+        let mut i = 0;
+        for (bundle, &count) in counts.iter().enumerate() {
+            for strand in 0..count {
+                let range = i * verts..(i + 1) * verts;
+                self.strand(
+                    bundle as u32,
+                    strand,
+                    segments,
+                    &mut set.positions[range.clone()],
+                    &mut set.tangents[range.clone()],
+                    &mut set.widths[range],
+                );
+                set.strand_bundle.push(bundle as u32);
+                i += 1;
+            }
+        }
+        set
+    }
+}

@@ -1,0 +1,132 @@
+//! Level-of-detail maths of paper 003, section 3.6 (eq. 7-12), as plain functions shared by the
+//! CPU reference and mirrored in GLSL.
+
+use glam::Vec3;
+
+/// Eq. 7, perspective: `L = min(1, h R alpha / (d tan theta))` for bundle size `h`, vertical
+/// resolution `R` in pixels, distance `d`, vertical field of view `theta` (radians).
+pub fn detail_level(h: f32, resolution: f32, distance: f32, fov_y: f32, alpha: f32) -> f32 {
+    let denom = distance.max(1e-6) * fov_y.tan();
+    (h * resolution * alpha / denom).clamp(0.0, 1.0)
+}
+
+/// Eq. 7, orthographic (shadow maps): `d tan theta` replaced by the view height in world units.
+pub fn detail_level_ortho(h: f32, resolution: f32, view_height: f32, alpha: f32) -> f32 {
+    (h * resolution * alpha / view_height.max(1e-6)).clamp(0.0, 1.0)
+}
+
+/// Eq. 8: strands kept in a bundle of `n` strands at level `l` with random increment
+/// `delta` in `[0, 1)`. At least one strand for `l > 0`; never more than `n` (eq. 8 alone
+/// could give `n + 1` at `l = 1`).
+pub fn strands_at_level(l: f32, n: u32, delta: f32) -> u32 {
+    if l <= 0.0 || n == 0 {
+        return 0;
+    }
+    ((l * (n as f32 + delta)).ceil() as u32).clamp(1, n)
+}
+
+/// Thickness compensation of section 3.6.1: widths grow by `min(1 / L, N)`.
+pub fn thickness_scale(l: f32, n: u32) -> f32 {
+    (1.0 / l.max(1e-6)).min(n.max(1) as f32)
+}
+
+/// Eq. 9: vertex level `e` (strands get `2^e + 1` vertices) for `ns` segments at full detail.
+/// Clamped to `log2(ns)`, the full-detail level.
+pub fn vertex_level(l: f32, ns: u32) -> u32 {
+    let full = ns.max(1).ilog2();
+    let x = (l * ns as f32).max(1e-30).log2().ceil();
+    (x.max(0.0) as u32).min(full)
+}
+
+/// Eq. 10 and 12: the next-lower level `e~` and the geomorph factor `gamma` in `[0, 1]` for a
+/// transition window `lambda` in `(0, 1]`. `gamma = 0` outside the window (no morphing).
+pub fn geomorph(l: f32, ns: u32, lambda: f32) -> (u32, f32) {
+    let e = vertex_level(l, ns);
+    let x = (l * ns as f32).max(1e-30).log2();
+    let lambda = lambda.clamp(1e-6, 1.0);
+    let e_next = (x - lambda).ceil().max(0.0) as u32;
+    if e > e_next && e > 0 {
+        let gamma = 1.0 - (x - e_next as f32) / lambda;
+        (e_next.min(e - 1), gamma.clamp(0.0, 1.0))
+    } else {
+        (e, 0.0)
+    }
+}
+
+/// Eq. 11 and the tangent morph of section 3.6.2, in place: odd vertices move toward the
+/// midpoint of their neighbours by `gamma`, tangents blend toward the even-only tangents
+/// (odd ones the average of their even neighbours).
+pub fn apply_geomorph(p: &mut [Vec3], t: &mut [Vec3], gamma: f32) {
+    let m = p.len() - 1;
+    if gamma <= 0.0 || m < 2 {
+        return;
+    }
+    let even: Vec<Vec3> = p.iter().step_by(2).copied().collect();
+    let mut t_even = vec![Vec3::ZERO; even.len()];
+    crate::generate::strand_tangents(&even, &mut t_even);
+    for k in (1..m).step_by(2) {
+        p[k] = p[k] * (1.0 - gamma) + (p[k - 1] + p[k + 1]) * (0.5 * gamma);
+    }
+    for k in 0..=m {
+        let coarse = if k % 2 == 0 {
+            t_even[k / 2]
+        } else {
+            (t_even[k / 2] + t_even[k / 2 + 1]) * 0.5
+        };
+        t[k] = (t[k] * (1.0 - gamma) + coarse * gamma).normalize_or(t[k]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn detail_level_falls_with_distance_and_clamps() {
+        let near = detail_level(0.02, 720.0, 0.5, 0.5, 0.05);
+        let far = detail_level(0.02, 720.0, 50.0, 0.5, 0.05);
+        assert_eq!(near, 1.0);
+        assert!((far - 0.02 * 720.0 * 0.05 / (50.0 * 0.5f32.tan())).abs() < 1e-6);
+        assert!((detail_level_ortho(0.1, 1000.0, 10.0, 0.01) - 0.1).abs() < 1e-6);
+    }
+
+    #[test]
+    fn strands_never_zero_never_above_n() {
+        assert_eq!(strands_at_level(1.0, 64, 0.9), 64);
+        assert_eq!(strands_at_level(1e-4, 64, 0.0), 1);
+        assert_eq!(strands_at_level(0.5, 64, 0.5), 33);
+        assert_eq!(strands_at_level(0.0, 64, 0.5), 0);
+        // Monotone in L for a fixed delta.
+        let mut prev = 0;
+        for i in 1..=100 {
+            let c = strands_at_level(i as f32 / 100.0, 50, 0.37);
+            assert!(c >= prev);
+            prev = c;
+        }
+        assert_eq!(thickness_scale(0.25, 64), 4.0);
+        assert_eq!(thickness_scale(0.001, 3), 3.0);
+    }
+
+    #[test]
+    fn vertex_level_is_power_of_two_plus_one() {
+        assert_eq!(vertex_level(1.0, 32), 5);
+        assert_eq!(vertex_level(0.5, 32), 4);
+        assert_eq!(vertex_level(0.3, 32), 4); // ceil(log2(9.6)) = 4
+        assert_eq!(vertex_level(0.01, 32), 0);
+    }
+
+    #[test]
+    fn geomorph_is_continuous_across_levels() {
+        // Just above a level boundary gamma -> 1 (fully morphed), far from it gamma = 0.
+        let ns = 32;
+        let (_, g_hi) = geomorph(0.5 + 1e-4, ns, 0.5);
+        assert!(g_hi > 0.99, "{g_hi}");
+        let (e, g) = geomorph(0.99, ns, 0.5);
+        assert_eq!((e, g), (5, 0.0));
+        // Morphing odd vertices fully gives the coarse polyline's midpoints.
+        let mut p: Vec<Vec3> = (0..5).map(|i| Vec3::new(i as f32, (i % 2) as f32, 0.0)).collect();
+        let mut t = vec![Vec3::X; 5];
+        apply_geomorph(&mut p, &mut t, 1.0);
+        assert!(p[1].y.abs() < 1e-6 && p[3].y.abs() < 1e-6);
+    }
+}

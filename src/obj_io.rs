@@ -1,0 +1,354 @@
+//! Hair meshes in Wavefront OBJ, parsed with `obj-rs`.
+//!
+//! # Convention
+//! One OBJ file holds every layer. Layer `k` is the group `g layerK` (`layer0` is the scalp).
+//! Every layer lists the same number of faces, in the same order, with the same degree; corner
+//! `c` of face `f` on layer `k` lies above corner `c` of face `f` on `layer0`. Faces that share a
+//! vertex on `layer0` must share the corresponding vertex on every layer. `layer0` faces carry
+//! `vt` indices: the root `uv` styling coordinates. `w` is generated from path length unless
+//! every `vt` line in the file has three components, in which case the third component of the
+//! `vt` used on layer `k` is that vertex's `w`. Faces with more than four corners are split into
+//! quads (and one triangle) the same way on every layer.
+//!
+//! A file without `layerK` groups is a *scalp*: [`load_scalp`] reads it for [`crate::extrude`].
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+use obj::raw::object::{Polygon, RawObj};
+
+use crate::error::{HairError, Result};
+use crate::hair_mesh::{Face, HairMesh, split_polygon};
+
+/// Statements obj-rs does not implement (it panics on them); rejected with their line number.
+const UNSUPPORTED: &[&str] = &[
+    "curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con",
+];
+
+/// Line numbers of statements, gathered before parsing so errors can name lines.
+struct LineIndex {
+    vertex_lines: Vec<usize>,
+    face_lines: Vec<usize>,
+    all_vt_have_w: bool,
+}
+
+fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
+    let mut idx = LineIndex {
+        vertex_lines: Vec::new(),
+        face_lines: Vec::new(),
+        all_vt_have_w: true,
+    };
+    let mut vt_count = 0;
+    for (n, line) in text.lines().enumerate() {
+        let line_no = n + 1;
+        let mut tok = line.split('#').next().unwrap_or("").split_whitespace();
+        let Some(stmt) = tok.next() else { continue };
+        let args: Vec<&str> = tok.collect();
+        match stmt {
+            "v" => {
+                for a in &args {
+                    match a.parse::<f32>() {
+                        Ok(x) if x.is_finite() => {}
+                        _ => {
+                            return Err(HairError::invalid(
+                                name,
+                                format!("line {line_no}: vertex coordinate '{a}' is not a finite number"),
+                            ));
+                        }
+                    }
+                }
+                idx.vertex_lines.push(line_no);
+            }
+            "vt" => {
+                vt_count += 1;
+                if args.len() != 3 {
+                    idx.all_vt_have_w = false;
+                }
+                for a in &args {
+                    if !a.parse::<f32>().is_ok_and(f32::is_finite) {
+                        return Err(HairError::invalid(
+                            name,
+                            format!("line {line_no}: texture coordinate '{a}' is not a finite number"),
+                        ));
+                    }
+                }
+            }
+            "f" | "fo" => idx.face_lines.push(line_no),
+            s if UNSUPPORTED.contains(&s) => {
+                return Err(HairError::invalid(
+                    name,
+                    format!("line {line_no}: free-form statement '{s}' is not supported"),
+                ));
+            }
+            _ => {}
+        }
+    }
+    idx.all_vt_have_w &= vt_count > 0;
+    Ok(idx)
+}
+
+fn parse(name: &str, path: &Path) -> Result<(RawObj, LineIndex)> {
+    let bytes = std::fs::read(path).map_err(|e| HairError::io(path, e))?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|e| HairError::invalid(name, format!("not UTF-8 text: {e}")))?;
+    let lines = scan_lines(name, text)?;
+    // obj-rs may panic on inputs it does not implement; never let that escape as a crash.
+    let parsed = std::panic::catch_unwind(|| obj::raw::parse_obj(text.as_bytes()));
+    match parsed {
+        Ok(Ok(raw)) => Ok((raw, lines)),
+        Ok(Err(e)) => Err(HairError::invalid(name, format!("malformed OBJ: {e}"))),
+        Err(_) => Err(HairError::invalid(name, "malformed OBJ: the parser rejected it")),
+    }
+}
+
+/// One polygon corner: position index and optional texture-coordinate index.
+type Corner = (usize, Option<usize>);
+
+fn corners(p: &Polygon) -> Vec<Corner> {
+    match p {
+        Polygon::P(v) => v.iter().map(|&p| (p, None)).collect(),
+        Polygon::PT(v) => v.iter().map(|&(p, t)| (p, Some(t))).collect(),
+        Polygon::PN(v) => v.iter().map(|&(p, _)| (p, None)).collect(),
+        Polygon::PTN(v) => v.iter().map(|&(p, t, _)| (p, Some(t))).collect(),
+    }
+}
+
+fn group_polygons(raw: &RawObj, group: &str) -> Vec<usize> {
+    raw.groups
+        .get(group)
+        .map(|g| g.polygons.iter().flat_map(|r| r.start..r.end).collect())
+        .unwrap_or_default()
+}
+
+fn layer_group_count(raw: &RawObj) -> usize {
+    (0..).take_while(|k| raw.groups.contains_key(&format!("layer{k}"))).count()
+}
+
+fn position(raw: &RawObj, i: usize) -> Vec3 {
+    let p = raw.positions[i];
+    Vec3::new(p.0, p.1, p.2)
+}
+
+/// Load a hair mesh from an OBJ that follows the layer convention of this module.
+pub fn load_hair_mesh_obj(path: &Path) -> Result<HairMesh> {
+    let name = path.display().to_string();
+    let (raw, lines) = parse(&name, path)?;
+    let err = |what: String| HairError::invalid(&name, what);
+    let layer_count = layer_group_count(&raw);
+    if let Some(extra) = raw
+        .groups
+        .keys()
+        .filter_map(|g| g.strip_prefix("layer")?.parse::<usize>().ok())
+        .find(|&k| k >= layer_count)
+    {
+        return Err(err(format!(
+            "group layer{extra} exists but layer{layer_count} is missing (layers must be numbered 0..N without gaps)"
+        )));
+    }
+    if layer_count == 0 {
+        return Err(err(if raw.polygons.is_empty() {
+            "empty hair mesh: no faces".into()
+        } else {
+            "no layer groups: expected 'g layer0', 'g layer1', ... (a scalp without layers needs --extrude)".into()
+        }));
+    }
+    if layer_count < 2 {
+        return Err(err(format!(
+            "a hair mesh needs at least 2 layers, found {layer_count}"
+        )));
+    }
+    let root_polys = group_polygons(&raw, "layer0");
+    if root_polys.is_empty() {
+        return Err(err("empty hair mesh: layer0 has no faces".into()));
+    }
+    let face_line = |p: usize| lines.face_lines.get(p).copied().unwrap_or(0);
+
+    // Root vertices are unique (position, uv) pairs of layer0.
+    let mut root_index: HashMap<Corner, u32> = HashMap::new();
+    let mut root_corners: Vec<Corner> = Vec::new();
+    let mut root_faces: Vec<Vec<u32>> = Vec::new();
+    for &p in &root_polys {
+        let cs = corners(&raw.polygons[p]);
+        let mut face = Vec::with_capacity(cs.len());
+        for &c in &cs {
+            if c.1.is_none() {
+                return Err(err(format!(
+                    "line {}: layer0 face has no vt index; root vertices need uv coordinates",
+                    face_line(p)
+                )));
+            }
+            let next = root_corners.len() as u32;
+            let id = *root_index.entry(c).or_insert_with(|| {
+                root_corners.push(c);
+                next
+            });
+            face.push(id);
+        }
+        root_faces.push(face);
+    }
+    let n = root_corners.len();
+    let uv: Vec<Vec2> = root_corners
+        .iter()
+        .map(|&(_, t)| {
+            let t = raw.tex_coords[t.unwrap_or(0)];
+            Vec2::new(t.0, t.1)
+        })
+        .collect();
+
+    let mut layers = Vec::with_capacity(layer_count);
+    let mut w_layers = Vec::with_capacity(layer_count);
+    for k in 0..layer_count {
+        let polys = group_polygons(&raw, &format!("layer{k}"));
+        if polys.len() != root_polys.len() {
+            return Err(err(format!(
+                "layer{k} has {} faces but layer0 has {} (layers must share face topology)",
+                polys.len(),
+                root_polys.len()
+            )));
+        }
+        let mut pos_of: Vec<Option<usize>> = vec![None; n];
+        let mut w_of: Vec<f32> = vec![0.0; n];
+        for (f, &p) in polys.iter().enumerate() {
+            let cs = corners(&raw.polygons[p]);
+            if cs.len() != root_faces[f].len() {
+                return Err(err(format!(
+                    "line {}: layer{k} face {f} has {} corners but layer0 face {f} has {}",
+                    face_line(p),
+                    cs.len(),
+                    root_faces[f].len()
+                )));
+            }
+            for (c, &(pi, ti)) in cs.iter().enumerate() {
+                let r = root_faces[f][c] as usize;
+                match pos_of[r] {
+                    Some(prev) if prev != pi => {
+                        return Err(err(format!(
+                            "line {}: layer{k} face {f} corner {c} uses vertex {} but the same root vertex is vertex {} elsewhere on this layer (inconsistent layer topology)",
+                            face_line(p),
+                            pi + 1,
+                            prev + 1
+                        )));
+                    }
+                    _ => pos_of[r] = Some(pi),
+                }
+                if lines.all_vt_have_w && k > 0 {
+                    let Some(t) = ti else {
+                        return Err(err(format!(
+                            "line {}: layer{k} face {f} has no vt index, but the file gives w in vt",
+                            face_line(p)
+                        )));
+                    };
+                    w_of[r] = raw.tex_coords[t].2;
+                }
+            }
+        }
+        layers.push(
+            pos_of
+                .iter()
+                .map(|p| position(&raw, p.unwrap_or(0)))
+                .collect::<Vec<_>>(),
+        );
+        w_layers.push(w_of);
+    }
+
+    let mut faces = Vec::new();
+    for face in &root_faces {
+        for part in split_polygon(face.len()) {
+            let v: Vec<u32> = part.iter().map(|&c| face[c]).collect();
+            faces.push(match v.len() {
+                3 => Face::Tri([v[0], v[1], v[2]]),
+                _ => Face::Quad([v[0], v[1], v[2], v[3]]),
+            });
+        }
+    }
+    let w = lines.all_vt_have_w.then_some(w_layers);
+    HairMesh::new(name, layers, w, uv, faces)
+}
+
+/// A scalp: positions, uvs and faces of an OBJ without layer groups (input of `extrude`).
+pub struct Scalp {
+    /// Unique (position, uv) vertices.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex uv.
+    pub uv: Vec<Vec2>,
+    /// Faces split into quads and triangles.
+    pub faces: Vec<Face>,
+}
+
+/// Load a scalp OBJ (every face, any groups) for extrusion into a hair mesh.
+pub fn load_scalp(path: &Path) -> Result<Scalp> {
+    let name = path.display().to_string();
+    let (raw, lines) = parse(&name, path)?;
+    if raw.polygons.is_empty() {
+        return Err(HairError::invalid(&name, "empty scalp: no faces"));
+    }
+    let mut index: HashMap<Corner, u32> = HashMap::new();
+    let mut scalp = Scalp {
+        positions: Vec::new(),
+        uv: Vec::new(),
+        faces: Vec::new(),
+    };
+    for (p, poly) in raw.polygons.iter().enumerate() {
+        let cs = corners(poly);
+        let mut face = Vec::new();
+        for &c in &cs {
+            let Some(t) = c.1 else {
+                return Err(HairError::invalid(
+                    &name,
+                    format!(
+                        "line {}: face has no vt index; scalp vertices need uv coordinates",
+                        lines.face_lines.get(p).copied().unwrap_or(0)
+                    ),
+                ));
+            };
+            let next = scalp.positions.len() as u32;
+            let id = *index.entry(c).or_insert_with(|| {
+                scalp.positions.push(position(&raw, c.0));
+                let tc = raw.tex_coords[t];
+                scalp.uv.push(Vec2::new(tc.0, tc.1));
+                next
+            });
+            face.push(id);
+        }
+        for part in split_polygon(face.len()) {
+            let v: Vec<u32> = part.iter().map(|&c| face[c]).collect();
+            scalp.faces.push(match v.len() {
+                3 => Face::Tri([v[0], v[1], v[2]]),
+                _ => Face::Quad([v[0], v[1], v[2], v[3]]),
+            });
+        }
+    }
+    Ok(scalp)
+}
+
+/// Write a hair mesh as OBJ in the layer convention (positions per layer, shared root `vt`).
+pub fn write_hair_mesh_obj(mesh: &HairMesh, path: &Path, comment: &str) -> Result<()> {
+    let mut out = Vec::new();
+    let n = mesh.vertices_per_layer();
+    let io = |e| HairError::io(path, e);
+    writeln!(out, "# hair mesh: {} layers, {} faces", mesh.layer_count(), mesh.faces.len()).map_err(io)?;
+    for line in comment.lines() {
+        writeln!(out, "# {line}").map_err(io)?;
+    }
+    for layer in &mesh.layers {
+        for p in layer {
+            writeln!(out, "v {} {} {}", p.x, p.y, p.z).map_err(io)?;
+        }
+    }
+    for uv in &mesh.uv {
+        writeln!(out, "vt {} {}", uv.x, uv.y).map_err(io)?;
+    }
+    for k in 0..mesh.layer_count() {
+        writeln!(out, "g layer{k}").map_err(io)?;
+        for face in &mesh.faces {
+            write!(out, "f").map_err(io)?;
+            for &v in face.vertices() {
+                write!(out, " {}/{}", k * n + v as usize + 1, v + 1).map_err(io)?;
+            }
+            writeln!(out).map_err(io)?;
+        }
+    }
+    crate::fsutil::write_atomic(path, &out)
+}
