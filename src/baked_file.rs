@@ -75,7 +75,10 @@ impl Reader<'_> {
         let Some(end) = end else {
             return Err(HairError::invalid(
                 self.name,
-                format!("truncated: {what} needs {n} bytes at payload offset {}", self.pos),
+                format!(
+                    "truncated: {what} needs {n} bytes at payload offset {}",
+                    self.pos
+                ),
             ));
         };
         let s = &self.data[self.pos..end];
@@ -95,14 +98,19 @@ impl Reader<'_> {
 pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<BakedHairMesh> {
     let bad = |what: String| HairError::invalid(name, what);
     if bytes.len() < HEADER {
-        return Err(bad(format!("truncated: {} bytes, header needs {HEADER}", bytes.len())));
+        return Err(bad(format!(
+            "truncated: {} bytes, header needs {HEADER}",
+            bytes.len()
+        )));
     }
     if &bytes[..8] != MAGIC {
         return Err(bad("not a baked hair mesh (bad magic)".into()));
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
     if version != VERSION {
-        return Err(bad(format!("unsupported format version {version} (this build reads {VERSION})")));
+        return Err(bad(format!(
+            "unsupported format version {version} (this build reads {VERSION})"
+        )));
     }
     let crc = u32::from_le_bytes(bytes[12..16].try_into().unwrap());
     let len = u64::from_le_bytes(bytes[16..24].try_into().unwrap());
@@ -116,13 +124,23 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<BakedHairMesh> {
     if crc32fast::hash(payload) != crc {
         return Err(bad("checksum mismatch: the file is corrupt".into()));
     }
-    let mut r = Reader { name, data: payload, pos: 0 };
+    let mut r = Reader {
+        name,
+        data: payload,
+        pos: 0,
+    };
     let info: MeshInfo = bytemuck::pod_read_unaligned(r.take(size_of::<MeshInfo>(), "MeshInfo")?);
-    let style: HairStyle = bytemuck::pod_read_unaligned(r.take(size_of::<HairStyle>(), "HairStyle")?);
+    let style: HairStyle =
+        bytemuck::pod_read_unaligned(r.take(size_of::<HairStyle>(), "HairStyle")?);
     style.validate(name)?;
     let [w, h] = info.root_size;
-    if info.layers < 2 || info.layers > MAX_TEXTURE_SIDE / 4 || w == 0 || h == 0
-        || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE || info.bundle_count == 0
+    if info.layers < 2
+        || info.layers > MAX_TEXTURE_SIDE / 4
+        || w == 0
+        || h == 0
+        || w > MAX_TEXTURE_SIDE
+        || h > MAX_TEXTURE_SIDE
+        || info.bundle_count == 0
         || info.bundle_count as usize > w as usize * h as usize
     {
         return Err(bad(format!(
@@ -130,15 +148,28 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<BakedHairMesh> {
             info.layers, info.bundle_count
         )));
     }
-    if !info.pos_origin.iter().chain(&info.pos_extent).chain(&info.uv_origin_extent).all(|x| x.is_finite()) {
+    if !info
+        .pos_origin
+        .iter()
+        .chain(&info.pos_extent)
+        .chain(&info.uv_origin_extent)
+        .all(|x| x.is_finite())
+    {
         return Err(bad("non-finite decode constants".into()));
     }
     let slice = info.slice_texels();
     let layers = info.layers as usize;
     let bundles: Vec<BundleDesc> = r.vec(info.bundle_count as usize, "bundle table")?;
     for (i, b) in bundles.iter().enumerate() {
-        if b.origin[0] + 1 >= w || b.origin[1] + 1 >= h || !b.rest_size.is_finite() || !b.density.is_finite() {
-            return Err(bad(format!("bundle {i}: cell {:?} outside the {w}x{h} root slice or bad size", b.origin)));
+        if b.origin[0] + 1 >= w
+            || b.origin[1] + 1 >= h
+            || !b.rest_size.is_finite()
+            || !b.density.is_finite()
+        {
+            return Err(bad(format!(
+                "bundle {i}: cell {:?} outside the {w}x{h} root slice or bad size",
+                b.origin
+            )));
         }
     }
     let baked = BakedHairMesh {
@@ -152,7 +183,10 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<BakedHairMesh> {
         v_dir: r.vec(slice * layers, "v-texture")?,
     };
     if r.pos != payload.len() {
-        return Err(bad(format!("{} trailing bytes after the v-texture", payload.len() - r.pos)));
+        return Err(bad(format!(
+            "{} trailing bytes after the v-texture",
+            payload.len() - r.pos
+        )));
     }
     Ok(baked)
 }

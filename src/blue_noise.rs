@@ -93,7 +93,11 @@ fn neighbours(points: &[Vec2], radius: f32, domain: Domain) -> Vec<Vec<(u32, f32
                 let (x, y) = (cx as i64 + dx, cy as i64 + dy);
                 let (x, y) = match domain {
                     Domain::Torus => (x.rem_euclid(cells as i64), y.rem_euclid(cells as i64)),
-                    Domain::Triangle if x < 0 || y < 0 || x >= cells as i64 || y >= cells as i64 => continue,
+                    Domain::Triangle
+                        if x < 0 || y < 0 || x >= cells as i64 || y >= cells as i64 =>
+                    {
+                        continue;
+                    }
                     Domain::Triangle => (x, y),
                 };
                 for &j in &grid[y as usize * cells + x as usize] {
@@ -128,13 +132,22 @@ fn eliminate(points: &[Vec2], target: usize, domain: Domain) -> (Vec<Vec2>, Vec<
     let rmin = rmax * (1.0 - (target as f32 / points.len() as f32).powf(GAMMA)) * BETA;
     let weight = |d: f32| (1.0 - d.max(rmin) / (2.0 * rmax)).max(0.0).powf(ALPHA);
     let nb = neighbours(points, 2.0 * rmax, domain);
-    let mut w: Vec<f32> = nb.iter().map(|n| n.iter().map(|&(_, d)| weight(d)).sum()).collect();
+    let mut w: Vec<f32> = nb
+        .iter()
+        .map(|n| n.iter().map(|&(_, d)| weight(d)).sum())
+        .collect();
     let mut alive = vec![true; points.len()];
-    let mut heap: BinaryHeap<HeapItem> = w.iter().enumerate().map(|(i, &x)| HeapItem(x, i as u32)).collect();
+    let mut heap: BinaryHeap<HeapItem> = w
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| HeapItem(x, i as u32))
+        .collect();
     let mut eliminated = Vec::with_capacity(points.len() - target);
     let mut remaining = points.len();
     while remaining > target {
-        let Some(HeapItem(wi, i)) = heap.pop() else { break };
+        let Some(HeapItem(wi, i)) = heap.pop() else {
+            break;
+        };
         let i = i as usize;
         if !alive[i] || wi != w[i] {
             continue; // stale heap entry
@@ -150,7 +163,12 @@ fn eliminate(points: &[Vec2], target: usize, domain: Domain) -> (Vec<Vec2>, Vec<
             }
         }
     }
-    let kept = points.iter().zip(&alive).filter(|(_, a)| **a).map(|(p, _)| *p).collect();
+    let kept = points
+        .iter()
+        .zip(&alive)
+        .filter(|(_, a)| **a)
+        .map(|(p, _)| *p)
+        .collect();
     (kept, eliminated)
 }
 
@@ -160,7 +178,9 @@ pub fn progressive_samples(n: usize, domain: Domain, seed: u64) -> Vec<Vec2> {
         return Vec::new();
     }
     let mut rng = Pcg32::new(seed);
-    let candidates: Vec<Vec2> = (0..n * CANDIDATE_FACTOR).map(|_| domain.random(&mut rng)).collect();
+    let candidates: Vec<Vec2> = (0..n * CANDIDATE_FACTOR)
+        .map(|_| domain.random(&mut rng))
+        .collect();
     let (mut current, _) = eliminate(&candidates, n, domain);
     // Halve repeatedly; the samples eliminated last in each stage come first in its half.
     let mut tail: Vec<Vec2> = Vec::with_capacity(n);
@@ -227,13 +247,24 @@ mod tests {
             // distance is 2 r_max; Yuksel 2015 reports about 1.5 r_max for a final set.
             let norm = db[k] / r_max(domain.area(), k + 1);
             white_worst = white_worst.min(dw[k] / r_max(domain.area(), k + 1));
-            assert!(norm > 1.0, "{domain:?} prefix {}: min distance {} is only {norm} r_max", k + 1, db[k]);
+            assert!(
+                norm > 1.0,
+                "{domain:?} prefix {}: min distance {} is only {norm} r_max",
+                k + 1,
+                db[k]
+            );
             if k >= 16 {
                 worst_ratio = worst_ratio.min(db[k] / dw[k]);
             }
         }
-        assert!(worst_ratio > 4.0, "{domain:?}: blue noise prefix not clearly better than white ({worst_ratio})");
-        assert!(white_worst < 1.0, "white noise should fail the same bound ({white_worst})");
+        assert!(
+            worst_ratio > 4.0,
+            "{domain:?}: blue noise prefix not clearly better than white ({worst_ratio})"
+        );
+        assert!(
+            white_worst < 1.0,
+            "white noise should fail the same bound ({white_worst})"
+        );
     }
 
     #[test]
@@ -245,11 +276,17 @@ mod tests {
     fn every_prefix_is_blue_in_triangle() {
         check_prefixes(Domain::Triangle);
         let tri = progressive_samples(256, Domain::Triangle, 3);
-        assert!(tri.iter().all(|p| p.x >= 0.0 && p.y >= 0.0 && p.x + p.y <= 1.0));
+        assert!(
+            tri.iter()
+                .all(|p| p.x >= 0.0 && p.y >= 0.0 && p.x + p.y <= 1.0)
+        );
     }
 
     #[test]
     fn deterministic() {
-        assert_eq!(progressive_samples(64, Domain::Torus, 1), progressive_samples(64, Domain::Torus, 1));
+        assert_eq!(
+            progressive_samples(64, Domain::Torus, 1),
+            progressive_samples(64, Domain::Torus, 1)
+        );
     }
 }

@@ -117,7 +117,9 @@ mod tests {
             t[i] = t[i - 1] + p[i].distance(p[i - 1]).powf(0.5);
         }
         let tt = t[1] + (t[2] - t[1]) * u;
-        let l = |a: Vec3, b: Vec3, ta: f32, tb: f32| a * ((tb - tt) / (tb - ta)) + b * ((tt - ta) / (tb - ta));
+        let l = |a: Vec3, b: Vec3, ta: f32, tb: f32| {
+            a * ((tb - tt) / (tb - ta)) + b * ((tt - ta) / (tb - ta))
+        };
         let a1 = l(p[0], p[1], t[0], t[1]);
         let a2 = l(p[1], p[2], t[1], t[2]);
         let a3 = l(p[2], p[3], t[2], t[3]);
@@ -166,7 +168,10 @@ mod tests {
                 };
                 worst = worst.max(approx.distance(eval_cubic(&b, t)));
             }
-            assert!(worst <= bound * 1.001 + 1e-5, "seed {seed}: error {worst} > bound {bound}");
+            assert!(
+                worst <= bound * 1.001 + 1e-5,
+                "seed {seed}: error {worst} > bound {bound}"
+            );
             if bound > 1e-3 {
                 tight = tight.max(worst / bound);
             }
@@ -188,16 +193,27 @@ mod tests {
         // Derivative of each half w.r.t. the cubic's t: 2 (q_{i+1} - q_i) / (1/2).
         let c1 = (q[2] - q[1]) - (q[3] - q[2]);
         assert!(c1.length() < 1e-6, "joint must be C1");
-        assert!(((q[1] - q[0]) * 4.0 - (b[1] - b[0]) * 3.0).length() < 1e-5, "start tangent");
+        assert!(
+            ((q[1] - q[0]) * 4.0 - (b[1] - b[0]) * 3.0).length() < 1e-5,
+            "start tangent"
+        );
     }
 
     #[test]
     fn column_passes_through_layers() {
-        let p = vec![Vec3::ZERO, Vec3::Y, Vec3::new(1.0, 2.0, 0.0), Vec3::new(3.0, 2.5, 0.5)];
+        let p = vec![
+            Vec3::ZERO,
+            Vec3::Y,
+            Vec3::new(1.0, 2.0, 0.0),
+            Vec3::new(3.0, 2.5, 0.5),
+        ];
         let ctrl = column_control_points(&p);
         assert_eq!(ctrl.len(), 13);
         for (k, pk) in p.iter().enumerate() {
-            assert!(eval_column(&ctrl, k as f32).distance(*pk) < 1e-6, "layer {k}");
+            assert!(
+                eval_column(&ctrl, k as f32).distance(*pk) < 1e-6,
+                "layer {k}"
+            );
         }
     }
 }

@@ -55,7 +55,12 @@ impl SampledTexture {
         let w = self.size[0];
         Footprint {
             offsets: [y0 * w + x0, y0 * w + x1, y1 * w + x0, y1 * w + x1],
-            weights: [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy],
+            weights: [
+                (1.0 - fx) * (1.0 - fy),
+                fx * (1.0 - fy),
+                (1.0 - fx) * fy,
+                fx * fy,
+            ],
         }
     }
 
@@ -70,7 +75,11 @@ impl SampledTexture {
 
     /// Trilinear sample at footprint `fp` and normalised depth `w`.
     pub fn sample_3d(&self, fp: &Footprint, w: f32) -> Vec4 {
-        let (z0, z1, fz) = axis(w, self.size[2]);
+        self.sample_depth(fp, axis(w, self.size[2]))
+    }
+
+    /// Trilinear sample with a precomputed depth axis (shared by same-sized textures).
+    fn sample_depth(&self, fp: &Footprint, (z0, z1, fz): (usize, usize, f32)) -> Vec4 {
         self.bilinear(fp, z0).lerp(self.bilinear(fp, z1), fz)
     }
 
@@ -125,7 +134,9 @@ impl HairTextures {
             uv: SampledTexture::new([wd, ht, 1], &baked.uv, |t| {
                 Vec4::new(uo0 + ue0 * unorm(t[0]), uo1 + ue1 * unorm(t[1]), 0.0, 0.0)
             }),
-            w: SampledTexture::new([wd, ht, l], &baked.w, |t| Vec4::new(w_scale * unorm(t), 0.0, 0.0, 0.0)),
+            w: SampledTexture::new([wd, ht, l], &baked.w, |t| {
+                Vec4::new(w_scale * unorm(t), 0.0, 0.0, 0.0)
+            }),
             u_dir: SampledTexture::new([wd, ht, l], &baked.u_dir, |t| {
                 Vec4::new(snorm(t[0]), snorm(t[1]), snorm(t[2]), 0.0)
             }),
@@ -158,8 +169,12 @@ impl HairTextures {
     pub fn curve_point(&self, fp: &Footprint, r: f32) -> Vec3 {
         let (slice, t) = crate::curve::quadratic_slice(r, self.info.layers as usize);
         let depth = self.position.depth() as f32;
-        let a = self.position.sample_3d(fp, (slice as f32 + 0.5 + t) / depth);
-        let b = self.position.sample_3d(fp, (slice as f32 + 1.5 + t) / depth);
+        let a = self
+            .position
+            .sample_3d(fp, (slice as f32 + 0.5 + t) / depth);
+        let b = self
+            .position
+            .sample_3d(fp, (slice as f32 + 1.5 + t) / depth);
         a.lerp(b, t).truncate()
     }
 
@@ -172,11 +187,23 @@ impl HairTextures {
 
     /// Styling frame `(u, v, w)` at curve parameter `r` (eq. 4 for `w`), and the `w` coordinate.
     pub fn frame(&self, fp: &Footprint, r: f32) -> ([Vec3; 3], f32) {
-        let z = (r + 0.5) / self.info.layers as f32;
-        let u = self.u_dir.sample_3d(fp, z).truncate().normalize_or(Vec3::X);
-        let v = self.v_dir.sample_3d(fp, z).truncate().normalize_or(Vec3::Y);
+        // u-, v- and w-textures share their size: one depth axis for all three fetches.
+        let z = axis(
+            (r + 0.5) / self.info.layers as f32,
+            self.info.layers as usize,
+        );
+        let u = self
+            .u_dir
+            .sample_depth(fp, z)
+            .truncate()
+            .normalize_or(Vec3::X);
+        let v = self
+            .v_dir
+            .sample_depth(fp, z)
+            .truncate()
+            .normalize_or(Vec3::Y);
         let w = u.cross(v).normalize_or(Vec3::Z);
-        ([u, v, w], self.w.sample_3d(fp, z).x)
+        ([u, v, w], self.w.sample_depth(fp, z).x)
     }
 
     /// Root `uv` styling coordinate.
@@ -248,9 +275,11 @@ pub fn styling_offset(style: &HairStyle, key: u32, s: f32, w: f32) -> Vec3 {
     use std::f32::consts::TAU;
     let ramp = smoothstep(0.0, style.root_ramp, w);
     let mut off = Vec3::ZERO;
-    let curl_phase = TAU * (style.curl_frequency * w + style.curl_phase_jitter * strand_rand(key, 1));
+    let curl_phase =
+        TAU * (style.curl_frequency * w + style.curl_phase_jitter * strand_rand(key, 1));
     off += Vec3::new(curl_phase.cos(), curl_phase.sin(), 0.0) * (style.curl_radius * ramp);
-    let wave_phase = TAU * (style.wave_frequency * w + style.wave_phase_jitter * strand_rand(key, 2));
+    let wave_phase =
+        TAU * (style.wave_frequency * w + style.wave_phase_jitter * strand_rand(key, 2));
     let wave_dir = Vec3::new(style.wave_angle.cos(), style.wave_angle.sin(), 0.0);
     off += wave_dir * (style.wave_amplitude * ramp * wave_phase.sin());
     let frizz = style.frizz_amplitude * s.powf(style.frizz_power);
@@ -335,11 +364,21 @@ impl CpuGenerator {
 
     /// Generate strand `strand` of bundle `bundle` with `segments` segments into the outputs
     /// (each of length `segments + 1`).
-    pub fn strand(&self, bundle: u32, strand: u32, segments: u32, pos: &mut [Vec3], tan: &mut [Vec3], width: &mut [f32]) {
+    pub fn strand(
+        &self,
+        bundle: u32,
+        strand: u32,
+        segments: u32,
+        pos: &mut [Vec3],
+        tan: &mut [Vec3],
+        width: &mut [f32],
+    ) {
         let b = &self.tex.bundles[bundle as usize];
         let style = &self.style;
         let key = strand_key(style.seed, bundle, strand);
-        let fp = self.tex.footprint(self.tex.root_coord(b, root_sample(b, bundle, strand)));
+        let fp = self
+            .tex
+            .footprint(self.tex.root_coord(b, root_sample(b, bundle, strand)));
         let centre_xi = if b.is_triangle() {
             Vec2::new(1.0 / 3.0, 1.0 / 3.0)
         } else {

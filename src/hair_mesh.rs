@@ -119,9 +119,9 @@ impl HairMesh {
             }
             for (i, p) in layer.iter().enumerate() {
                 if !p.is_finite() {
-                    return Err(self.err(format!(
-                        "layer {k} vertex {i}: non-finite position {p:?}"
-                    )));
+                    return Err(
+                        self.err(format!("layer {k} vertex {i}: non-finite position {p:?}"))
+                    );
                 }
             }
             for (i, &wi) in w.iter().enumerate() {
@@ -166,9 +166,7 @@ impl HairMesh {
             }
             let area = polygon_area(v.iter().map(|&i| self.layers[0][i as usize]));
             if area <= DEGENERATE_EPS * extent * extent {
-                return Err(self.err(format!(
-                    "face {f}: degenerate, zero area on the root layer"
-                )));
+                return Err(self.err(format!("face {f}: degenerate, zero area on the root layer")));
             }
             // Eq. 2 needs an invertible T_i for every corner triangle (vertex and its two edges).
             for c in 0..v.len() {
@@ -269,9 +267,10 @@ pub fn polygon_area(points: impl Iterator<Item = Vec3>) -> f32 {
 
 /// Axis-aligned bounds of a point set; `(MAX, MIN)` when empty.
 pub fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
-    points.fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
-        (lo.min(p), hi.max(p))
-    })
+    points.fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
 }
 
 /// Split a polygon of any degree `>= 3` into quads and at most one triangle (fan of quads).
@@ -365,7 +364,10 @@ pub fn extrude(
 ) -> Result<HairMesh> {
     let name = name.into();
     if desc.layers < 2 {
-        return Err(HairError::invalid(&name, "extrusion needs at least 2 layers"));
+        return Err(HairError::invalid(
+            &name,
+            "extrusion needs at least 2 layers",
+        ));
     }
     if !(desc.step.is_finite() && desc.step > 0.0) {
         return Err(HairError::invalid(&name, "extrusion step must be positive"));
@@ -441,7 +443,10 @@ mod tests {
         let mut l1 = square(1.0);
         l1[2].y = f32::NAN;
         let e = quad_mesh(vec![square(0.0), l1]).unwrap_err().to_string();
-        assert!(e.contains("layer 1 vertex 2") && e.contains("non-finite"), "{e}");
+        assert!(
+            e.contains("layer 1 vertex 2") && e.contains("non-finite"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -489,7 +494,10 @@ mod tests {
         assert_eq!(split_polygon(5), vec![vec![0, 1, 2, 3], vec![0, 3, 4]]);
         assert_eq!(split_polygon(6), vec![vec![0, 1, 2, 3], vec![0, 3, 4, 5]]);
         let total: usize = split_polygon(9).iter().map(|p| p.len() - 2).sum();
-        assert_eq!(total, 7, "a fan split covers the n-gon with n-2 triangles' worth");
+        assert_eq!(
+            total, 7,
+            "a fan split covers the n-gon with n-2 triangles' worth"
+        );
     }
 
     #[test]

@@ -149,14 +149,14 @@ impl ChartBuilder<'_> {
             new_faces.push(f);
         }
         let mut verts = Vec::with_capacity((nx + 2) * (ny + 1));
-        for j in 0..=ny {
-            verts.extend_from_slice(&piece.verts[j * (nx + 1)..(j + 1) * (nx + 1)]);
-            verts.push(new_verts[j]);
+        for (row, &v) in piece.verts.chunks(nx + 1).zip(&new_verts) {
+            verts.extend_from_slice(row);
+            verts.push(v);
         }
         let mut cells = Vec::with_capacity((nx + 1) * ny);
-        for j in 0..ny {
-            cells.extend_from_slice(&piece.cells[j * nx..(j + 1) * nx]);
-            cells.push((new_faces[j], false));
+        for (row, &f) in piece.cells.chunks(nx).zip(&new_faces) {
+            cells.extend_from_slice(row);
+            cells.push((f, false));
         }
         piece.verts = verts;
         piece.cells = cells;
@@ -242,7 +242,12 @@ pub fn layout_root_slice(mesh: &HairMesh, use_charts: bool) -> RootLayout {
 }
 
 /// Shelf packing: tallest pieces first, rows of a width near the square root of the total area.
-fn pack(mut pieces: Vec<Piece>, face_count: usize, charts: usize, charted_faces: usize) -> RootLayout {
+fn pack(
+    mut pieces: Vec<Piece>,
+    face_count: usize,
+    charts: usize,
+    charted_faces: usize,
+) -> RootLayout {
     pieces.sort_by_key(|p| std::cmp::Reverse((p.ny + 1, p.nx + 1)));
     let area: usize = pieces.iter().map(|p| (p.nx + 1) * (p.ny + 1)).sum();
     let widest = pieces.iter().map(|p| p.nx + 1).max().unwrap_or(1);
@@ -316,7 +321,12 @@ mod tests {
         let mut faces = Vec::new();
         for j in 0..ny {
             for i in 0..nx {
-                faces.push(Face::Quad([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]));
+                faces.push(Face::Quad([
+                    id(i, j),
+                    id(i + 1, j),
+                    id(i + 1, j + 1),
+                    id(i, j + 1),
+                ]));
             }
         }
         if with_triangles {
@@ -357,7 +367,10 @@ mod tests {
                 }
                 Face::Tri(t) => {
                     assert!(b.triangle);
-                    assert_eq!([cell[0], cell[1], cell[2], cell[3]], [t[0], t[1], t[2], t[2]]);
+                    assert_eq!(
+                        [cell[0], cell[1], cell[2], cell[3]],
+                        [t[0], t[1], t[2], t[2]]
+                    );
                 }
             }
         }
@@ -369,7 +382,11 @@ mod tests {
         let layout = layout_root_slice(&mesh, true);
         assert_eq!(layout.charts, 1);
         assert_eq!(layout.charted_faces, 30);
-        assert!(layout.texels_per_face() < 1.5, "{}", layout.texels_per_face());
+        assert!(
+            layout.texels_per_face() < 1.5,
+            "{}",
+            layout.texels_per_face()
+        );
         assert_cells_match_faces(&mesh, &layout);
     }
 
@@ -393,7 +410,11 @@ mod tests {
         for (f, b) in layout.bundles.iter().enumerate() {
             // The open square between the four texel centres belongs to one face only.
             let key = (b.origin[1] * layout.width + b.origin[0]) as usize;
-            assert!(owner[key].is_none(), "faces {:?} and {f} share a cell", owner[key]);
+            assert!(
+                owner[key].is_none(),
+                "faces {:?} and {f} share a cell",
+                owner[key]
+            );
             owner[key] = Some(f);
             assert!(b.origin[0] + 1 < layout.width && b.origin[1] + 1 < layout.height);
         }

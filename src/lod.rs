@@ -124,7 +124,9 @@ mod tests {
         let (e, g) = geomorph(0.99, ns, 0.5);
         assert_eq!((e, g), (5, 0.0));
         // Morphing odd vertices fully gives the coarse polyline's midpoints.
-        let mut p: Vec<Vec3> = (0..5).map(|i| Vec3::new(i as f32, (i % 2) as f32, 0.0)).collect();
+        let mut p: Vec<Vec3> = (0..5)
+            .map(|i| Vec3::new(i as f32, (i % 2) as f32, 0.0))
+            .collect();
         let mut t = vec![Vec3::X; 5];
         apply_geomorph(&mut p, &mut t, 1.0);
         assert!(p[1].y.abs() < 1e-6 && p[3].y.abs() < 1e-6);

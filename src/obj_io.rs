@@ -54,7 +54,9 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
                         _ => {
                             return Err(HairError::invalid(
                                 name,
-                                format!("line {line_no}: vertex coordinate '{a}' is not a finite number"),
+                                format!(
+                                    "line {line_no}: vertex coordinate '{a}' is not a finite number"
+                                ),
                             ));
                         }
                     }
@@ -70,7 +72,9 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
                     if !a.parse::<f32>().is_ok_and(f32::is_finite) {
                         return Err(HairError::invalid(
                             name,
-                            format!("line {line_no}: texture coordinate '{a}' is not a finite number"),
+                            format!(
+                                "line {line_no}: texture coordinate '{a}' is not a finite number"
+                            ),
                         ));
                     }
                 }
@@ -99,7 +103,10 @@ fn parse(name: &str, path: &Path) -> Result<(RawObj, LineIndex)> {
     match parsed {
         Ok(Ok(raw)) => Ok((raw, lines)),
         Ok(Err(e)) => Err(HairError::invalid(name, format!("malformed OBJ: {e}"))),
-        Err(_) => Err(HairError::invalid(name, "malformed OBJ: the parser rejected it")),
+        Err(_) => Err(HairError::invalid(
+            name,
+            "malformed OBJ: the parser rejected it",
+        )),
     }
 }
 
@@ -123,7 +130,9 @@ fn group_polygons(raw: &RawObj, group: &str) -> Vec<usize> {
 }
 
 fn layer_group_count(raw: &RawObj) -> usize {
-    (0..).take_while(|k| raw.groups.contains_key(&format!("layer{k}"))).count()
+    (0..)
+        .take_while(|k| raw.groups.contains_key(&format!("layer{k}")))
+        .count()
 }
 
 fn position(raw: &RawObj, i: usize) -> Vec3 {
@@ -328,7 +337,13 @@ pub fn write_hair_mesh_obj(mesh: &HairMesh, path: &Path, comment: &str) -> Resul
     let mut out = Vec::new();
     let n = mesh.vertices_per_layer();
     let io = |e| HairError::io(path, e);
-    writeln!(out, "# hair mesh: {} layers, {} faces", mesh.layer_count(), mesh.faces.len()).map_err(io)?;
+    writeln!(
+        out,
+        "# hair mesh: {} layers, {} faces",
+        mesh.layer_count(),
+        mesh.faces.len()
+    )
+    .map_err(io)?;
     for line in comment.lines() {
         writeln!(out, "# {line}").map_err(io)?;
     }

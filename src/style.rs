@@ -165,14 +165,24 @@ impl HairStyle {
         ];
         for (field, v) in floats {
             if !v.is_finite() {
-                return Err(HairError::invalid(name, format!("style field {field} is not finite")));
+                return Err(HairError::invalid(
+                    name,
+                    format!("style field {field} is not finite"),
+                ));
             }
             if v < 0.0 && field != "wave_angle" {
-                return Err(HairError::invalid(name, format!("style field {field} must be >= 0, got {v}")));
+                return Err(HairError::invalid(
+                    name,
+                    format!("style field {field} must be >= 0, got {v}"),
+                ));
             }
         }
         let check = |ok: bool, what: &str| {
-            if ok { Ok(()) } else { Err(HairError::invalid(name, format!("style: {what}"))) }
+            if ok {
+                Ok(())
+            } else {
+                Err(HairError::invalid(name, format!("style: {what}")))
+            }
         };
         check(self.strand_width > 0.0, "strand_width must be > 0")?;
         check(self.length_variation < 1.0, "length_variation must be < 1")?;
@@ -197,11 +207,20 @@ mod tests {
 
     #[test]
     fn rejects_bad_styles() {
-        let e = HairStyle::from_toml("s.toml", "curl_radus = 1.0").unwrap_err().to_string();
-        assert!(e.starts_with("s.toml: bad style") && e.contains("curl_radus"), "{e}");
-        let e = HairStyle::from_toml("s.toml", "strand_width = nan").unwrap_err().to_string();
+        let e = HairStyle::from_toml("s.toml", "curl_radus = 1.0")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("s.toml: bad style") && e.contains("curl_radus"),
+            "{e}"
+        );
+        let e = HairStyle::from_toml("s.toml", "strand_width = nan")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("strand_width is not finite"), "{e}");
-        let e = HairStyle::from_toml("s.toml", "length_variation = 1.5").unwrap_err().to_string();
+        let e = HairStyle::from_toml("s.toml", "length_variation = 1.5")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("length_variation"), "{e}");
     }
 }
