@@ -23,3 +23,4 @@ pub use error::{HairError, Result};
 pub use generate::{CpuGenerator, StrandSet};
 pub use hair_mesh::{ExtrudeDesc, Face, HairMesh, extrude};
 pub use style::HairStyle;
+pub mod vk;

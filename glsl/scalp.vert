@@ -1,0 +1,28 @@
+#version 460
+// Opaque scalp: two triangles per bundle pulled from the root slice of the hair mesh texture.
+#extension GL_GOOGLE_include_directive : require
+#include "bindings.glsl"
+#include "common.glsl"
+#include "strand_eval.glsl"
+
+layout(location = 0) out vec3 out_normal;
+
+vec3 corner_pos(BundleDesc b, int c) {
+    ivec3 t = ivec3(ivec2(b.origin) + ivec2(c & 1, c >> 1), 0);
+    return (push.model * vec4(decode_position(texelFetch(tex_position, t, 0).xyz), 1.0)).xyz;
+}
+
+void main() {
+    uint bundle = uint(gl_VertexIndex) / 6u;
+    uint corner = uint(gl_VertexIndex) % 6u;
+    BundleDesc b = bundles[bundle];
+    // Cell corners (0,0) (1,0) (1,1) (0,1) as indices 0 1 3 2; triangles (0,1,3) and (0,3,2).
+    const int order[6] = int[6](0, 1, 3, 0, 3, 2);
+    vec3 p00 = corner_pos(b, 0);
+    vec3 p10 = corner_pos(b, 1);
+    vec3 p01 = corner_pos(b, 2);
+    vec3 p11 = corner_pos(b, 3);
+    vec3 n = cross(p11 - p00, p01 - p10);
+    out_normal = length(n) > 0.0 ? normalize(n) : vec3(0.0, 1.0, 0.0);
+    gl_Position = frame.view_proj * vec4(corner_pos(b, order[corner]), 1.0);
+}

@@ -1,0 +1,142 @@
+// Strand evaluation from the five textures: the GPU twin of src/generate.rs (CPU oracle).
+// Included unchanged by the compute path (generate.comp) and the mesh path.
+// Requires bindings.glsl and common.glsl.
+#ifndef STRAND_EVAL_GLSL
+#define STRAND_EVAL_GLSL
+
+#define MAX_STRANDS_PER_BUNDLE 4096u
+#define BUNDLE_TRIANGLE 1u
+
+// Root sample of a strand (paper 003 sec. 3.3); quads shift the toroidal set per bundle.
+vec2 root_sample(BundleDesc b, uint bundle_index, uint strand) {
+    uint s = strand % MAX_STRANDS_PER_BUNDLE;
+    if ((b.flags & BUNDLE_TRIANGLE) != 0u) {
+        return root_samples[MAX_STRANDS_PER_BUNDLE + s];
+    }
+    uint h = hash_u32(bundle_index ^ 0x51ed270bu);
+    return fract(root_samples[s] + vec2(hash_f32(h), hash_f32(h + 1u)));
+}
+
+// Normalised root-slice coordinate; triangles map xi -> (xi.x / (1 - xi.y), xi.y).
+vec2 root_coord(BundleDesc b, vec2 xi) {
+    vec2 local = xi;
+    if ((b.flags & BUNDLE_TRIANGLE) != 0u) {
+        local = vec2(xi.x / max(1.0 - xi.y, 1e-6), xi.y);
+    }
+    local = clamp(local, vec2(0.0), vec2(1.0));
+    return (vec2(b.origin) + 0.5 + local) / vec2(mesh.root_size);
+}
+
+vec3 decode_position(vec3 t) {
+    return mesh.pos_origin.xyz + mesh.pos_extent.xyz * t;
+}
+
+// Curve point at parameter r in [0, L-1]: two trilinear fetches + one lerp (sec. 3.1).
+vec3 curve_point(vec2 coord, float r) {
+    uint layers = mesh.layers;
+    r = clamp(r, 0.0, float(layers - 1u));
+    uint j = min(uint(floor(r)), layers - 2u);
+    float tau = r - float(j);
+    uint slice = 4u * j;
+    float t = tau * 2.0;
+    if (tau >= 0.5) {
+        slice += 2u;
+        t = tau * 2.0 - 1.0;
+    }
+    float depth = float(4u * (layers - 1u) + 1u);
+    vec3 a = texture(tex_position, vec3(coord, (float(slice) + 0.5 + t) / depth)).xyz;
+    vec3 b = texture(tex_position, vec3(coord, (float(slice) + 1.5 + t) / depth)).xyz;
+    return decode_position(mix(a, b, t));
+}
+
+vec3 root_point(vec2 coord) {
+    float depth = float(4u * (mesh.layers - 1u) + 1u);
+    return decode_position(texture(tex_position, vec3(coord, 0.5 / depth)).xyz);
+}
+
+// Styling frame (eq. 4) and w at parameter r.
+void styling_frame(vec2 coord, float r, out vec3 fu, out vec3 fv, out vec3 fw, out float w) {
+    float z = (r + 0.5) / float(mesh.layers);
+    vec3 u = texture(tex_u, vec3(coord, z)).xyz;
+    vec3 v = texture(tex_v, vec3(coord, z)).xyz;
+    fu = length(u) > 0.0 ? normalize(u) : vec3(1.0, 0.0, 0.0);
+    fv = length(v) > 0.0 ? normalize(v) : vec3(0.0, 1.0, 0.0);
+    vec3 c = cross(fu, fv);
+    fw = length(c) > 0.0 ? normalize(c) : vec3(0.0, 0.0, 1.0);
+    w = mesh.pos_origin.w * texture(tex_w, vec3(coord, z)).x;
+}
+
+float smoothstep_safe(float e0, float e1, float x) {
+    if (e1 <= e0) {
+        return x >= e1 ? 1.0 : 0.0;
+    }
+    return smoothstep(e0, e1, x);
+}
+
+// Styling offset in the u v w frame (sec. 3.4; src/generate.rs: styling_offset).
+vec3 styling_offset(uint key, float s, float w) {
+    const float TAU = 6.28318530718;
+    float ramp = smoothstep_safe(0.0, style.root_ramp, w);
+    vec3 off = vec3(0.0);
+    float cp = TAU * (style.curl_frequency * w + style.curl_phase_jitter * strand_rand(key, 1u));
+    off += vec3(cos(cp), sin(cp), 0.0) * (style.curl_radius * ramp);
+    float wp = TAU * (style.wave_frequency * w + style.wave_phase_jitter * strand_rand(key, 2u));
+    off += vec3(cos(style.wave_angle), sin(style.wave_angle), 0.0) * (style.wave_amplitude * ramp * sin(wp));
+    float frizz = style.frizz_amplitude * pow(s, style.frizz_power);
+    float x = w * style.frizz_frequency;
+    uint fk = hash_u32(key ^ 0x7f4a7c15u);
+    off += vec3(value_noise(fk, x), value_noise(fk + 0x68bc21ebu, x), value_noise(fk + 0x02e5be93u, x)) * frizz;
+    return off;
+}
+
+float strand_width_at(float s) {
+    return style.strand_width * (1.0 + (style.tip_width_ratio - 1.0) * pow(s, style.taper_power));
+}
+
+// Everything constant along one strand.
+struct StrandInfo {
+    vec2 coord;         // root-slice coordinate of the root sample
+    vec2 centre_coord;  // bundle centre (clumping target)
+    uint key;           // per-strand random key
+    float span;         // curve parameter at the tip
+};
+
+StrandInfo strand_info(uint bundle_index, uint strand) {
+    BundleDesc b = bundles[bundle_index];
+    StrandInfo si;
+    si.key = strand_key(style.seed, bundle_index, strand);
+    si.coord = root_coord(b, root_sample(b, bundle_index, strand));
+    vec2 centre = (b.flags & BUNDLE_TRIANGLE) != 0u ? vec2(1.0 / 3.0) : vec2(0.5);
+    si.centre_coord = root_coord(b, centre);
+    float length_factor = 1.0 - style.length_variation * strand_rand(si.key, 0u);
+    si.span = float(mesh.layers - 1u) * length_factor;
+    return si;
+}
+
+// Position of vertex k of `segments` (k = 0 is the root: one lookup, no styling).
+vec3 strand_vertex(StrandInfo si, uint k, uint segments) {
+    if (k == 0u) {
+        return root_point(si.coord);
+    }
+    float s = float(k) / float(segments);
+    float r = s * si.span;
+    vec3 p = curve_point(si.coord, r);
+    if (style.clump_strength > 0.0) {
+        vec3 c = curve_point(si.centre_coord, r);
+        p += (c - p) * (style.clump_strength * pow(s, style.clump_power));
+    }
+    vec3 fu, fv, fw;
+    float w;
+    styling_frame(si.coord, r, fu, fv, fw, w);
+    vec3 off = styling_offset(si.key, s, w);
+    return p + fu * off.x + fv * off.y + fw * off.z;
+}
+
+// Tangents from positions (sec. 3.5): central differences, eq. 5 / eq. 6 at the ends.
+// `prev`/`next` are the neighbours (ignored where they do not exist).
+vec3 safe_normalize(vec3 v, vec3 fallback) {
+    float l = length(v);
+    return l > 0.0 ? v / l : fallback;
+}
+
+#endif

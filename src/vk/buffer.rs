@@ -1,0 +1,135 @@
+//! Buffers with gpu-allocator memory.
+
+use std::sync::Arc;
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+
+use super::{Context, GpuError, GpuResult, VkContext};
+
+/// How to create a [`Buffer`].
+#[derive(Clone, Debug)]
+pub struct BufferDesc {
+    /// Debug name.
+    pub name: String,
+    /// Size in bytes (> 0).
+    pub size: u64,
+    /// Usage flags.
+    pub usage: vk::BufferUsageFlags,
+    /// Memory location.
+    pub location: MemoryLocation,
+}
+
+impl BufferDesc {
+    /// A device-local buffer.
+    pub fn new(name: &str, size: u64, usage: vk::BufferUsageFlags) -> Self {
+        BufferDesc {
+            name: name.into(),
+            size: size.max(16),
+            usage,
+            location: MemoryLocation::GpuOnly,
+        }
+    }
+
+    /// Host-visible memory the CPU writes (uploads, uniforms).
+    pub fn host_visible(mut self) -> Self {
+        self.location = MemoryLocation::CpuToGpu;
+        self
+    }
+
+    /// Host-visible memory the CPU reads back.
+    pub fn readback(mut self) -> Self {
+        self.location = MemoryLocation::GpuToCpu;
+        self
+    }
+}
+
+/// A buffer and its memory; freed on drop.
+pub struct Buffer {
+    ctx: Arc<Context>,
+    /// The raw handle.
+    pub raw: vk::Buffer,
+    allocation: Option<Allocation>,
+    /// Size in bytes.
+    pub size: u64,
+}
+
+impl Buffer {
+    /// Create a buffer as described.
+    pub fn new(ctx: &Arc<Context>, desc: &BufferDesc) -> GpuResult<Self> {
+        let info = vk::BufferCreateInfo::default()
+            .size(desc.size)
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: valid device and create info.
+        let raw = unsafe { ctx.device.create_buffer(&info, None) }.ctx("create buffer")?;
+        // SAFETY: `raw` was just created on this device.
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
+            name: &desc.name,
+            requirements,
+            location: desc.location,
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: unbound buffer, not in use.
+                unsafe { ctx.device.destroy_buffer(raw, None) };
+                return Err(GpuError::Alloc(e));
+            }
+        };
+        // SAFETY: memory from the allocator matches the requirements of `raw`.
+        unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.ctx("bind buffer memory")?;
+        ctx.name_object(raw, &desc.name);
+        Ok(Buffer {
+            ctx: ctx.clone(),
+            raw,
+            allocation: Some(allocation),
+            size: desc.size,
+        })
+    }
+
+    /// Create a host-visible buffer holding `data`.
+    pub fn with_data(ctx: &Arc<Context>, name: &str, usage: vk::BufferUsageFlags, data: &[u8]) -> GpuResult<Self> {
+        let mut b = Buffer::new(ctx, &BufferDesc::new(name, data.len() as u64, usage).host_visible())?;
+        b.write(0, data)?;
+        Ok(b)
+    }
+
+    fn mapped(&mut self) -> GpuResult<&mut [u8]> {
+        self.allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .ok_or_else(|| GpuError::Unsupported("buffer is not host visible".into()))
+    }
+
+    /// Write `data` at byte `offset` of a host-visible buffer.
+    pub fn write(&mut self, offset: usize, data: &[u8]) -> GpuResult<()> {
+        let m = self.mapped()?;
+        let end = offset
+            .checked_add(data.len())
+            .filter(|&e| e <= m.len())
+            .ok_or_else(|| GpuError::Unsupported("buffer write out of range".into()))?;
+        m[offset..end].copy_from_slice(data);
+        Ok(())
+    }
+
+    /// Read the contents of a host-visible buffer.
+    pub fn read(&mut self) -> GpuResult<Vec<u8>> {
+        let size = self.size as usize;
+        Ok(self.mapped()?[..size].to_vec())
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        // SAFETY: callers wait for the GPU before dropping resources it uses.
+        unsafe { self.ctx.device.destroy_buffer(self.raw, None) };
+        if let Some(a) = self.allocation.take() {
+            let _ = self.ctx.allocator().free(a);
+        }
+    }
+}

@@ -1,0 +1,53 @@
+//! Thin Vulkan layer: one file per object kind, every `unsafe` ash call behind a small safe
+//! function. Objects are described by small `*Desc` values.
+
+pub mod buffer;
+pub mod context;
+pub mod descriptor;
+pub mod image;
+pub mod pipeline;
+pub mod profiler;
+pub mod shader;
+
+pub use buffer::{Buffer, BufferDesc};
+pub use context::{Context, ContextDesc};
+pub use image::{Image, ImageDesc};
+
+/// Errors of the GPU layer.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// A Vulkan call failed.
+    #[error("Vulkan: {what}: {result}")]
+    Vk {
+        /// What was being done.
+        what: &'static str,
+        /// The result code.
+        result: ash::vk::Result,
+    },
+    /// The Vulkan loader could not be opened.
+    #[error("Vulkan loader not found: {0} (run tools/setup.sh)")]
+    Loader(String),
+    /// No usable device or a missing feature.
+    #[error("{0}")]
+    Unsupported(String),
+    /// Memory allocation failed.
+    #[error("GPU memory: {0}")]
+    Alloc(#[from] gpu_allocator::AllocationError),
+    /// A shader failed to compile; the message names file and line.
+    #[error("shader {0}")]
+    Shader(String),
+}
+
+/// Result alias of the GPU layer.
+pub type GpuResult<T> = std::result::Result<T, GpuError>;
+
+/// Attach context to a raw `vk::Result`.
+pub(crate) trait VkContext<T> {
+    fn ctx(self, what: &'static str) -> GpuResult<T>;
+}
+
+impl<T> VkContext<T> for Result<T, ash::vk::Result> {
+    fn ctx(self, what: &'static str) -> GpuResult<T> {
+        self.map_err(|result| GpuError::Vk { what, result })
+    }
+}
