@@ -21,7 +21,10 @@ fn main() {
         "glslang",
         "glslang-default-resource-limits",
     ];
-    if libs.iter().all(|l| Path::new(&dir).join(format!("lib{l}.a")).is_file()) {
+    if libs
+        .iter()
+        .all(|l| Path::new(&dir).join(format!("lib{l}.a")).is_file())
+    {
         println!("cargo:rustc-link-search=native={dir}");
         for l in libs {
             println!("cargo:rustc-link-lib=static={l}");

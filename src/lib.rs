@@ -23,4 +23,5 @@ pub use error::{HairError, Result};
 pub use generate::{CpuGenerator, StrandSet};
 pub use hair_mesh::{ExtrudeDesc, Face, HairMesh, extrude};
 pub use style::HairStyle;
+pub mod render;
 pub mod vk;

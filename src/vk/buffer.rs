@@ -82,7 +82,11 @@ impl Buffer {
             }
         };
         // SAFETY: memory from the allocator matches the requirements of `raw`.
-        unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.ctx("bind buffer memory")?;
+        unsafe {
+            ctx.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        }
+        .ctx("bind buffer memory")?;
         ctx.name_object(raw, &desc.name);
         Ok(Buffer {
             ctx: ctx.clone(),
@@ -93,8 +97,16 @@ impl Buffer {
     }
 
     /// Create a host-visible buffer holding `data`.
-    pub fn with_data(ctx: &Arc<Context>, name: &str, usage: vk::BufferUsageFlags, data: &[u8]) -> GpuResult<Self> {
-        let mut b = Buffer::new(ctx, &BufferDesc::new(name, data.len() as u64, usage).host_visible())?;
+    pub fn with_data(
+        ctx: &Arc<Context>,
+        name: &str,
+        usage: vk::BufferUsageFlags,
+        data: &[u8],
+    ) -> GpuResult<Self> {
+        let mut b = Buffer::new(
+            ctx,
+            &BufferDesc::new(name, data.len() as u64, usage).host_visible(),
+        )?;
         b.write(0, data)?;
         Ok(b)
     }
@@ -114,6 +126,27 @@ impl Buffer {
             .filter(|&e| e <= m.len())
             .ok_or_else(|| GpuError::Unsupported("buffer write out of range".into()))?;
         m[offset..end].copy_from_slice(data);
+        Ok(())
+    }
+
+    /// Write `data` at the start of a host-visible buffer through a shared reference (for
+    /// per-frame uniforms the GPU is not reading at the time).
+    pub fn write_shared(&self, data: &[u8]) -> GpuResult<()> {
+        let a = self
+            .allocation
+            .as_ref()
+            .ok_or_else(|| GpuError::Unsupported("freed buffer".into()))?;
+        let ptr = a
+            .mapped_ptr()
+            .ok_or_else(|| GpuError::Unsupported("buffer is not host visible".into()))?;
+        if data.len() as u64 > self.size {
+            return Err(GpuError::Unsupported("buffer write out of range".into()));
+        }
+        // SAFETY: the mapping covers `size` bytes, checked above; callers ensure the GPU is not
+        // accessing the buffer (frames are submitted and waited for one at a time).
+        unsafe {
+            std::ptr::copy_nonoverlapping(data.as_ptr(), ptr.as_ptr() as *mut u8, data.len())
+        };
         Ok(())
     }
 

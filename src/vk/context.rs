@@ -66,7 +66,9 @@ unsafe extern "system" fn debug_callback(
         let msg = if data.is_null() || (*data).p_message.is_null() {
             String::from("(no message)")
         } else {
-            CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
+            CStr::from_ptr((*data).p_message)
+                .to_string_lossy()
+                .into_owned()
         };
         (msg, &*(user as *const DebugState))
     };
@@ -118,7 +120,8 @@ impl Context {
         let mut layers: Vec<*const i8> = Vec::new();
         if desc.validation {
             // SAFETY: plain enumeration call.
-            let available = unsafe { entry.enumerate_instance_layer_properties() }.ctx("enumerate layers")?;
+            let available =
+                unsafe { entry.enumerate_instance_layer_properties() }.ctx("enumerate layers")?;
             let found = available
                 .iter()
                 .any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
@@ -135,7 +138,10 @@ impl Context {
             messages: Mutex::new(Vec::new()),
         });
         let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-            .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+            )
             .message_type(
                 vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
                     | vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
@@ -155,7 +161,8 @@ impl Context {
         let debug = if desc.validation {
             let loader = debug_utils::Instance::new(&entry, &instance);
             // SAFETY: messenger info is valid; the DebugState outlives the messenger (dropped after it).
-            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info, None) }.ctx("create messenger")?;
+            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info, None) }
+                .ctx("create messenger")?;
             Some((loader, messenger))
         } else {
             None
@@ -172,12 +179,16 @@ impl Context {
         desc: &ContextDesc,
     ) -> GpuResult<Self> {
         // SAFETY: plain enumeration/query calls on a valid instance.
-        let physicals = unsafe { instance.enumerate_physical_devices() }.ctx("enumerate devices")?;
+        let physicals =
+            unsafe { instance.enumerate_physical_devices() }.ctx("enumerate devices")?;
         let mut candidates = Vec::new();
         for &pd in &physicals {
             // SAFETY: valid physical device handle.
             let props = unsafe { instance.get_physical_device_properties(pd) };
-            let name = props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
+            let name = props
+                .device_name_as_c_str()
+                .map(|c| c.to_string_lossy().into_owned())
+                .unwrap_or_default();
             if props.api_version < vk::API_VERSION_1_3 {
                 continue;
             }
@@ -206,18 +217,28 @@ impl Context {
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let queue_family = families
             .iter()
-            .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) && f.timestamp_valid_bits > 0)
-            .ok_or_else(|| GpuError::Unsupported(format!("{name}: no graphics+compute queue with timestamps")))? as u32;
+            .position(|f| {
+                f.queue_flags
+                    .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+                    && f.timestamp_valid_bits > 0
+            })
+            .ok_or_else(|| {
+                GpuError::Unsupported(format!("{name}: no graphics+compute queue with timestamps"))
+            })? as u32;
         // SAFETY: valid physical device.
-        let exts = unsafe { instance.enumerate_device_extension_properties(physical) }.ctx("device extensions")?;
-        let has_mesh = exts
-            .iter()
-            .any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == ash::ext::mesh_shader::NAME));
+        let exts = unsafe { instance.enumerate_device_extension_properties(physical) }
+            .ctx("device extensions")?;
+        let has_mesh = exts.iter().any(|e| {
+            e.extension_name_as_c_str()
+                .is_ok_and(|n| n == ash::ext::mesh_shader::NAME)
+        });
 
         let mut mesh_features = vk::PhysicalDeviceMeshShaderFeaturesEXT::default();
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
-        let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13).push_next(&mut f12);
+        let mut features2 = vk::PhysicalDeviceFeatures2::default()
+            .push_next(&mut f13)
+            .push_next(&mut f12);
         if has_mesh {
             features2 = features2.push_next(&mut mesh_features);
         }
@@ -225,7 +246,9 @@ impl Context {
         unsafe { instance.get_physical_device_features2(physical, &mut features2) };
         let base = features2.features;
         if f13.dynamic_rendering == 0 || f13.synchronization2 == 0 {
-            return Err(GpuError::Unsupported(format!("{name}: needs dynamicRendering and synchronization2")));
+            return Err(GpuError::Unsupported(format!(
+                "{name}: needs dynamicRendering and synchronization2"
+            )));
         }
         let mesh_ok = has_mesh && mesh_features.mesh_shader != 0 && mesh_features.task_shader != 0;
 
@@ -241,7 +264,8 @@ impl Context {
             .dynamic_rendering(true)
             .synchronization2(true)
             .maintenance4(f13.maintenance4 != 0);
-        let mut enable12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(f12.host_query_reset != 0);
+        let mut enable12 = vk::PhysicalDeviceVulkan12Features::default()
+            .host_query_reset(f12.host_query_reset != 0);
         let mut enable_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default()
             .mesh_shader(true)
             .task_shader(true)
@@ -259,7 +283,8 @@ impl Context {
             device_info = device_info.push_next(&mut enable_mesh);
         }
         // SAFETY: every pointer in device_info lives until the call returns.
-        let device = unsafe { instance.create_device(physical, &device_info, None) }.ctx("create device")?;
+        let device =
+            unsafe { instance.create_device(physical, &device_info, None) }.ctx("create device")?;
         // SAFETY: the queue family/index were requested above.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let allocator = Allocator::new(&AllocatorCreateDesc {
@@ -274,7 +299,8 @@ impl Context {
             .queue_family_index(queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         // SAFETY: valid device.
-        let command_pool = unsafe { device.create_command_pool(&pool_info, None) }.ctx("create command pool")?;
+        let command_pool =
+            unsafe { device.create_command_pool(&pool_info, None) }.ctx("create command pool")?;
 
         // SAFETY: property queries with a chain living on this frame.
         let (props, driver, mesh_limits) = unsafe {
@@ -288,13 +314,21 @@ impl Context {
             let props = p2.properties;
             let driver_name = format!(
                 "{} {}",
-                driver.driver_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default(),
-                driver.driver_info_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default()
+                driver
+                    .driver_name_as_c_str()
+                    .map(|c| c.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                driver
+                    .driver_info_as_c_str()
+                    .map(|c| c.to_string_lossy().into_owned())
+                    .unwrap_or_default()
             );
             mesh_props.p_next = std::ptr::null_mut();
             (props, driver_name, mesh_ok.then_some(mesh_props))
         };
-        let debug_device = debug.as_ref().map(|_| debug_utils::Device::new(&instance, &device));
+        let debug_device = debug
+            .as_ref()
+            .map(|_| debug_utils::Device::new(&instance, &device));
         let mesh_ext = mesh_ok.then(|| ash::ext::mesh_shader::Device::new(&instance, &device));
         Ok(Context {
             _entry: entry,
@@ -331,14 +365,22 @@ impl Context {
 
     /// The validation error messages reported so far.
     pub fn validation_messages(&self) -> Vec<String> {
-        self.debug_state.messages.lock().map(|m| m.clone()).unwrap_or_default()
+        self.debug_state
+            .messages
+            .lock()
+            .map(|m| m.clone())
+            .unwrap_or_default()
     }
 
     /// Attach a debug name to a Vulkan object (no-op without validation).
     pub fn name_object<H: vk::Handle>(&self, handle: H, name: &str) {
         if let Some(d) = &self.debug_device {
-            let Ok(cname) = CString::new(name) else { return };
-            let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&cname);
+            let Ok(cname) = CString::new(name) else {
+                return;
+            };
+            let info = vk::DebugUtilsObjectNameInfoEXT::default()
+                .object_handle(handle)
+                .object_name(&cname);
             // SAFETY: handle belongs to this device; the name lives for the call.
             let _ = unsafe { d.set_debug_utils_object_name(&info) };
         }
@@ -351,23 +393,34 @@ impl Context {
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
         // SAFETY: the pool belongs to this device and is used from this thread only.
-        let cmd = unsafe { self.device.allocate_command_buffers(&alloc) }.ctx("allocate command buffer")?[0];
-        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        let cmd = unsafe { self.device.allocate_command_buffers(&alloc) }
+            .ctx("allocate command buffer")?[0];
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         // SAFETY: fresh command buffer.
         unsafe { self.device.begin_command_buffer(cmd, &begin) }.ctx("begin command buffer")?;
         let out = record(cmd);
         let result = (|| {
             // SAFETY: recording finished; fence and submission are local to this call.
             unsafe {
-                self.device.end_command_buffer(cmd).ctx("end command buffer")?;
-                let fence = self.device.create_fence(&vk::FenceCreateInfo::default(), None).ctx("create fence")?;
+                self.device
+                    .end_command_buffer(cmd)
+                    .ctx("end command buffer")?;
+                let fence = self
+                    .device
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+                    .ctx("create fence")?;
                 let cmds = [cmd];
                 let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
                 let r = self
                     .device
                     .queue_submit(self.queue, &submit, fence)
                     .ctx("queue submit")
-                    .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX).ctx("wait for fence"));
+                    .and_then(|_| {
+                        self.device
+                            .wait_for_fences(&[fence], true, u64::MAX)
+                            .ctx("wait for fence")
+                    });
                 self.device.destroy_fence(fence, None);
                 r
             }
@@ -375,6 +428,23 @@ impl Context {
         // SAFETY: the submission completed (or failed); the buffer is no longer in use.
         unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
         result.map(|_| out)
+    }
+
+    /// Record a global memory barrier (buffers written by one stage, read by another).
+    pub fn barrier(
+        &self,
+        cmd: vk::CommandBuffer,
+        src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+        dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    ) {
+        let b = [vk::MemoryBarrier2::default()
+            .src_stage_mask(src.0)
+            .src_access_mask(src.1)
+            .dst_stage_mask(dst.0)
+            .dst_access_mask(dst.1)];
+        let dep = vk::DependencyInfo::default().memory_barriers(&b);
+        // SAFETY: recording into a command buffer in the recording state.
+        unsafe { self.device.cmd_pipeline_barrier2(cmd, &dep) };
     }
 
     /// Wait until the device is idle.
@@ -386,9 +456,13 @@ impl Context {
     /// Whether `format` supports linear-filtered sampling with optimal tiling.
     pub fn supports_linear_filter(&self, format: vk::Format) -> bool {
         // SAFETY: plain query.
-        let props = unsafe { self.instance.get_physical_device_format_properties(self.physical, format) };
+        let props = unsafe {
+            self.instance
+                .get_physical_device_format_properties(self.physical, format)
+        };
         props.optimal_tiling_features.contains(
-            vk::FormatFeatureFlags::SAMPLED_IMAGE | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
+            vk::FormatFeatureFlags::SAMPLED_IMAGE
+                | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
         )
     }
 }

@@ -53,23 +53,41 @@ impl DescriptorSet {
         let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
         // SAFETY: valid create infos throughout; objects are destroyed in Drop.
         unsafe {
-            let layout = ctx.device.create_descriptor_set_layout(&info, None).ctx("descriptor set layout")?;
+            let layout = ctx
+                .device
+                .create_descriptor_set_layout(&info, None)
+                .ctx("descriptor set layout")?;
             let sizes: Vec<_> = bindings
                 .iter()
-                .map(|b| vk::DescriptorPoolSize { ty: b.ty(), descriptor_count: 1 })
+                .map(|b| vk::DescriptorPoolSize {
+                    ty: b.ty(),
+                    descriptor_count: 1,
+                })
                 .collect();
-            let pool_info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
-            let pool = ctx.device.create_descriptor_pool(&pool_info, None).ctx("descriptor pool")?;
+            let pool_info = vk::DescriptorPoolCreateInfo::default()
+                .max_sets(1)
+                .pool_sizes(&sizes);
+            let pool = ctx
+                .device
+                .create_descriptor_pool(&pool_info, None)
+                .ctx("descriptor pool")?;
             let layouts = [layout];
-            let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
-            let set = ctx.device.allocate_descriptor_sets(&alloc).ctx("allocate descriptor set")?[0];
+            let alloc = vk::DescriptorSetAllocateInfo::default()
+                .descriptor_pool(pool)
+                .set_layouts(&layouts);
+            let set = ctx
+                .device
+                .allocate_descriptor_sets(&alloc)
+                .ctx("allocate descriptor set")?[0];
             ctx.name_object(set, name);
             let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
                 .iter()
                 .map(|b| match b {
-                    Binding::Uniform(buf) | Binding::Storage(buf) => {
-                        [vk::DescriptorBufferInfo { buffer: buf.raw, offset: 0, range: vk::WHOLE_SIZE }]
-                    }
+                    Binding::Uniform(buf) | Binding::Storage(buf) => [vk::DescriptorBufferInfo {
+                        buffer: buf.raw,
+                        offset: 0,
+                        range: vk::WHOLE_SIZE,
+                    }],
                     Binding::Texture(..) => [vk::DescriptorBufferInfo::default()],
                 })
                 .collect();
@@ -88,7 +106,10 @@ impl DescriptorSet {
                 .iter()
                 .enumerate()
                 .map(|(i, b)| {
-                    let w = vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(b.ty());
+                    let w = vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(i as u32)
+                        .descriptor_type(b.ty());
                     match b {
                         Binding::Texture(..) => w.image_info(&image_infos[i]),
                         _ => w.buffer_info(&buffer_infos[i]),
@@ -96,7 +117,12 @@ impl DescriptorSet {
                 })
                 .collect();
             ctx.device.update_descriptor_sets(&writes, &[]);
-            Ok(DescriptorSet { ctx: ctx.clone(), layout, pool, set })
+            Ok(DescriptorSet {
+                ctx: ctx.clone(),
+                layout,
+                pool,
+                set,
+            })
         }
     }
 }
@@ -106,7 +132,9 @@ impl Drop for DescriptorSet {
         // SAFETY: not in use once dropped.
         unsafe {
             self.ctx.device.destroy_descriptor_pool(self.pool, None);
-            self.ctx.device.destroy_descriptor_set_layout(self.layout, None);
+            self.ctx
+                .device
+                .destroy_descriptor_set_layout(self.layout, None);
         }
     }
 }

@@ -77,7 +77,10 @@ fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
 pub fn texel_bytes(format: vk::Format) -> u64 {
     match format {
         vk::Format::R16_UNORM => 2,
-        vk::Format::R16G16_UNORM | vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB | vk::Format::D32_SFLOAT => 4,
+        vk::Format::R16G16_UNORM
+        | vk::Format::R8G8B8A8_UNORM
+        | vk::Format::R8G8B8A8_SRGB
+        | vk::Format::D32_SFLOAT => 4,
         vk::Format::R16G16B16A16_UNORM | vk::Format::R16G16B16A16_SNORM => 8,
         vk::Format::R32G32B32A32_SFLOAT => 16,
         _ => 0,
@@ -88,9 +91,17 @@ impl Image {
     /// Create an image as described.
     pub fn new(ctx: &Arc<Context>, desc: &ImageDesc) -> GpuResult<Self> {
         let info = vk::ImageCreateInfo::default()
-            .image_type(if desc.dim_3d { vk::ImageType::TYPE_3D } else { vk::ImageType::TYPE_2D })
+            .image_type(if desc.dim_3d {
+                vk::ImageType::TYPE_3D
+            } else {
+                vk::ImageType::TYPE_2D
+            })
             .format(desc.format)
-            .extent(vk::Extent3D { width: desc.extent[0], height: desc.extent[1], depth: desc.extent[2] })
+            .extent(vk::Extent3D {
+                width: desc.extent[0],
+                height: desc.extent[1],
+                depth: desc.extent[2],
+            })
             .mip_levels(1)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -117,21 +128,39 @@ impl Image {
             }
         };
         // SAFETY: memory matches the image requirements.
-        unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }.ctx("bind image memory")?;
+        unsafe {
+            ctx.device
+                .bind_image_memory(raw, allocation.memory(), allocation.offset())
+        }
+        .ctx("bind image memory")?;
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
-            .view_type(if desc.dim_3d { vk::ImageViewType::TYPE_3D } else { vk::ImageViewType::TYPE_2D })
+            .view_type(if desc.dim_3d {
+                vk::ImageViewType::TYPE_3D
+            } else {
+                vk::ImageViewType::TYPE_2D
+            })
             .format(desc.format)
             .subresource_range(Self::range(desc.format));
         // SAFETY: view of a bound image.
-        let view = unsafe { ctx.device.create_image_view(&view_info, None) }.ctx("create image view")?;
+        let view =
+            unsafe { ctx.device.create_image_view(&view_info, None) }.ctx("create image view")?;
         ctx.name_object(raw, &desc.name);
         ctx.name_object(view, &desc.name);
-        Ok(Image { ctx: ctx.clone(), raw, view, allocation: Some(allocation), desc: desc.clone() })
+        Ok(Image {
+            ctx: ctx.clone(),
+            raw,
+            view,
+            allocation: Some(allocation),
+            desc: desc.clone(),
+        })
     }
 
     fn range(format: vk::Format) -> vk::ImageSubresourceRange {
-        vk::ImageSubresourceRange::default().aspect_mask(aspect(format)).level_count(1).layer_count(1)
+        vk::ImageSubresourceRange::default()
+            .aspect_mask(aspect(format))
+            .level_count(1)
+            .layer_count(1)
     }
 
     /// Record a layout transition with full stage/access masks (simple and correct).
@@ -156,21 +185,49 @@ impl Image {
         let [w, h, d] = desc.extent;
         let expected = w as u64 * h as u64 * d as u64 * texel_bytes(desc.format);
         if expected != data.len() as u64 {
-            return Err(GpuError::Unsupported(format!("{}: {} bytes for a {expected}-byte image", desc.name, data.len())));
+            return Err(GpuError::Unsupported(format!(
+                "{}: {} bytes for a {expected}-byte image",
+                desc.name,
+                data.len()
+            )));
         }
-        let desc = desc.clone().usage(vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST);
+        let desc = desc
+            .clone()
+            .usage(vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST);
         let image = Image::new(ctx, &desc)?;
         let staging = Buffer::with_data(ctx, "staging", vk::BufferUsageFlags::TRANSFER_SRC, data)?;
         ctx.submit_and_wait(|cmd| {
-            image.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+            image.transition(
+                cmd,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            );
             let region = [vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1))
-                .image_extent(vk::Extent3D { width: w, height: h, depth: d })];
+                .image_subresource(
+                    vk::ImageSubresourceLayers::default()
+                        .aspect_mask(vk::ImageAspectFlags::COLOR)
+                        .layer_count(1),
+                )
+                .image_extent(vk::Extent3D {
+                    width: w,
+                    height: h,
+                    depth: d,
+                })];
             // SAFETY: staging holds exactly the image's texels; layouts set above.
             unsafe {
-                ctx.device.cmd_copy_buffer_to_image(cmd, staging.raw, image.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &region)
+                ctx.device.cmd_copy_buffer_to_image(
+                    cmd,
+                    staging.raw,
+                    image.raw,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &region,
+                )
             };
-            image.transition(cmd, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+            image.transition(
+                cmd,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            );
         })?;
         Ok(image)
     }
@@ -179,13 +236,30 @@ impl Image {
     pub fn record_readback(&self, cmd: vk::CommandBuffer) -> GpuResult<Buffer> {
         let [w, h, _] = self.desc.extent;
         let size = w as u64 * h as u64 * texel_bytes(self.desc.format);
-        let buffer = Buffer::new(&self.ctx, &BufferDesc::new("readback", size, vk::BufferUsageFlags::TRANSFER_DST).readback())?;
+        let buffer = Buffer::new(
+            &self.ctx,
+            &BufferDesc::new("readback", size, vk::BufferUsageFlags::TRANSFER_DST).readback(),
+        )?;
         let region = [vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(aspect(self.desc.format)).layer_count(1))
-            .image_extent(vk::Extent3D { width: w, height: h, depth: 1 })];
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(aspect(self.desc.format))
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: w,
+                height: h,
+                depth: 1,
+            })];
         // SAFETY: buffer is large enough; image is in TRANSFER_SRC_OPTIMAL.
         unsafe {
-            self.ctx.device.cmd_copy_image_to_buffer(cmd, self.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &region)
+            self.ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                self.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                buffer.raw,
+                &region,
+            )
         };
         Ok(buffer)
     }
@@ -224,7 +298,10 @@ impl Sampler {
             .max_lod(0.0);
         // SAFETY: valid create info.
         let raw = unsafe { ctx.device.create_sampler(&info, None) }.ctx("create sampler")?;
-        Ok(Sampler { ctx: ctx.clone(), raw })
+        Ok(Sampler {
+            ctx: ctx.clone(),
+            raw,
+        })
     }
 }
 

@@ -17,17 +17,28 @@ pub struct Profiler {
 impl Profiler {
     /// Room for `passes` timed passes.
     pub fn new(ctx: &Arc<Context>, passes: u32) -> GpuResult<Self> {
-        let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(passes * 2);
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(passes * 2);
         // SAFETY: valid create info.
         let pool = unsafe { ctx.device.create_query_pool(&info, None) }.ctx("create query pool")?;
-        Ok(Profiler { ctx: ctx.clone(), pool, names: Vec::new(), capacity: passes })
+        Ok(Profiler {
+            ctx: ctx.clone(),
+            pool,
+            names: Vec::new(),
+            capacity: passes,
+        })
     }
 
     /// Reset all queries (record at the start of a frame).
     pub fn reset(&mut self, cmd: vk::CommandBuffer) {
         self.names.clear();
         // SAFETY: recording; the range is within the pool.
-        unsafe { self.ctx.device.cmd_reset_query_pool(cmd, self.pool, 0, self.capacity * 2) };
+        unsafe {
+            self.ctx
+                .device
+                .cmd_reset_query_pool(cmd, self.pool, 0, self.capacity * 2)
+        };
     }
 
     /// Timestamp the start of pass `name`.
@@ -38,14 +49,30 @@ impl Profiler {
         let q = self.names.len() as u32 * 2;
         self.names.push(name.to_string());
         // SAFETY: recording; query was reset this frame.
-        unsafe { self.ctx.device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, self.pool, q) };
+        unsafe {
+            self.ctx.device.cmd_write_timestamp2(
+                cmd,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.pool,
+                q,
+            )
+        };
     }
 
     /// Timestamp the end of the pass begun last.
     pub fn end(&mut self, cmd: vk::CommandBuffer) {
-        let Some(n) = self.names.len().checked_sub(1) else { return };
+        let Some(n) = self.names.len().checked_sub(1) else {
+            return;
+        };
         // SAFETY: recording; query was reset this frame.
-        unsafe { self.ctx.device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, self.pool, n as u32 * 2 + 1) };
+        unsafe {
+            self.ctx.device.cmd_write_timestamp2(
+                cmd,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.pool,
+                n as u32 * 2 + 1,
+            )
+        };
     }
 
     /// `(pass, milliseconds)` after the frame completed.
@@ -57,9 +84,12 @@ impl Profiler {
         let mut data = vec![0u64; n * 2];
         // SAFETY: the frame's submission completed; WAIT makes the results available.
         unsafe {
-            self.ctx
-                .device
-                .get_query_pool_results(self.pool, 0, &mut data, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT)
+            self.ctx.device.get_query_pool_results(
+                self.pool,
+                0,
+                &mut data,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
         }
         .ctx("query results")?;
         let period = self.ctx.info.timestamp_period as f64;
@@ -67,7 +97,12 @@ impl Profiler {
             .names
             .iter()
             .enumerate()
-            .map(|(i, name)| (name.clone(), data[2 * i + 1].saturating_sub(data[2 * i]) as f64 * period / 1e6))
+            .map(|(i, name)| {
+                (
+                    name.clone(),
+                    data[2 * i + 1].saturating_sub(data[2 * i]) as f64 * period / 1e6,
+                )
+            })
             .collect())
     }
 }

@@ -7,8 +7,14 @@ use super::{GpuError, GpuResult};
 pub const SOURCES: &[(&str, &str)] = &[
     ("bindings.glsl", include_str!("../../glsl/bindings.glsl")),
     ("common.glsl", include_str!("../../glsl/common.glsl")),
-    ("hair_types.glsl", include_str!("../../glsl/hair_types.glsl")),
-    ("strand_eval.glsl", include_str!("../../glsl/strand_eval.glsl")),
+    (
+        "hair_types.glsl",
+        include_str!("../../glsl/hair_types.glsl"),
+    ),
+    (
+        "strand_eval.glsl",
+        include_str!("../../glsl/strand_eval.glsl"),
+    ),
     ("cull.comp", include_str!("../../glsl/cull.comp")),
     ("scan.comp", include_str!("../../glsl/scan.comp")),
     ("generate.comp", include_str!("../../glsl/generate.comp")),
@@ -30,17 +36,29 @@ pub fn compile(name: &str) -> GpuResult<Vec<u32>> {
         Some("frag") => shaderc::ShaderKind::Fragment,
         Some("task") => shaderc::ShaderKind::Task,
         Some("mesh") => shaderc::ShaderKind::Mesh,
-        _ => return Err(GpuError::Shader(format!("glsl/{name}: unknown shader stage"))),
+        _ => {
+            return Err(GpuError::Shader(format!(
+                "glsl/{name}: unknown shader stage"
+            )));
+        }
     };
-    let text = source(name).ok_or_else(|| GpuError::Shader(format!("glsl/{name}: not embedded")))?;
+    let text =
+        source(name).ok_or_else(|| GpuError::Shader(format!("glsl/{name}: not embedded")))?;
     let compiler = shaderc::Compiler::new().map_err(|e| GpuError::Shader(e.to_string()))?;
-    let mut options = shaderc::CompileOptions::new().map_err(|e| GpuError::Shader(e.to_string()))?;
-    options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_3 as u32);
+    let mut options =
+        shaderc::CompileOptions::new().map_err(|e| GpuError::Shader(e.to_string()))?;
+    options.set_target_env(
+        shaderc::TargetEnv::Vulkan,
+        shaderc::EnvVersion::Vulkan1_3 as u32,
+    );
     options.set_target_spirv(shaderc::SpirvVersion::V1_6);
     options.set_optimization_level(shaderc::OptimizationLevel::Performance);
     options.set_include_callback(|requested, _ty, _from, _depth| {
         source(requested)
-            .map(|content| shaderc::ResolvedInclude { resolved_name: requested.to_string(), content: content.to_string() })
+            .map(|content| shaderc::ResolvedInclude {
+                resolved_name: requested.to_string(),
+                content: content.to_string(),
+            })
             .ok_or_else(|| format!("include '{requested}' not found in glsl/"))
     });
     let artifact = compiler

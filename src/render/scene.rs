@@ -1,0 +1,183 @@
+//! Scene files (TOML): a camera, a light and any number of characters.
+//!
+//! ```toml
+//! size = [1280, 720]
+//! [camera]
+//! eye = [0.0, 0.1, 0.6]
+//! target = [0.0, -0.05, 0.0]
+//! fov_y_degrees = 40.0
+//! [light]
+//! direction = [0.3, 1.0, 0.5]      # toward the light
+//! [[character]]
+//! mesh = "hairmeshes/head_long.obj" # .obj (baked on load) or .hmb; relative to this file
+//! style = "hairmeshes/head_long.toml" # optional: default is the style beside the mesh / baked in
+//! translation = [0.0, 0.0, 0.0]
+//! rotation_y_degrees = 0.0
+//! scale = 1.0
+//! strands_per_bundle = 64
+//! verts_log2 = 5
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec3};
+use serde::Deserialize;
+
+use crate::baked_file;
+use crate::error::{HairError, Result};
+use crate::obj_io::load_hair_mesh_obj;
+use crate::style::HairStyle;
+use crate::{BakeOptions, BakedHairMesh, bake};
+
+/// Camera block of a scene file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Eye position.
+    pub eye: [f32; 3],
+    /// Target position.
+    pub target: [f32; 3],
+    /// Vertical field of view in degrees.
+    #[serde(default = "default_fov")]
+    pub fov_y_degrees: f32,
+}
+
+fn default_fov() -> f32 {
+    40.0
+}
+
+/// Light block of a scene file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightDesc {
+    /// Direction toward the light.
+    pub direction: [f32; 3],
+}
+
+/// One character.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CharacterDesc {
+    /// Hair mesh `.obj` or baked `.hmb`.
+    pub mesh: PathBuf,
+    /// Style TOML overriding the baked/beside style.
+    pub style: Option<PathBuf>,
+    /// World translation.
+    #[serde(default)]
+    pub translation: [f32; 3],
+    /// Rotation about +Y in degrees.
+    #[serde(default)]
+    pub rotation_y_degrees: f32,
+    /// Uniform scale.
+    #[serde(default = "one")]
+    pub scale: f32,
+    /// Strands per average bundle.
+    #[serde(default = "default_strands")]
+    pub strands_per_bundle: u32,
+    /// Vertices per strand are `2^verts_log2 + 1`.
+    #[serde(default = "default_verts")]
+    pub verts_log2: u32,
+}
+
+fn one() -> f32 {
+    1.0
+}
+fn default_strands() -> u32 {
+    64
+}
+fn default_verts() -> u32 {
+    5
+}
+
+/// A scene file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    /// Image size.
+    pub size: Option<[u32; 2]>,
+    /// Camera (default: frame all characters).
+    pub camera: Option<CameraDesc>,
+    /// Light (default: from above-front).
+    pub light: Option<LightDesc>,
+    /// Characters.
+    #[serde(rename = "character")]
+    pub characters: Vec<CharacterDesc>,
+}
+
+impl SceneDesc {
+    /// Load and validate a scene file; relative paths are resolved against its folder.
+    pub fn load(path: &Path) -> Result<Self> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| HairError::io(path, e))?;
+        let mut scene: SceneDesc = toml::from_str(&text)
+            .map_err(|e| HairError::invalid(&name, format!("bad scene: {}", e.message())))?;
+        if scene.characters.is_empty() {
+            return Err(HairError::invalid(&name, "scene has no [[character]]"));
+        }
+        let base = path.parent().unwrap_or(Path::new("."));
+        for (i, c) in scene.characters.iter_mut().enumerate() {
+            let finite = c
+                .translation
+                .iter()
+                .chain([&c.rotation_y_degrees, &c.scale])
+                .all(|x| x.is_finite());
+            if !finite || c.scale <= 0.0 {
+                return Err(HairError::invalid(
+                    &name,
+                    format!("character {i}: non-finite transform or scale <= 0"),
+                ));
+            }
+            if c.strands_per_bundle == 0 || c.strands_per_bundle > 4096 || c.verts_log2 > 8 {
+                return Err(HairError::invalid(
+                    &name,
+                    format!(
+                        "character {i}: strands_per_bundle must be 1..=4096 and verts_log2 <= 8"
+                    ),
+                ));
+            }
+            if c.mesh.is_relative() {
+                c.mesh = base.join(&c.mesh);
+            }
+            if let Some(s) = &mut c.style {
+                if s.is_relative() {
+                    *s = base.join(&*s);
+                }
+            }
+        }
+        Ok(scene)
+    }
+}
+
+impl CharacterDesc {
+    /// Object-to-world transform.
+    pub fn model(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(self.scale),
+            Quat::from_rotation_y(self.rotation_y_degrees.to_radians()),
+            Vec3::from(self.translation),
+        )
+    }
+}
+
+/// Load a mesh (`.obj` is baked on load, anything else is read as a baked file) and its style:
+/// `style` if given, else the `.toml` beside an OBJ, else the style stored in the bake.
+pub fn load_mesh(mesh: &Path, style: Option<&Path>) -> Result<(BakedHairMesh, HairStyle)> {
+    let is_obj = mesh
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    let baked = if is_obj {
+        let m = load_hair_mesh_obj(mesh)?;
+        let s = match HairStyle::beside(mesh) {
+            Some(p) => HairStyle::load(&p)?,
+            None => HairStyle::default(),
+        };
+        bake(&m, &s, BakeOptions::default(), |_, _| {})?
+    } else {
+        baked_file::load(mesh)?
+    };
+    let style = match style {
+        Some(p) => HairStyle::load(p)?,
+        None => baked.style,
+    };
+    Ok((baked, style))
+}

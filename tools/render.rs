@@ -1,0 +1,214 @@
+//! `render`: headless render of hair meshes to PNG, printing GPU time per pass.
+//!
+//! ```text
+//! render --mesh hairmeshes/head_long.obj --size 1280x720 --strands-per-bundle 64 -o out.png
+//! render --scene scene.toml -o out.png
+//! ```
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result, bail};
+use clap::Parser;
+use glam::{Mat4, Vec3};
+use hairmesh::render::scene::{SceneDesc, load_mesh};
+use hairmesh::render::{Camera, HairGpu, Renderer, StrandParams};
+use hairmesh::vk::{Context, ContextDesc};
+
+/// Render hair generated on the GPU from hair-mesh textures.
+#[derive(Parser)]
+#[command(version, about)]
+struct Args {
+    /// Hair mesh (.obj, baked on load) or baked file (.hmb).
+    #[arg(long, conflicts_with = "scene")]
+    mesh: Option<PathBuf>,
+    /// Style TOML (overrides the style beside the mesh / in the bake).
+    #[arg(long)]
+    style: Option<PathBuf>,
+    /// Scene TOML with several characters (see src/render/scene.rs).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Camera as `eye_x,eye_y,eye_z:target_x,target_y,target_z` (default: frame the mesh).
+    #[arg(long)]
+    camera: Option<String>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 40.0)]
+    fov: f32,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720")]
+    size: String,
+    /// Strands per average bundle.
+    #[arg(long, default_value_t = 64)]
+    strands_per_bundle: u32,
+    /// Vertices per strand are 2^e + 1.
+    #[arg(long, default_value_t = 5)]
+    verts_log2: u32,
+    /// Choose the GPU by name substring (default: discrete, else integrated, else lavapipe).
+    #[arg(long)]
+    device: Option<String>,
+    /// Enable Vulkan validation layers.
+    #[arg(long)]
+    validation: bool,
+    /// Output PNG.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("bad vector '{s}'"))?;
+    if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
+        bail!("bad vector '{s}': expected x,y,z");
+    }
+    Ok(Vec3::new(v[0], v[1], v[2]))
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let (w, h) = s
+        .split_once('x')
+        .with_context(|| format!("bad size '{s}': expected WIDTHxHEIGHT"))?;
+    let (w, h): (u32, u32) = (w.parse()?, h.parse()?);
+    if w == 0 || h == 0 || w > 8192 || h > 8192 {
+        bail!("bad size '{s}': 1..=8192 per side");
+    }
+    Ok((w, h))
+}
+
+fn run(args: Args) -> Result<()> {
+    let (mut width, mut height) = parse_size(&args.size)?;
+    // Load and validate every input before touching the GPU.
+    struct Character {
+        baked: hairmesh::BakedHairMesh,
+        style: hairmesh::HairStyle,
+        params: StrandParams,
+        model: Mat4,
+    }
+    let mut characters = Vec::new();
+    let mut scene_camera = None;
+    let mut light = Vec3::new(0.4, 1.0, 0.6);
+    if let Some(scene_path) = &args.scene {
+        let scene = SceneDesc::load(scene_path)?;
+        if let Some([w, h]) = scene.size {
+            (width, height) = parse_size(&format!("{w}x{h}"))?;
+        }
+        if let Some(c) = &scene.camera {
+            scene_camera = Some(Camera::look_at(
+                Vec3::from(c.eye),
+                Vec3::from(c.target),
+                c.fov_y_degrees,
+            ));
+        }
+        if let Some(l) = &scene.light {
+            light = Vec3::from(l.direction);
+        }
+        for c in &scene.characters {
+            let (baked, style) = load_mesh(&c.mesh, c.style.as_deref())?;
+            characters.push(Character {
+                baked,
+                style,
+                params: StrandParams {
+                    strands_per_bundle: c.strands_per_bundle,
+                    verts_log2: c.verts_log2,
+                },
+                model: c.model(),
+            });
+        }
+    } else {
+        let Some(mesh) = &args.mesh else {
+            bail!("give --mesh or --scene")
+        };
+        let (baked, style) = load_mesh(mesh, args.style.as_deref())?;
+        characters.push(Character {
+            baked,
+            style,
+            params: StrandParams {
+                strands_per_bundle: args.strands_per_bundle,
+                verts_log2: args.verts_log2,
+            },
+            model: Mat4::IDENTITY,
+        });
+    }
+    let camera = match (&args.camera, scene_camera) {
+        (Some(c), _) => {
+            let (eye, target) = c
+                .split_once(':')
+                .with_context(|| format!("bad camera '{c}': expected eye:target"))?;
+            Camera::look_at(parse_vec3(eye)?, parse_vec3(target)?, args.fov)
+        }
+        (None, Some(c)) => c,
+        (None, None) => {
+            let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+            for c in &characters {
+                let o = Vec3::from_slice(&c.baked.info.pos_origin[..3]);
+                let e = Vec3::from_slice(&c.baked.info.pos_extent[..3]);
+                for corner in [o, o + e] {
+                    let p = c.model.transform_point3(corner);
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            Camera::framing(lo, hi, Vec3::new(0.7, 0.35, -1.0), args.fov)
+        }
+    };
+
+    let start = Instant::now();
+    let ctx = Arc::new(Context::new(
+        &ContextDesc::default()
+            .validation(args.validation)
+            .device(args.device.clone()),
+    )?);
+    let mut renderer = Renderer::new(&ctx)?;
+    let hairs: Vec<HairGpu> = characters
+        .iter()
+        .map(|c| {
+            HairGpu::new(
+                &ctx,
+                &renderer.sampler,
+                &c.baked,
+                &c.style,
+                c.params,
+                c.model,
+            )
+        })
+        .collect::<Result<_, _>>()?;
+    let out = renderer.render(&hairs, &camera, light, width, height)?;
+    let wall = start.elapsed().as_secs_f64();
+    let img = image::RgbaImage::from_raw(width, height, out.rgba).context("image size mismatch")?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    hairmesh::fsutil::write_atomic(&args.output, &png)?;
+    println!("device: {} ({})", ctx.info.name, ctx.info.driver);
+    println!(
+        "{} character(s), {} strands x {} vertices, {} strand triangles, {}x{}",
+        hairs.len(),
+        out.strands,
+        (1u32 << args.verts_log2) + 1,
+        out.triangles,
+        width,
+        height
+    );
+    for (pass, ms) in &out.pass_ms {
+        println!("  gpu {pass:<10} {ms:9.3} ms");
+    }
+    println!(
+        "  total gpu  {:9.3} ms; wall (incl. setup, shader compile) {:.2} s",
+        out.pass_ms.iter().map(|p| p.1).sum::<f64>(),
+        wall
+    );
+    if ctx.validation_errors() > 0 {
+        bail!("{} Vulkan validation error(s)", ctx.validation_errors());
+    }
+    println!("wrote {}", args.output.display());
+    Ok(())
+}
+
+fn main() {
+    if let Err(e) = run(Args::parse()) {
+        eprintln!("render: {e:#}");
+        std::process::exit(1);
+    }
+}
