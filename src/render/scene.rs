@@ -138,10 +138,10 @@ impl SceneDesc {
             if c.mesh.is_relative() {
                 c.mesh = base.join(&c.mesh);
             }
-            if let Some(s) = &mut c.style {
-                if s.is_relative() {
-                    *s = base.join(&*s);
-                }
+            if let Some(s) = &mut c.style
+                && s.is_relative()
+            {
+                *s = base.join(&*s);
             }
         }
         Ok(scene)

@@ -167,8 +167,7 @@ impl Context {
         } else {
             None
         };
-        let result = Self::create_device(entry, instance, debug, debug_state, desc);
-        result
+        Self::create_device(entry, instance, debug, debug_state, desc)
     }
 
     fn create_device(
@@ -192,10 +191,10 @@ impl Context {
             if props.api_version < vk::API_VERSION_1_3 {
                 continue;
             }
-            if let Some(want) = &desc.device {
-                if !name.to_lowercase().contains(&want.to_lowercase()) {
-                    continue;
-                }
+            if let Some(want) = &desc.device
+                && !name.to_lowercase().contains(&want.to_lowercase())
+            {
+                continue;
             }
             let rank = match props.device_type {
                 vk::PhysicalDeviceType::DISCRETE_GPU => 0,
@@ -208,6 +207,7 @@ impl Context {
         }
         candidates.sort_by_key(|c| c.0);
         let Some((_, physical, name)) = candidates.into_iter().next() else {
+            destroy_instance(&instance, debug);
             return Err(GpuError::Unsupported(match &desc.device {
                 Some(d) => format!("no Vulkan 1.3 device matches '{d}'"),
                 None => "no Vulkan 1.3 device found (run tools/setup.sh for lavapipe)".into(),
@@ -464,6 +464,17 @@ impl Context {
             vk::FormatFeatureFlags::SAMPLED_IMAGE
                 | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
         )
+    }
+}
+
+/// Destroy an instance (and its messenger) when device creation fails half-way.
+fn destroy_instance(instance: &ash::Instance, debug: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>) {
+    // SAFETY: no device was created from this instance.
+    unsafe {
+        if let Some((loader, messenger)) = debug {
+            loader.destroy_debug_utils_messenger(messenger, None);
+        }
+        instance.destroy_instance(None);
     }
 }
 

@@ -1,0 +1,88 @@
+//! Shared helpers of the GPU tests. Every GPU test runs with validation layers on and fails on
+//! any validation error. There is no skipping: without Vulkan the tests fail loudly (run
+//! `tools/setup.sh` for lavapipe).
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+use hairmesh::render::scene::load_mesh;
+use hairmesh::render::{Camera, HairGpu, RenderOutput, Renderer, StrandParams};
+use hairmesh::vk::{Context, ContextDesc};
+use hairmesh::{BakedHairMesh, HairStyle};
+
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+pub fn context() -> Arc<Context> {
+    match Context::new(&ContextDesc::default().validation(true)) {
+        Ok(c) => Arc::new(c),
+        Err(e) => panic!("GPU tests need Vulkan with validation layers (run tools/setup.sh): {e}"),
+    }
+}
+
+pub fn assert_no_validation_errors(ctx: &Context) {
+    assert_eq!(
+        ctx.validation_errors(),
+        0,
+        "validation errors: {:#?}",
+        ctx.validation_messages()
+    );
+}
+
+pub fn sample(name: &str) -> (BakedHairMesh, HairStyle) {
+    load_mesh(&root().join("hairmeshes").join(name), None).unwrap()
+}
+
+/// Camera framing the mesh from a fixed 3/4 back view.
+pub fn framing(baked: &BakedHairMesh) -> Camera {
+    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+    let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
+    Camera::framing(o, o + e, Vec3::new(0.7, 0.35, -1.0), 40.0)
+}
+
+pub fn light() -> Vec3 {
+    Vec3::new(0.4, 1.0, 0.6)
+}
+
+/// Render one sample mesh.
+pub fn render_sample(
+    ctx: &Arc<Context>,
+    name: &str,
+    n: u32,
+    e: u32,
+    size: u32,
+    camera: Option<Camera>,
+) -> RenderOutput {
+    let (baked, style) = sample(name);
+    let mut r = Renderer::new(ctx).unwrap();
+    let hair = HairGpu::new(
+        ctx,
+        &r.sampler,
+        &baked,
+        &style,
+        StrandParams {
+            strands_per_bundle: n,
+            verts_log2: e,
+        },
+        Mat4::IDENTITY,
+    )
+    .unwrap();
+    let cam = camera.unwrap_or_else(|| framing(&baked));
+    r.render(&[hair], &cam, light(), size, size).unwrap()
+}
+
+pub fn output_dir() -> PathBuf {
+    let d = root().join("tests").join("output");
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+pub fn save_png(path: &Path, w: u32, h: u32, rgba: &[u8]) {
+    image::RgbaImage::from_raw(w, h, rgba.to_vec())
+        .unwrap()
+        .save(path)
+        .unwrap();
+}

@@ -1,0 +1,97 @@
+//! The GPU compute path generates the same strands as the CPU reference generator.
+
+mod common;
+
+use common::*;
+use glam::{Mat4, Vec3};
+use hairmesh::CpuGenerator;
+use hairmesh::render::{HairGpu, Renderer, StrandParams};
+
+#[test]
+fn gpu_strands_match_cpu_oracle() {
+    let ctx = context();
+    for (name, n, e) in [
+        ("small_patch.obj", 16, 4),
+        ("triangle_tuft.obj", 8, 5),
+        ("head_long.obj", 4, 5),
+        ("sphere_fur.obj", 4, 3),
+    ] {
+        let (baked, style) = sample(name);
+        let mut r = Renderer::new(&ctx).unwrap();
+        let hair = HairGpu::new(
+            &ctx,
+            &r.sampler,
+            &baked,
+            &style,
+            StrandParams {
+                strands_per_bundle: n,
+                verts_log2: e,
+            },
+            Mat4::IDENTITY,
+        )
+        .unwrap();
+        // Far camera: every bundle is inside the frustum, nothing is culled.
+        let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+        let ext = Vec3::from_slice(&baked.info.pos_extent[..3]);
+        let cam = hairmesh::render::Camera::framing(o, o + ext, Vec3::new(0.3, 0.5, 1.0), 60.0);
+        r.render(std::slice::from_ref(&hair), &cam, light(), 64, 64)
+            .unwrap();
+        let (gpu, strands) = r.read_vertices(&hair).unwrap();
+        let cpu = CpuGenerator::new(&baked, style).generate(n, e);
+        assert_eq!(strands as usize, cpu.strand_count(), "{name}: strand count");
+        assert_eq!(gpu.len(), cpu.positions.len(), "{name}: vertex count");
+        // Tolerance: lavapipe (like GPU texture units) filters with fixed-point weights
+        // (8 bits of sub-texel precision), so a lerp between two texels can be off by up to
+        // |a - b| / 512; between slices of the hair mesh texture |a - b| is at most a layer step.
+        // Add sin/cos/pow differences of the styling (~1e-6 relative). 2e-3 of the model size
+        // bounds both with margin on every sample mesh while catching any real divergence
+        // (a wrong root sample or slice moves vertices by a bundle or layer, 1e-2 and more).
+        let tol = ext.length() * 2e-3;
+        let mut worst = 0.0f32;
+        let mut worst_t = 0.0f32;
+        for (i, v) in gpu.iter().enumerate() {
+            let p = Vec3::new(v[0], v[1], v[2]);
+            worst = worst.max(p.distance(cpu.positions[i]));
+            let t = Vec3::new(v[4], v[5], v[6]);
+            worst_t = worst_t.max(1.0 - t.dot(cpu.tangents[i]));
+            assert!(
+                (v[3] - cpu.widths[i]).abs() <= 1e-6 + 1e-4 * cpu.widths[i],
+                "{name}: width {i}"
+            );
+        }
+        println!(
+            "{name}: worst position error {worst:e} (tol {tol:e}), worst tangent 1-cos {worst_t:e}"
+        );
+        assert!(
+            worst <= tol,
+            "{name}: GPU vertex off the oracle by {worst} > {tol}"
+        );
+        assert!(
+            worst_t < 1e-2,
+            "{name}: tangents differ (1 - cos = {worst_t})"
+        );
+    }
+    assert_no_validation_errors(&ctx);
+}
+
+#[test]
+fn bundles_outside_the_frustum_generate_nothing() {
+    let ctx = context();
+    let (baked, _) = sample("small_patch.obj");
+    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+    // Look away from the mesh.
+    let cam = hairmesh::render::Camera::look_at(
+        o + Vec3::new(0.0, 0.0, 5.0),
+        o + Vec3::new(0.0, 0.0, 10.0),
+        40.0,
+    );
+    let out = render_sample(&ctx, "small_patch.obj", 16, 4, 32, Some(cam));
+    assert_eq!(out.strands, 0);
+    let full = render_sample(&ctx, "small_patch.obj", 16, 4, 32, None);
+    assert!(
+        full.strands >= 25 * 16 / 2,
+        "visible mesh generates strands ({})",
+        full.strands
+    );
+    assert_no_validation_errors(&ctx);
+}

@@ -1,0 +1,101 @@
+//! The `render` tool: scene files work; bad input fails before any GPU work with one line
+//! naming the file, exit code 1 and no output image.
+
+use std::process::Command;
+
+fn render(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_render"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn renders_a_scene_file_with_two_characters() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    let root = env!("CARGO_MANIFEST_DIR");
+    std::fs::write(
+        &scene,
+        format!(
+            "size = [96, 64]\n[camera]\neye = [0.0, 0.1, -0.9]\ntarget = [0.0, -0.05, 0.0]\n\
+             [[character]]\nmesh = \"{root}/hairmeshes/head_long.obj\"\ntranslation = [-0.15, 0.0, 0.0]\nstrands_per_bundle = 8\n\
+             [[character]]\nmesh = \"{root}/hairmeshes/sphere_fur.obj\"\ntranslation = [0.2, 0.0, 0.0]\nscale = 0.2\nstrands_per_bundle = 8\nverts_log2 = 3\n"
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("scene.png");
+    let o = render(&[
+        "--scene",
+        scene.to_str().unwrap(),
+        "--validation",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{}\n{}",
+        stdout,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        stdout.contains("2 character(s)") && stdout.contains("gpu generate"),
+        "{stdout}"
+    );
+    let img = image::open(&out).unwrap();
+    assert_eq!((img.width(), img.height()), (96, 64));
+}
+
+#[test]
+fn bad_inputs_fail_before_the_gpu() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad_mesh = dir.path().join("bad.obj");
+    std::fs::write(&bad_mesh, "v 0 0 0\ng layer0\nf 1 1 1\n").unwrap();
+    let bad_scene = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad_scene,
+        "[[character]]\nmesh = \"x.obj\"\nscale = -1.0\n",
+    )
+    .unwrap();
+    let bad_hmb = dir.path().join("bad.hmb");
+    std::fs::write(&bad_hmb, b"HAIRMESH\x01\x00\x00\x00").unwrap();
+    let out = dir.path().join("never.png");
+    let o = out.to_str().unwrap();
+    for (args, names) in [
+        (
+            vec!["--mesh", bad_mesh.to_str().unwrap(), "-o", o],
+            bad_mesh.to_str().unwrap(),
+        ),
+        (
+            vec!["--scene", bad_scene.to_str().unwrap(), "-o", o],
+            bad_scene.to_str().unwrap(),
+        ),
+        (
+            vec!["--mesh", bad_hmb.to_str().unwrap(), "-o", o],
+            bad_hmb.to_str().unwrap(),
+        ),
+        (
+            vec![
+                "--mesh",
+                bad_hmb.to_str().unwrap(),
+                "--size",
+                "0x5",
+                "-o",
+                o,
+            ],
+            "bad size",
+        ),
+    ] {
+        let r = render(&args);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert!(err.contains(names), "{err}");
+        assert!(
+            !err.contains("device:") && String::from_utf8_lossy(&r.stdout).is_empty(),
+            "no GPU work: {err}"
+        );
+        assert!(!out.exists());
+    }
+}

@@ -1,0 +1,24 @@
+//! Every shader in glsl/ is embedded and compiles.
+
+use hairmesh::vk::shader::{SOURCES, compile};
+
+#[test]
+fn every_glsl_file_is_embedded_and_compiles() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/glsl");
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        assert!(
+            SOURCES.iter().any(|(n, _)| *n == name),
+            "glsl/{name} is not listed in src/vk/shader.rs SOURCES"
+        );
+        if !name.ends_with(".glsl") {
+            compile(&name).unwrap_or_else(|e| panic!("{e}"));
+        }
+    }
+}
+
+#[test]
+fn unknown_shader_is_an_error_naming_it() {
+    let e = compile("nope.comp").unwrap_err().to_string();
+    assert!(e.contains("glsl/nope.comp"), "{e}");
+}
