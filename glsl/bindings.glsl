@@ -10,8 +10,10 @@ layout(set = 0, binding = 0, std140) uniform Frame {
     vec4 camera_pos;      // xyz, w: vertical resolution in pixels
     vec4 light_dir;       // xyz towards the light, w: 1 / tan(fov_y / 2) (0: orthographic)
     vec4 viewport;        // width, height, 1/width, 1/height
-    uvec4 params;         // x: strands per bundle N, y: vertex level e (2^e segments), z: bundle count, w: unused
+    uvec4 params;         // x: strands per bundle N, y: full vertex level e (2^e segments), z: bundle count, w: LoD on
     vec4 planes[6];       // frustum planes (xyz normal, w offset), inside when dot >= 0
+    vec4 lod;             // x: alpha strands, y: alpha vertices, z: lambda, w: tan(fov_y) (0: orthographic, see lod_ortho)
+    vec4 lod_ortho;       // x: view height for orthographic views (eq. 7 orthographic form), yzw unused
 } frame;
 
 layout(set = 0, binding = 1, std430) readonly buffer MeshBuf {
@@ -27,9 +29,10 @@ layout(set = 0, binding = 7) uniform sampler3D tex_v;
 // Root samples: [0, 4096) quad set, [4096, 8192) triangle set.
 layout(set = 0, binding = 8, std430) readonly buffer RootSamples { vec2 root_samples[]; };
 
-// Per-bundle strand counts and their exclusive prefix sum (pass 1 -> pass 2 and draw).
-layout(set = 0, binding = 9, std430) buffer Counts { uint bundle_strands[]; };
-layout(set = 0, binding = 10, std430) buffer Offsets { uint bundle_offsets[]; };
+// Per-bundle LoD decision (x: strands, y: vertex level e, z: gamma bits, w: thickness bits) and
+// exclusive prefix sums (x: first strand, y: first vertex slot, z: first draw vertex).
+layout(set = 0, binding = 9, std430) buffer Counts { uvec4 bundle_lods[]; };
+layout(set = 0, binding = 10, std430) buffer Offsets { uvec4 bundle_offsets[]; };
 // Indirect arguments: VkDispatchIndirectCommand then VkDrawIndirectCommand.
 layout(set = 0, binding = 11, std430) buffer Indirect {
     uint dispatch_x;
@@ -40,6 +43,10 @@ layout(set = 0, binding = 11, std430) buffer Indirect {
     uint draw_instance_count;
     uint draw_first_vertex;
     uint draw_first_instance;
+    uint total_triangles;   // strand triangles generated (both paths)
+    uint total_vertex_slots;
+    uint pad0;
+    uint pad1;
 } indirect;
 
 // Generated strand vertices (compute path): position + width, tangent + s.

@@ -405,6 +405,32 @@ impl CpuGenerator {
         strand_tangents(pos, tan);
     }
 
+    /// Generate with level of detail (paper sec. 3.6): per bundle the strand count, vertex level,
+    /// geomorph (eq. 11 + tangent morph) and thickness of [`crate::lod::bundle_lod`]. Strands are
+    /// bundle-major; `counts[i]` is the vertex count of strand `i`.
+    pub fn generate_lod(&self, n: u32, e_max: u32, baked: &BakedHairMesh, view: &crate::lod::LodView) -> (StrandSet, Vec<usize>) {
+        let mut set = StrandSet { verts_per_strand: 0, ..Default::default() };
+        let mut counts = Vec::new();
+        for (bundle, b) in self.tex.bundles.iter().enumerate() {
+            let lod = crate::lod::bundle_lod(baked, &self.style, bundle, strands_in_bundle(b, &self.style, n), e_max, view);
+            let segments = 1u32 << lod.e;
+            let verts = segments as usize + 1;
+            for strand in 0..lod.strands {
+                let mut p = vec![Vec3::ZERO; verts];
+                let mut t = vec![Vec3::ZERO; verts];
+                let mut w = vec![0.0; verts];
+                self.strand(bundle as u32, strand, segments, &mut p, &mut t, &mut w);
+                crate::lod::apply_geomorph(&mut p, &mut t, lod.gamma);
+                set.positions.extend(p);
+                set.tangents.extend(t);
+                set.widths.extend(w.iter().map(|x| x * lod.thickness));
+                set.strand_bundle.push(bundle as u32);
+                counts.push(verts);
+            }
+        }
+        (set, counts)
+    }
+
     /// Generate every strand with `n` strands per average bundle and `2^e + 1` vertices each.
     pub fn generate(&self, n: u32, e: u32) -> StrandSet {
         let segments = 1u32 << e;

@@ -132,3 +132,86 @@ mod tests {
         assert!(p[1].y.abs() < 1e-6 && p[3].y.abs() < 1e-6);
     }
 }
+
+/// The view a LoD decision is made for (mirrors the `Frame` fields `bundle_lod.glsl` reads).
+#[derive(Clone, Copy, Debug)]
+pub struct LodView {
+    /// Eye position (object space of the mesh; the CPU reference uses identity transforms).
+    pub eye: Vec3,
+    /// Vertical resolution `R` in pixels.
+    pub resolution: f32,
+    /// `tan(theta)` of eq. 7 with `theta` the vertical field of view.
+    pub tan_fov: f32,
+    /// Alpha for strand LoD.
+    pub alpha_strands: f32,
+    /// Alpha for vertex LoD.
+    pub alpha_verts: f32,
+    /// Geomorph window lambda.
+    pub lambda: f32,
+}
+
+/// One bundle's LoD decision (GLSL: `BundleLod`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BundleLod {
+    /// Strands generated (eq. 8).
+    pub strands: u32,
+    /// Vertex level: `2^e` segments (eq. 9).
+    pub e: u32,
+    /// Geomorph factor toward level `e - 1` (eq. 12); 0 for none.
+    pub gamma: f32,
+    /// Width factor `min(1/L, N)`.
+    pub thickness: f32,
+}
+
+/// Per-bundle random increment `delta_i` of eq. 8 (GLSL: in `bundle_lod`).
+pub fn bundle_delta(bundle: u32, seed: u32) -> f32 {
+    use crate::rng::{hash_f32, hash_u32};
+    hash_f32(hash_u32(bundle ^ 0x2545_f491) ^ seed)
+}
+
+/// Bounds of bundle `b`: its Bezier control points (decoded texels) grown by `margin`.
+pub fn bundle_bounds(baked: &crate::BakedHairMesh, b: usize, margin: f32) -> (Vec3, Vec3) {
+    let info = &baked.info;
+    let [w, _] = info.root_size;
+    let o = Vec3::from_slice(&info.pos_origin[..3]);
+    let e = Vec3::from_slice(&info.pos_extent[..3]);
+    let [x0, y0] = baked.bundles[b].origin;
+    let mut lo = Vec3::splat(f32::MAX);
+    let mut hi = Vec3::splat(f32::MIN);
+    for z in 0..info.position_depth() as usize {
+        for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let t = baked.position[z * info.slice_texels() + ((y0 + dy) * w + x0 + dx) as usize];
+            let p = o + e * Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 65535.0;
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    (lo - margin, hi + margin)
+}
+
+/// LoD decision of bundle `b` with `n` strands before LoD and full vertex level `e_max`
+/// (culling not included): eq. 7-10 and 12, the CPU twin of `bundle_lod.glsl`.
+pub fn bundle_lod(baked: &crate::BakedHairMesh, style: &crate::HairStyle, b: usize, n: u32, e_max: u32, view: &LodView) -> BundleLod {
+    let margin = style.curl_radius + style.wave_amplitude + style.frizz_amplitude + style.strand_width;
+    let (lo, hi) = bundle_bounds(baked, b, margin);
+    let d = view.eye.distance(view.eye.clamp(lo, hi));
+    let h = baked.bundles[b].rest_size;
+    let level = |alpha: f32| (h * view.resolution * alpha / (d.max(1e-6) * view.tan_fov)).clamp(0.0, 1.0);
+    let ls = level(view.alpha_strands);
+    let strands = if ls > 0.0 {
+        ((ls * (n as f32 + bundle_delta(b as u32, style.seed))).ceil() as u32).clamp(1, n)
+    } else {
+        0
+    };
+    let lv = level(view.alpha_verts);
+    let x = (lv * (1u32 << e_max) as f32).max(1e-30).log2();
+    let e = x.ceil().clamp(0.0, e_max as f32) as u32;
+    let lambda = view.lambda.clamp(1e-6, 1.0);
+    let e_next = (x - lambda).ceil().max(0.0);
+    let gamma = if e as f32 > e_next && e > 0 {
+        (1.0 - (x - e_next) / lambda).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    BundleLod { strands, e, gamma, thickness: (1.0 / ls.max(1e-6)).min(n as f32) }
+}

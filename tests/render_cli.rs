@@ -40,7 +40,7 @@ fn renders_a_scene_file_with_two_characters() {
         String::from_utf8_lossy(&o.stderr)
     );
     assert!(
-        stdout.contains("2 character(s)") && stdout.contains("gpu generate"),
+        stdout.contains("2 character(s)") && stdout.contains("strand triangles"),
         "{stdout}"
     );
     let img = image::open(&out).unwrap();

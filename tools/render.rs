@@ -13,7 +13,7 @@ use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::{Mat4, Vec3};
 use hairmesh::render::scene::{SceneDesc, load_mesh};
-use hairmesh::render::{Camera, HairGpu, Renderer, StrandParams};
+use hairmesh::render::{Camera, HairGpu, LodSettings, RenderPath, RenderSettings, Renderer, StrandParams};
 use hairmesh::vk::{Context, ContextDesc};
 
 /// Render hair generated on the GPU from hair-mesh textures.
@@ -47,6 +47,22 @@ struct Args {
     /// Choose the GPU by name substring (default: discrete, else integrated, else lavapipe).
     #[arg(long)]
     device: Option<String>,
+    /// Generation path: mesh (task + mesh shaders) or compute (compute + vertex pulling);
+    /// default: mesh where the device supports it.
+    #[arg(long, value_parser = ["mesh", "compute"])]
+    path: Option<String>,
+    /// Level of detail (paper sec. 3.6).
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    lod: String,
+    /// Alpha of eq. 7 for strand LoD.
+    #[arg(long, default_value_t = 0.1)]
+    lod_alpha_strands: f32,
+    /// Alpha of eq. 7 for vertex LoD.
+    #[arg(long, default_value_t = 0.1)]
+    lod_alpha_verts: f32,
+    /// Geomorph window lambda of eq. 10-12, in (0, 1].
+    #[arg(long, default_value_t = 0.5)]
+    lod_lambda: f32,
     /// Enable Vulkan validation layers.
     #[arg(long)]
     validation: bool,
@@ -80,6 +96,22 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
 
 fn run(args: Args) -> Result<()> {
     let (mut width, mut height) = parse_size(&args.size)?;
+    let lod = LodSettings {
+        enabled: args.lod == "on",
+        alpha_strands: args.lod_alpha_strands,
+        alpha_verts: args.lod_alpha_verts,
+        lambda: args.lod_lambda,
+    };
+    if !(lod.alpha_strands > 0.0 && lod.alpha_verts > 0.0 && lod.alpha_strands.is_finite() && lod.alpha_verts.is_finite()) {
+        bail!("LoD alphas must be positive and finite");
+    }
+    if !(lod.lambda > 0.0 && lod.lambda <= 1.0) {
+        bail!("--lod-lambda must be in (0, 1]");
+    }
+    let settings = RenderSettings {
+        path: args.path.as_deref().map(|p| if p == "mesh" { RenderPath::Mesh } else { RenderPath::Compute }),
+        lod,
+    };
     // Load and validate every input before touching the GPU.
     struct Character {
         baked: hairmesh::BakedHairMesh,
@@ -175,7 +207,7 @@ fn run(args: Args) -> Result<()> {
             )
         })
         .collect::<Result<_, _>>()?;
-    let out = renderer.render(&hairs, &camera, light, width, height)?;
+    let out = renderer.render(&hairs, &camera, light, width, height, &settings)?;
     let wall = start.elapsed().as_secs_f64();
     let img = image::RgbaImage::from_raw(width, height, out.rgba).context("image size mismatch")?;
     let mut png = Vec::new();
@@ -183,7 +215,9 @@ fn run(args: Args) -> Result<()> {
     hairmesh::fsutil::write_atomic(&args.output, &png)?;
     println!("device: {} ({})", ctx.info.name, ctx.info.driver);
     println!(
-        "{} character(s), {} strands x {} vertices, {} strand triangles, {}x{}",
+        "{:?} path, LoD {}, {} character(s), {} strands (up to {} vertices each), {} strand triangles, {}x{}",
+        out.path,
+        args.lod,
         hairs.len(),
         out.strands,
         (1u32 << args.verts_log2) + 1,

@@ -70,7 +70,33 @@ impl Camera {
     }
 }
 
-/// Per-frame uniform block; mirrors `Frame` in `glsl/bindings.glsl` (std140, 224 bytes).
+/// Level-of-detail settings (paper 003 sec. 3.6): separate alphas for strands and vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LodSettings {
+    /// LoD on; off renders every bundle at full detail.
+    pub enabled: bool,
+    /// Alpha of eq. 7 for strand LoD.
+    pub alpha_strands: f32,
+    /// Alpha of eq. 7 for vertex LoD.
+    pub alpha_verts: f32,
+    /// Geomorph transition window lambda of eq. 10-12, in `(0, 1]`.
+    pub lambda: f32,
+}
+
+impl Default for LodSettings {
+    fn default() -> Self {
+        LodSettings { enabled: true, alpha_strands: 0.1, alpha_verts: 0.1, lambda: 0.5 }
+    }
+}
+
+impl LodSettings {
+    /// Every bundle at full detail.
+    pub fn off() -> Self {
+        LodSettings { enabled: false, ..Default::default() }
+    }
+}
+
+/// Per-frame uniform block; mirrors `Frame` in `glsl/bindings.glsl` (std140, 256 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct FrameParams {
@@ -86,6 +112,10 @@ pub struct FrameParams {
     pub params: [u32; 4],
     /// Frustum planes (inside where `dot(n, p) + d >= 0`).
     pub planes: [[f32; 4]; 6],
+    /// x alpha strands, y alpha vertices, z lambda, w `tan(fov_y)` of eq. 7.
+    pub lod: [f32; 4],
+    /// x view height of orthographic views (unused for perspective).
+    pub lod_ortho: [f32; 4],
 }
 
 /// Frustum planes of a Vulkan view-projection matrix (Gribb-Hartmann), normalised.
@@ -100,6 +130,7 @@ pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
 
 impl FrameParams {
     /// Fill the block for `camera` at `width x height`.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         camera: &Camera,
         light_dir: Vec3,
@@ -108,6 +139,7 @@ impl FrameParams {
         strands: u32,
         verts_log2: u32,
         bundles: u32,
+        lod: &LodSettings,
     ) -> Self {
         let vp = camera.view_proj(width as f32 / height as f32);
         FrameParams {
@@ -123,8 +155,10 @@ impl FrameParams {
                 1.0 / width as f32,
                 1.0 / height as f32,
             ],
-            params: [strands, verts_log2, bundles, 0],
+            params: [strands, verts_log2, bundles, lod.enabled as u32],
             planes: frustum_planes(vp),
+            lod: [lod.alpha_strands, lod.alpha_verts, lod.lambda, camera.fov_y.tan()],
+            lod_ortho: [0.0; 4],
         }
     }
 }
@@ -145,6 +179,6 @@ mod tests {
         assert!(inside(Vec3::ZERO));
         assert!(!inside(Vec3::new(0.0, 0.0, 10.0)), "behind the camera");
         assert!(!inside(Vec3::new(100.0, 0.0, 0.0)), "far to the side");
-        assert_eq!(size_of::<FrameParams>(), 224);
+        assert_eq!(size_of::<FrameParams>(), 256);
     }
 }

@@ -15,8 +15,12 @@ use crate::vk::descriptor::{Binding, DescriptorSet};
 use crate::vk::image::Sampler;
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult, Image, ImageDesc};
 
-/// Largest vertex level on the GPU path (`2^8 = 256` segments, `MAX_SEGMENTS` in generate.comp).
-pub const MAX_VERTS_LOG2: u32 = 8;
+/// Largest vertex level on the GPU paths (`2^6 = 64` segments = `MAX_SEGMENTS` = 2 vertices
+/// per thread of a 32-thread workgroup in strand_build.glsl).
+pub const MAX_VERTS_LOG2: u32 = 6;
+
+/// Bytes of the `Indirect` block of bindings.glsl.
+pub const INDIRECT_BYTES: u64 = 48;
 
 /// Bytes of one generated vertex (`HairVertex` in bindings.glsl).
 pub const HAIR_VERTEX_BYTES: u64 = 32;
@@ -132,20 +136,21 @@ impl HairGpu {
         let bundle_count = baked.bundles.len() as u64;
         let counts = Buffer::new(
             ctx,
-            &BufferDesc::new("bundle strands", 4 * bundle_count, storage),
+            &BufferDesc::new("bundle lods", 16 * bundle_count, storage),
         )?;
         let offsets = Buffer::new(
             ctx,
-            &BufferDesc::new("bundle offsets", 4 * bundle_count, storage),
+            &BufferDesc::new("bundle offsets", 16 * bundle_count, storage),
         )?;
         let indirect = Buffer::new(
             ctx,
             &BufferDesc::new(
                 "indirect",
-                32,
+                INDIRECT_BYTES,
                 storage
                     | vk::BufferUsageFlags::INDIRECT_BUFFER
-                    | vk::BufferUsageFlags::TRANSFER_SRC,
+                    | vk::BufferUsageFlags::TRANSFER_SRC
+                    | vk::BufferUsageFlags::TRANSFER_DST,
             ),
         )?;
         let max_strands: u64 = baked

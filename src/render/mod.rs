@@ -11,4 +11,5 @@ pub mod scene;
 
 pub use frame::{Camera, FrameParams};
 pub use hair_gpu::{HairGpu, StrandParams};
-pub use renderer::{RenderOutput, Renderer};
+pub use frame::LodSettings;
+pub use renderer::{RenderOutput, RenderPath, RenderSettings, Renderer};

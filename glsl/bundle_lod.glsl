@@ -1,0 +1,82 @@
+// Per-bundle decisions shared by the compute path (cull.comp) and the task shader:
+// frustum culling and strand / vertex level of detail (paper 003 sec. 3.6, eq. 7-12).
+// CPU twin: src/lod.rs + src/generate.rs (bundle_lod_cpu). Requires bindings.glsl, common.glsl,
+// strand_eval.glsl.
+#ifndef BUNDLE_LOD_GLSL
+#define BUNDLE_LOD_GLSL
+
+struct BundleLod {
+    uint strands;     // eq. 8 (0 when culled)
+    uint e;           // eq. 9: 2^e segments
+    float gamma;      // eq. 12 geomorph factor toward level e - 1 (0: none)
+    float thickness;  // sec. 3.6.1 width factor min(1/L, N)
+};
+
+bool box_visible(vec3 lo, vec3 hi) {
+    for (int p = 0; p < 6; p++) {
+        vec4 pl = frame.planes[p];
+        vec3 c = vec3(pl.x >= 0.0 ? hi.x : lo.x, pl.y >= 0.0 ? hi.y : lo.y, pl.z >= 0.0 ? hi.z : lo.z);
+        if (dot(pl.xyz, c) + pl.w < 0.0) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// Eq. 7 (perspective, or orthographic when lod.w == 0).
+float detail_level(float h, float d, float alpha) {
+    float denom = frame.lod.w > 0.0 ? max(d, 1e-6) * frame.lod.w : max(frame.lod_ortho.x, 1e-6);
+    return clamp(h * frame.camera_pos.w * alpha / denom, 0.0, 1.0);
+}
+
+BundleLod bundle_lod(uint b) {
+    BundleDesc desc = bundles[b];
+    // World bounds: convex hull of the bundle's Bezier control points, grown by the styling.
+    int depth = int(4u * (mesh.layers - 1u) + 1u);
+    vec3 lo = vec3(1e30);
+    vec3 hi = vec3(-1e30);
+    for (int z = 0; z < depth; z++) {
+        for (int c = 0; c < 4; c++) {
+            ivec3 t = ivec3(ivec2(desc.origin) + ivec2(c & 1, c >> 1), z);
+            vec3 p = (push.model * vec4(decode_position(texelFetch(tex_position, t, 0).xyz), 1.0)).xyz;
+            lo = min(lo, p);
+            hi = max(hi, p);
+        }
+    }
+    float scale = length(push.model[0].xyz);
+    float margin = scale * (style.curl_radius + style.wave_amplitude + style.frizz_amplitude + style.strand_width);
+    lo -= margin;
+    hi += margin;
+    uint n = frame.params.x;
+    uint count = style.density_by_area != 0u ? uint(round(float(n) * desc.density)) : n;
+    count = clamp(count, 1u, MAX_STRANDS_PER_BUNDLE);
+    uint emax = frame.params.y;
+    BundleLod r = BundleLod(count, emax, 0.0, 1.0);
+    if (!box_visible(lo, hi)) {
+        r.strands = 0u;
+        return r;
+    }
+    if (frame.params.w == 0u) {
+        return r;
+    }
+    vec3 eye = frame.camera_pos.xyz;
+    float d = length(eye - clamp(eye, lo, hi));
+    float h = scale * desc.rest_size;
+    // Strand LoD: eq. 7 and eq. 8 with a per-bundle increment delta_i, clamped to N_i.
+    float ls = detail_level(h, d, frame.lod.x);
+    float delta = hash_f32(hash_u32(b ^ 0x2545f491u) ^ style.seed);
+    r.strands = ls > 0.0 ? clamp(uint(ceil(ls * (float(count) + delta))), 1u, count) : 0u;
+    r.thickness = min(1.0 / max(ls, 1e-6), float(count));
+    // Vertex LoD: eq. 9, 10, 12.
+    float lv = detail_level(h, d, frame.lod.y);
+    float x = log2(max(lv * float(1u << emax), 1e-30));
+    r.e = uint(clamp(ceil(x), 0.0, float(emax)));
+    float lambda = clamp(frame.lod.z, 1e-6, 1.0);
+    float e_next = max(ceil(x - lambda), 0.0);
+    if (float(r.e) > e_next && r.e > 0u) {
+        r.gamma = clamp(1.0 - (x - e_next) / lambda, 0.0, 1.0);
+    }
+    return r;
+}
+
+#endif
