@@ -408,11 +408,27 @@ impl CpuGenerator {
     /// Generate with level of detail (paper sec. 3.6): per bundle the strand count, vertex level,
     /// geomorph (eq. 11 + tangent morph) and thickness of [`crate::lod::bundle_lod`]. Strands are
     /// bundle-major; `counts[i]` is the vertex count of strand `i`.
-    pub fn generate_lod(&self, n: u32, e_max: u32, baked: &BakedHairMesh, view: &crate::lod::LodView) -> (StrandSet, Vec<usize>) {
-        let mut set = StrandSet { verts_per_strand: 0, ..Default::default() };
+    pub fn generate_lod(
+        &self,
+        n: u32,
+        e_max: u32,
+        baked: &BakedHairMesh,
+        view: &crate::lod::LodView,
+    ) -> (StrandSet, Vec<usize>) {
+        let mut set = StrandSet {
+            verts_per_strand: 0,
+            ..Default::default()
+        };
         let mut counts = Vec::new();
         for (bundle, b) in self.tex.bundles.iter().enumerate() {
-            let lod = crate::lod::bundle_lod(baked, &self.style, bundle, strands_in_bundle(b, &self.style, n), e_max, view);
+            let lod = crate::lod::bundle_lod(
+                baked,
+                &self.style,
+                bundle,
+                strands_in_bundle(b, &self.style, n),
+                e_max,
+                view,
+            );
             let segments = 1u32 << lod.e;
             let verts = segments as usize + 1;
             for strand in 0..lod.strands {

@@ -191,12 +191,21 @@ pub fn bundle_bounds(baked: &crate::BakedHairMesh, b: usize, margin: f32) -> (Ve
 
 /// LoD decision of bundle `b` with `n` strands before LoD and full vertex level `e_max`
 /// (culling not included): eq. 7-10 and 12, the CPU twin of `bundle_lod.glsl`.
-pub fn bundle_lod(baked: &crate::BakedHairMesh, style: &crate::HairStyle, b: usize, n: u32, e_max: u32, view: &LodView) -> BundleLod {
-    let margin = style.curl_radius + style.wave_amplitude + style.frizz_amplitude + style.strand_width;
+pub fn bundle_lod(
+    baked: &crate::BakedHairMesh,
+    style: &crate::HairStyle,
+    b: usize,
+    n: u32,
+    e_max: u32,
+    view: &LodView,
+) -> BundleLod {
+    let margin =
+        style.curl_radius + style.wave_amplitude + style.frizz_amplitude + style.strand_width;
     let (lo, hi) = bundle_bounds(baked, b, margin);
     let d = view.eye.distance(view.eye.clamp(lo, hi));
     let h = baked.bundles[b].rest_size;
-    let level = |alpha: f32| (h * view.resolution * alpha / (d.max(1e-6) * view.tan_fov)).clamp(0.0, 1.0);
+    let level =
+        |alpha: f32| (h * view.resolution * alpha / (d.max(1e-6) * view.tan_fov)).clamp(0.0, 1.0);
     let ls = level(view.alpha_strands);
     let strands = if ls > 0.0 {
         ((ls * (n as f32 + bundle_delta(b as u32, style.seed))).ceil() as u32).clamp(1, n)
@@ -213,5 +222,10 @@ pub fn bundle_lod(baked: &crate::BakedHairMesh, style: &crate::HairStyle, b: usi
     } else {
         0.0
     };
-    BundleLod { strands, e, gamma, thickness: (1.0 / ls.max(1e-6)).min(n as f32) }
+    BundleLod {
+        strands,
+        e,
+        gamma,
+        thickness: (1.0 / ls.max(1e-6)).min(n as f32),
+    }
 }

@@ -34,8 +34,15 @@ fn gpu_strands_match_cpu_oracle() {
         let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
         let ext = Vec3::from_slice(&baked.info.pos_extent[..3]);
         let cam = hairmesh::render::Camera::framing(o, o + ext, Vec3::new(0.3, 0.5, 1.0), 60.0);
-        r.render(std::slice::from_ref(&hair), &cam, light(), 64, 64, &compute_full())
-            .unwrap();
+        r.render(
+            std::slice::from_ref(&hair),
+            &cam,
+            light(),
+            64,
+            64,
+            &compute_full(),
+        )
+        .unwrap();
         let (gpu, strands) = r.read_vertices(&hair).unwrap();
         let cpu = CpuGenerator::new(&baked, style).generate(n, e);
         assert_eq!(strands as usize, cpu.strand_count(), "{name}: strand count");

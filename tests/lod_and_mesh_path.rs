@@ -7,13 +7,22 @@ mod common;
 use common::*;
 use glam::{Mat4, Vec3};
 use hairmesh::lod::{LodView, bundle_lod};
-use hairmesh::render::{Camera, HairGpu, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer, StrandParams};
+use hairmesh::render::{
+    Camera, HairGpu, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer, StrandParams,
+};
 use hairmesh::{CpuGenerator, generate::strands_in_bundle};
 
 const SIZE: u32 = 160;
 
 fn settings(path: RenderPath, lod: bool) -> RenderSettings {
-    RenderSettings { path: Some(path), lod: if lod { LodSettings::default() } else { LodSettings::off() } }
+    RenderSettings {
+        path: Some(path),
+        lod: if lod {
+            LodSettings::default()
+        } else {
+            LodSettings::off()
+        },
+    }
 }
 
 /// Camera on the default framing axis at `dist` times the framing distance.
@@ -24,12 +33,19 @@ fn dolly(name: &str, dist: f32) -> Camera {
 }
 
 fn mean_abs_diff(a: &RenderOutput, b: &RenderOutput) -> f64 {
-    let s: u64 = a.rgba.iter().zip(&b.rgba).map(|(x, y)| (*x as i32 - *y as i32).unsigned_abs() as u64).sum();
+    let s: u64 = a
+        .rgba
+        .iter()
+        .zip(&b.rgba)
+        .map(|(x, y)| (*x as i32 - *y as i32).unsigned_abs() as u64)
+        .sum();
     s as f64 / a.rgba.len() as f64 / 255.0
 }
 
 fn flip_mean(a: &RenderOutput, b: &RenderOutput) -> f32 {
-    let rgb = |o: &RenderOutput| -> Vec<u8> { o.rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
+    let rgb = |o: &RenderOutput| -> Vec<u8> {
+        o.rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
+    };
     let ra = nv_flip::FlipImageRgb8::with_data(a.width, a.height, &rgb(a));
     let rb = nv_flip::FlipImageRgb8::with_data(b.width, b.height, &rgb(b));
     nv_flip::FlipPool::from_image(&nv_flip::flip(ra, rb, nv_flip::DEFAULT_PIXELS_PER_DEGREE)).mean()
@@ -38,17 +54,49 @@ fn flip_mean(a: &RenderOutput, b: &RenderOutput) -> f32 {
 #[test]
 fn mesh_path_matches_compute_path() {
     let ctx = context();
-    assert!(ctx.info.mesh_shader, "lavapipe from Mesa 25 must expose VK_EXT_mesh_shader (run tools/setup.sh)");
-    for (name, n, e, lod, dist) in [("head_long.obj", 16, 5, false, 1.0), ("triangle_tuft.obj", 32, 4, false, 1.0), ("head_long.obj", 32, 5, true, 3.0)] {
+    assert!(
+        ctx.info.mesh_shader,
+        "lavapipe from Mesa 25 must expose VK_EXT_mesh_shader (run tools/setup.sh)"
+    );
+    for (name, n, e, lod, dist) in [
+        ("head_long.obj", 16, 5, false, 1.0),
+        ("triangle_tuft.obj", 32, 4, false, 1.0),
+        ("head_long.obj", 32, 5, true, 3.0),
+    ] {
         let cam = dolly(name, dist);
-        let mesh = render_sample_with(&ctx, name, n, e, SIZE, Some(cam), &settings(RenderPath::Mesh, lod));
-        let compute = render_sample_with(&ctx, name, n, e, SIZE, Some(cam), &settings(RenderPath::Compute, lod));
+        let mesh = render_sample_with(
+            &ctx,
+            name,
+            n,
+            e,
+            SIZE,
+            Some(cam),
+            &settings(RenderPath::Mesh, lod),
+        );
+        let compute = render_sample_with(
+            &ctx,
+            name,
+            n,
+            e,
+            SIZE,
+            Some(cam),
+            &settings(RenderPath::Compute, lod),
+        );
         assert_eq!(mesh.path, RenderPath::Mesh);
-        assert_eq!(mesh.triangles, compute.triangles, "{name}: triangle counts differ");
+        assert_eq!(
+            mesh.triangles, compute.triangles,
+            "{name}: triangle counts differ"
+        );
         assert_eq!(mesh.strands, compute.strands);
         let d = mean_abs_diff(&mesh, &compute);
-        println!("{name} lod {lod}: {} triangles, mean abs diff {d:.6}", mesh.triangles);
-        assert!(d <= 1.0 / 255.0, "{name}: mean absolute pixel difference {d} > 1/255");
+        println!(
+            "{name} lod {lod}: {} triangles, mean abs diff {d:.6}",
+            mesh.triangles
+        );
+        assert!(
+            d <= 1.0 / 255.0,
+            "{name}: mean absolute pixel difference {d} > 1/255"
+        );
     }
     assert_no_validation_errors(&ctx);
 }
@@ -62,7 +110,15 @@ fn triangle_counts_follow_cpu_lod_functions() {
     let mut previous = u64::MAX;
     for dist in [0.5, 1.0, 2.0, 4.0, 8.0, 16.0] {
         let cam = dolly(name, dist);
-        let out = render_sample_with(&ctx, name, n, e, SIZE, Some(cam), &settings(RenderPath::Mesh, true));
+        let out = render_sample_with(
+            &ctx,
+            name,
+            n,
+            e,
+            SIZE,
+            Some(cam),
+            &settings(RenderPath::Mesh, true),
+        );
         let lod = LodSettings::default();
         let view = LodView {
             eye: cam.eye,
@@ -81,15 +137,37 @@ fn triangle_counts_follow_cpu_lod_functions() {
                 l.strands as u64 * 2 * (1u64 << l.e)
             })
             .sum();
-        println!("distance x{dist}: {} triangles (CPU LoD predicts {expected})", out.triangles);
+        println!(
+            "distance x{dist}: {} triangles (CPU LoD predicts {expected})",
+            out.triangles
+        );
         // Rounding of ceil() at exact level boundaries may differ by an ulp between CPU and GPU.
         let rel = (out.triangles as f64 - expected as f64).abs() / expected as f64;
-        assert!(rel <= 0.005, "distance x{dist}: GPU {} vs CPU {expected} triangles", out.triangles);
-        assert!(out.triangles <= previous, "triangles must not grow with distance");
+        assert!(
+            rel <= 0.005,
+            "distance x{dist}: GPU {} vs CPU {expected} triangles",
+            out.triangles
+        );
+        assert!(
+            out.triangles <= previous,
+            "triangles must not grow with distance"
+        );
         previous = out.triangles;
     }
-    let full = render_sample_with(&ctx, name, n, e, SIZE, Some(dolly(name, 16.0)), &settings(RenderPath::Mesh, false));
-    assert!(previous * 4 < full.triangles, "far LoD should cut triangles at least 4x ({previous} vs {})", full.triangles);
+    let full = render_sample_with(
+        &ctx,
+        name,
+        n,
+        e,
+        SIZE,
+        Some(dolly(name, 16.0)),
+        &settings(RenderPath::Mesh, false),
+    );
+    assert!(
+        previous * 4 < full.triangles,
+        "far LoD should cut triangles at least 4x ({previous} vs {})",
+        full.triangles
+    );
     assert_no_validation_errors(&ctx);
 }
 
@@ -101,13 +179,42 @@ fn gpu_lod_strands_match_cpu_oracle() {
     let (n, e) = (8, 5);
     let cam = dolly(name, 3.0);
     let mut r = Renderer::new(&ctx).unwrap();
-    let hair = HairGpu::new(&ctx, &r.sampler, &baked, &style, StrandParams { strands_per_bundle: n, verts_log2: e }, Mat4::IDENTITY).unwrap();
+    let hair = HairGpu::new(
+        &ctx,
+        &r.sampler,
+        &baked,
+        &style,
+        StrandParams {
+            strands_per_bundle: n,
+            verts_log2: e,
+        },
+        Mat4::IDENTITY,
+    )
+    .unwrap();
     // A wide camera at the same position: nothing culled, LoD from the same eye.
-    let wide = Camera { fov_y: cam.fov_y, ..cam };
-    r.render(std::slice::from_ref(&hair), &wide, light(), SIZE, SIZE, &settings(RenderPath::Compute, true)).unwrap();
+    let wide = Camera {
+        fov_y: cam.fov_y,
+        ..cam
+    };
+    r.render(
+        std::slice::from_ref(&hair),
+        &wide,
+        light(),
+        SIZE,
+        SIZE,
+        &settings(RenderPath::Compute, true),
+    )
+    .unwrap();
     let (gpu, strands) = r.read_vertices(&hair).unwrap();
     let lod = LodSettings::default();
-    let view = LodView { eye: cam.eye, resolution: SIZE as f32, tan_fov: cam.fov_y.tan(), alpha_strands: lod.alpha_strands, alpha_verts: lod.alpha_verts, lambda: lod.lambda };
+    let view = LodView {
+        eye: cam.eye,
+        resolution: SIZE as f32,
+        tan_fov: cam.fov_y.tan(),
+        alpha_strands: lod.alpha_strands,
+        alpha_verts: lod.alpha_verts,
+        lambda: lod.lambda,
+    };
     let (cpu, counts) = CpuGenerator::new(&baked, style).generate_lod(n, e, &baked, &view);
     assert_eq!(strands as usize, counts.len(), "strand count");
     assert_eq!(gpu.len(), cpu.positions.len(), "vertex count");
@@ -117,10 +224,21 @@ fn gpu_lod_strands_match_cpu_oracle() {
     let mut worst = 0.0f32;
     for (i, v) in gpu.iter().enumerate() {
         worst = worst.max(Vec3::new(v[0], v[1], v[2]).distance(cpu.positions[i]));
-        assert!((v[3] - cpu.widths[i]).abs() <= 1e-6 + 1e-3 * cpu.widths[i], "width {i}: {} vs {}", v[3], cpu.widths[i]);
-        assert!(Vec3::new(v[4], v[5], v[6]).dot(cpu.tangents[i]) > 0.99, "tangent {i}");
+        assert!(
+            (v[3] - cpu.widths[i]).abs() <= 1e-6 + 1e-3 * cpu.widths[i],
+            "width {i}: {} vs {}",
+            v[3],
+            cpu.widths[i]
+        );
+        assert!(
+            Vec3::new(v[4], v[5], v[6]).dot(cpu.tangents[i]) > 0.99,
+            "tangent {i}"
+        );
     }
-    println!("LoD oracle: {} strands, worst position error {worst:e}", counts.len());
+    println!(
+        "LoD oracle: {} strands, worst position error {worst:e}",
+        counts.len()
+    );
     assert!(worst <= ext * 2e-3, "worst {worst}");
     assert_no_validation_errors(&ctx);
 }
@@ -131,7 +249,20 @@ fn lod_has_no_popping_over_a_dolly() {
     let name = "head_long.obj";
     let distances: Vec<f32> = (0..16).map(|i| 0.8 * 1.22f32.powi(i)).collect();
     let frames = |lod: bool| -> Vec<RenderOutput> {
-        distances.iter().map(|&d| render_sample_with(&ctx, name, 32, 5, SIZE, Some(dolly(name, d)), &settings(RenderPath::Mesh, lod))).collect()
+        distances
+            .iter()
+            .map(|&d| {
+                render_sample_with(
+                    &ctx,
+                    name,
+                    32,
+                    5,
+                    SIZE,
+                    Some(dolly(name, d)),
+                    &settings(RenderPath::Mesh, lod),
+                )
+            })
+            .collect()
     };
     let on = frames(true);
     let off = frames(false);
@@ -140,13 +271,24 @@ fn lod_has_no_popping_over_a_dolly() {
         let d_on = mean_abs_diff(&on[i - 1], &on[i]);
         let d_off = mean_abs_diff(&off[i - 1], &off[i]);
         worst_ratio = worst_ratio.max(d_on / d_off.max(1e-9));
-        println!("step {i}: consecutive diff LoD on {d_on:.5}, off {d_off:.5}; on vs off FLIP {:.4}, triangles {} / {}", flip_mean(&on[i], &off[i]), on[i].triangles, off[i].triangles);
-        assert!(d_on <= 1.5 * d_off, "step {i}: LoD pops ({d_on} vs {d_off} without LoD)");
+        println!(
+            "step {i}: consecutive diff LoD on {d_on:.5}, off {d_off:.5}; on vs off FLIP {:.4}, triangles {} / {}",
+            flip_mean(&on[i], &off[i]),
+            on[i].triangles,
+            off[i].triangles
+        );
+        assert!(
+            d_on <= 1.5 * d_off,
+            "step {i}: LoD pops ({d_on} vs {d_off} without LoD)"
+        );
     }
     for (i, (a, b)) in on.iter().zip(&off).enumerate() {
         // Documented threshold: LoD on vs off at the same distance, FLIP mean <= 0.06.
         let f = flip_mean(a, b);
-        assert!(f <= 0.06, "distance {i}: LoD image differs from full detail by FLIP {f}");
+        assert!(
+            f <= 0.06,
+            "distance {i}: LoD image differs from full detail by FLIP {f}"
+        );
     }
     println!("worst consecutive-difference ratio on/off: {worst_ratio:.3}");
     assert_no_validation_errors(&ctx);
@@ -157,8 +299,20 @@ fn mesh_path_culls_bundles_outside_the_frustum() {
     let ctx = context();
     let (baked, _) = sample("small_patch.obj");
     let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
-    let away = Camera::look_at(o + Vec3::new(0.0, 0.0, 5.0), o + Vec3::new(0.0, 0.0, 10.0), 40.0);
-    let out = render_sample_with(&ctx, "small_patch.obj", 16, 4, 32, Some(away), &settings(RenderPath::Mesh, false));
+    let away = Camera::look_at(
+        o + Vec3::new(0.0, 0.0, 5.0),
+        o + Vec3::new(0.0, 0.0, 10.0),
+        40.0,
+    );
+    let out = render_sample_with(
+        &ctx,
+        "small_patch.obj",
+        16,
+        4,
+        32,
+        Some(away),
+        &settings(RenderPath::Mesh, false),
+    );
     assert_eq!((out.strands, out.triangles), (0, 0));
     assert_no_validation_errors(&ctx);
 }

@@ -2,13 +2,25 @@
 //!
 //! `bench cpu-generate [--mesh M] [--strands 100000] [--verts-log2 5] [--runs 7]`: CPU reference
 //! generator throughput on one core; prints every run and the median.
+//!
+//! `bench lod [--mesh M] [--size 1280x720] [--runs 5] [--picture out.png]`: one scene at near,
+//! mid and far distances; strand triangles and median GPU time with LoD on vs off, mesh vs
+//! compute path (timestamp queries); optionally a near/mid/far picture with LoD on.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
 use hairmesh::obj_io::load_hair_mesh_obj;
+use hairmesh::render::scene::load_mesh;
+use hairmesh::render::{
+    Camera, HairGpu, LodSettings, RenderPath, RenderSettings, Renderer, StrandParams,
+};
+use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakeOptions, CpuGenerator, HairStyle, bake};
 
 #[derive(Parser)]
@@ -35,6 +47,137 @@ enum Cmd {
         #[arg(long, default_value_t = 7)]
         runs: usize,
     },
+    /// GPU LoD comparison at near / mid / far distances, both paths.
+    Lod {
+        /// Hair mesh (.obj or .hmb).
+        #[arg(long, default_value = "hairmeshes/head_long.obj")]
+        mesh: PathBuf,
+        /// Image width.
+        #[arg(long, default_value_t = 1280)]
+        width: u32,
+        /// Image height.
+        #[arg(long, default_value_t = 720)]
+        height: u32,
+        /// Strands per bundle.
+        #[arg(long, default_value_t = 64)]
+        strands_per_bundle: u32,
+        /// Timed runs per configuration (after one warm-up).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Choose the GPU by name substring.
+        #[arg(long)]
+        device: Option<String>,
+        /// Write a near / mid / far picture (LoD on) here.
+        #[arg(long)]
+        picture: Option<PathBuf>,
+    },
+}
+
+fn bench_lod(
+    mesh: PathBuf,
+    width: u32,
+    height: u32,
+    n: u32,
+    runs: usize,
+    device: Option<String>,
+    picture: Option<PathBuf>,
+) -> Result<()> {
+    if runs == 0 || width == 0 || height == 0 || width > 8192 || height > 8192 {
+        bail!("runs must be >= 1 and sizes 1..=8192");
+    }
+    let (baked, style) = load_mesh(&mesh, None)?;
+    let ctx = Arc::new(Context::new(&ContextDesc::default().device(device))?);
+    let mut renderer = Renderer::new(&ctx)?;
+    let hair = HairGpu::new(
+        &ctx,
+        &renderer.sampler,
+        &baked,
+        &style,
+        StrandParams {
+            strands_per_bundle: n,
+            verts_log2: 5,
+        },
+        Mat4::IDENTITY,
+    )?;
+    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+    let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
+    let frame = Camera::framing(o, o + e, Vec3::new(0.7, 0.35, -1.0), 40.0);
+    let at = |k: f32| {
+        Camera::look_at(
+            frame.target + (frame.eye - frame.target) * k,
+            frame.target,
+            40.0,
+        )
+    };
+    let views = [("near", at(0.6)), ("mid", at(2.5)), ("far", at(8.0))];
+    println!(
+        "device: {} ({}), {}x{}, {} strands/bundle, 33 vertices at full detail",
+        ctx.info.name, ctx.info.driver, width, height, n
+    );
+    println!("| view | path | LoD | strands | triangles | GPU ms (median of {runs}) |");
+    println!("|---|---|---|---|---|---|");
+    let mut paths = vec![RenderPath::Compute];
+    if ctx.info.mesh_shader {
+        paths.insert(0, RenderPath::Mesh);
+    }
+    let mut pics = Vec::new();
+    for (label, cam) in &views {
+        for &path in &paths {
+            for lod_on in [true, false] {
+                let settings = RenderSettings {
+                    path: Some(path),
+                    lod: if lod_on {
+                        LodSettings::default()
+                    } else {
+                        LodSettings::off()
+                    },
+                };
+                let first = renderer.render(
+                    std::slice::from_ref(&hair),
+                    cam,
+                    Vec3::new(0.4, 1.0, 0.6),
+                    width,
+                    height,
+                    &settings,
+                )?;
+                let mut times = Vec::new();
+                for _ in 0..runs {
+                    let out = renderer.render(
+                        std::slice::from_ref(&hair),
+                        cam,
+                        Vec3::new(0.4, 1.0, 0.6),
+                        width,
+                        height,
+                        &settings,
+                    )?;
+                    times.push(out.pass_ms.iter().map(|p| p.1).sum::<f64>());
+                }
+                println!(
+                    "| {label} | {path:?} | {} | {} | {} | {:.2} |",
+                    if lod_on { "on" } else { "off" },
+                    first.strands,
+                    first.triangles,
+                    median(times)
+                );
+                if lod_on && path == paths[0] {
+                    pics.push(first);
+                }
+            }
+        }
+    }
+    if let Some(p) = picture {
+        let mut strip = image::RgbaImage::new(width * 3, height);
+        for (i, out) in pics.iter().enumerate() {
+            let img =
+                image::RgbaImage::from_raw(width, height, out.rgba.clone()).context("size")?;
+            image::imageops::replace(&mut strip, &img, (i as u32 * width) as i64, 0);
+        }
+        let mut png = Vec::new();
+        strip.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+        hairmesh::fsutil::write_atomic(&p, &png)?;
+        println!("wrote {}", p.display());
+    }
+    Ok(())
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -44,6 +187,25 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn main() -> Result<()> {
     match Args::parse().cmd {
+        Cmd::Lod {
+            mesh,
+            width,
+            height,
+            strands_per_bundle,
+            runs,
+            device,
+            picture,
+        } => {
+            bench_lod(
+                mesh,
+                width,
+                height,
+                strands_per_bundle,
+                runs,
+                device,
+                picture,
+            )?;
+        }
         Cmd::CpuGenerate {
             mesh,
             strands,

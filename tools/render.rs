@@ -13,7 +13,9 @@ use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::{Mat4, Vec3};
 use hairmesh::render::scene::{SceneDesc, load_mesh};
-use hairmesh::render::{Camera, HairGpu, LodSettings, RenderPath, RenderSettings, Renderer, StrandParams};
+use hairmesh::render::{
+    Camera, HairGpu, LodSettings, RenderPath, RenderSettings, Renderer, StrandParams,
+};
 use hairmesh::vk::{Context, ContextDesc};
 
 /// Render hair generated on the GPU from hair-mesh textures.
@@ -102,14 +104,24 @@ fn run(args: Args) -> Result<()> {
         alpha_verts: args.lod_alpha_verts,
         lambda: args.lod_lambda,
     };
-    if !(lod.alpha_strands > 0.0 && lod.alpha_verts > 0.0 && lod.alpha_strands.is_finite() && lod.alpha_verts.is_finite()) {
+    if !(lod.alpha_strands > 0.0
+        && lod.alpha_verts > 0.0
+        && lod.alpha_strands.is_finite()
+        && lod.alpha_verts.is_finite())
+    {
         bail!("LoD alphas must be positive and finite");
     }
     if !(lod.lambda > 0.0 && lod.lambda <= 1.0) {
         bail!("--lod-lambda must be in (0, 1]");
     }
     let settings = RenderSettings {
-        path: args.path.as_deref().map(|p| if p == "mesh" { RenderPath::Mesh } else { RenderPath::Compute }),
+        path: args.path.as_deref().map(|p| {
+            if p == "mesh" {
+                RenderPath::Mesh
+            } else {
+                RenderPath::Compute
+            }
+        }),
         lod,
     };
     // Load and validate every input before touching the GPU.

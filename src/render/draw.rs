@@ -55,7 +55,11 @@ impl HairDraw {
             )
         };
         let mesh_strands = if mesh_path_supported(ctx) {
-            let (t, m, f) = (shader::compile("strands.task")?, shader::compile("strands.mesh")?, shader::compile("strands.frag")?);
+            let (t, m, f) = (
+                shader::compile("strands.task")?,
+                shader::compile("strands.mesh")?,
+                shader::compile("strands.frag")?,
+            );
             Some(Pipeline::graphics(
                 ctx,
                 layout,
@@ -90,13 +94,19 @@ impl HairDraw {
     pub fn record_scalp(&self, cmd: vk::CommandBuffer, hair: &HairGpu) {
         self.scalp.bind(cmd, hair.set.set, &hair.model_cols());
         // SAFETY: recording inside a render pass instance with viewport/scissor set.
-        unsafe { self.ctx.device.cmd_draw(cmd, hair.bundle_count() * 6, 1, 0, 0) };
+        unsafe {
+            self.ctx
+                .device
+                .cmd_draw(cmd, hair.bundle_count() * 6, 1, 0, 0)
+        };
     }
 
     /// Mesh path: one task workgroup per bundle generates and draws the strands of `hair`
     /// (inside dynamic rendering; the indirect block's counters must be zeroed before).
     pub fn record_mesh_strands(&self, cmd: vk::CommandBuffer, hair: &HairGpu) {
-        let (Some(p), Some(ext)) = (&self.mesh_strands, &self.ctx.mesh_ext) else { return };
+        let (Some(p), Some(ext)) = (&self.mesh_strands, &self.ctx.mesh_ext) else {
+            return;
+        };
         p.bind(cmd, hair.set.set, &hair.model_cols());
         let b = hair.bundle_count();
         let row = 65535;
@@ -109,6 +119,10 @@ impl HairDraw {
     pub fn record_pulled_strands(&self, cmd: vk::CommandBuffer, hair: &HairGpu) {
         self.strands.bind(cmd, hair.set.set, &hair.model_cols());
         // SAFETY: draw arguments at offset 16 of the indirect buffer (written by scan.comp).
-        unsafe { self.ctx.device.cmd_draw_indirect(cmd, hair.indirect.raw, 16, 1, 16) };
+        unsafe {
+            self.ctx
+                .device
+                .cmd_draw_indirect(cmd, hair.indirect.raw, 16, 1, 16)
+        };
     }
 }

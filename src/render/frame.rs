@@ -85,14 +85,22 @@ pub struct LodSettings {
 
 impl Default for LodSettings {
     fn default() -> Self {
-        LodSettings { enabled: true, alpha_strands: 0.1, alpha_verts: 0.1, lambda: 0.5 }
+        LodSettings {
+            enabled: true,
+            alpha_strands: 0.1,
+            alpha_verts: 0.1,
+            lambda: 0.5,
+        }
     }
 }
 
 impl LodSettings {
     /// Every bundle at full detail.
     pub fn off() -> Self {
-        LodSettings { enabled: false, ..Default::default() }
+        LodSettings {
+            enabled: false,
+            ..Default::default()
+        }
     }
 }
 
@@ -157,7 +165,12 @@ impl FrameParams {
             ],
             params: [strands, verts_log2, bundles, lod.enabled as u32],
             planes: frustum_planes(vp),
-            lod: [lod.alpha_strands, lod.alpha_verts, lod.lambda, camera.fov_y.tan()],
+            lod: [
+                lod.alpha_strands,
+                lod.alpha_verts,
+                lod.lambda,
+                camera.fov_y.tan(),
+            ],
             lod_ortho: [0.0; 4],
         }
     }

@@ -9,7 +9,7 @@ pub mod hair_gpu;
 pub mod renderer;
 pub mod scene;
 
+pub use frame::LodSettings;
 pub use frame::{Camera, FrameParams};
 pub use hair_gpu::{HairGpu, StrandParams};
-pub use frame::LodSettings;
 pub use renderer::{RenderOutput, RenderPath, RenderSettings, Renderer};

@@ -23,7 +23,7 @@ pub enum RenderPath {
 }
 
 /// Per-render choices.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct RenderSettings {
     /// Forced path; `None` picks mesh where available, else compute.
     pub path: Option<RenderPath>,
@@ -31,11 +31,6 @@ pub struct RenderSettings {
     pub lod: LodSettings,
 }
 
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings { path: None, lod: LodSettings::default() }
-    }
-}
 
 /// A rendered frame and what it cost.
 pub struct RenderOutput {
@@ -104,11 +99,22 @@ impl Renderer {
         settings: &RenderSettings,
     ) -> GpuResult<RenderOutput> {
         if hairs.is_empty() || width == 0 || height == 0 || width > 8192 || height > 8192 {
-            return Err(GpuError::Unsupported(format!("nothing to render or bad size {width}x{height}")));
+            return Err(GpuError::Unsupported(format!(
+                "nothing to render or bad size {width}x{height}"
+            )));
         }
         for hair in hairs {
             let p = &hair.params;
-            let frame = FrameParams::new(camera, light_dir, width, height, p.strands_per_bundle, p.verts_log2, hair.bundle_count(), &settings.lod);
+            let frame = FrameParams::new(
+                camera,
+                light_dir,
+                width,
+                height,
+                p.strands_per_bundle,
+                p.verts_log2,
+                hair.bundle_count(),
+                &settings.lod,
+            );
             hair.frame.write_shared(bytemuck::bytes_of(&frame))?;
         }
         let ctx = self.ctx.clone();
@@ -116,7 +122,10 @@ impl Renderer {
         let pipelines = self.pipelines.as_ref().expect("created above");
         let path = match settings.path {
             Some(RenderPath::Mesh) if !pipelines.draw.has_mesh_path() => {
-                return Err(GpuError::Unsupported(format!("{}: no usable VK_EXT_mesh_shader for --path mesh", ctx.info.name)));
+                return Err(GpuError::Unsupported(format!(
+                    "{}: no usable VK_EXT_mesh_shader for --path mesh",
+                    ctx.info.name
+                )));
             }
             Some(p) => p,
             None if pipelines.draw.has_mesh_path() => RenderPath::Mesh,
@@ -124,19 +133,42 @@ impl Renderer {
         };
         let color = Image::new(
             &ctx,
-            &ImageDesc::new_2d("color", COLOR_FORMAT, width, height).usage(vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC),
+            &ImageDesc::new_2d("color", COLOR_FORMAT, width, height)
+                .usage(vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC),
         )?;
-        let depth = Image::new(&ctx, &ImageDesc::new_2d("depth", DEPTH_FORMAT, width, height).usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT))?;
+        let depth = Image::new(
+            &ctx,
+            &ImageDesc::new_2d("depth", DEPTH_FORMAT, width, height)
+                .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT),
+        )?;
         let stats: Vec<Buffer> = hairs
             .iter()
-            .map(|_| Buffer::new(&ctx, &BufferDesc::new("indirect readback", INDIRECT_BYTES, vk::BufferUsageFlags::TRANSFER_DST).readback()))
+            .map(|_| {
+                Buffer::new(
+                    &ctx,
+                    &BufferDesc::new(
+                        "indirect readback",
+                        INDIRECT_BYTES,
+                        vk::BufferUsageFlags::TRANSFER_DST,
+                    )
+                    .readback(),
+                )
+            })
             .collect::<GpuResult<_>>()?;
         let profiler = &mut self.profiler;
         let background = self.background;
         let mut readback = ctx.submit_and_wait(|cmd| -> GpuResult<Buffer> {
             profiler.reset(cmd);
-            color.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
-            depth.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+            color.transition(
+                cmd,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            );
+            depth.transition(
+                cmd,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            );
             for (i, (hair, stat)) in hairs.iter().zip(&stats).enumerate() {
                 match path {
                     RenderPath::Compute => pipelines.generate.record(cmd, hair, profiler),
@@ -144,41 +176,91 @@ impl Renderer {
                         // The task shader accumulates statistics into the indirect block.
                         ctx.barrier(
                             cmd,
-                            (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE),
-                            (vk::PipelineStageFlags2::TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+                            (
+                                vk::PipelineStageFlags2::ALL_COMMANDS,
+                                vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
+                            ),
+                            (
+                                vk::PipelineStageFlags2::TRANSFER,
+                                vk::AccessFlags2::TRANSFER_WRITE,
+                            ),
                         );
                         // SAFETY: recording outside a render pass; the buffer allows TRANSFER_DST.
-                        unsafe { ctx.device.cmd_fill_buffer(cmd, hair.indirect.raw, 0, INDIRECT_BYTES, 0) };
+                        unsafe {
+                            ctx.device
+                                .cmd_fill_buffer(cmd, hair.indirect.raw, 0, INDIRECT_BYTES, 0)
+                        };
                         ctx.barrier(
                             cmd,
-                            (vk::PipelineStageFlags2::TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-                            (vk::PipelineStageFlags2::TASK_SHADER_EXT, vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE),
+                            (
+                                vk::PipelineStageFlags2::TRANSFER,
+                                vk::AccessFlags2::TRANSFER_WRITE,
+                            ),
+                            (
+                                vk::PipelineStageFlags2::TASK_SHADER_EXT,
+                                vk::AccessFlags2::SHADER_STORAGE_READ
+                                    | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                            ),
                         );
                     }
                 }
-                let load = if i == 0 { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD };
+                let load = if i == 0 {
+                    vk::AttachmentLoadOp::CLEAR
+                } else {
+                    vk::AttachmentLoadOp::LOAD
+                };
                 let color_att = [vk::RenderingAttachmentInfo::default()
                     .image_view(color.view)
                     .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
                     .load_op(load)
                     .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [background[0], background[1], background[2], 1.0] } })];
+                    .clear_value(vk::ClearValue {
+                        color: vk::ClearColorValue {
+                            float32: [background[0], background[1], background[2], 1.0],
+                        },
+                    })];
                 let depth_att = vk::RenderingAttachmentInfo::default()
                     .image_view(depth.view)
                     .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
                     .load_op(load)
                     .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
-                let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width, height } };
-                let info = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color_att).depth_attachment(&depth_att);
-                profiler.begin(cmd, if path == RenderPath::Mesh { "mesh draw" } else { "draw" });
+                    .clear_value(vk::ClearValue {
+                        depth_stencil: vk::ClearDepthStencilValue {
+                            depth: 1.0,
+                            stencil: 0,
+                        },
+                    });
+                let area = vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent: vk::Extent2D { width, height },
+                };
+                let info = vk::RenderingInfo::default()
+                    .render_area(area)
+                    .layer_count(1)
+                    .color_attachments(&color_att)
+                    .depth_attachment(&depth_att);
+                profiler.begin(
+                    cmd,
+                    if path == RenderPath::Mesh {
+                        "mesh draw"
+                    } else {
+                        "draw"
+                    },
+                );
                 // SAFETY: attachments are in the layouts named above; viewport covers the target.
                 unsafe {
                     ctx.device.cmd_begin_rendering(cmd, &info);
                     ctx.device.cmd_set_viewport(
                         cmd,
                         0,
-                        &[vk::Viewport { x: 0.0, y: 0.0, width: width as f32, height: height as f32, min_depth: 0.0, max_depth: 1.0 }],
+                        &[vk::Viewport {
+                            x: 0.0,
+                            y: 0.0,
+                            width: width as f32,
+                            height: height as f32,
+                            min_depth: 0.0,
+                            max_depth: 1.0,
+                        }],
                     );
                     ctx.device.cmd_set_scissor(cmd, 0, &[area]);
                 }
@@ -192,15 +274,34 @@ impl Renderer {
                 profiler.end(cmd);
                 ctx.barrier(
                     cmd,
-                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
-                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE),
+                    (
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                        vk::AccessFlags2::MEMORY_WRITE,
+                    ),
+                    (
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                        vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
+                    ),
                 );
                 // SAFETY: the barrier above orders the shader writes before this copy.
                 unsafe {
-                    ctx.device.cmd_copy_buffer(cmd, hair.indirect.raw, stat.raw, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: INDIRECT_BYTES }])
+                    ctx.device.cmd_copy_buffer(
+                        cmd,
+                        hair.indirect.raw,
+                        stat.raw,
+                        &[vk::BufferCopy {
+                            src_offset: 0,
+                            dst_offset: 0,
+                            size: INDIRECT_BYTES,
+                        }],
+                    )
                 };
             }
-            color.transition(cmd, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+            color.transition(
+                cmd,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            );
             color.record_readback(cmd)
         })??;
         let rgba = readback.read()?;
@@ -218,25 +319,70 @@ impl Renderer {
                 None => pass_ms.push((name, ms)),
             }
         }
-        Ok(RenderOutput { width, height, rgba, pass_ms, strands, triangles, path })
+        Ok(RenderOutput {
+            width,
+            height,
+            rgba,
+            pass_ms,
+            strands,
+            triangles,
+            path,
+        })
     }
 
     /// Read back the compute path's generated vertices of `hair` (`[x, y, z, width, tx, ty, tz,
     /// s]` each, bundle-major) and the number of strands of the last render.
     pub fn read_vertices(&self, hair: &HairGpu) -> GpuResult<(Vec<[f32; 8]>, u32)> {
         let ctx = &self.ctx;
-        let mut verts = Buffer::new(ctx, &BufferDesc::new("vertex readback", hair.vertices.size, vk::BufferUsageFlags::TRANSFER_DST).readback())?;
-        let mut ind = Buffer::new(ctx, &BufferDesc::new("indirect readback", INDIRECT_BYTES, vk::BufferUsageFlags::TRANSFER_DST).readback())?;
+        let mut verts = Buffer::new(
+            ctx,
+            &BufferDesc::new(
+                "vertex readback",
+                hair.vertices.size,
+                vk::BufferUsageFlags::TRANSFER_DST,
+            )
+            .readback(),
+        )?;
+        let mut ind = Buffer::new(
+            ctx,
+            &BufferDesc::new(
+                "indirect readback",
+                INDIRECT_BYTES,
+                vk::BufferUsageFlags::TRANSFER_DST,
+            )
+            .readback(),
+        )?;
         ctx.submit_and_wait(|cmd| {
             // SAFETY: both copies are within the buffers' sizes.
             unsafe {
-                ctx.device.cmd_copy_buffer(cmd, hair.vertices.raw, verts.raw, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: hair.vertices.size }]);
-                ctx.device.cmd_copy_buffer(cmd, hair.indirect.raw, ind.raw, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: INDIRECT_BYTES }]);
+                ctx.device.cmd_copy_buffer(
+                    cmd,
+                    hair.vertices.raw,
+                    verts.raw,
+                    &[vk::BufferCopy {
+                        src_offset: 0,
+                        dst_offset: 0,
+                        size: hair.vertices.size,
+                    }],
+                );
+                ctx.device.cmd_copy_buffer(
+                    cmd,
+                    hair.indirect.raw,
+                    ind.raw,
+                    &[vk::BufferCopy {
+                        src_offset: 0,
+                        dst_offset: 0,
+                        size: INDIRECT_BYTES,
+                    }],
+                );
             }
         })?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&ind.read()?);
         let n = (words[9] as u64 * HAIR_VERTEX_BYTES) as usize;
         let bytes = verts.read()?;
-        Ok((bytemuck::pod_collect_to_vec(&bytes[..n.min(bytes.len())]), words[3]))
+        Ok((
+            bytemuck::pod_collect_to_vec(&bytes[..n.min(bytes.len())]),
+            words[3],
+        ))
     }
 }

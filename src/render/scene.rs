@@ -127,11 +127,11 @@ impl SceneDesc {
                     format!("character {i}: non-finite transform or scale <= 0"),
                 ));
             }
-            if c.strands_per_bundle == 0 || c.strands_per_bundle > 4096 || c.verts_log2 > 8 {
+            if c.strands_per_bundle == 0 || c.strands_per_bundle > 4096 || c.verts_log2 > 6 {
                 return Err(HairError::invalid(
                     &name,
                     format!(
-                        "character {i}: strands_per_bundle must be 1..=4096 and verts_log2 <= 8"
+                        "character {i}: strands_per_bundle must be 1..=4096 and verts_log2 <= 6"
                     ),
                 ));
             }

@@ -468,7 +468,10 @@ impl Context {
 }
 
 /// Destroy an instance (and its messenger) when device creation fails half-way.
-fn destroy_instance(instance: &ash::Instance, debug: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>) {
+fn destroy_instance(
+    instance: &ash::Instance,
+    debug: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+) {
     // SAFETY: no device was created from this instance.
     unsafe {
         if let Some((loader, messenger)) = debug {

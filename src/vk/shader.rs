@@ -15,8 +15,14 @@ pub const SOURCES: &[(&str, &str)] = &[
         "strand_eval.glsl",
         include_str!("../../glsl/strand_eval.glsl"),
     ),
-    ("bundle_lod.glsl", include_str!("../../glsl/bundle_lod.glsl")),
-    ("strand_build.glsl", include_str!("../../glsl/strand_build.glsl")),
+    (
+        "bundle_lod.glsl",
+        include_str!("../../glsl/bundle_lod.glsl"),
+    ),
+    (
+        "strand_build.glsl",
+        include_str!("../../glsl/strand_build.glsl"),
+    ),
     ("strip.glsl", include_str!("../../glsl/strip.glsl")),
     ("strands.task", include_str!("../../glsl/strands.task")),
     ("strands.mesh", include_str!("../../glsl/strands.mesh")),

@@ -8,7 +8,9 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 use hairmesh::render::scene::load_mesh;
-use hairmesh::render::{Camera, HairGpu, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer, StrandParams};
+use hairmesh::render::{
+    Camera, HairGpu, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer, StrandParams,
+};
 use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakedHairMesh, HairStyle};
 
@@ -49,21 +51,51 @@ pub fn light() -> Vec3 {
 
 /// Compute path, LoD off: the settings the golden images were made with.
 pub fn compute_full() -> RenderSettings {
-    RenderSettings { path: Some(RenderPath::Compute), lod: LodSettings::off() }
+    RenderSettings {
+        path: Some(RenderPath::Compute),
+        lod: LodSettings::off(),
+    }
 }
 
 /// Render one sample mesh on the compute path without LoD.
-pub fn render_sample(ctx: &Arc<Context>, name: &str, n: u32, e: u32, size: u32, camera: Option<Camera>) -> RenderOutput {
+pub fn render_sample(
+    ctx: &Arc<Context>,
+    name: &str,
+    n: u32,
+    e: u32,
+    size: u32,
+    camera: Option<Camera>,
+) -> RenderOutput {
     render_sample_with(ctx, name, n, e, size, camera, &compute_full())
 }
 
 /// Render one sample mesh with explicit settings.
-pub fn render_sample_with(ctx: &Arc<Context>, name: &str, n: u32, e: u32, size: u32, camera: Option<Camera>, settings: &RenderSettings) -> RenderOutput {
+pub fn render_sample_with(
+    ctx: &Arc<Context>,
+    name: &str,
+    n: u32,
+    e: u32,
+    size: u32,
+    camera: Option<Camera>,
+    settings: &RenderSettings,
+) -> RenderOutput {
     let (baked, style) = sample(name);
     let mut r = Renderer::new(ctx).unwrap();
-    let hair = HairGpu::new(ctx, &r.sampler, &baked, &style, StrandParams { strands_per_bundle: n, verts_log2: e }, Mat4::IDENTITY).unwrap();
+    let hair = HairGpu::new(
+        ctx,
+        &r.sampler,
+        &baked,
+        &style,
+        StrandParams {
+            strands_per_bundle: n,
+            verts_log2: e,
+        },
+        Mat4::IDENTITY,
+    )
+    .unwrap();
     let cam = camera.unwrap_or_else(|| framing(&baked));
-    r.render(&[hair], &cam, light(), size, size, settings).unwrap()
+    r.render(&[hair], &cam, light(), size, size, settings)
+        .unwrap()
 }
 
 pub fn output_dir() -> PathBuf {
