@@ -6,6 +6,9 @@
 #ifndef STRAND_BUILD_GLSL
 #define STRAND_BUILD_GLSL
 
+// Vertices each thread owns in the tangent / morph phases: ceil((MAX_SEGMENTS + 1) / S).
+#define PER_THREAD ((MAX_SEGMENTS + S) / S)
+
 shared vec3 sp[MAX_SEGMENTS + 1u];   // positions
 shared vec3 st[MAX_SEGMENTS + 1u];   // tangents
 
@@ -58,9 +61,9 @@ void build_strand(StrandInfo si, uint segments, float gamma, uint t) {
     }
     barrier();
     // Tangents from the unmorphed positions, blended toward the coarse tangents by gamma.
-    vec3 tl[2];
+    vec3 tl[PER_THREAD];
     uint cnt = 0u;
-    for (uint k = t; k <= segments && cnt < 2u; k += S) {
+    for (uint k = t; k <= segments && cnt < PER_THREAD; k += S) {
         vec3 tk = tangent_at(k, segments);
         if (gamma > 0.0 && segments >= 2u) {
             tk = safe_normalize(mix(tk, coarse_tangent_at(k, segments), gamma), tk);
@@ -69,13 +72,13 @@ void build_strand(StrandInfo si, uint segments, float gamma, uint t) {
     }
     barrier();
     cnt = 0u;
-    for (uint k = t; k <= segments && cnt < 2u; k += S) {
+    for (uint k = t; k <= segments && cnt < PER_THREAD; k += S) {
         st[k] = tl[cnt++];
     }
     // Eq. 11: odd vertices move toward the midpoint of their even neighbours.
-    vec3 morphed[2];
+    vec3 morphed[PER_THREAD];
     cnt = 0u;
-    for (uint k = t; k <= segments && cnt < 2u; k += S) {
+    for (uint k = t; k <= segments && cnt < PER_THREAD; k += S) {
         vec3 pk = sp[k];
         if (gamma > 0.0 && (k & 1u) == 1u && k < segments) {
             pk = mix(pk, 0.5 * (sp[k - 1u] + sp[k + 1u]), gamma);
@@ -84,7 +87,7 @@ void build_strand(StrandInfo si, uint segments, float gamma, uint t) {
     }
     barrier();
     cnt = 0u;
-    for (uint k = t; k <= segments && cnt < 2u; k += S) {
+    for (uint k = t; k <= segments && cnt < PER_THREAD; k += S) {
         sp[k] = morphed[cnt++];
     }
     barrier();
