@@ -30,7 +30,8 @@ layout(set = 0, binding = 7) uniform sampler3D tex_v;
 layout(set = 0, binding = 8, std430) readonly buffer RootSamples { vec2 root_samples[]; };
 
 // Per-bundle LoD decision (x: strands, y: vertex level e, z: gamma bits, w: thickness bits) and
-// exclusive prefix sums (x: first strand, y: first vertex slot, z: first draw vertex).
+// exclusive prefix sums (x: first strand, y: first vertex slot, z: first draw vertex,
+// w: first compute workgroup).
 layout(set = 0, binding = 9, std430) buffer Counts { uvec4 bundle_lods[]; };
 layout(set = 0, binding = 10, std430) buffer Offsets { uvec4 bundle_offsets[]; };
 // Indirect arguments: VkDispatchIndirectCommand then VkDrawIndirectCommand.
@@ -45,7 +46,7 @@ layout(set = 0, binding = 11, std430) buffer Indirect {
     uint draw_first_instance;
     uint total_triangles;   // strand triangles generated (both paths)
     uint total_vertex_slots;
-    uint pad0;
+    uint total_groups;      // compute path: strand-building workgroups
     uint pad1;
 } indirect;
 

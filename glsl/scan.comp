@@ -6,12 +6,17 @@
 layout(local_size_x = 256) in;
 #include "bindings.glsl"
 
-shared uvec3 partial[256];
+shared uvec4 partial[256];
 
-uvec3 bundle_sizes(uint i) {
+#define S 32u
+
+// Strands, vertex slots, draw vertices and workgroups (strand_build.glsl packs
+// max(S / segments, 1) strands per workgroup) of bundle i.
+uvec4 bundle_sizes(uint i) {
     uvec4 l = bundle_lods[i];
     uint segments = 1u << l.y;
-    return uvec3(l.x, l.x * (segments + 1u), l.x * segments * 6u);
+    uint per = max(S / segments, 1u);
+    return uvec4(l.x, l.x * (segments + 1u), l.x * segments * 6u, (l.x + per - 1u) / per);
 }
 
 void main() {
@@ -20,24 +25,25 @@ void main() {
     uint chunk = (count + 255u) / 256u;
     uint begin = min(t * chunk, count);
     uint end = min(begin + chunk, count);
-    uvec3 sum = uvec3(0u);
+    uvec4 sum = uvec4(0u);
     for (uint i = begin; i < end; i++) {
         sum += bundle_sizes(i);
     }
     partial[t] = sum;
     barrier();
     if (t == 0u) {
-        uvec3 run = uvec3(0u);
+        uvec4 run = uvec4(0u);
         for (uint i = 0u; i < 256u; i++) {
-            uvec3 v = partial[i];
+            uvec4 v = partial[i];
             partial[i] = run;
             run += v;
         }
         indirect.total_strands = run.x;
         indirect.total_vertex_slots = run.y;
         indirect.total_triangles = run.z / 3u;
-        indirect.dispatch_x = min(run.x, DISPATCH_ROW);
-        indirect.dispatch_y = (run.x + DISPATCH_ROW - 1u) / DISPATCH_ROW;
+        indirect.total_groups = run.w;
+        indirect.dispatch_x = min(run.w, DISPATCH_ROW);
+        indirect.dispatch_y = (run.w + DISPATCH_ROW - 1u) / DISPATCH_ROW;
         indirect.dispatch_z = 1u;
         indirect.draw_vertex_count = run.z;
         indirect.draw_instance_count = 1u;
@@ -45,9 +51,9 @@ void main() {
         indirect.draw_first_instance = 0u;
     }
     barrier();
-    uvec3 run = partial[t];
+    uvec4 run = partial[t];
     for (uint i = begin; i < end; i++) {
-        bundle_offsets[i] = uvec4(run, 0u);
+        bundle_offsets[i] = run;
         run += bundle_sizes(i);
     }
 }

@@ -31,7 +31,6 @@ pub struct RenderSettings {
     pub lod: LodSettings,
 }
 
-
 /// A rendered frame and what it cost.
 pub struct RenderOutput {
     /// Width in pixels.
