@@ -3,9 +3,9 @@
 mod common;
 
 use common::*;
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use hairmesh::CpuGenerator;
-use hairmesh::render::{HairGpu, Renderer, StrandParams};
+use hairmesh::render::Renderer;
 
 #[test]
 fn gpu_strands_match_cpu_oracle() {
@@ -18,18 +18,7 @@ fn gpu_strands_match_cpu_oracle() {
     ] {
         let (baked, style) = sample(name);
         let mut r = Renderer::new(&ctx).unwrap();
-        let hair = HairGpu::new(
-            &ctx,
-            &r.sampler,
-            &baked,
-            &style,
-            StrandParams {
-                strands_per_bundle: n,
-                verts_log2: e,
-            },
-            Mat4::IDENTITY,
-        )
-        .unwrap();
+        let hair = upload(&ctx, &r, &baked, &style, n, e);
         // Far camera: every bundle is inside the frustum, nothing is culled.
         let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
         let ext = Vec3::from_slice(&baked.info.pos_extent[..3]);

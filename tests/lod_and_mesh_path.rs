@@ -5,11 +5,9 @@
 mod common;
 
 use common::*;
-use glam::{Mat4, Vec3};
-use hairmesh::lod::{LodView, bundle_lod};
-use hairmesh::render::{
-    Camera, HairGpu, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer, StrandParams,
-};
+use glam::Vec3;
+use hairmesh::lod::bundle_lod;
+use hairmesh::render::{Camera, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer};
 use hairmesh::{CpuGenerator, generate::strands_in_bundle};
 
 const SIZE: u32 = 160;
@@ -119,15 +117,7 @@ fn triangle_counts_follow_cpu_lod_functions() {
             Some(cam),
             &settings(RenderPath::Mesh, true),
         );
-        let lod = LodSettings::default();
-        let view = LodView {
-            eye: cam.eye,
-            resolution: SIZE as f32,
-            tan_fov: cam.fov_y.tan(),
-            alpha_strands: lod.alpha_strands,
-            alpha_verts: lod.alpha_verts,
-            lambda: lod.lambda,
-        };
+        let view = lod_view(&cam, SIZE);
         let expected: u64 = baked
             .bundles
             .iter()
@@ -179,26 +169,11 @@ fn gpu_lod_strands_match_cpu_oracle() {
     let (n, e) = (8, 5);
     let cam = dolly(name, 3.0);
     let mut r = Renderer::new(&ctx).unwrap();
-    let hair = HairGpu::new(
-        &ctx,
-        &r.sampler,
-        &baked,
-        &style,
-        StrandParams {
-            strands_per_bundle: n,
-            verts_log2: e,
-        },
-        Mat4::IDENTITY,
-    )
-    .unwrap();
-    // A wide camera at the same position: nothing culled, LoD from the same eye.
-    let wide = Camera {
-        fov_y: cam.fov_y,
-        ..cam
-    };
+    let hair = upload(&ctx, &r, &baked, &style, n, e);
+
     r.render(
         std::slice::from_ref(&hair),
-        &wide,
+        &cam,
         light(),
         SIZE,
         SIZE,
@@ -206,15 +181,7 @@ fn gpu_lod_strands_match_cpu_oracle() {
     )
     .unwrap();
     let (gpu, strands) = r.read_vertices(&hair).unwrap();
-    let lod = LodSettings::default();
-    let view = LodView {
-        eye: cam.eye,
-        resolution: SIZE as f32,
-        tan_fov: cam.fov_y.tan(),
-        alpha_strands: lod.alpha_strands,
-        alpha_verts: lod.alpha_verts,
-        lambda: lod.lambda,
-    };
+    let view = lod_view(&cam, SIZE);
     let (cpu, counts) = CpuGenerator::new(&baked, style).generate_lod(n, e, &baked, &view);
     assert_eq!(strands as usize, counts.len(), "strand count");
     assert_eq!(gpu.len(), cpu.positions.len(), "vertex count");

@@ -81,18 +81,7 @@ pub fn render_sample_with(
 ) -> RenderOutput {
     let (baked, style) = sample(name);
     let mut r = Renderer::new(ctx).unwrap();
-    let hair = HairGpu::new(
-        ctx,
-        &r.sampler,
-        &baked,
-        &style,
-        StrandParams {
-            strands_per_bundle: n,
-            verts_log2: e,
-        },
-        Mat4::IDENTITY,
-    )
-    .unwrap();
+    let hair = upload(ctx, &r, &baked, &style, n, e);
     let cam = camera.unwrap_or_else(|| framing(&baked));
     r.render(&[hair], &cam, light(), size, size, settings)
         .unwrap()
@@ -109,4 +98,33 @@ pub fn save_png(path: &Path, w: u32, h: u32, rgba: &[u8]) {
         .unwrap()
         .save(path)
         .unwrap();
+}
+
+/// Upload a mesh with `n` strands per bundle and `2^e + 1` vertices, identity transform.
+pub fn upload(
+    ctx: &Arc<Context>,
+    r: &Renderer,
+    baked: &BakedHairMesh,
+    style: &HairStyle,
+    n: u32,
+    e: u32,
+) -> HairGpu {
+    let params = StrandParams {
+        strands_per_bundle: n,
+        verts_log2: e,
+    };
+    HairGpu::new(ctx, &r.sampler, baked, style, params, Mat4::IDENTITY).unwrap()
+}
+
+/// The LoD inputs the shaders see for `cam` at `size` pixels with default LoD settings.
+pub fn lod_view(cam: &Camera, size: u32) -> hairmesh::lod::LodView {
+    let lod = LodSettings::default();
+    hairmesh::lod::LodView {
+        eye: cam.eye,
+        resolution: size as f32,
+        tan_fov: cam.fov_y.tan(),
+        alpha_strands: lod.alpha_strands,
+        alpha_verts: lod.alpha_verts,
+        lambda: lod.lambda,
+    }
 }
