@@ -81,6 +81,14 @@ fn mesh_path_matches_compute_path() {
             &settings(RenderPath::Compute, lod),
         );
         assert_eq!(mesh.path, RenderPath::Mesh);
+        // The task shader's counters agree with the device's mesh primitive query.
+        assert_eq!(mesh.mesh_primitives_query.is_some(), ctx.info.mesh_queries);
+        if let Some(q) = mesh.mesh_primitives_query {
+            assert_eq!(
+                q, mesh.triangles,
+                "{name}: MESH_PRIMITIVES_GENERATED_EXT vs task counters"
+            );
+        }
         assert_eq!(
             mesh.triangles, compute.triangles,
             "{name}: triangle counts differ"

@@ -237,6 +237,9 @@ fn run(args: Args) -> Result<()> {
         width,
         height
     );
+    if let Some(q) = out.mesh_primitives_query {
+        println!("  mesh primitives generated (VK_EXT_mesh_shader query): {q}");
+    }
     for (pass, ms) in &out.pass_ms {
         println!("  gpu {pass:<10} {ms:9.3} ms");
     }

@@ -10,7 +10,7 @@ use super::draw::{COLOR_FORMAT, DEPTH_FORMAT, HairDraw};
 use super::frame::{Camera, FrameParams, LodSettings};
 use super::hair_gpu::{HAIR_VERTEX_BYTES, HairGpu, INDIRECT_BYTES};
 use crate::vk::image::Sampler;
-use crate::vk::profiler::Profiler;
+use crate::vk::profiler::{MeshPrimitivesQuery, Profiler};
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult, Image, ImageDesc};
 
 /// Which generation path draws the strands.
@@ -47,6 +47,9 @@ pub struct RenderOutput {
     pub triangles: u64,
     /// The path used.
     pub path: RenderPath,
+    /// Mesh path: primitives the mesh shaders emitted, from `MESH_PRIMITIVES_GENERATED_EXT`
+    /// queries where the device supports them.
+    pub mesh_primitives_query: Option<u64>,
 }
 
 struct Pipelines {
@@ -154,10 +157,18 @@ impl Renderer {
                 )
             })
             .collect::<GpuResult<_>>()?;
+        let mesh_query = if path == RenderPath::Mesh {
+            MeshPrimitivesQuery::new(&ctx, hairs.len() as u32)?
+        } else {
+            None
+        };
         let profiler = &mut self.profiler;
         let background = self.background;
         let mut readback = ctx.submit_and_wait(|cmd| -> GpuResult<Buffer> {
             profiler.reset(cmd);
+            if let Some(q) = &mesh_query {
+                q.reset(cmd);
+            }
             color.transition(
                 cmd,
                 vk::ImageLayout::UNDEFINED,
@@ -266,7 +277,15 @@ impl Renderer {
                 pipelines.draw.record_scalp(cmd, hair);
                 match path {
                     RenderPath::Compute => pipelines.draw.record_pulled_strands(cmd, hair),
-                    RenderPath::Mesh => pipelines.draw.record_mesh_strands(cmd, hair),
+                    RenderPath::Mesh => {
+                        if let Some(q) = &mesh_query {
+                            q.begin(cmd, i as u32);
+                        }
+                        pipelines.draw.record_mesh_strands(cmd, hair);
+                        if let Some(q) = &mesh_query {
+                            q.end(cmd, i as u32);
+                        }
+                    }
                 }
                 // SAFETY: matching begin above.
                 unsafe { ctx.device.cmd_end_rendering(cmd) };
@@ -311,6 +330,10 @@ impl Renderer {
             strands += words[3] as u64;
             triangles += words[8] as u64;
         }
+        let mesh_primitives_query = match &mesh_query {
+            Some(q) => Some(q.total(hairs.len() as u32)?),
+            None => None,
+        };
         let mut pass_ms: Vec<(String, f64)> = Vec::new();
         for (name, ms) in self.profiler.results()? {
             match pass_ms.iter_mut().find(|(n, _)| *n == name) {
@@ -326,6 +349,7 @@ impl Renderer {
             strands,
             triangles,
             path,
+            mesh_primitives_query,
         })
     }
 

@@ -45,6 +45,8 @@ pub struct DeviceInfo {
     pub timestamp_period: f32,
     /// Whether VK_EXT_mesh_shader (task + mesh) is available and enabled.
     pub mesh_shader: bool,
+    /// Whether VK_EXT_mesh_shader queries (`MESH_PRIMITIVES_GENERATED_EXT`) are enabled.
+    pub mesh_queries: bool,
     /// Mesh shader limits, when available.
     pub mesh_limits: Option<vk::PhysicalDeviceMeshShaderPropertiesEXT<'static>>,
 }
@@ -348,6 +350,7 @@ impl Context {
                 driver,
                 timestamp_period: props.limits.timestamp_period,
                 mesh_shader: mesh_ok,
+                mesh_queries: mesh_ok && mesh_features.mesh_shader_queries != 0,
                 mesh_limits,
             },
         })

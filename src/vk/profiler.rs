@@ -113,3 +113,91 @@ impl Drop for Profiler {
         unsafe { self.ctx.device.destroy_query_pool(self.pool, None) };
     }
 }
+
+/// A `MESH_PRIMITIVES_GENERATED_EXT` query per slot (VK_EXT_mesh_shader queries): counts the
+/// primitives mesh shaders emit between `begin` and `end`.
+pub struct MeshPrimitivesQuery {
+    ctx: Arc<Context>,
+    pool: vk::QueryPool,
+    slots: u32,
+}
+
+impl MeshPrimitivesQuery {
+    /// `slots` queries; `None` where the device has no mesh shader queries.
+    pub fn new(ctx: &Arc<Context>, slots: u32) -> GpuResult<Option<Self>> {
+        if !ctx.info.mesh_queries || slots == 0 {
+            return Ok(None);
+        }
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::MESH_PRIMITIVES_GENERATED_EXT)
+            .query_count(slots);
+        // SAFETY: valid create info; the query type is enabled (meshShaderQueries).
+        let pool =
+            unsafe { ctx.device.create_query_pool(&info, None) }.ctx("create mesh query pool")?;
+        Ok(Some(MeshPrimitivesQuery {
+            ctx: ctx.clone(),
+            pool,
+            slots,
+        }))
+    }
+
+    /// Reset all slots (outside a render pass instance).
+    pub fn reset(&self, cmd: vk::CommandBuffer) {
+        // SAFETY: recording; range within the pool.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_reset_query_pool(cmd, self.pool, 0, self.slots)
+        };
+    }
+
+    /// Start counting into `slot`.
+    pub fn begin(&self, cmd: vk::CommandBuffer, slot: u32) {
+        // SAFETY: recording; slot reset this frame.
+        unsafe {
+            self.ctx.device.cmd_begin_query(
+                cmd,
+                self.pool,
+                slot.min(self.slots - 1),
+                vk::QueryControlFlags::empty(),
+            )
+        };
+    }
+
+    /// Stop counting into `slot`.
+    pub fn end(&self, cmd: vk::CommandBuffer, slot: u32) {
+        // SAFETY: matches `begin` in the same render pass instance.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_end_query(cmd, self.pool, slot.min(self.slots - 1))
+        };
+    }
+
+    /// Sum of the first `used` slots after the submission completed.
+    pub fn total(&self, used: u32) -> GpuResult<u64> {
+        let used = used.min(self.slots);
+        if used == 0 {
+            return Ok(0);
+        }
+        let mut data = vec![0u64; used as usize];
+        // SAFETY: the submission completed; WAIT makes results available.
+        unsafe {
+            self.ctx.device.get_query_pool_results(
+                self.pool,
+                0,
+                &mut data,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .ctx("mesh query results")?;
+        Ok(data.iter().sum())
+    }
+}
+
+impl Drop for MeshPrimitivesQuery {
+    fn drop(&mut self) {
+        // SAFETY: not in use once dropped.
+        unsafe { self.ctx.device.destroy_query_pool(self.pool, None) };
+    }
+}
