@@ -82,31 +82,25 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
     }
     barrier();
     uint entries = per * stride;
-    // Tangents from the unmorphed positions, blended toward the coarse tangents by gamma.
+    // Tangents from the unmorphed positions, blended toward the coarse tangents by gamma, and
+    // eq. 11: odd vertices move toward the midpoint of their even neighbours. Both read the
+    // unmorphed positions, so results are written back after a barrier.
     vec3 tl[PER_THREAD];
-    for (uint i = 0u; i < PER_THREAD; i++) {
-        uint idx = t + i * S;
-        if (idx < entries) {
-            uint base = (idx / stride) * stride;
-            uint k = idx - base;
-            vec3 tk = tangent_at(base, k, segments);
-            if (gamma > 0.0 && segments >= 2u) {
-                tk = safe_normalize(mix(tk, coarse_tangent_at(base, k, segments), gamma), tk);
-            }
-            tl[i] = tk;
-        }
-    }
-    // Eq. 11: odd vertices move toward the midpoint of their even neighbours.
     vec3 morphed[PER_THREAD];
     for (uint i = 0u; i < PER_THREAD; i++) {
         uint idx = t + i * S;
         if (idx < entries) {
             uint base = (idx / stride) * stride;
             uint k = idx - base;
+            vec3 tk = tangent_at(base, k, segments);
             vec3 pk = sp[idx];
-            if (gamma > 0.0 && (k & 1u) == 1u && k < segments) {
-                pk = mix(pk, 0.5 * (sp[idx - 1u] + sp[idx + 1u]), gamma);
+            if (gamma > 0.0 && segments >= 2u) {
+                tk = safe_normalize(mix(tk, coarse_tangent_at(base, k, segments), gamma), tk);
+                if ((k & 1u) == 1u && k < segments) {
+                    pk = mix(pk, 0.5 * (sp[idx - 1u] + sp[idx + 1u]), gamma);
+                }
             }
+            tl[i] = tk;
             morphed[i] = pk;
         }
     }
