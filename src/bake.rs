@@ -15,7 +15,7 @@
 //! take half the memory of 32-bit floats.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat2, Vec2, Vec3};
+use glam::{Mat2, Vec3};
 
 use crate::curve::column_control_points;
 use crate::error::{HairError, Result};
@@ -361,10 +361,4 @@ pub fn bake(
 /// Root-slice statistics of a bake, for reports.
 pub fn texels_per_face(baked: &BakedHairMesh) -> f32 {
     baked.info.slice_texels() as f32 / baked.bundles.len().max(1) as f32
-}
-
-/// Convenience: the uv extent as a vector (decode of the uv-texture).
-pub fn uv_decode(info: &MeshInfo) -> (Vec2, Vec2) {
-    let e = info.uv_origin_extent;
-    (Vec2::new(e[0], e[1]), Vec2::new(e[2], e[3]))
 }

@@ -140,8 +140,8 @@ pub struct LodView {
     pub eye: Vec3,
     /// Vertical resolution `R` in pixels.
     pub resolution: f32,
-    /// `tan(theta)` of eq. 7 with `theta` the vertical field of view.
-    pub tan_fov: f32,
+    /// Vertical field of view `theta` of eq. 7, radians.
+    pub fov_y: f32,
     /// Alpha for strand LoD.
     pub alpha_strands: f32,
     /// Alpha for vertex LoD.
@@ -204,28 +204,16 @@ pub fn bundle_lod(
     let (lo, hi) = bundle_bounds(baked, b, margin);
     let d = view.eye.distance(view.eye.clamp(lo, hi));
     let h = baked.bundles[b].rest_size;
-    let level =
-        |alpha: f32| (h * view.resolution * alpha / (d.max(1e-6) * view.tan_fov)).clamp(0.0, 1.0);
-    let ls = level(view.alpha_strands);
-    let strands = if ls > 0.0 {
-        ((ls * (n as f32 + bundle_delta(b as u32, style.seed))).ceil() as u32).clamp(1, n)
-    } else {
-        0
-    };
-    let lv = level(view.alpha_verts);
-    let x = (lv * (1u32 << e_max) as f32).max(1e-30).log2();
-    let e = x.ceil().clamp(0.0, e_max as f32) as u32;
-    let lambda = view.lambda.clamp(1e-6, 1.0);
-    let e_next = (x - lambda).ceil().max(0.0);
-    let gamma = if e as f32 > e_next && e > 0 {
-        (1.0 - (x - e_next) / lambda).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let ls = detail_level(h, view.resolution, d, view.fov_y, view.alpha_strands);
+    let strands = strands_at_level(ls, n, bundle_delta(b as u32, style.seed));
+    let lv = detail_level(h, view.resolution, d, view.fov_y, view.alpha_verts);
+    let ns = 1u32 << e_max;
+    let e = vertex_level(lv, ns);
+    let (_, gamma) = geomorph(lv, ns, view.lambda);
     BundleLod {
         strands,
         e,
         gamma,
-        thickness: (1.0 / ls.max(1e-6)).min(n as f32),
+        thickness: thickness_scale(ls, n),
     }
 }

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 
 use crate::bake::{BakedHairMesh, MeshInfo};
 use crate::blue_noise::{quad_samples, triangle_samples};
@@ -49,8 +49,6 @@ pub struct HairGpu {
     pub model: Mat4,
     /// Generation parameters.
     pub params: StrandParams,
-    /// Upper bound on generated strands (no culling).
-    pub max_strands: u64,
     /// Per-frame uniforms.
     pub frame: Buffer,
     /// Generated vertices (`HairVertex`).
@@ -59,8 +57,6 @@ pub struct HairGpu {
     pub indirect: Buffer,
     /// Descriptor set 0.
     pub set: DescriptorSet,
-    /// Object-space bounds of the control points.
-    pub bounds: (Vec3, Vec3),
     _keep: Vec<Buffer>,
     _images: Vec<Image>,
 }
@@ -195,18 +191,14 @@ impl HairGpu {
                 Binding::Storage(&vertices),
             ],
         )?;
-        let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
-        let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
         Ok(HairGpu {
             info: baked.info,
             model,
             params,
-            max_strands,
             frame,
             vertices,
             indirect,
             set,
-            bounds: (o, o + e),
             _keep: vec![mesh, bundles, samples, counts, offsets],
             _images: images,
         })

@@ -122,7 +122,7 @@ pub fn lod_view(cam: &Camera, size: u32) -> hairmesh::lod::LodView {
     hairmesh::lod::LodView {
         eye: cam.eye,
         resolution: size as f32,
-        tan_fov: cam.fov_y.tan(),
+        fov_y: cam.fov_y,
         alpha_strands: lod.alpha_strands,
         alpha_verts: lod.alpha_verts,
         lambda: lod.lambda,
