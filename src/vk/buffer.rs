@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::vulkan::Allocation;
 
 use super::{Context, GpuError, GpuResult, VkContext};
 
@@ -66,27 +66,24 @@ impl Buffer {
         let raw = unsafe { ctx.device.create_buffer(&info, None) }.ctx("create buffer")?;
         // SAFETY: `raw` was just created on this device.
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
-        let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
-            name: &desc.name,
+        let allocation = ctx.allocate_bound(
+            &desc.name,
             requirements,
-            location: desc.location,
-            linear: true,
-            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-        });
+            desc.location,
+            true,
+            |memory, offset| {
+                // SAFETY: memory from the allocator matches the requirements of `raw`.
+                unsafe { ctx.device.bind_buffer_memory(raw, memory, offset) }
+            },
+        );
         let allocation = match allocation {
             Ok(a) => a,
             Err(e) => {
                 // SAFETY: unbound buffer, not in use.
                 unsafe { ctx.device.destroy_buffer(raw, None) };
-                return Err(GpuError::Alloc(e));
+                return Err(e);
             }
         };
-        // SAFETY: memory from the allocator matches the requirements of `raw`.
-        unsafe {
-            ctx.device
-                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
-        }
-        .ctx("bind buffer memory")?;
         ctx.name_object(raw, &desc.name);
         Ok(Buffer {
             ctx: ctx.clone(),

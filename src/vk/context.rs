@@ -361,6 +361,37 @@ impl Context {
         self.allocator.lock().unwrap_or_else(|e| e.into_inner())
     }
 
+    /// Allocate memory for `requirements` and bind it with `bind(memory, offset)`; the
+    /// allocation is freed again if binding fails. Callers destroy their object on error.
+    pub(crate) fn allocate_bound(
+        &self,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: gpu_allocator::MemoryLocation,
+        linear: bool,
+        bind: impl FnOnce(vk::DeviceMemory, u64) -> Result<(), vk::Result>,
+    ) -> GpuResult<gpu_allocator::vulkan::Allocation> {
+        let allocation =
+            self.allocator()
+                .allocate(&gpu_allocator::vulkan::AllocationCreateDesc {
+                    name,
+                    requirements,
+                    location,
+                    linear,
+                    allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
+                })?;
+        // SAFETY: the memory handle is only passed to `bind`, while the allocation is alive.
+        let memory = unsafe { allocation.memory() };
+        if let Err(result) = bind(memory, allocation.offset()) {
+            let _ = self.allocator().free(allocation);
+            return Err(GpuError::Vk {
+                what: "bind memory",
+                result,
+            });
+        }
+        Ok(allocation)
+    }
+
     /// Number of validation errors reported so far (0 when validation is off).
     pub fn validation_errors(&self) -> u32 {
         self.debug_state.errors.load(Ordering::SeqCst)

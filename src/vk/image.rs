@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::vulkan::Allocation;
 
 use super::buffer::{Buffer, BufferDesc};
 use super::{Context, GpuError, GpuResult, VkContext};
@@ -112,27 +112,24 @@ impl Image {
         let raw = unsafe { ctx.device.create_image(&info, None) }.ctx("create image")?;
         // SAFETY: `raw` belongs to this device.
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
-        let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
-            name: &desc.name,
+        let allocation = ctx.allocate_bound(
+            &desc.name,
             requirements,
-            location: MemoryLocation::GpuOnly,
-            linear: false,
-            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-        });
+            MemoryLocation::GpuOnly,
+            false,
+            |memory, offset| {
+                // SAFETY: memory from the allocator matches the requirements of `raw`.
+                unsafe { ctx.device.bind_image_memory(raw, memory, offset) }
+            },
+        );
         let allocation = match allocation {
             Ok(a) => a,
             Err(e) => {
                 // SAFETY: unbound image, unused.
                 unsafe { ctx.device.destroy_image(raw, None) };
-                return Err(GpuError::Alloc(e));
+                return Err(e);
             }
         };
-        // SAFETY: memory matches the image requirements.
-        unsafe {
-            ctx.device
-                .bind_image_memory(raw, allocation.memory(), allocation.offset())
-        }
-        .ctx("bind image memory")?;
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(if desc.dim_3d {
