@@ -101,7 +101,7 @@ fn bench_lod(
     )?;
     let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
     let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    let frame = Camera::framing(o, o + e, Vec3::new(0.7, 0.35, -1.0), 40.0);
+    let frame = Camera::framing(o, o + e, hairmesh::render::frame::DEFAULT_VIEW_DIR, 40.0);
     let at = |k: f32| {
         Camera::look_at(
             frame.target + (frame.eye - frame.target) * k,

@@ -195,7 +195,7 @@ fn run(args: Args) -> Result<()> {
                     hi = hi.max(p);
                 }
             }
-            Camera::framing(lo, hi, Vec3::new(0.7, 0.35, -1.0), args.fov)
+            Camera::framing(lo, hi, hairmesh::render::frame::DEFAULT_VIEW_DIR, args.fov)
         }
     };
 

@@ -3,6 +3,10 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 
+/// Default viewing direction (target toward eye) of `render`, `bench` and the tests: a 3/4 view
+/// from behind and above, where the sample heads show their hair.
+pub const DEFAULT_VIEW_DIR: Vec3 = Vec3::new(0.7, 0.35, -1.0);
+
 /// A perspective look-at camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {

@@ -42,7 +42,7 @@ pub fn sample(name: &str) -> (BakedHairMesh, HairStyle) {
 pub fn framing(baked: &BakedHairMesh) -> Camera {
     let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
     let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    Camera::framing(o, o + e, Vec3::new(0.7, 0.35, -1.0), 40.0)
+    Camera::framing(o, o + e, hairmesh::render::frame::DEFAULT_VIEW_DIR, 40.0)
 }
 
 pub fn light() -> Vec3 {
