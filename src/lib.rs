@@ -1,27 +1,21 @@
 //! Real-time strand hair from hair meshes (Bhokare, Montalvo, Diaz, Yuksel, SIGGRAPH 2024).
 //!
-//! Data flows one way: [`HairMesh`] (OBJ, [`obj_io`]) -> [`bake::bake`] -> [`BakedHairMesh`]
-//! (five textures, [`baked_file`]) -> strand generation ([`generate`] on the CPU, shaders in
-//! `glsl/` on the GPU) -> shading -> image.
+//! Data flows one way, and the modules follow it:
+//! [`model`] (hair mesh, OBJ, style) -> [`bake`] (five textures, `.hmb` file) ->
+//! [`reference`] (CPU oracle of strand generation and LoD) | [`render`] (GPU generation,
+//! shading, image) on the thin Vulkan layer [`vk`].
 
 pub mod bake;
-pub mod baked_file;
-pub mod blue_noise;
-pub mod curve;
 pub mod error;
 pub mod fsutil;
-pub mod generate;
-pub mod hair_mesh;
-pub mod layout;
-pub mod lod;
-pub mod obj_io;
+pub mod model;
+pub mod reference;
+pub mod render;
 pub mod rng;
-pub mod style;
+pub mod vk;
 
 pub use bake::{BakeOptions, BakedHairMesh, BundleDesc, MeshInfo, bake};
 pub use error::{HairError, Result};
-pub use generate::{CpuGenerator, StrandSet};
-pub use hair_mesh::{ExtrudeDesc, Face, HairMesh, extrude};
-pub use style::HairStyle;
-pub mod render;
-pub mod vk;
+pub use model::hair_mesh::{ExtrudeDesc, Face, HairMesh, extrude};
+pub use model::style::HairStyle;
+pub use reference::generate::{CpuGenerator, StrandSet};

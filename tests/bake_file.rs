@@ -2,8 +2,9 @@
 
 use std::path::Path;
 
-use hairmesh::obj_io::load_hair_mesh_obj;
-use hairmesh::{BakeOptions, HairStyle, bake, baked_file};
+use hairmesh::bake::baked_file;
+use hairmesh::model::obj_io::load_hair_mesh_obj;
+use hairmesh::{BakeOptions, HairStyle, bake};
 
 fn baked(name: &str) -> hairmesh::BakedHairMesh {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))

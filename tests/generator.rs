@@ -4,10 +4,10 @@
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
-use hairmesh::curve::{column_control_points, eval_column};
-use hairmesh::generate::{HairTextures, strand_key, styling_offset};
-use hairmesh::layout::layout_root_slice;
-use hairmesh::obj_io::load_hair_mesh_obj;
+use hairmesh::bake::curve::{column_control_points, eval_column};
+use hairmesh::bake::layout::layout_root_slice;
+use hairmesh::model::obj_io::load_hair_mesh_obj;
+use hairmesh::reference::generate::{HairTextures, strand_key, styling_offset};
 use hairmesh::{BakeOptions, CpuGenerator, Face, HairMesh, HairStyle, bake};
 
 fn mesh(name: &str) -> HairMesh {
@@ -20,7 +20,7 @@ fn mesh(name: &str) -> HairMesh {
 }
 
 /// Root-slice sample position of vertex `v` in face `f`'s cell, as a cell-local xi.
-fn corner_xi(layout: &hairmesh::layout::RootLayout, f: usize, v: u32) -> Vec2 {
+fn corner_xi(layout: &hairmesh::bake::layout::RootLayout, f: usize, v: u32) -> Vec2 {
     let [x, y] = layout.bundles[f].origin;
     for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
         if layout.texel(x + dx, y + dy) == v {

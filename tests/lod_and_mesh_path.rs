@@ -6,9 +6,9 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use hairmesh::lod::bundle_lod;
+use hairmesh::reference::lod::bundle_lod;
 use hairmesh::render::{Camera, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer};
-use hairmesh::{CpuGenerator, generate::strands_in_bundle};
+use hairmesh::{CpuGenerator, reference::generate::strands_in_bundle};
 
 const SIZE: u32 = 160;
 

@@ -1,6 +1,6 @@
 //! Every validation error of the OBJ loader: one line naming the file, the location and cause.
 
-use hairmesh::obj_io::load_hair_mesh_obj;
+use hairmesh::model::obj_io::load_hair_mesh_obj;
 
 const LAYER0: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
 const LAYER1: &str = "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";

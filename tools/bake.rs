@@ -7,9 +7,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::Parser;
+use hairmesh::bake::baked_file;
 use hairmesh::bake::{BakeOptions, texels_per_face};
-use hairmesh::obj_io::{load_hair_mesh_obj, load_scalp};
-use hairmesh::{ExtrudeDesc, HairStyle, baked_file, extrude};
+use hairmesh::model::obj_io::{load_hair_mesh_obj, load_scalp};
+use hairmesh::{ExtrudeDesc, HairStyle, extrude};
 
 /// Bake a hair mesh into the five textures of the hair-meshes paper.
 #[derive(Parser)]

@@ -15,7 +15,7 @@ use clap::{Parser, Subcommand};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
-use hairmesh::obj_io::load_hair_mesh_obj;
+use hairmesh::model::obj_io::load_hair_mesh_obj;
 use hairmesh::render::scene::load_mesh;
 use hairmesh::render::{
     Camera, HairGpu, LodSettings, RenderPath, RenderSettings, Renderer, StrandParams,

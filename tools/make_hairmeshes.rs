@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use glam::{Vec2, Vec3};
-use hairmesh::obj_io::write_hair_mesh_obj;
+use hairmesh::model::obj_io::write_hair_mesh_obj;
 use hairmesh::{ExtrudeDesc, Face, HairMesh, extrude};
 
 /// A scalp under construction: positions, uvs, faces.

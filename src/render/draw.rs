@@ -30,7 +30,8 @@ pub fn mesh_path_supported(ctx: &Context) -> bool {
             && l.max_mesh_output_primitives >= 128
             && l.max_task_payload_size >= 20
             && l.max_mesh_work_group_invocations >= 32
-            && l.max_mesh_work_group_total_count >= crate::blue_noise::MAX_STRANDS_PER_BUNDLE as u32
+            && l.max_mesh_work_group_total_count
+                >= crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE as u32
             && l.max_task_work_group_count[0] >= 65535
     })
 }

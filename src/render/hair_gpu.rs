@@ -7,10 +7,10 @@ use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 
+use crate::bake::blue_noise::{quad_samples, triangle_samples};
 use crate::bake::{BakedHairMesh, MeshInfo};
-use crate::blue_noise::{quad_samples, triangle_samples};
-use crate::generate::strands_in_bundle;
-use crate::style::HairStyle;
+use crate::model::style::HairStyle;
+use crate::reference::generate::strands_in_bundle;
 use crate::vk::descriptor::{Binding, DescriptorSet};
 use crate::vk::image::Sampler;
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult, Image, ImageDesc};

@@ -23,10 +23,10 @@ use std::path::{Path, PathBuf};
 use glam::{Mat4, Quat, Vec3};
 use serde::Deserialize;
 
-use crate::baked_file;
+use crate::bake::baked_file;
 use crate::error::{HairError, Result};
-use crate::obj_io::load_hair_mesh_obj;
-use crate::style::HairStyle;
+use crate::model::obj_io::load_hair_mesh_obj;
+use crate::model::style::HairStyle;
 use crate::{BakeOptions, BakedHairMesh, bake};
 
 /// Camera block of a scene file.

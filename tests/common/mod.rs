@@ -117,9 +117,9 @@ pub fn upload(
 }
 
 /// The LoD inputs the shaders see for `cam` at `size` pixels with default LoD settings.
-pub fn lod_view(cam: &Camera, size: u32) -> hairmesh::lod::LodView {
+pub fn lod_view(cam: &Camera, size: u32) -> hairmesh::reference::lod::LodView {
     let lod = LodSettings::default();
-    hairmesh::lod::LodView {
+    hairmesh::reference::lod::LodView {
         eye: cam.eye,
         resolution: size as f32,
         fov_y: cam.fov_y,

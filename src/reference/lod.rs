@@ -63,7 +63,7 @@ pub fn apply_geomorph(p: &mut [Vec3], t: &mut [Vec3], gamma: f32) {
     }
     let even: Vec<Vec3> = p.iter().step_by(2).copied().collect();
     let mut t_even = vec![Vec3::ZERO; even.len()];
-    crate::generate::strand_tangents(&even, &mut t_even);
+    crate::bake::curve::strand_tangents(&even, &mut t_even);
     for k in (1..m).step_by(2) {
         p[k] = p[k] * (1.0 - gamma) + (p[k - 1] + p[k + 1]) * (0.5 * gamma);
     }

@@ -8,7 +8,7 @@
 
 use std::collections::HashMap;
 
-use crate::hair_mesh::{Face, HairMesh};
+use crate::model::hair_mesh::{Face, HairMesh};
 
 /// Marks a root-slice texel that holds no vertex.
 pub const EMPTY_TEXEL: u32 = u32::MAX;

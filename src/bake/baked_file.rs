@@ -26,7 +26,7 @@ use bytemuck::Pod;
 
 use crate::bake::{BakedHairMesh, BundleDesc, MAX_TEXTURE_SIDE, MeshInfo};
 use crate::error::{HairError, Result};
-use crate::style::HairStyle;
+use crate::model::style::HairStyle;
 
 /// File magic.
 pub const MAGIC: &[u8; 8] = b"HAIRMESH";

@@ -20,7 +20,7 @@ use glam::{Vec2, Vec3};
 use obj::raw::object::{Polygon, RawObj};
 
 use crate::error::{HairError, Result};
-use crate::hair_mesh::{Face, HairMesh, split_polygon};
+use crate::model::hair_mesh::{Face, HairMesh, split_polygon};
 
 /// Statements obj-rs does not implement (it panics on them); rejected with their line number.
 const UNSUPPORTED: &[&str] = &[

@@ -8,10 +8,10 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::bake::blue_noise::{MAX_STRANDS_PER_BUNDLE, quad_samples, triangle_samples};
 use crate::bake::{BakedHairMesh, BundleDesc, MeshInfo};
-use crate::blue_noise::{MAX_STRANDS_PER_BUNDLE, quad_samples, triangle_samples};
+use crate::model::style::HairStyle;
 use crate::rng::{hash_f32, hash_u32};
-use crate::style::HairStyle;
 
 /// A decoded texture sampled like a GPU texture unit: normalised coordinates, linear filter,
 /// clamp to edge. Texels are stored decoded as `Vec4` (unused channels 0).
@@ -167,7 +167,7 @@ impl HairTextures {
     /// Object-space curve point at curve parameter `r` in `[0, L-1]` for footprint `fp`:
     /// two trilinear fetches and one lerp (section 3.1).
     pub fn curve_point(&self, fp: &Footprint, r: f32) -> Vec3 {
-        let (slice, t) = crate::curve::quadratic_slice(r, self.info.layers as usize);
+        let (slice, t) = crate::bake::curve::quadratic_slice(r, self.info.layers as usize);
         let depth = self.position.depth() as f32;
         let a = self
             .position
@@ -321,30 +321,6 @@ impl StrandSet {
     }
 }
 
-/// Tangents of a polyline by section 3.5: central differences inside, eq. 5 and 6 at the ends.
-pub fn strand_tangents(p: &[Vec3], out: &mut [Vec3]) {
-    let m = p.len() - 1;
-    if m == 0 {
-        out[0] = Vec3::Y;
-        return;
-    }
-    if m == 1 {
-        let d = (p[1] - p[0]).normalize_or(Vec3::Y);
-        out[0] = d;
-        out[1] = d;
-        return;
-    }
-    for k in 1..m {
-        out[k] = (p[k + 1] - p[k - 1]).normalize_or(Vec3::Y);
-    }
-    // Eq. 5: mirror t_{m-1} about the last segment direction q_m.
-    let q = (p[m] - p[m - 1]).normalize_or(out[m - 1]);
-    out[m] = (q * (2.0 * out[m - 1].dot(q)) - out[m - 1]).normalize_or(q);
-    // Eq. 6: mirror t_1 about the first segment direction q_1.
-    let q = (p[1] - p[0]).normalize_or(out[1]);
-    out[0] = (q * (2.0 * out[1].dot(q)) - out[1]).normalize_or(q);
-}
-
 /// The CPU reference generator over one baked mesh and style.
 pub struct CpuGenerator {
     /// Decoded textures.
@@ -402,18 +378,18 @@ impl CpuGenerator {
             pos[k] = p + fu * off.x + fv * off.y + fw * off.z;
             width[k] = strand_width(style, s);
         }
-        strand_tangents(pos, tan);
+        crate::bake::curve::strand_tangents(pos, tan);
     }
 
     /// Generate with level of detail (paper sec. 3.6): per bundle the strand count, vertex level,
-    /// geomorph (eq. 11 + tangent morph) and thickness of [`crate::lod::bundle_lod`]. Strands are
+    /// geomorph (eq. 11 + tangent morph) and thickness of [`crate::reference::lod::bundle_lod`]. Strands are
     /// bundle-major; `counts[i]` is the vertex count of strand `i`.
     pub fn generate_lod(
         &self,
         n: u32,
         e_max: u32,
         baked: &BakedHairMesh,
-        view: &crate::lod::LodView,
+        view: &crate::reference::lod::LodView,
     ) -> (StrandSet, Vec<usize>) {
         let mut set = StrandSet {
             verts_per_strand: 0,
@@ -421,7 +397,7 @@ impl CpuGenerator {
         };
         let mut counts = Vec::new();
         for (bundle, b) in self.tex.bundles.iter().enumerate() {
-            let lod = crate::lod::bundle_lod(
+            let lod = crate::reference::lod::bundle_lod(
                 baked,
                 &self.style,
                 bundle,
@@ -436,7 +412,7 @@ impl CpuGenerator {
                 let mut t = vec![Vec3::ZERO; verts];
                 let mut w = vec![0.0; verts];
                 self.strand(bundle as u32, strand, segments, &mut p, &mut t, &mut w);
-                crate::lod::apply_geomorph(&mut p, &mut t, lod.gamma);
+                crate::reference::lod::apply_geomorph(&mut p, &mut t, lod.gamma);
                 set.positions.extend(p);
                 set.tangents.extend(t);
                 set.widths.extend(w.iter().map(|x| x * lod.thickness));

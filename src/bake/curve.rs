@@ -106,6 +106,30 @@ pub fn quadratic_slice(r: f32, layers: usize) -> (usize, f32) {
     }
 }
 
+/// Tangents of a polyline by section 3.5: central differences inside, eq. 5 and 6 at the ends.
+pub fn strand_tangents(p: &[Vec3], out: &mut [Vec3]) {
+    let m = p.len() - 1;
+    if m == 0 {
+        out[0] = Vec3::Y;
+        return;
+    }
+    if m == 1 {
+        let d = (p[1] - p[0]).normalize_or(Vec3::Y);
+        out[0] = d;
+        out[1] = d;
+        return;
+    }
+    for k in 1..m {
+        out[k] = (p[k + 1] - p[k - 1]).normalize_or(Vec3::Y);
+    }
+    // Eq. 5: mirror t_{m-1} about the last segment direction q_m.
+    let q = (p[m] - p[m - 1]).normalize_or(out[m - 1]);
+    out[m] = (q * (2.0 * out[m - 1].dot(q)) - out[m - 1]).normalize_or(q);
+    // Eq. 6: mirror t_1 about the first segment direction q_1.
+    let q = (p[1] - p[0]).normalize_or(out[1]);
+    out[0] = (q * (2.0 * out[1].dot(q)) - out[1]).normalize_or(q);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

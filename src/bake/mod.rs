@@ -14,14 +14,19 @@
 //! (15 micrometres on a 1 m model) where half floats lose precision away from the origin; they
 //! take half the memory of 32-bit floats.
 
+pub mod baked_file;
+pub mod blue_noise;
+pub mod curve;
+pub mod layout;
+
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat2, Vec3};
 
-use crate::curve::column_control_points;
+use crate::bake::curve::column_control_points;
+use crate::bake::layout::{EMPTY_TEXEL, RootLayout, layout_root_slice};
 use crate::error::{HairError, Result};
-use crate::hair_mesh::{HairMesh, bounds, corner_triangle};
-use crate::layout::{EMPTY_TEXEL, RootLayout, layout_root_slice};
-use crate::style::HairStyle;
+use crate::model::hair_mesh::{HairMesh, bounds, corner_triangle};
+use crate::model::style::HairStyle;
 
 /// Texture decode constants and sizes, shared with GLSL as `MeshInfo` (std430, 64 bytes).
 #[repr(C)]
