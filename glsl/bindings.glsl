@@ -1,68 +1,62 @@
-// Descriptor set 0 of every hair pass (src/render/hair_resources.rs creates it).
-// Binding numbers are shared by the compute path, the mesh path and the draw.
+// Resources of every hair pass. Binding numbers, constants and structs come from the generated
+// include shared.glsl (src/render/shared.rs); nothing here restates them.
 #ifndef BINDINGS_GLSL
 #define BINDINGS_GLSL
-#include "hair_types.glsl"
+#extension GL_EXT_nonuniform_qualifier : require
+#include "shared.glsl"
 
-// src/render/frame.rs: FrameParams
-layout(set = 0, binding = 0, std140) uniform Frame {
-    mat4 view_proj;
-    vec4 camera_pos;      // xyz, w: vertical resolution in pixels
-    vec4 light_dir;       // xyz towards the light, w: 1 / tan(fov_y / 2) (0: orthographic)
-    vec4 viewport;        // width, height, 1/width, 1/height
-    uvec4 params;         // x: strands per bundle N, y: full vertex level e (2^e segments), z: bundle count, w: LoD on
-    vec4 planes[6];       // frustum planes (xyz normal, w offset), inside when dot >= 0
-    vec4 lod;             // x: alpha strands, y: alpha vertices, z: lambda, w: tan(fov_y) (0: orthographic, see lod_ortho)
-    vec4 lod_ortho;       // x: view height for orthographic views (eq. 7 orthographic form), yzw unused
-} frame;
+layout(set = SET_FRAME, binding = BINDING_FRAME, std140) uniform FrameUbo { FrameBlock frame; };
+layout(set = SET_FRAME, binding = BINDING_CHARACTERS, std430) readonly buffer Characters { CharacterRecord characters[]; };
+layout(set = SET_FRAME, binding = BINDING_BUNDLES, std430) readonly buffer Bundles { GpuBundle bundles[]; };
+// Root samples: [0, MAX_STRANDS_PER_BUNDLE) quad set, then the triangle set.
+layout(set = SET_FRAME, binding = BINDING_ROOT_SAMPLES, std430) readonly buffer RootSamples { vec2 root_samples[]; };
+// Per bundle: LoD decision (x strands, y vertex level e, z gamma bits, w thickness bits) and
+// exclusive prefix sums (x first strand, y first vertex slot, z first draw vertex,
+// w first strand workgroup).
+layout(set = SET_FRAME, binding = BINDING_BUNDLE_LODS, std430) buffer BundleLods { uvec4 bundle_lods[]; };
+layout(set = SET_FRAME, binding = BINDING_BUNDLE_OFFSETS, std430) buffer BundleOffsets { uvec4 bundle_offsets[]; };
+layout(set = SET_FRAME, binding = BINDING_SCAN_SCRATCH, std430) buffer ScanScratch { uvec4 scan_scratch[]; };
+layout(set = SET_FRAME, binding = BINDING_ARGS, std430) buffer Args { GenerateArgs args; };
+layout(set = SET_FRAME, binding = BINDING_VERTICES, std430) buffer Vertices { HairVertex hair_vertices[]; };
 
-layout(set = 0, binding = 1, std430) readonly buffer MeshBuf {
-    MeshInfo mesh;
-    HairStyle style;
-};
-layout(set = 0, binding = 2, std430) readonly buffer Bundles { BundleDesc bundles[]; };
-layout(set = 0, binding = 3) uniform sampler3D tex_position;
-layout(set = 0, binding = 4) uniform sampler2D tex_uv;
-layout(set = 0, binding = 5) uniform sampler3D tex_w;
-layout(set = 0, binding = 6) uniform sampler3D tex_u;
-layout(set = 0, binding = 7) uniform sampler3D tex_v;
-// Root samples: [0, 4096) quad set, [4096, 8192) triangle set.
-layout(set = 0, binding = 8, std430) readonly buffer RootSamples { vec2 root_samples[]; };
+// The five textures of every character (paper 003 Table 1), indexed by texture slot.
+layout(set = SET_TEXTURES, binding = BINDING_TEX_POSITION) uniform sampler3D tex_position[];
+layout(set = SET_TEXTURES, binding = BINDING_TEX_UV) uniform sampler2D tex_uv[];
+layout(set = SET_TEXTURES, binding = BINDING_TEX_W) uniform sampler3D tex_w[];
+layout(set = SET_TEXTURES, binding = BINDING_TEX_U) uniform sampler3D tex_u[];
+layout(set = SET_TEXTURES, binding = BINDING_TEX_V) uniform sampler3D tex_v[];
 
-// Per-bundle LoD decision (x: strands, y: vertex level e, z: gamma bits, w: thickness bits) and
-// exclusive prefix sums (x: first strand, y: first vertex slot, z: first draw vertex,
-// w: first compute workgroup).
-layout(set = 0, binding = 9, std430) buffer Counts { uvec4 bundle_lods[]; };
-layout(set = 0, binding = 10, std430) buffer Offsets { uvec4 bundle_offsets[]; };
-// Indirect arguments: VkDispatchIndirectCommand then VkDrawIndirectCommand.
-layout(set = 0, binding = 11, std430) buffer Indirect {
-    uint dispatch_x;
-    uint dispatch_y;
-    uint dispatch_z;
-    uint total_strands;
-    uint draw_vertex_count;
-    uint draw_instance_count;
-    uint draw_first_vertex;
-    uint draw_first_instance;
-    uint total_triangles;   // strand triangles generated (both paths)
-    uint total_vertex_slots;
-    uint total_groups;      // compute path: strand-building workgroups
-    uint pad1;
-} indirect;
+// Small per-dispatch parameters (scan levels).
+layout(push_constant) uniform Push { uvec4 params; } push;
 
-// Generated strand vertices (compute path): position + width, tangent + s.
-struct HairVertex {
-    vec4 pos_width;
-    vec4 tangent_s;
-};
-layout(set = 0, binding = 12, std430) buffer Vertices { HairVertex hair_vertices[]; };
+// The character this invocation works on, loaded by bind_character().
+MeshInfo mesh;
+HairStyle style;
+mat4 model;
+float model_scale;
+uint tex_slot;
+uint ch_strands;    // N of eq. 8
+uint ch_emax;       // full-detail vertex level e
+bool ch_visible;
 
-// Object-to-world transform of the character being drawn.
-layout(push_constant) uniform Push {
-    mat4 model;
-} push;
+void bind_character(uint c) {
+    mesh = characters[c].mesh;
+    style = characters[c].style;
+    model = characters[c].model;
+    model_scale = characters[c].model_scale;
+    tex_slot = characters[c].texture_slot;
+    ch_strands = characters[c].strands_per_bundle;
+    ch_emax = characters[c].verts_log2;
+    ch_visible = (characters[c].flags & CHARACTER_VISIBLE) != 0u;
+}
 
-// Largest dispatch size per dimension we rely on (Vulkan guarantees 65535).
-#define DISPATCH_ROW 65535u
+#define TEX_POSITION tex_position[nonuniformEXT(tex_slot)]
+#define TEX_W tex_w[nonuniformEXT(tex_slot)]
+#define TEX_U tex_u[nonuniformEXT(tex_slot)]
+#define TEX_V tex_v[nonuniformEXT(tex_slot)]
+
+vec3 style_color() {
+    return vec3(style.color[0], style.color[1], style.color[2]);
+}
 
 #endif

@@ -1,6 +1,6 @@
 // Per-bundle decisions shared by the compute path (cull.comp) and the task shader:
 // frustum culling and strand / vertex level of detail (paper 003 sec. 3.6, eq. 7-12).
-// CPU twin: src/lod.rs + src/generate.rs (bundle_lod_cpu). Requires bindings.glsl, common.glsl,
+// CPU twin: src/reference/lod.rs (bundle_lod). Requires bindings.glsl, common.glsl,
 // strand_eval.glsl.
 #ifndef BUNDLE_LOD_GLSL
 #define BUNDLE_LOD_GLSL
@@ -29,34 +29,35 @@ float detail_level(float h, float d, float alpha) {
     return clamp(h * frame.camera_pos.w * alpha / denom, 0.0, 1.0);
 }
 
-BundleLod bundle_lod(uint b) {
-    BundleDesc desc = bundles[b];
+// Culling and LoD of crowd bundle g (its character bound with bind_character).
+BundleLod bundle_lod(uint g) {
+    GpuBundle desc = bundles[g];
     // World bounds: convex hull of the bundle's Bezier control points, grown by the styling.
-    int depth = int(4u * (mesh.layers - 1u) + 1u);
+    int depth = int(POSITION_DEPTH(mesh.layers));
     vec3 lo = vec3(1e30);
     vec3 hi = vec3(-1e30);
     for (int z = 0; z < depth; z++) {
         for (int c = 0; c < 4; c++) {
             ivec3 t = ivec3(ivec2(desc.origin) + ivec2(c & 1, c >> 1), z);
-            vec3 p = (push.model * vec4(decode_position(texelFetch(tex_position, t, 0).xyz), 1.0)).xyz;
+            vec3 p = (model * vec4(decode_position(texelFetch(TEX_POSITION, t, 0).xyz), 1.0)).xyz;
             lo = min(lo, p);
             hi = max(hi, p);
         }
     }
-    float scale = length(push.model[0].xyz);
+    float scale = model_scale;
     float margin = scale * (style.curl_radius + style.wave_amplitude + style.frizz_amplitude + style.strand_width);
     lo -= margin;
     hi += margin;
-    uint n = frame.params.x;
+    uint n = ch_strands;
     uint count = style.density_by_area != 0u ? uint(round(float(n) * desc.density)) : n;
     count = clamp(count, 1u, MAX_STRANDS_PER_BUNDLE);
-    uint emax = frame.params.y;
+    uint emax = ch_emax;
     BundleLod r = BundleLod(count, emax, 0.0, 1.0);
-    if (!box_visible(lo, hi)) {
+    if (!ch_visible || !box_visible(lo, hi)) {
         r.strands = 0u;
         return r;
     }
-    if (frame.params.w == 0u) {
+    if (frame.counts.z == 0u) {
         return r;
     }
     vec3 eye = frame.camera_pos.xyz;
@@ -64,7 +65,7 @@ BundleLod bundle_lod(uint b) {
     float h = scale * desc.rest_size;
     // Strand LoD: eq. 7 and eq. 8 with a per-bundle increment delta_i, clamped to N_i.
     float ls = detail_level(h, d, frame.lod.x);
-    float delta = hash_f32(hash_u32(b ^ 0x2545f491u) ^ style.seed);
+    float delta = hash_f32(hash_u32(desc.local_index ^ 0x2545f491u) ^ style.seed);
     r.strands = ls > 0.0 ? clamp(uint(ceil(ls * (float(count) + delta))), 1u, count) : 0u;
     r.thickness = min(1.0 / max(ls, 1e-6), float(count));
     // Vertex LoD: eq. 9, 10, 12.

@@ -1,18 +1,19 @@
 #version 460
-// Compute path, pass 1a: one invocation per bundle: culling and LoD (bundle_lod.glsl, shared
-// with the task shader). Writes bundle_lods[].
+// Compute path, pass 1: one invocation per bundle of the whole crowd: culling and LoD
+// (bundle_lod.glsl, shared with the task shader). Writes bundle_lods[].
 #extension GL_GOOGLE_include_directive : require
-layout(local_size_x = 64) in;
 #include "bindings.glsl"
+layout(local_size_x = CULL_GROUP_SIZE) in;
 #include "common.glsl"
 #include "strand_eval.glsl"
 #include "bundle_lod.glsl"
 
 void main() {
-    uint b = gl_GlobalInvocationID.x;
-    if (b >= frame.params.z) {
+    uint g = gl_WorkGroupID.y * (DISPATCH_ROW * uint(CULL_GROUP_SIZE)) + gl_GlobalInvocationID.x;
+    if (g >= frame.counts.x) {
         return;
     }
-    BundleLod r = bundle_lod(b);
-    bundle_lods[b] = uvec4(r.strands, r.e, floatBitsToUint(r.gamma), floatBitsToUint(r.thickness));
+    bind_character(bundles[g].character);
+    BundleLod r = bundle_lod(g);
+    bundle_lods[g] = uvec4(r.strands, r.e, floatBitsToUint(r.gamma), floatBitsToUint(r.thickness));
 }

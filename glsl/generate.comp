@@ -1,12 +1,10 @@
 #version 460
-// Compute path, pass 2: one workgroup of S threads per group of strands (one long strand, or
+// Compute path, pass 4: one workgroup of S threads per group of strands (one long strand, or
 // several short ones) builds them in shared memory (strand_build.glsl, shared with the mesh
-// shader) and writes HairVertex records.
+// shader) and writes HairVertex records into the pool, never past the kept slots.
 #extension GL_GOOGLE_include_directive : require
-#define S 32u
-#define MAX_SEGMENTS 64u
-layout(local_size_x = 32) in;
 #include "bindings.glsl"
+layout(local_size_x = STRAND_GROUP_SIZE) in;
 #include "common.glsl"
 #include "strand_eval.glsl"
 #include "strand_build.glsl"
@@ -14,7 +12,7 @@ layout(local_size_x = 32) in;
 // Last bundle whose first workgroup is <= g (never an empty one for g < total).
 uint find_bundle(uint g) {
     uint lo = 0u;
-    uint hi = frame.params.z - 1u;
+    uint hi = frame.counts.x - 1u;
     while (lo < hi) {
         uint mid = (lo + hi + 1u) / 2u;
         if (bundle_offsets[mid].w <= g) {
@@ -28,25 +26,29 @@ uint find_bundle(uint g) {
 
 void main() {
     uint g = gl_WorkGroupID.y * DISPATCH_ROW + gl_WorkGroupID.x;
-    if (g >= indirect.total_groups) {
+    if (g >= args.stats.groups) {
         return;
     }
     uint bundle = find_bundle(g);
+    bind_character(bundles[bundle].character);
     uvec4 lod = bundle_lods[bundle];
     uint segments = 1u << lod.y;
     uint per = strands_per_group(segments);
     uint first = (g - bundle_offsets[bundle].w) * per;
     uint t = gl_LocalInvocationID.x;
     build_strands(bundle, first, segments, uintBitsToFloat(lod.z), t);
-    float width_scale = length(push.model[0].xyz) * uintBitsToFloat(lod.w);
+    float width_scale = model_scale * uintBitsToFloat(lod.w);
     uint stride = segments + 1u;
     uint count = min(per, lod.x - first);
+    uint limit = args.stats.vertex_slots_written;
     for (uint idx = t; idx < count * stride; idx += S) {
         uint j = idx / stride;
         uint k = idx - j * stride;
         float s = float(k) / float(segments);
         uint out_index = bundle_offsets[bundle].y + (first + j) * stride + k;
-        hair_vertices[out_index].pos_width = vec4(sp[idx], width_scale * strand_width_at(s));
-        hair_vertices[out_index].tangent_s = vec4(st[idx], s);
+        if (out_index < limit) {
+            hair_vertices[out_index].pos_width = vec4(sp[idx], width_scale * strand_width_at(s));
+            hair_vertices[out_index].tangent_s = vec4(st[idx], s);
+        }
     }
 }

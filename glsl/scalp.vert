@@ -1,21 +1,30 @@
 #version 460
-// Opaque scalp: two triangles per bundle pulled from the root slice of the hair mesh texture.
+// Opaque scalps of the whole crowd in one draw: two triangles per bundle pulled from the root
+// slice of each character's hair mesh texture.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 #include "common.glsl"
 #include "strand_eval.glsl"
 
 layout(location = 0) out vec3 out_normal;
+layout(location = 1) flat out vec3 out_color;
 
-vec3 corner_pos(BundleDesc b, int c) {
+vec3 corner_pos(GpuBundle b, int c) {
     ivec3 t = ivec3(ivec2(b.origin) + ivec2(c & 1, c >> 1), 0);
-    return (push.model * vec4(decode_position(texelFetch(tex_position, t, 0).xyz), 1.0)).xyz;
+    return (model * vec4(decode_position(texelFetch(TEX_POSITION, t, 0).xyz), 1.0)).xyz;
 }
 
 void main() {
-    uint bundle = uint(gl_VertexIndex) / 6u;
+    uint g = uint(gl_VertexIndex) / 6u;
     uint corner = uint(gl_VertexIndex) % 6u;
-    BundleDesc b = bundles[bundle];
+    GpuBundle b = bundles[g];
+    bind_character(b.character);
+    out_color = style_color() * 0.6;
+    if (!ch_visible) {
+        out_normal = vec3(0.0, 1.0, 0.0);
+        gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // outside the depth range: clipped
+        return;
+    }
     // Cell corners (0,0) (1,0) (1,1) (0,1) as indices 0 1 3 2; triangles (0,1,3) and (0,3,2).
     const int order[6] = int[6](0, 1, 3, 0, 3, 2);
     vec3 p00 = corner_pos(b, 0);

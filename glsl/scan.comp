@@ -1,59 +1,57 @@
 #version 460
-// Compute path, pass 1b: one workgroup. Exclusive prefix sums over bundles of strands, vertex
-// slots (strands x (2^e + 1)) and draw vertices (strands x 2^e x 6), plus the indirect
-// dispatch / draw arguments and triangle statistics.
+// Compute path, pass 2 (up-sweep of a multi-level exclusive scan, any number of bundles):
+// each workgroup scans SCAN_BLOCK elements in place and writes its block total.
+// push.params: x element count, y input offset into scan_scratch, z block-sum offset into
+// scan_scratch, w level (0: input is the bundle sizes, output bundle_offsets).
 #extension GL_GOOGLE_include_directive : require
-layout(local_size_x = 256) in;
 #include "bindings.glsl"
+layout(local_size_x = SCAN_THREADS) in;
+#include "bundle_sizes.glsl"
 
-shared uvec4 partial[256];
+shared uvec4 partial[SCAN_THREADS];
 
-#define S 32u
+#define PER_THREAD (SCAN_BLOCK / uint(SCAN_THREADS))
 
-// Strands, vertex slots, draw vertices and workgroups (strand_build.glsl packs
-// max(S / segments, 1) strands per workgroup) of bundle i.
-uvec4 bundle_sizes(uint i) {
-    uvec4 l = bundle_lods[i];
-    uint segments = 1u << l.y;
-    uint per = max(S / segments, 1u);
-    return uvec4(l.x, l.x * (segments + 1u), l.x * segments * 6u, (l.x + per - 1u) / per);
+uvec4 load(uint i) {
+    return push.params.w == 0u ? bundle_sizes(bundle_lods[i]) : scan_scratch[push.params.y + i];
+}
+
+void store(uint i, uvec4 v) {
+    if (push.params.w == 0u) {
+        bundle_offsets[i] = v;
+    } else {
+        scan_scratch[push.params.y + i] = v;
+    }
 }
 
 void main() {
-    uint count = frame.params.z;
+    uint count = push.params.x;
+    uint block = gl_WorkGroupID.y * DISPATCH_ROW + gl_WorkGroupID.x;
     uint t = gl_LocalInvocationID.x;
-    uint chunk = (count + 255u) / 256u;
-    uint begin = min(t * chunk, count);
-    uint end = min(begin + chunk, count);
+    uint base = block * SCAN_BLOCK + t * PER_THREAD;
+    uvec4 v[PER_THREAD];
     uvec4 sum = uvec4(0u);
-    for (uint i = begin; i < end; i++) {
-        sum += bundle_sizes(i);
+    for (uint i = 0u; i < PER_THREAD; i++) {
+        v[i] = base + i < count ? load(base + i) : uvec4(0u);
+        sum += v[i];
     }
+    // Hillis-Steele inclusive scan of the per-thread sums.
     partial[t] = sum;
     barrier();
-    if (t == 0u) {
-        uvec4 run = uvec4(0u);
-        for (uint i = 0u; i < 256u; i++) {
-            uvec4 v = partial[i];
-            partial[i] = run;
-            run += v;
-        }
-        indirect.total_strands = run.x;
-        indirect.total_vertex_slots = run.y;
-        indirect.total_triangles = run.z / 3u;
-        indirect.total_groups = run.w;
-        indirect.dispatch_x = min(run.w, DISPATCH_ROW);
-        indirect.dispatch_y = (run.w + DISPATCH_ROW - 1u) / DISPATCH_ROW;
-        indirect.dispatch_z = 1u;
-        indirect.draw_vertex_count = run.z;
-        indirect.draw_instance_count = 1u;
-        indirect.draw_first_vertex = 0u;
-        indirect.draw_first_instance = 0u;
+    for (uint step = 1u; step < uint(SCAN_THREADS); step <<= 1u) {
+        uvec4 add = t >= step ? partial[t - step] : uvec4(0u);
+        barrier();
+        partial[t] += add;
+        barrier();
     }
-    barrier();
-    uvec4 run = partial[t];
-    for (uint i = begin; i < end; i++) {
-        bundle_offsets[i] = run;
-        run += bundle_sizes(i);
+    uvec4 run = partial[t] - sum;
+    for (uint i = 0u; i < PER_THREAD; i++) {
+        if (base + i < count) {
+            store(base + i, run);
+        }
+        run += v[i];
+    }
+    if (t == uint(SCAN_THREADS) - 1u) {
+        scan_scratch[push.params.z + block] = partial[t];
     }
 }

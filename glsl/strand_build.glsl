@@ -3,10 +3,12 @@
 // Short strands (segments < S, i.e. n would drop below 1): P = S / segments strands per
 // workgroup, one vertex per thread, so no thread idles (the "reduce s" option of sec. 3.6.2).
 // Then tangents by eq. 5-6 (sec. 3.5) and the vertex-LoD geomorph (eq. 11 + tangent morph).
-// Used unchanged by generate.comp (compute path) and strands.mesh (mesh path); the including
-// shader defines S and MAX_SEGMENTS (<= 2 S).
+// Used unchanged by generate.comp (compute path) and strands.mesh (mesh path), both with
+// local_size_x = STRAND_GROUP_SIZE (MAX_SEGMENTS <= 2 S, from shared.glsl).
 #ifndef STRAND_BUILD_GLSL
 #define STRAND_BUILD_GLSL
+
+#define S uint(STRAND_GROUP_SIZE)
 
 // Shared entries: P strands x (segments + 1) vertices <= S + P <= MAX_SEGMENTS + 1.
 #define MAX_ENTRIES (MAX_SEGMENTS + 1u)
@@ -56,7 +58,7 @@ vec3 coarse_tangent_at(uint base, uint k, uint segments) {
     return coarse_tangent_at_even(base, k, segments);
 }
 
-// Build strands first .. first + strands_per_group(segments) - 1 of `bundle` (extra strands
+// Build strands first .. first + strands_per_group(segments) - 1 of crowd bundle `bundle` (extra strands
 // past the bundle's count are computed and ignored by the caller). Must be called by all S
 // threads (contains barriers). World-space results in sp / st.
 void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) {
@@ -67,17 +69,17 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
         uint n = segments / S;
         for (uint i = 0u; i < n; i++) {
             uint k = t * n + i + 1u;
-            sp[k] = (push.model * vec4(strand_vertex(si, k, segments), 1.0)).xyz;
+            sp[k] = (model * vec4(strand_vertex(si, k, segments), 1.0)).xyz;
         }
         if (t == 0u) {
-            sp[0] = (push.model * vec4(strand_vertex(si, 0u, segments), 1.0)).xyz;
+            sp[0] = (model * vec4(strand_vertex(si, 0u, segments), 1.0)).xyz;
         }
     } else {
         uint j = t / segments;
         uint k = t % segments + 1u;
-        sp[j * stride + k] = (push.model * vec4(strand_vertex(strand_info(bundle, first + j), k, segments), 1.0)).xyz;
+        sp[j * stride + k] = (model * vec4(strand_vertex(strand_info(bundle, first + j), k, segments), 1.0)).xyz;
         if (t < per) {
-            sp[t * stride] = (push.model * vec4(strand_vertex(strand_info(bundle, first + t), 0u, segments), 1.0)).xyz;
+            sp[t * stride] = (model * vec4(strand_vertex(strand_info(bundle, first + t), 0u, segments), 1.0)).xyz;
         }
     }
     barrier();

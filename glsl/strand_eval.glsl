@@ -4,11 +4,9 @@
 #ifndef STRAND_EVAL_GLSL
 #define STRAND_EVAL_GLSL
 
-#define MAX_STRANDS_PER_BUNDLE 4096u
-#define BUNDLE_TRIANGLE 1u
-
 // Root sample of a strand (paper 003 sec. 3.3); quads shift the toroidal set per bundle.
-vec2 root_sample(BundleDesc b, uint bundle_index, uint strand) {
+// bundle_index is the bundle's index within its mesh (as in the CPU oracle).
+vec2 root_sample(GpuBundle b, uint bundle_index, uint strand) {
     uint s = strand % MAX_STRANDS_PER_BUNDLE;
     if ((b.flags & BUNDLE_TRIANGLE) != 0u) {
         return root_samples[MAX_STRANDS_PER_BUNDLE + s];
@@ -18,7 +16,7 @@ vec2 root_sample(BundleDesc b, uint bundle_index, uint strand) {
 }
 
 // Normalised root-slice coordinate; triangles map xi -> (xi.x / (1 - xi.y), xi.y).
-vec2 root_coord(BundleDesc b, vec2 xi) {
+vec2 root_coord(GpuBundle b, vec2 xi) {
     vec2 local = xi;
     if ((b.flags & BUNDLE_TRIANGLE) != 0u) {
         local = vec2(xi.x / max(1.0 - xi.y, 1e-6), xi.y);
@@ -43,27 +41,27 @@ vec3 curve_point(vec2 coord, float r) {
         slice += 2u;
         t = tau * 2.0 - 1.0;
     }
-    float depth = float(4u * (layers - 1u) + 1u);
-    vec3 a = texture(tex_position, vec3(coord, (float(slice) + 0.5 + t) / depth)).xyz;
-    vec3 b = texture(tex_position, vec3(coord, (float(slice) + 1.5 + t) / depth)).xyz;
+    float depth = float(POSITION_DEPTH(layers));
+    vec3 a = texture(TEX_POSITION, vec3(coord, (float(slice) + 0.5 + t) / depth)).xyz;
+    vec3 b = texture(TEX_POSITION, vec3(coord, (float(slice) + 1.5 + t) / depth)).xyz;
     return decode_position(mix(a, b, t));
 }
 
 vec3 root_point(vec2 coord) {
-    float depth = float(4u * (mesh.layers - 1u) + 1u);
-    return decode_position(texture(tex_position, vec3(coord, 0.5 / depth)).xyz);
+    float depth = float(POSITION_DEPTH(mesh.layers));
+    return decode_position(texture(TEX_POSITION, vec3(coord, 0.5 / depth)).xyz);
 }
 
 // Styling frame (eq. 4) and w at parameter r.
 void styling_frame(vec2 coord, float r, out vec3 fu, out vec3 fv, out vec3 fw, out float w) {
     float z = (r + 0.5) / float(mesh.layers);
-    vec3 u = texture(tex_u, vec3(coord, z)).xyz;
-    vec3 v = texture(tex_v, vec3(coord, z)).xyz;
+    vec3 u = texture(TEX_U, vec3(coord, z)).xyz;
+    vec3 v = texture(TEX_V, vec3(coord, z)).xyz;
     fu = length(u) > 0.0 ? normalize(u) : vec3(1.0, 0.0, 0.0);
     fv = length(v) > 0.0 ? normalize(v) : vec3(0.0, 1.0, 0.0);
     vec3 c = cross(fu, fv);
     fw = length(c) > 0.0 ? normalize(c) : vec3(0.0, 0.0, 1.0);
-    w = mesh.pos_origin.w * texture(tex_w, vec3(coord, z)).x;
+    w = mesh.pos_origin.w * texture(TEX_W, vec3(coord, z)).x;
 }
 
 float smoothstep_safe(float e0, float e1, float x) {
@@ -101,11 +99,12 @@ struct StrandInfo {
     float span;         // curve parameter at the tip
 };
 
-StrandInfo strand_info(uint bundle_index, uint strand) {
-    BundleDesc b = bundles[bundle_index];
+// Strand `strand` of crowd bundle `g` (its character bound with bind_character).
+StrandInfo strand_info(uint g, uint strand) {
+    GpuBundle b = bundles[g];
     StrandInfo si;
-    si.key = strand_key(style.seed, bundle_index, strand);
-    si.coord = root_coord(b, root_sample(b, bundle_index, strand));
+    si.key = strand_key(style.seed, b.local_index, strand);
+    si.coord = root_coord(b, root_sample(b, b.local_index, strand));
     vec2 centre = (b.flags & BUNDLE_TRIANGLE) != 0u ? vec2(1.0 / 3.0) : vec2(0.5);
     si.centre_coord = root_coord(b, centre);
     float length_factor = 1.0 - style.length_variation * strand_rand(si.key, 0u);

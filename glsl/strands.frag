@@ -7,6 +7,7 @@
 layout(location = 0) in vec3 in_tangent;
 layout(location = 1) in float in_s;
 layout(location = 2) in vec3 in_pos;
+layout(location = 3) flat in vec3 in_color;
 layout(location = 0) out vec4 out_color;
 
 void main() {
@@ -18,7 +19,7 @@ void main() {
     vec3 h = normalize(l + e);
     float th = dot(t, h);
     float spec = pow(sqrt(max(1.0 - th * th, 0.0)), 80.0);
-    vec3 base = vec3(style.color[0], style.color[1], style.color[2]);
+    vec3 base = in_color;
     float root_shadow = mix(0.55, 1.0, smoothstep(0.0, 0.3, in_s));
     vec3 c = base * (0.25 + 0.75 * diffuse) * root_shadow + vec3(0.25) * spec * root_shadow;
     out_color = vec4(c, 1.0);

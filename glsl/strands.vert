@@ -1,6 +1,6 @@
 #version 460
 // Compute-path draw: pull generated vertices and expand each segment into a camera-facing quad
-// (2 triangles; a strand of ns segments gives 2ns triangles).
+// (2 triangles; a strand of ns segments gives 2ns triangles). One draw for the whole crowd.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 #include "strip.glsl"
@@ -8,12 +8,13 @@
 layout(location = 0) out vec3 out_tangent;
 layout(location = 1) out float out_s;
 layout(location = 2) out vec3 out_pos;
+layout(location = 3) flat out vec3 out_color;
 
 void main() {
     uint idx = uint(gl_VertexIndex);
     // Bundle owning this draw vertex: last bundle whose first draw vertex is <= idx.
     uint lo = 0u;
-    uint hi = frame.params.z - 1u;
+    uint hi = frame.counts.x - 1u;
     while (lo < hi) {
         uint mid = (lo + hi + 1u) / 2u;
         if (bundle_offsets[mid].z <= idx) {
@@ -22,6 +23,7 @@ void main() {
             hi = mid - 1u;
         }
     }
+    bind_character(bundles[lo].character);
     uint segments = 1u << bundle_lods[lo].y;
     uint local = idx - bundle_offsets[lo].z;
     uint strand = local / (segments * 6u);
@@ -36,4 +38,5 @@ void main() {
     out_tangent = v.tangent_s.xyz;
     out_s = v.tangent_s.w;
     out_pos = world;
+    out_color = style_color();
 }

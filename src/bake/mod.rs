@@ -47,15 +47,9 @@ pub struct MeshInfo {
 }
 
 impl MeshInfo {
-    /// Field offsets (mirrors `glsl/hair_types.glsl`).
-    pub fn field_offsets() -> Vec<(&'static str, usize)> {
-        crate::field_offsets!(MeshInfo; pos_origin, pos_extent, uv_origin_extent, root_size,
-            layers, bundle_count)
-    }
-
     /// Depth of the hair mesh texture: root/layer slices plus three intermediate slices each.
     pub fn position_depth(&self) -> u32 {
-        4 * (self.layers - 1) + 1
+        SLICES_PER_SEGMENT * (self.layers - 1) + 1
     }
 
     /// Texels in one root slice.
@@ -80,15 +74,14 @@ pub struct BundleDesc {
     pub _pad: [u32; 3],
 }
 
+/// Slices of the hair mesh texture per layer segment: the layer slice and the three
+/// intermediate quadratic-Bezier slices (paper 003 sec. 3.1); depth is `4 (L - 1) + 1`.
+pub const SLICES_PER_SEGMENT: u32 = 4;
+
 /// `BundleDesc::flags` bit of triangle bundles.
 pub const BUNDLE_TRIANGLE: u32 = 1;
 
 impl BundleDesc {
-    /// Field offsets (mirrors `glsl/hair_types.glsl`).
-    pub fn field_offsets() -> Vec<(&'static str, usize)> {
-        crate::field_offsets!(BundleDesc; origin, flags, rest_size, density, _pad)
-    }
-
     /// Whether this is a triangle bundle.
     pub fn is_triangle(&self) -> bool {
         self.flags & BUNDLE_TRIANGLE != 0
@@ -257,7 +250,7 @@ pub fn bake(
     style.validate(&mesh.name)?;
     let layout: RootLayout = layout_root_slice(mesh, options.charts);
     let layers = mesh.layer_count();
-    let depth = 4 * (layers - 1) + 1;
+    let depth = SLICES_PER_SEGMENT as usize * (layers - 1) + 1;
     if layout.width > MAX_TEXTURE_SIDE
         || layout.height > MAX_TEXTURE_SIDE
         || depth as u32 > MAX_TEXTURE_SIDE

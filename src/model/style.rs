@@ -102,23 +102,7 @@ impl Default for HairStyle {
     }
 }
 
-/// `(field name, byte offset)` of every field, for the layout check against GLSL.
-#[macro_export]
-macro_rules! field_offsets {
-    ($ty:ty; $($field:ident),* $(,)?) => {
-        vec![$((stringify!($field), std::mem::offset_of!($ty, $field))),*]
-    };
-}
-
 impl HairStyle {
-    /// Field offsets in declaration order (mirrors `glsl/hair_types.glsl`).
-    pub fn field_offsets() -> Vec<(&'static str, usize)> {
-        field_offsets!(HairStyle; seed, strand_width, tip_width_ratio, taper_power,
-            length_variation, root_ramp, clump_strength, clump_power, curl_radius, curl_frequency,
-            curl_phase_jitter, wave_amplitude, wave_frequency, wave_angle, wave_phase_jitter,
-            frizz_amplitude, frizz_frequency, frizz_power, density_by_area, color, _pad)
-    }
-
     /// Parse a style from TOML text; `name` is used in errors.
     pub fn from_toml(name: &str, text: &str) -> Result<Self> {
         let style: HairStyle = toml::from_str(text)

@@ -1,201 +1,127 @@
-//! Camera and the per-frame uniform block (`Frame` in `glsl/bindings.glsl`, std140).
+//! What each of the frames in flight owns: command buffer, fence, per-frame uniform data and
+//! character records, timestamp and mesh queries (reset every frame), statistics and image
+//! readback, its descriptor set 0, and the resources retired with it.
 
-use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3, Vec4};
+use std::any::Any;
+use std::sync::Arc;
 
-/// Default viewing direction (target toward eye) of `render`, `bench` and the tests: a 3/4 view
-/// from behind and above, where the sample heads show their hair.
-pub const DEFAULT_VIEW_DIR: Vec3 = Vec3::new(0.7, 0.35, -1.0);
+use ash::vk;
 
-/// A perspective look-at camera.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    /// Eye position.
-    pub eye: Vec3,
-    /// Point looked at.
-    pub target: Vec3,
-    /// Up direction.
-    pub up: Vec3,
-    /// Vertical field of view, radians.
-    pub fov_y: f32,
-    /// Near plane distance.
-    pub near: f32,
-    /// Far plane distance.
-    pub far: f32,
+use super::RenderPath;
+use super::shared::{CharacterRecord, FrameBlock, FrameStats, GenerateArgs};
+use crate::vk::{
+    Buffer, BufferDesc, CommandBuffer, Context, DescriptorSet, DescriptorSetLayout, Fence,
+    GpuResult, MeshPrimitivesQuery, Profiler,
+};
+
+/// Frames the CPU may record ahead of the GPU.
+pub const FRAMES_IN_FLIGHT: usize = 2;
+
+/// A resource released once the frame it was retired with has completed.
+pub enum Retired {
+    /// Any GPU object (buffer, image, set...): dropped.
+    Resource(Box<dyn Any>),
+    /// A character slot: reusable.
+    CharacterSlot(u32),
 }
 
-impl Camera {
-    /// Look from `eye` at `target` with a vertical field of view in degrees.
-    pub fn look_at(eye: Vec3, target: Vec3, fov_y_degrees: f32) -> Self {
-        let dist = eye.distance(target).max(1e-3);
-        Camera {
-            eye,
-            target,
-            up: Vec3::Y,
-            fov_y: fov_y_degrees.to_radians(),
-            near: dist * 0.01,
-            far: dist * 20.0,
-        }
-    }
+/// What a completed frame did.
+#[derive(Clone, Debug)]
+pub struct FrameReport {
+    /// Frame number (from 0, per renderer).
+    pub frame: u64,
+    /// Generation path used.
+    pub path: RenderPath,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// What the GPU generated.
+    pub stats: FrameStats,
+    /// GPU milliseconds per pass.
+    pub pass_ms: Vec<(&'static str, f64)>,
+    /// Mesh path: `MESH_PRIMITIVES_GENERATED_EXT` where the device supports it.
+    pub mesh_primitives: Option<u64>,
+    /// CPU milliseconds spent recording the frame's commands.
+    pub record_ms: f64,
+    /// RGBA8 pixels (sRGB), top row first, when requested.
+    pub rgba: Option<Vec<u8>>,
+}
 
-    /// Frame a bounding box from direction `dir` (from the target toward the eye).
-    pub fn framing(lo: Vec3, hi: Vec3, dir: Vec3, fov_y_degrees: f32) -> Self {
-        let centre = (lo + hi) * 0.5;
-        let radius = ((hi - lo) * 0.5).length().max(1e-3);
-        let dist = radius / (fov_y_degrees.to_radians() * 0.5).tan() * 1.1;
-        Camera::look_at(
-            centre + dir.normalize_or(Vec3::Z) * dist,
-            centre,
-            fov_y_degrees,
+impl FrameReport {
+    /// Total GPU milliseconds.
+    pub fn gpu_ms(&self) -> f64 {
+        self.pass_ms.iter().map(|p| p.1).sum()
+    }
+}
+
+pub(crate) struct Pending {
+    pub frame: u64,
+    pub path: RenderPath,
+    pub width: u32,
+    pub height: u32,
+    pub record_ms: f64,
+    pub read_image: bool,
+}
+
+/// One frame in flight.
+pub(crate) struct FrameSlot {
+    pub cmd: CommandBuffer,
+    pub fence: Fence,
+    pub frame_ubo: Buffer,
+    pub records: Buffer,
+    pub stats_readback: Buffer,
+    pub image_readback: Option<Buffer>,
+    pub profiler: Profiler,
+    pub mesh_query: Option<MeshPrimitivesQuery>,
+    pub set: DescriptorSet,
+    pub retired: Vec<Retired>,
+    pub pending: Option<Pending>,
+}
+
+impl FrameSlot {
+    pub fn new(ctx: &Arc<Context>, layout: &Arc<DescriptorSetLayout>) -> GpuResult<Self> {
+        Ok(FrameSlot {
+            cmd: CommandBuffer::new(ctx, "frame")?,
+            fence: Fence::new(ctx, true)?,
+            frame_ubo: Buffer::new(
+                ctx,
+                &BufferDesc::new(
+                    "frame block",
+                    size_of::<FrameBlock>() as u64,
+                    vk::BufferUsageFlags::UNIFORM_BUFFER,
+                )
+                .host_visible(),
+            )?,
+            records: records_buffer(ctx, 1)?,
+            stats_readback: Buffer::new(
+                ctx,
+                &BufferDesc::new(
+                    "stats readback",
+                    size_of::<GenerateArgs>() as u64,
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                )
+                .readback(),
+            )?,
+            image_readback: None,
+            profiler: Profiler::new(ctx)?,
+            mesh_query: MeshPrimitivesQuery::new(ctx)?,
+            set: DescriptorSet::new(ctx, "frame set", layout)?,
+            retired: Vec::new(),
+            pending: None,
+        })
+    }
+}
+
+/// A host-visible buffer for `n` character records.
+pub(crate) fn records_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            "character records",
+            n.max(1) as u64 * size_of::<CharacterRecord>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
         )
-    }
-
-    /// Vulkan clip-space view-projection (y down, depth 0..1).
-    pub fn view_proj(&self, aspect: f32) -> Mat4 {
-        // Right-handed view, Vulkan projection: y down in clip space, depth in [0, 1].
-        let f = (self.target - self.eye).normalize_or(Vec3::NEG_Z);
-        let s = f.cross(self.up).normalize_or(Vec3::X);
-        let u = s.cross(f);
-        let view = Mat4::from_cols(
-            Vec4::new(s.x, u.x, -f.x, 0.0),
-            Vec4::new(s.y, u.y, -f.y, 0.0),
-            Vec4::new(s.z, u.z, -f.z, 0.0),
-            Vec4::new(-s.dot(self.eye), -u.dot(self.eye), f.dot(self.eye), 1.0),
-        );
-        let g = 1.0 / (self.fov_y * 0.5).tan();
-        let (n, fa) = (self.near, self.far);
-        let proj = Mat4::from_cols(
-            Vec4::new(g / aspect, 0.0, 0.0, 0.0),
-            Vec4::new(0.0, -g, 0.0, 0.0),
-            Vec4::new(0.0, 0.0, fa / (n - fa), -1.0),
-            Vec4::new(0.0, 0.0, n * fa / (n - fa), 0.0),
-        );
-        proj * view
-    }
-}
-
-/// Level-of-detail settings (paper 003 sec. 3.6): separate alphas for strands and vertices.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LodSettings {
-    /// LoD on; off renders every bundle at full detail.
-    pub enabled: bool,
-    /// Alpha of eq. 7 for strand LoD.
-    pub alpha_strands: f32,
-    /// Alpha of eq. 7 for vertex LoD.
-    pub alpha_verts: f32,
-    /// Geomorph transition window lambda of eq. 10-12, in `(0, 1]`.
-    pub lambda: f32,
-}
-
-impl Default for LodSettings {
-    fn default() -> Self {
-        LodSettings {
-            enabled: true,
-            alpha_strands: 0.1,
-            alpha_verts: 0.1,
-            lambda: 0.5,
-        }
-    }
-}
-
-impl LodSettings {
-    /// Every bundle at full detail.
-    pub fn off() -> Self {
-        LodSettings {
-            enabled: false,
-            ..Default::default()
-        }
-    }
-}
-
-/// Per-frame uniform block; mirrors `Frame` in `glsl/bindings.glsl` (std140, 256 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct FrameParams {
-    /// World to clip.
-    pub view_proj: [[f32; 4]; 4],
-    /// xyz eye, w vertical resolution in pixels.
-    pub camera_pos: [f32; 4],
-    /// xyz direction toward the light, w `1 / tan(fov_y / 2)`.
-    pub light_dir: [f32; 4],
-    /// width, height, 1/width, 1/height.
-    pub viewport: [f32; 4],
-    /// x strands per bundle, y vertex level e, z bundle count, w unused.
-    pub params: [u32; 4],
-    /// Frustum planes (inside where `dot(n, p) + d >= 0`).
-    pub planes: [[f32; 4]; 6],
-    /// x alpha strands, y alpha vertices, z lambda, w `tan(fov_y)` of eq. 7.
-    pub lod: [f32; 4],
-    /// x view height of orthographic views (unused for perspective).
-    pub lod_ortho: [f32; 4],
-}
-
-/// Frustum planes of a Vulkan view-projection matrix (Gribb-Hartmann), normalised.
-pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
-    let row = |i: usize| Vec4::new(m.x_axis[i], m.y_axis[i], m.z_axis[i], m.w_axis[i]);
-    let (r0, r1, r2, r3) = (row(0), row(1), row(2), row(3));
-    [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2].map(|p| {
-        let n = p.truncate().length().max(1e-20);
-        (p / n).to_array()
-    })
-}
-
-impl FrameParams {
-    /// Fill the block for `camera` at `width x height`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        camera: &Camera,
-        light_dir: Vec3,
-        width: u32,
-        height: u32,
-        strands: u32,
-        verts_log2: u32,
-        bundles: u32,
-        lod: &LodSettings,
-    ) -> Self {
-        let vp = camera.view_proj(width as f32 / height as f32);
-        FrameParams {
-            view_proj: vp.to_cols_array_2d(),
-            camera_pos: camera.eye.extend(height as f32).to_array(),
-            light_dir: light_dir
-                .normalize_or(Vec3::Y)
-                .extend(1.0 / (camera.fov_y * 0.5).tan())
-                .to_array(),
-            viewport: [
-                width as f32,
-                height as f32,
-                1.0 / width as f32,
-                1.0 / height as f32,
-            ],
-            params: [strands, verts_log2, bundles, lod.enabled as u32],
-            planes: frustum_planes(vp),
-            lod: [
-                lod.alpha_strands,
-                lod.alpha_verts,
-                lod.lambda,
-                camera.fov_y.tan(),
-            ],
-            lod_ortho: [0.0; 4],
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn frustum_contains_target_not_behind() {
-        let cam = Camera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, 45.0);
-        let planes = frustum_planes(cam.view_proj(1.0));
-        let inside = |p: Vec3| {
-            planes
-                .iter()
-                .all(|pl| Vec3::from_slice(&pl[..3]).dot(p) + pl[3] >= 0.0)
-        };
-        assert!(inside(Vec3::ZERO));
-        assert!(!inside(Vec3::new(0.0, 0.0, 10.0)), "behind the camera");
-        assert!(!inside(Vec3::new(100.0, 0.0, 0.0)), "far to the side");
-        assert_eq!(size_of::<FrameParams>(), 256);
-    }
+        .host_visible(),
+    )
 }

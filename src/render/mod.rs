@@ -1,15 +1,19 @@
-//! Rendering: per-character GPU resources, the generation passes and the raster passes.
-//! Data flow: [`HairGpu`] (textures) -> [`compute_path::ComputeGenerate`] (strand vertices)
-//! -> [`draw::HairDraw`] (scalp + strips) -> colour image.
+//! The GPU side: the crowd's tables, one frame for all characters, one file per pass.
+//! Data flow per frame: [`Crowd`] (textures, records, bundles) -> generation (task shader, or
+//! [`passes::compute_generate`]) -> strips and scalps ([`passes::strands`], [`passes::scalp`])
+//! -> colour image ([`targets`]). The CPU/GPU contract lives in [`shared`].
 
-pub mod compute_path;
-pub mod draw;
+pub mod camera;
+pub mod crowd;
 pub mod frame;
-pub mod hair_gpu;
+pub mod passes;
 pub mod renderer;
 pub mod scene;
+pub mod shared;
+pub mod targets;
 
-pub use frame::LodSettings;
-pub use frame::{Camera, FrameParams};
-pub use hair_gpu::{HairGpu, StrandParams};
-pub use renderer::{RenderOutput, RenderPath, RenderSettings, Renderer};
+pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
+pub use crowd::{CharacterId, Crowd, StrandParams};
+pub use frame::{FRAMES_IN_FLIGHT, FrameReport};
+pub use renderer::{FrameOptions, FrameTicket, RenderPath, Renderer, RendererDesc};
+pub use shared::FrameStats;

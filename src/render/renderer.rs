@@ -1,17 +1,31 @@
-//! Headless renderer: owns the pipelines and render targets, renders characters to RGBA8.
+//! The renderer: one frame serves every character. It owns the pipelines, the render targets
+//! (recreated on resize only), the crowd's GPU tables and [`FRAMES_IN_FLIGHT`] frame slots.
+//! A frame is recorded with [`Renderer::render_frame`] and its [`FrameReport`] collected with
+//! [`Renderer::wait`]; headless tools and tests do both with [`Renderer::render_one`].
 
+use std::collections::VecDeque;
 use std::sync::Arc;
+use std::time::Instant;
 
 use ash::vk;
-use glam::Vec3;
+use glam::{Mat4, Vec2};
 
-use super::compute_path::ComputeGenerate;
-use super::draw::{COLOR_FORMAT, DEPTH_FORMAT, HairDraw};
-use super::frame::{Camera, FrameParams, LodSettings};
-use super::hair_gpu::{HAIR_VERTEX_BYTES, HairGpu, INDIRECT_BYTES};
-use crate::vk::image::Sampler;
-use crate::vk::profiler::{MeshPrimitivesQuery, Profiler};
-use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult, Image, ImageDesc};
+use super::camera::View;
+use super::crowd::{CharacterId, Crowd, StrandParams};
+use super::frame::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Pending, Retired, records_buffer};
+use super::passes::PassSets;
+use super::passes::compute_generate::{ComputeGenerate, scan_plan};
+use super::passes::scalp::ScalpPass;
+use super::passes::strands::StrandDraw;
+use super::shared::{FrameBinding, GenerateArgs, HairVertex, SET_FRAME, SET_TEXTURES};
+use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets};
+use crate::bake::BakedHairMesh;
+use crate::bake::blue_noise::{quad_samples, triangle_samples};
+use crate::model::style::HairStyle;
+use crate::vk::{
+    Access, Attachment, BindingDesc, Buffer, BufferDesc, Context, DescriptorKind,
+    DescriptorSetLayout, GpuError, GpuResult, PipelineLayout,
+};
 
 /// Which generation path draws the strands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -22,390 +36,651 @@ pub enum RenderPath {
     Compute,
 }
 
-/// Per-render choices.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RenderSettings {
-    /// Forced path; `None` picks mesh where available, else compute.
+/// How to create a [`Renderer`].
+#[derive(Clone, Debug)]
+pub struct RendererDesc {
+    /// Default path; `None` picks mesh where available, else compute.
     pub path: Option<RenderPath>,
-    /// Level of detail.
-    pub lod: LodSettings,
-}
-
-/// A rendered frame and what it cost.
-pub struct RenderOutput {
-    /// Width in pixels.
+    /// Size of the compute path's generated-vertex pool in bytes (<= the device's
+    /// `maxStorageBufferRange`). Frames that need more keep whole strands up to it.
+    pub vertex_pool_bytes: u64,
+    /// Bundles one task workgroup culls (1..=32).
+    pub task_bundles: u32,
+    /// Most characters at once (five bindless textures each).
+    pub max_characters: u32,
+    /// Initial target size.
     pub width: u32,
-    /// Height in pixels.
+    /// Initial target size.
     pub height: u32,
-    /// RGBA8 pixels (sRGB), row-major, top row first.
-    pub rgba: Vec<u8>,
-    /// GPU milliseconds per pass, summed over characters, in first-seen order.
-    pub pass_ms: Vec<(String, f64)>,
-    /// Strands generated (after culling and LoD), over all characters.
-    pub strands: u64,
-    /// Strand triangles generated.
-    pub triangles: u64,
-    /// The path used.
-    pub path: RenderPath,
-    /// Mesh path: primitives the mesh shaders emitted, from `MESH_PRIMITIVES_GENERATED_EXT`
-    /// queries where the device supports them.
-    pub mesh_primitives_query: Option<u64>,
 }
 
-struct Pipelines {
-    generate: ComputeGenerate,
-    draw: HairDraw,
+impl Default for RendererDesc {
+    fn default() -> Self {
+        RendererDesc {
+            path: None,
+            vertex_pool_bytes: 96 << 20,
+            task_bundles: super::shared::TASK_PAYLOAD_BUNDLES,
+            max_characters: 1024,
+            width: 1280,
+            height: 720,
+        }
+    }
 }
 
-/// Renders hair characters headlessly.
+impl RendererDesc {
+    /// Set the initial target size.
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.width = width;
+        self.height = height;
+        self
+    }
+
+    /// Set the default path.
+    pub fn path(mut self, path: Option<RenderPath>) -> Self {
+        self.path = path;
+        self
+    }
+
+    /// Set the vertex pool size in bytes.
+    pub fn vertex_pool_bytes(mut self, bytes: u64) -> Self {
+        self.vertex_pool_bytes = bytes;
+        self
+    }
+}
+
+/// Per-frame choices.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameOptions {
+    /// Path for this frame (`None`: the renderer's default).
+    pub path: Option<RenderPath>,
+    /// Clear colour and depth first (else draw over the previous frame's contents).
+    pub clear: bool,
+    /// Read the colour target back into the report.
+    pub read_image: bool,
+}
+
+impl Default for FrameOptions {
+    fn default() -> Self {
+        FrameOptions {
+            path: None,
+            clear: true,
+            read_image: false,
+        }
+    }
+}
+
+/// A submitted frame, to [`Renderer::wait`] for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameTicket(pub u64);
+
+/// GPU working buffers sized by the crowd's bundle count (grown, never shrunk).
+struct Workspace {
+    root_samples: Buffer,
+    lods: Buffer,
+    offsets: Buffer,
+    scan: Buffer,
+    args: Buffer,
+    pool: Option<Buffer>,
+    placeholder: Buffer,
+    bundles: u32,
+}
+
+/// Renders every character of the crowd in one frame.
 pub struct Renderer {
     ctx: Arc<Context>,
-    /// Linear clamp sampler for the five textures.
-    pub sampler: Sampler,
-    pipelines: Option<Pipelines>,
-    profiler: Profiler,
+    desc: RendererDesc,
+    crowd: Crowd,
+    frame_layout: Arc<DescriptorSetLayout>,
+    generate: ComputeGenerate,
+    scalp: ScalpPass,
+    strands: StrandDraw,
+    frames: Vec<FrameSlot>,
+    next: usize,
+    frame_number: u64,
+    targets: RenderTargets,
+    work: Workspace,
+    completed: VecDeque<FrameReport>,
     /// Background colour (linear RGB).
     pub background: [f32; 3],
 }
 
+fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(name, bytes, vk::BufferUsageFlags::STORAGE_BUFFER),
+    )
+}
+
+fn check_size(width: u32, height: u32) -> GpuResult<()> {
+    if width == 0 || height == 0 || width > 8192 || height > 8192 {
+        return Err(GpuError::Unsupported(format!(
+            "bad target size {width}x{height}: 1..=8192 per side"
+        )));
+    }
+    Ok(())
+}
+
 impl Renderer {
-    /// A renderer on `ctx`.
-    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
+    /// Create pipelines, targets and frame slots; checks the device limits the settings need.
+    pub fn new(ctx: &Arc<Context>, desc: &RendererDesc) -> GpuResult<Self> {
+        check_size(desc.width, desc.height)?;
+        let range = ctx.info.max_storage_buffer_range;
+        if desc.vertex_pool_bytes < size_of::<HairVertex>() as u64 || desc.vertex_pool_bytes > range
+        {
+            return Err(GpuError::Unsupported(format!(
+                "vertex pool of {} bytes: must be {}..={range} (maxStorageBufferRange of {})",
+                desc.vertex_pool_bytes,
+                size_of::<HairVertex>(),
+                ctx.info.name
+            )));
+        }
+        let crowd = Crowd::new(ctx, desc.max_characters)?;
+        let bindings: Vec<BindingDesc> = FrameBinding::ALL
+            .iter()
+            .map(|(b, _)| {
+                let kind = if *b == FrameBinding::Frame {
+                    DescriptorKind::UniformBuffer
+                } else {
+                    DescriptorKind::StorageBuffer
+                };
+                BindingDesc::single(*b as u32, kind)
+            })
+            .collect();
+        let frame_layout = DescriptorSetLayout::new(ctx, &bindings)?;
+        let mut set_layouts = vec![frame_layout.clone(); 2];
+        set_layouts[SET_FRAME as usize] = frame_layout.clone();
+        set_layouts[SET_TEXTURES as usize] = crowd.texture_layout().clone();
+        let layout = PipelineLayout::new(ctx, &set_layouts)?;
+        let generate = ComputeGenerate::new(ctx, &layout)?;
+        let scalp = ScalpPass::new(ctx, &layout, COLOR_FORMAT, DEPTH_FORMAT)?;
+        let strands = StrandDraw::new(ctx, &layout, COLOR_FORMAT, DEPTH_FORMAT, desc.task_bundles)?;
+        if desc.path == Some(RenderPath::Mesh) && !strands.has_mesh_path() {
+            return Err(GpuError::Unsupported(format!(
+                "{}: no usable VK_EXT_mesh_shader for the mesh path",
+                ctx.info.name
+            )));
+        }
+        let frames = (0..FRAMES_IN_FLIGHT)
+            .map(|_| FrameSlot::new(ctx, &frame_layout))
+            .collect::<GpuResult<_>>()?;
+        let samples: Vec<Vec2> = quad_samples()
+            .iter()
+            .chain(triangle_samples())
+            .copied()
+            .collect();
+        let args = Buffer::new(
+            ctx,
+            &BufferDesc::new(
+                "generate args",
+                size_of::<GenerateArgs>() as u64,
+                vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::INDIRECT_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC
+                    | vk::BufferUsageFlags::TRANSFER_DST,
+            ),
+        )?;
+        let work = Workspace {
+            root_samples: Buffer::with_data(
+                ctx,
+                "root samples",
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                bytemuck::cast_slice(&samples),
+            )?,
+            lods: storage(ctx, "bundle lods", 16)?,
+            offsets: storage(ctx, "bundle offsets", 16)?,
+            scan: storage(ctx, "scan scratch", 16)?,
+            args,
+            pool: None,
+            placeholder: storage(ctx, "vertex pool (unused)", 16)?,
+            bundles: 0,
+        };
         Ok(Renderer {
             ctx: ctx.clone(),
-            sampler: Sampler::linear_clamp(ctx)?,
-            pipelines: None,
-            profiler: Profiler::new(ctx, 64)?,
+            desc: desc.clone(),
+            crowd,
+            frame_layout,
+            generate,
+            scalp,
+            strands,
+            frames,
+            next: 0,
+            frame_number: 0,
+            targets: RenderTargets::new(ctx, desc.width, desc.height)?,
+            work,
+            completed: VecDeque::new(),
             background: [0.6, 0.65, 0.7],
         })
     }
 
-    fn pipelines(&mut self, hair: &HairGpu) -> GpuResult<&Pipelines> {
-        if self.pipelines.is_none() {
-            self.pipelines = Some(Pipelines {
-                generate: ComputeGenerate::new(&self.ctx, hair.set.layout)?,
-                draw: HairDraw::new(&self.ctx, hair.set.layout)?,
-            });
+    /// The path frames use unless told otherwise.
+    pub fn default_path(&self) -> RenderPath {
+        match self.desc.path {
+            Some(p) => p,
+            None if self.strands.has_mesh_path() => RenderPath::Mesh,
+            None => RenderPath::Compute,
         }
-        Ok(self.pipelines.as_ref().expect("just created"))
     }
 
-    /// Render `hairs` from `camera` at `width x height`.
-    pub fn render(
+    /// Whether the mesh path is available.
+    pub fn has_mesh_path(&self) -> bool {
+        self.strands.has_mesh_path()
+    }
+
+    /// The characters.
+    pub fn crowd(&self) -> &Crowd {
+        &self.crowd
+    }
+
+    /// Vertex slots of the compute path's pool.
+    pub fn vertex_budget(&self) -> u32 {
+        (self.desc.vertex_pool_bytes / size_of::<HairVertex>() as u64).min(u32::MAX as u64) as u32
+    }
+
+    /// Add a character (uploads its textures; blocks until they are on the GPU).
+    pub fn add_character(
         &mut self,
-        hairs: &[HairGpu],
-        camera: &Camera,
-        light_dir: Vec3,
-        width: u32,
-        height: u32,
-        settings: &RenderSettings,
-    ) -> GpuResult<RenderOutput> {
-        if hairs.is_empty() || width == 0 || height == 0 || width > 8192 || height > 8192 {
+        baked: &BakedHairMesh,
+        style: &HairStyle,
+        params: StrandParams,
+        model: Mat4,
+    ) -> GpuResult<CharacterId> {
+        self.crowd.add(baked, style, params, model)
+    }
+
+    /// Remove a character; its textures are released after the frames using them.
+    pub fn remove_character(&mut self, id: CharacterId) -> GpuResult<()> {
+        let removed = self.crowd.remove(id)?;
+        self.retire(Retired::Resource(Box::new(removed.textures)));
+        self.retire(Retired::CharacterSlot(removed.slot));
+        Ok(())
+    }
+
+    /// Move a character.
+    pub fn set_model(&mut self, id: CharacterId, model: Mat4) -> GpuResult<()> {
+        self.crowd.set_model(id, model)
+    }
+
+    /// Show or hide a character.
+    pub fn set_visible(&mut self, id: CharacterId, visible: bool) -> GpuResult<()> {
+        self.crowd.set_visible(id, visible)
+    }
+
+    /// Change a character's strand settings.
+    pub fn set_params(&mut self, id: CharacterId, params: StrandParams) -> GpuResult<()> {
+        self.crowd.set_params(id, params)
+    }
+
+    /// Target size.
+    pub fn size(&self) -> (u32, u32) {
+        self.targets.size()
+    }
+
+    /// Recreate the targets at a new size (frames in flight keep the old ones until done).
+    pub fn resize(&mut self, width: u32, height: u32) -> GpuResult<()> {
+        check_size(width, height)?;
+        if self.targets.size() == (width, height) {
+            return Ok(());
+        }
+        let old = std::mem::replace(
+            &mut self.targets,
+            RenderTargets::new(&self.ctx, width, height)?,
+        );
+        self.retire(Retired::Resource(Box::new(old)));
+        Ok(())
+    }
+
+    /// Release `r` after the newest submitted frame completes (now if none is pending).
+    fn retire(&mut self, r: Retired) {
+        let last = (self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT;
+        if self.frames[last].pending.is_some() {
+            self.frames[last].retired.push(r);
+        } else if let Retired::CharacterSlot(s) = r {
+            self.crowd.free_slot(s);
+        }
+    }
+
+    /// Wait for frame slot `i`, collect its report and release what was retired with it.
+    fn retire_slot(&mut self, i: usize) -> GpuResult<()> {
+        let slot = &mut self.frames[i];
+        slot.fence.wait()?;
+        if let Some(p) = slot.pending.take() {
+            let args: GenerateArgs = bytemuck::pod_read_unaligned(&slot.stats_readback.read()?);
+            let rgba = match (&mut slot.image_readback, p.read_image) {
+                (Some(b), true) => Some(b.read_range(0, (p.width * p.height * 4) as usize)?),
+                _ => None,
+            };
+            let mesh_primitives = match (&slot.mesh_query, p.path) {
+                (Some(q), RenderPath::Mesh) => q.result()?,
+                _ => None,
+            };
+            self.completed.push_back(FrameReport {
+                frame: p.frame,
+                path: p.path,
+                width: p.width,
+                height: p.height,
+                stats: args.stats,
+                pass_ms: slot.profiler.results()?,
+                mesh_primitives,
+                record_ms: p.record_ms,
+                rgba,
+            });
+            while self.completed.len() > 2 * FRAMES_IN_FLIGHT {
+                self.completed.pop_front();
+            }
+        }
+        for r in std::mem::take(&mut self.frames[i].retired) {
+            if let Retired::CharacterSlot(s) = r {
+                self.crowd.free_slot(s);
+            }
+        }
+        Ok(())
+    }
+
+    /// Grow the working buffers for the crowd's bundles and allocate the vertex pool when the
+    /// compute path first needs it. Replaced buffers are retired with frame slot `i`.
+    fn prepare_workspace(&mut self, i: usize, path: RenderPath) -> GpuResult<()> {
+        if let Some(old) = self.crowd.update_bundle_table()? {
+            self.frames[i].retired.push(Retired::Resource(Box::new(old)));
+        }
+        let bundles = self.crowd.bundle_count();
+        if bundles > self.work.bundles {
+            let n = bundles.max(self.work.bundles + self.work.bundles / 2);
+            let (_, scratch) = scan_plan(n);
+            let retired = [
+                std::mem::replace(&mut self.work.lods, storage(&self.ctx, "bundle lods", 16 * n as u64)?),
+                std::mem::replace(
+                    &mut self.work.offsets,
+                    storage(&self.ctx, "bundle offsets", 16 * n as u64)?,
+                ),
+                std::mem::replace(
+                    &mut self.work.scan,
+                    storage(&self.ctx, "scan scratch", 16 * scratch as u64)?,
+                ),
+            ];
+            self.frames[i].retired.push(Retired::Resource(Box::new(retired)));
+            self.work.bundles = n;
+        }
+        if path == RenderPath::Compute && self.work.pool.is_none() {
+            self.work.pool = Some(storage(
+                &self.ctx,
+                "vertex pool",
+                self.desc.vertex_pool_bytes,
+            )?);
+        }
+        let slots = self.crowd.slot_count();
+        let slot = &mut self.frames[i];
+        if slot.records.size < slots as u64 * size_of::<super::shared::CharacterRecord>() as u64 {
+            slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
+        }
+        Ok(())
+    }
+
+    /// Write frame slot `i`'s descriptor set 0 (its previous frame has completed).
+    fn write_frame_set(&self, i: usize) -> GpuResult<()> {
+        let slot = &self.frames[i];
+        let w = &self.work;
+        let bundles = self.crowd.bundle_table().unwrap_or(&w.placeholder);
+        let pool = w.pool.as_ref().unwrap_or(&w.placeholder);
+        for (b, _) in FrameBinding::ALL {
+            let buffer = match b {
+                FrameBinding::Frame => &slot.frame_ubo,
+                FrameBinding::Characters => &slot.records,
+                FrameBinding::Bundles => bundles,
+                FrameBinding::RootSamples => &w.root_samples,
+                FrameBinding::BundleLods => &w.lods,
+                FrameBinding::BundleOffsets => &w.offsets,
+                FrameBinding::ScanScratch => &w.scan,
+                FrameBinding::Args => &w.args,
+                FrameBinding::Vertices => pool,
+            };
+            slot.set.write_buffer(b as u32, buffer)?;
+        }
+        Ok(())
+    }
+
+    /// Record and submit one frame of every visible character seen from `view`. Waits only
+    /// for the frame submitted [`FRAMES_IN_FLIGHT`] frames ago.
+    pub fn render_frame(&mut self, view: &View, opts: &FrameOptions) -> GpuResult<FrameTicket> {
+        let c = &view.camera;
+        if !(c.eye.is_finite() && c.target.is_finite() && c.fov_y.is_finite())
+            || !view.light_dir.is_finite()
+        {
+            return Err(GpuError::Unsupported("camera or light is not finite".into()));
+        }
+        let path = opts.path.unwrap_or(self.default_path());
+        if path == RenderPath::Mesh && !self.strands.has_mesh_path() {
             return Err(GpuError::Unsupported(format!(
-                "nothing to render or bad size {width}x{height}"
+                "{}: no usable VK_EXT_mesh_shader for the mesh path",
+                self.ctx.info.name
             )));
         }
-        for hair in hairs {
-            let p = &hair.params;
-            let frame = FrameParams::new(
-                camera,
-                light_dir,
-                width,
-                height,
-                p.strands_per_bundle,
-                p.verts_log2,
-                hair.bundle_count(),
-                &settings.lod,
-            );
-            hair.frame.write_shared(bytemuck::bytes_of(&frame))?;
-        }
-        let ctx = self.ctx.clone();
-        self.pipelines(&hairs[0])?;
-        let pipelines = self.pipelines.as_ref().expect("created above");
-        let path = match settings.path {
-            Some(RenderPath::Mesh) if !pipelines.draw.has_mesh_path() => {
-                return Err(GpuError::Unsupported(format!(
-                    "{}: no usable VK_EXT_mesh_shader for --path mesh",
-                    ctx.info.name
-                )));
-            }
-            Some(p) => p,
-            None if pipelines.draw.has_mesh_path() => RenderPath::Mesh,
-            None => RenderPath::Compute,
-        };
-        let color = Image::new(
-            &ctx,
-            &ImageDesc::new_2d("color", COLOR_FORMAT, width, height)
-                .usage(vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC),
-        )?;
-        let depth = Image::new(
-            &ctx,
-            &ImageDesc::new_2d("depth", DEPTH_FORMAT, width, height)
-                .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT),
-        )?;
-        let stats: Vec<Buffer> = hairs
-            .iter()
-            .map(|_| {
-                Buffer::new(
-                    &ctx,
-                    &BufferDesc::new(
-                        "indirect readback",
-                        INDIRECT_BYTES,
-                        vk::BufferUsageFlags::TRANSFER_DST,
-                    )
-                    .readback(),
-                )
-            })
-            .collect::<GpuResult<_>>()?;
-        let mesh_query = if path == RenderPath::Mesh {
-            MeshPrimitivesQuery::new(&ctx, hairs.len() as u32)?
-        } else {
-            None
-        };
-        let profiler = &mut self.profiler;
-        let background = self.background;
-        let mut readback = ctx.submit_and_wait(|cmd| -> GpuResult<Buffer> {
-            profiler.reset(cmd);
-            if let Some(q) = &mesh_query {
-                q.reset(cmd);
-            }
-            color.transition(
-                cmd,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            );
-            depth.transition(
-                cmd,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-            );
-            for (i, (hair, stat)) in hairs.iter().zip(&stats).enumerate() {
-                match path {
-                    RenderPath::Compute => pipelines.generate.record(cmd, hair, profiler),
-                    RenderPath::Mesh => {
-                        // The task shader accumulates statistics into the indirect block.
-                        ctx.barrier(
-                            cmd,
-                            (
-                                vk::PipelineStageFlags2::ALL_COMMANDS,
-                                vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
-                            ),
-                            (
-                                vk::PipelineStageFlags2::TRANSFER,
-                                vk::AccessFlags2::TRANSFER_WRITE,
-                            ),
-                        );
-                        // SAFETY: recording outside a render pass; the buffer allows TRANSFER_DST.
-                        unsafe {
-                            ctx.device
-                                .cmd_fill_buffer(cmd, hair.indirect.raw, 0, INDIRECT_BYTES, 0)
-                        };
-                        ctx.barrier(
-                            cmd,
-                            (
-                                vk::PipelineStageFlags2::TRANSFER,
-                                vk::AccessFlags2::TRANSFER_WRITE,
-                            ),
-                            (
-                                vk::PipelineStageFlags2::TASK_SHADER_EXT,
-                                vk::AccessFlags2::SHADER_STORAGE_READ
-                                    | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                            ),
-                        );
-                    }
-                }
-                let load = if i == 0 {
-                    vk::AttachmentLoadOp::CLEAR
-                } else {
-                    vk::AttachmentLoadOp::LOAD
-                };
-                let color_att = [vk::RenderingAttachmentInfo::default()
-                    .image_view(color.view)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(load)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue {
-                        color: vk::ClearColorValue {
-                            float32: [background[0], background[1], background[2], 1.0],
-                        },
-                    })];
-                let depth_att = vk::RenderingAttachmentInfo::default()
-                    .image_view(depth.view)
-                    .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                    .load_op(load)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue {
-                        depth_stencil: vk::ClearDepthStencilValue {
-                            depth: 1.0,
-                            stencil: 0,
-                        },
-                    });
-                let area = vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent: vk::Extent2D { width, height },
-                };
-                let info = vk::RenderingInfo::default()
-                    .render_area(area)
-                    .layer_count(1)
-                    .color_attachments(&color_att)
-                    .depth_attachment(&depth_att);
-                profiler.begin(
-                    cmd,
-                    if path == RenderPath::Mesh {
-                        "mesh draw"
-                    } else {
-                        "draw"
-                    },
-                );
-                // SAFETY: attachments are in the layouts named above; viewport covers the target.
-                unsafe {
-                    ctx.device.cmd_begin_rendering(cmd, &info);
-                    ctx.device.cmd_set_viewport(
-                        cmd,
-                        0,
-                        &[vk::Viewport {
-                            x: 0.0,
-                            y: 0.0,
-                            width: width as f32,
-                            height: height as f32,
-                            min_depth: 0.0,
-                            max_depth: 1.0,
-                        }],
-                    );
-                    ctx.device.cmd_set_scissor(cmd, 0, &[area]);
-                }
-                pipelines.draw.record_scalp(cmd, hair);
-                match path {
-                    RenderPath::Compute => pipelines.draw.record_pulled_strands(cmd, hair),
-                    RenderPath::Mesh => {
-                        if let Some(q) = &mesh_query {
-                            q.begin(cmd, i as u32);
-                        }
-                        pipelines.draw.record_mesh_strands(cmd, hair);
-                        if let Some(q) = &mesh_query {
-                            q.end(cmd, i as u32);
-                        }
-                    }
-                }
-                // SAFETY: matching begin above.
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
-                profiler.end(cmd);
-                ctx.barrier(
-                    cmd,
-                    (
-                        vk::PipelineStageFlags2::ALL_COMMANDS,
-                        vk::AccessFlags2::MEMORY_WRITE,
-                    ),
-                    (
-                        vk::PipelineStageFlags2::ALL_COMMANDS,
-                        vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
-                    ),
-                );
-                // SAFETY: the barrier above orders the shader writes before this copy.
-                unsafe {
-                    ctx.device.cmd_copy_buffer(
-                        cmd,
-                        hair.indirect.raw,
-                        stat.raw,
-                        &[vk::BufferCopy {
-                            src_offset: 0,
-                            dst_offset: 0,
-                            size: INDIRECT_BYTES,
-                        }],
-                    )
-                };
-            }
-            color.transition(
-                cmd,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            );
-            color.record_readback(cmd)
-        })??;
-        let rgba = readback.read()?;
-        let mut strands = 0;
-        let mut triangles = 0;
-        for mut s in stats {
-            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&s.read()?);
-            strands += words[3] as u64;
-            triangles += words[8] as u64;
-        }
-        let mesh_primitives_query = match &mesh_query {
-            Some(q) => Some(q.total(hairs.len() as u32)?),
-            None => None,
-        };
-        let mut pass_ms: Vec<(String, f64)> = Vec::new();
-        for (name, ms) in self.profiler.results()? {
-            match pass_ms.iter_mut().find(|(n, _)| *n == name) {
-                Some(e) => e.1 += ms,
-                None => pass_ms.push((name, ms)),
-            }
-        }
-        Ok(RenderOutput {
+        let i = self.next;
+        self.retire_slot(i)?;
+        self.prepare_workspace(i, path)?;
+        let (width, height) = self.targets.size();
+        let bundles = self.crowd.bundle_count();
+        let block = view.frame_block(
             width,
             height,
-            rgba,
-            pass_ms,
-            strands,
-            triangles,
+            bundles,
+            self.crowd.slot_count(),
+            self.vertex_budget(),
+        );
+        let records = self.crowd.records();
+        {
+            let slot = &mut self.frames[i];
+            slot.frame_ubo.write(0, bytemuck::bytes_of(&block))?;
+            slot.records.write(0, bytemuck::cast_slice(&records))?;
+            let image_bytes = width as u64 * height as u64 * 4;
+            if opts.read_image && slot.image_readback.as_ref().is_none_or(|b| b.size != image_bytes)
+            {
+                slot.image_readback = Some(Buffer::new(
+                    &self.ctx,
+                    &BufferDesc::new("image readback", image_bytes, vk::BufferUsageFlags::TRANSFER_DST)
+                        .readback(),
+                )?);
+            }
+        }
+        self.write_frame_set(i)?;
+        let start = Instant::now();
+        self.record(i, path, bundles, opts)?;
+        let record_ms = start.elapsed().as_secs_f64() * 1e3;
+        let slot = &mut self.frames[i];
+        slot.fence.reset()?;
+        if let Err(e) = self.ctx.submit(&slot.cmd, &slot.fence) {
+            // Keep the slot usable: a fence that will never be signalled would hang the next wait.
+            slot.fence = crate::vk::Fence::new(&self.ctx, true)?;
+            return Err(e);
+        }
+        let frame = self.frame_number;
+        slot.pending = Some(Pending {
+            frame,
             path,
-            mesh_primitives_query,
-        })
+            width,
+            height,
+            record_ms,
+            read_image: opts.read_image,
+        });
+        self.frame_number += 1;
+        self.next = (i + 1) % FRAMES_IN_FLIGHT;
+        Ok(FrameTicket(frame))
     }
 
-    /// Read back the compute path's generated vertices of `hair` (`[x, y, z, width, tx, ty, tz,
-    /// s]` each, bundle-major) and the number of strands of the last render.
-    pub fn read_vertices(&self, hair: &HairGpu) -> GpuResult<(Vec<[f32; 8]>, u32)> {
-        let ctx = &self.ctx;
-        let mut verts = Buffer::new(
-            ctx,
-            &BufferDesc::new(
-                "vertex readback",
-                hair.vertices.size,
-                vk::BufferUsageFlags::TRANSFER_DST,
-            )
-            .readback(),
-        )?;
-        let mut ind = Buffer::new(
-            ctx,
-            &BufferDesc::new(
-                "indirect readback",
-                INDIRECT_BYTES,
-                vk::BufferUsageFlags::TRANSFER_DST,
-            )
-            .readback(),
-        )?;
-        ctx.submit_and_wait(|cmd| {
-            // SAFETY: both copies are within the buffers' sizes.
-            unsafe {
-                ctx.device.cmd_copy_buffer(
-                    cmd,
-                    hair.vertices.raw,
-                    verts.raw,
-                    &[vk::BufferCopy {
-                        src_offset: 0,
-                        dst_offset: 0,
-                        size: hair.vertices.size,
-                    }],
-                );
-                ctx.device.cmd_copy_buffer(
-                    cmd,
-                    hair.indirect.raw,
-                    ind.raw,
-                    &[vk::BufferCopy {
-                        src_offset: 0,
-                        dst_offset: 0,
-                        size: INDIRECT_BYTES,
-                    }],
-                );
+    fn record(
+        &mut self,
+        i: usize,
+        path: RenderPath,
+        bundles: u32,
+        opts: &FrameOptions,
+    ) -> GpuResult<()> {
+        let slot = &mut self.frames[i];
+        let work = &self.work;
+        let targets = &mut self.targets;
+        let sets = PassSets {
+            frame: &slot.set,
+            textures: self.crowd.texture_set(),
+        };
+        let mut rec = slot.cmd.begin()?;
+        slot.profiler.reset(&mut rec);
+        if let Some(q) = &mut slot.mesh_query {
+            q.reset(&mut rec);
+        }
+        // Statistics accumulate from zero every frame.
+        rec.barrier(
+            &[
+                Access::ComputeReadWrite,
+                Access::TaskReadWrite,
+                Access::IndirectRead,
+                Access::TransferRead,
+            ],
+            &[Access::TransferWrite],
+        );
+        rec.fill_buffer(&work.args, 0, size_of::<GenerateArgs>() as u64, 0);
+        rec.barrier(
+            &[Access::TransferWrite],
+            &[Access::ComputeReadWrite, Access::TaskReadWrite],
+        );
+        if bundles > 0 && path == RenderPath::Compute {
+            self.generate
+                .record(&mut rec, &mut slot.profiler, sets, bundles, &work.args);
+        }
+        let (color_from, depth_from) = if opts.clear {
+            (Access::Nothing, Access::Nothing)
+        } else {
+            (targets.color_access, targets.depth_access)
+        };
+        rec.image_barrier(&targets.color, color_from, Access::ColorAttachment);
+        rec.image_barrier(&targets.depth, depth_from, Access::DepthAttachment);
+        let bg = self.background;
+        let clear = |v: [f32; 4]| opts.clear.then_some(v);
+        slot.profiler.begin(
+            &mut rec,
+            if path == RenderPath::Mesh { "mesh draw" } else { "draw" },
+        );
+        rec.begin_rendering(
+            Attachment {
+                image: &targets.color,
+                clear: clear([bg[0], bg[1], bg[2], 1.0]),
+            },
+            Attachment {
+                image: &targets.depth,
+                clear: clear([1.0; 4]),
+            },
+        );
+        if bundles > 0 {
+            self.scalp.record(&mut rec, sets, bundles);
+            match path {
+                RenderPath::Compute => self.strands.record_pulled(&mut rec, sets, &work.args),
+                RenderPath::Mesh => {
+                    if let Some(q) = &mut slot.mesh_query {
+                        q.begin(&mut rec);
+                    }
+                    let r = self.strands.record_mesh(&mut rec, sets, bundles);
+                    if let Some(q) = &mut slot.mesh_query {
+                        q.end(&mut rec);
+                    }
+                    r?;
+                }
             }
+        }
+        rec.end_rendering();
+        slot.profiler.end(&mut rec);
+        targets.depth_access = Access::DepthAttachment;
+        rec.barrier(
+            &[Access::ComputeReadWrite, Access::TaskReadWrite],
+            &[Access::TransferRead],
+        );
+        rec.copy_buffer(
+            &work.args,
+            0,
+            &slot.stats_readback,
+            0,
+            size_of::<GenerateArgs>() as u64,
+        );
+        targets.color_access = Access::ColorAttachment;
+        if opts.read_image
+            && let Some(readback) = &slot.image_readback
+        {
+            rec.image_barrier(&targets.color, Access::ColorAttachment, Access::TransferRead);
+            rec.copy_image_to_buffer(&targets.color, readback);
+            targets.color_access = Access::TransferRead;
+        }
+        rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
+        drop(rec);
+        slot.cmd.end()
+    }
+
+    /// Wait for a submitted frame and return its report.
+    pub fn wait(&mut self, ticket: FrameTicket) -> GpuResult<FrameReport> {
+        if let Some(i) = (0..FRAMES_IN_FLIGHT)
+            .find(|&i| self.frames[i].pending.as_ref().is_some_and(|p| p.frame == ticket.0))
+        {
+            // Frames complete in order: retire the older pending frame first.
+            let other = (i + 1) % FRAMES_IN_FLIGHT;
+            if self.frames[other]
+                .pending
+                .as_ref()
+                .is_some_and(|p| p.frame < ticket.0)
+            {
+                self.retire_slot(other)?;
+            }
+            self.retire_slot(i)?;
+        }
+        self.completed
+            .iter()
+            .position(|r| r.frame == ticket.0)
+            .and_then(|k| self.completed.remove(k))
+            .ok_or_else(|| {
+                GpuError::Unsupported(format!("report of frame {} is no longer kept", ticket.0))
+            })
+    }
+
+    /// Wait for every frame in flight.
+    pub fn finish(&mut self) -> GpuResult<()> {
+        for k in 1..=FRAMES_IN_FLIGHT {
+            self.retire_slot((self.next + k) % FRAMES_IN_FLIGHT)?;
+        }
+        Ok(())
+    }
+
+    /// Render one frame and wait for it (headless tools and tests).
+    pub fn render_one(&mut self, view: &View, opts: &FrameOptions) -> GpuResult<FrameReport> {
+        let t = self.render_frame(view, opts)?;
+        self.wait(t)
+    }
+
+    /// The first `count` vertices of the compute path's pool, as the last frame wrote them
+    /// (waits for every frame in flight).
+    pub fn read_vertices(&mut self, count: u32) -> GpuResult<Vec<HairVertex>> {
+        self.finish()?;
+        let Some(pool) = &self.work.pool else {
+            return Ok(Vec::new());
+        };
+        let bytes = (count as u64 * size_of::<HairVertex>() as u64).min(pool.size);
+        if bytes == 0 {
+            return Ok(Vec::new());
+        }
+        let mut readback = Buffer::new(
+            &self.ctx,
+            &BufferDesc::new("vertex readback", bytes, vk::BufferUsageFlags::TRANSFER_DST).readback(),
+        )?;
+        self.ctx.submit_and_wait(|rec| {
+            rec.barrier(&[Access::VertexRead, Access::ComputeReadWrite], &[Access::TransferRead]);
+            rec.copy_buffer(pool, 0, &readback, 0, bytes);
+            rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
         })?;
-        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&ind.read()?);
-        let n = (words[9] as u64 * HAIR_VERTEX_BYTES) as usize;
-        let bytes = verts.read()?;
-        Ok((
-            bytemuck::pod_collect_to_vec(&bytes[..n.min(bytes.len())]),
-            words[3],
-        ))
+        Ok(bytemuck::pod_collect_to_vec(&readback.read()?))
+    }
+
+    /// The descriptor set layout of set 0 (for passes added later).
+    pub fn frame_layout(&self) -> &Arc<DescriptorSetLayout> {
+        &self.frame_layout
+    }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        // Every frame's resources are released after the GPU is done with them.
+        self.ctx.wait_idle();
     }
 }

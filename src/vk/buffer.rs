@@ -48,11 +48,16 @@ impl BufferDesc {
 /// A buffer and its memory; freed on drop.
 pub struct Buffer {
     ctx: Arc<Context>,
-    /// The raw handle.
-    pub raw: vk::Buffer,
+    raw: vk::Buffer,
     allocation: Option<Allocation>,
     /// Size in bytes.
     pub size: u64,
+}
+
+impl std::fmt::Debug for Buffer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Buffer({} bytes)", self.size)
+    }
 }
 
 impl Buffer {
@@ -126,31 +131,23 @@ impl Buffer {
         Ok(())
     }
 
-    /// Write `data` at the start of a host-visible buffer through a shared reference (for
-    /// per-frame uniforms the GPU is not reading at the time).
-    pub fn write_shared(&self, data: &[u8]) -> GpuResult<()> {
-        let a = self
-            .allocation
-            .as_ref()
-            .ok_or_else(|| GpuError::Unsupported("freed buffer".into()))?;
-        let ptr = a
-            .mapped_ptr()
-            .ok_or_else(|| GpuError::Unsupported("buffer is not host visible".into()))?;
-        if data.len() as u64 > self.size {
-            return Err(GpuError::Unsupported("buffer write out of range".into()));
-        }
-        // SAFETY: the mapping covers `size` bytes, checked above; callers ensure the GPU is not
-        // accessing the buffer (frames are submitted and waited for one at a time).
-        unsafe {
-            std::ptr::copy_nonoverlapping(data.as_ptr(), ptr.as_ptr() as *mut u8, data.len())
-        };
-        Ok(())
+    pub(crate) fn raw(&self) -> vk::Buffer {
+        self.raw
     }
 
     /// Read the contents of a host-visible buffer.
     pub fn read(&mut self) -> GpuResult<Vec<u8>> {
-        let size = self.size as usize;
-        Ok(self.mapped()?[..size].to_vec())
+        self.read_range(0, self.size as usize)
+    }
+
+    /// Read `len` bytes at `offset` of a host-visible buffer.
+    pub fn read_range(&mut self, offset: usize, len: usize) -> GpuResult<Vec<u8>> {
+        let m = self.mapped()?;
+        let end = offset
+            .checked_add(len)
+            .filter(|&e| e <= m.len())
+            .ok_or_else(|| GpuError::Unsupported("buffer read out of range".into()))?;
+        Ok(m[offset..end].to_vec())
     }
 }
 

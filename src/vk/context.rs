@@ -9,6 +9,8 @@ use ash::ext::debug_utils;
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
+use super::command::{CommandBuffer, CommandRecorder};
+use super::sync::Fence;
 use super::{GpuError, GpuResult, VkContext};
 
 /// How to create a [`Context`].
@@ -49,6 +51,24 @@ pub struct DeviceInfo {
     pub mesh_queries: bool,
     /// Mesh shader limits, when available.
     pub mesh_limits: Option<vk::PhysicalDeviceMeshShaderPropertiesEXT<'static>>,
+    /// `maxStorageBufferRange`: the largest storage buffer binding.
+    pub max_storage_buffer_range: u64,
+    /// Most sampled images one bindless set may hold (the smaller of the per-stage and
+    /// per-set update-after-bind limits).
+    pub max_bindless_sampled_images: u32,
+    /// `maxComputeWorkGroupCount[0]`.
+    pub max_compute_groups_x: u32,
+}
+
+/// GPU memory the allocator holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryReport {
+    /// Bytes of live allocations.
+    pub allocated_bytes: u64,
+    /// Bytes of memory blocks (allocated + free space inside them).
+    pub capacity_bytes: u64,
+    /// Number of live allocations.
+    pub allocations: usize,
 }
 
 struct DebugState {
@@ -93,18 +113,12 @@ pub struct Context {
     debug: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     debug_device: Option<debug_utils::Device>,
     debug_state: Arc<DebugState>,
-    /// Physical device in use.
-    pub physical: vk::PhysicalDevice,
-    /// Logical device (use through the safe helpers of this module where possible).
-    pub device: ash::Device,
-    /// Graphics + compute queue.
-    pub queue: vk::Queue,
-    /// Its family index.
-    pub queue_family: u32,
+    physical: vk::PhysicalDevice,
+    pub(crate) device: ash::Device,
+    queue: vk::Queue,
+    pub(crate) queue_family: u32,
     allocator: ManuallyDrop<Mutex<Allocator>>,
-    command_pool: vk::CommandPool,
-    /// Mesh shader entry points, when enabled.
-    pub mesh_ext: Option<ash::ext::mesh_shader::Device>,
+    pub(crate) mesh_ext: Option<ash::ext::mesh_shader::Device>,
     /// Capabilities of the device.
     pub info: DeviceInfo,
 }
@@ -181,7 +195,7 @@ impl Context {
     ) -> GpuResult<Self> {
         // SAFETY: plain enumeration/query calls on a valid instance.
         let physicals =
-            unsafe { instance.enumerate_physical_devices() }.ctx("enumerate devices")?;
+            unsafe { instance.enumerate_physical_devices() }.unwrap_or_default();
         let mut candidates = Vec::new();
         for &pd in &physicals {
             // SAFETY: valid physical device handle.
@@ -217,19 +231,20 @@ impl Context {
         };
         // SAFETY: valid physical device.
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-        let queue_family = families
-            .iter()
-            .position(|f| {
-                f.queue_flags
-                    .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-                    && f.timestamp_valid_bits > 0
-            })
-            .ok_or_else(|| {
-                GpuError::Unsupported(format!("{name}: no graphics+compute queue with timestamps"))
-            })? as u32;
+        let Some(queue_family) = families.iter().position(|f| {
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+                && f.timestamp_valid_bits > 0
+        }) else {
+            destroy_instance(&instance, debug);
+            return Err(GpuError::Unsupported(format!(
+                "{name}: no graphics+compute queue with timestamps"
+            )));
+        };
+        let queue_family = queue_family as u32;
         // SAFETY: valid physical device.
         let exts = unsafe { instance.enumerate_device_extension_properties(physical) }
-            .ctx("device extensions")?;
+            .unwrap_or_default();
         let has_mesh = exts.iter().any(|e| {
             e.extension_name_as_c_str()
                 .is_ok_and(|n| n == ash::ext::mesh_shader::NAME)
@@ -248,8 +263,35 @@ impl Context {
         unsafe { instance.get_physical_device_features2(physical, &mut features2) };
         let base = features2.features;
         if f13.dynamic_rendering == 0 || f13.synchronization2 == 0 {
+            destroy_instance(&instance, debug);
             return Err(GpuError::Unsupported(format!(
                 "{name}: needs dynamicRendering and synchronization2"
+            )));
+        }
+        // Descriptor indexing: every character's textures are one bindless array element.
+        let indexing = [
+            ("runtimeDescriptorArray", f12.runtime_descriptor_array),
+            (
+                "descriptorBindingPartiallyBound",
+                f12.descriptor_binding_partially_bound,
+            ),
+            (
+                "descriptorBindingSampledImageUpdateAfterBind",
+                f12.descriptor_binding_sampled_image_update_after_bind,
+            ),
+            (
+                "descriptorBindingUpdateUnusedWhilePending",
+                f12.descriptor_binding_update_unused_while_pending,
+            ),
+            (
+                "shaderSampledImageArrayNonUniformIndexing",
+                f12.shader_sampled_image_array_non_uniform_indexing,
+            ),
+        ];
+        if let Some((missing, _)) = indexing.iter().find(|(_, on)| *on == 0) {
+            destroy_instance(&instance, debug);
+            return Err(GpuError::Unsupported(format!(
+                "{name}: needs descriptor indexing feature {missing}"
             )));
         }
         let mesh_ok = has_mesh && mesh_features.mesh_shader != 0 && mesh_features.task_shader != 0;
@@ -267,7 +309,12 @@ impl Context {
             .synchronization2(true)
             .maintenance4(f13.maintenance4 != 0);
         let mut enable12 = vk::PhysicalDeviceVulkan12Features::default()
-            .host_query_reset(f12.host_query_reset != 0);
+            .host_query_reset(f12.host_query_reset != 0)
+            .runtime_descriptor_array(true)
+            .descriptor_binding_partially_bound(true)
+            .descriptor_binding_sampled_image_update_after_bind(true)
+            .descriptor_binding_update_unused_while_pending(true)
+            .shader_sampled_image_array_non_uniform_indexing(true);
         let mut enable_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default()
             .mesh_shader(true)
             .task_shader(true)
@@ -285,30 +332,43 @@ impl Context {
             device_info = device_info.push_next(&mut enable_mesh);
         }
         // SAFETY: every pointer in device_info lives until the call returns.
-        let device =
-            unsafe { instance.create_device(physical, &device_info, None) }.ctx("create device")?;
+        let device = match unsafe { instance.create_device(physical, &device_info, None) } {
+            Ok(d) => d,
+            Err(result) => {
+                destroy_instance(&instance, debug);
+                return Err(GpuError::Vk {
+                    what: "create device",
+                    result,
+                });
+            }
+        };
         // SAFETY: the queue family/index were requested above.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        let allocator = Allocator::new(&AllocatorCreateDesc {
+        let allocator = match Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
             physical_device: physical,
             debug_settings: Default::default(),
             buffer_device_address: false,
             allocation_sizes: Default::default(),
-        })?;
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(queue_family)
-            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        // SAFETY: valid device.
-        let command_pool =
-            unsafe { device.create_command_pool(&pool_info, None) }.ctx("create command pool")?;
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: nothing was created on the device yet.
+                unsafe { device.destroy_device(None) };
+                destroy_instance(&instance, debug);
+                return Err(e.into());
+            }
+        };
 
         // SAFETY: property queries with a chain living on this frame.
-        let (props, driver, mesh_limits) = unsafe {
+        let (props, driver, mesh_limits, indexing) = unsafe {
             let mut driver = vk::PhysicalDeviceDriverProperties::default();
             let mut mesh_props = vk::PhysicalDeviceMeshShaderPropertiesEXT::default();
-            let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+            let mut indexing = vk::PhysicalDeviceDescriptorIndexingProperties::default();
+            let mut p2 = vk::PhysicalDeviceProperties2::default()
+                .push_next(&mut driver)
+                .push_next(&mut indexing);
             if mesh_ok {
                 p2 = p2.push_next(&mut mesh_props);
             }
@@ -326,7 +386,11 @@ impl Context {
                     .unwrap_or_default()
             );
             mesh_props.p_next = std::ptr::null_mut();
-            (props, driver_name, mesh_ok.then_some(mesh_props))
+            let bindless = indexing
+                .max_per_stage_descriptor_update_after_bind_sampled_images
+                .min(indexing.max_descriptor_set_update_after_bind_sampled_images)
+                .min(indexing.max_update_after_bind_descriptors_in_all_pools);
+            (props, driver_name, mesh_ok.then_some(mesh_props), bindless)
         };
         let debug_device = debug
             .as_ref()
@@ -343,7 +407,6 @@ impl Context {
             queue,
             queue_family,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
-            command_pool,
             mesh_ext,
             info: DeviceInfo {
                 name,
@@ -352,13 +415,25 @@ impl Context {
                 mesh_shader: mesh_ok,
                 mesh_queries: mesh_ok && mesh_features.mesh_shader_queries != 0,
                 mesh_limits,
+                max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
+                max_bindless_sampled_images: indexing,
+                max_compute_groups_x: props.limits.max_compute_work_group_count[0],
             },
         })
     }
 
-    /// The memory allocator.
-    pub fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
+    pub(crate) fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
         self.allocator.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// What the memory allocator holds now.
+    pub fn memory_report(&self) -> MemoryReport {
+        let r = self.allocator().generate_report();
+        MemoryReport {
+            allocated_bytes: r.total_allocated_bytes,
+            capacity_bytes: r.total_capacity_bytes,
+            allocations: r.allocations.len(),
+        }
     }
 
     /// Allocate memory for `requirements` and bind it with `bind(memory, offset)`; the
@@ -420,65 +495,29 @@ impl Context {
         }
     }
 
-    /// Record commands with `record`, submit them and wait for completion.
-    pub fn submit_and_wait<R>(&self, record: impl FnOnce(vk::CommandBuffer) -> R) -> GpuResult<R> {
-        let alloc = vk::CommandBufferAllocateInfo::default()
-            .command_pool(self.command_pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        // SAFETY: the pool belongs to this device and is used from this thread only.
-        let cmd = unsafe { self.device.allocate_command_buffers(&alloc) }
-            .ctx("allocate command buffer")?[0];
-        let begin = vk::CommandBufferBeginInfo::default()
-            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-        // SAFETY: fresh command buffer.
-        unsafe { self.device.begin_command_buffer(cmd, &begin) }.ctx("begin command buffer")?;
-        let out = record(cmd);
-        let result = (|| {
-            // SAFETY: recording finished; fence and submission are local to this call.
-            unsafe {
-                self.device
-                    .end_command_buffer(cmd)
-                    .ctx("end command buffer")?;
-                let fence = self
-                    .device
-                    .create_fence(&vk::FenceCreateInfo::default(), None)
-                    .ctx("create fence")?;
-                let cmds = [cmd];
-                let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-                let r = self
-                    .device
-                    .queue_submit(self.queue, &submit, fence)
-                    .ctx("queue submit")
-                    .and_then(|_| {
-                        self.device
-                            .wait_for_fences(&[fence], true, u64::MAX)
-                            .ctx("wait for fence")
-                    });
-                self.device.destroy_fence(fence, None);
-                r
-            }
-        })();
-        // SAFETY: the submission completed (or failed); the buffer is no longer in use.
-        unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
-        result.map(|_| out)
+    /// Record commands with `record`, submit them and wait for completion (uploads).
+    pub fn submit_and_wait<R>(
+        self: &Arc<Self>,
+        record: impl FnOnce(&mut CommandRecorder) -> R,
+    ) -> GpuResult<R> {
+        let mut cmd = CommandBuffer::new(self, "one-shot")?;
+        let fence = Fence::new(self, false)?;
+        let out = {
+            let mut rec = cmd.begin()?;
+            record(&mut rec)
+        };
+        cmd.end()?;
+        self.submit(&cmd, &fence)?;
+        fence.wait()?;
+        Ok(out)
     }
 
-    /// Record a global memory barrier (buffers written by one stage, read by another).
-    pub fn barrier(
-        &self,
-        cmd: vk::CommandBuffer,
-        src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-        dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    ) {
-        let b = [vk::MemoryBarrier2::default()
-            .src_stage_mask(src.0)
-            .src_access_mask(src.1)
-            .dst_stage_mask(dst.0)
-            .dst_access_mask(dst.1)];
-        let dep = vk::DependencyInfo::default().memory_barriers(&b);
-        // SAFETY: recording into a command buffer in the recording state.
-        unsafe { self.device.cmd_pipeline_barrier2(cmd, &dep) };
+    /// Submit `cmd` to the queue; `fence` is signalled when it completes.
+    pub fn submit(&self, cmd: &CommandBuffer, fence: &Fence) -> GpuResult<()> {
+        let cmds = [cmd.raw()];
+        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+        // SAFETY: the command buffer finished recording; the fence is unsignalled.
+        unsafe { self.device.queue_submit(self.queue, &submit, fence.raw()) }.ctx("queue submit")
     }
 
     /// Wait until the device is idle.
@@ -521,7 +560,6 @@ impl Drop for Context {
         // created from this context must already be destroyed (they borrow it).
         unsafe {
             let _ = self.device.device_wait_idle();
-            self.device.destroy_command_pool(self.command_pool, None);
             ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_device(None);
             if let Some((loader, messenger)) = self.debug.take() {

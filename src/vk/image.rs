@@ -6,7 +6,8 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 use gpu_allocator::vulkan::Allocation;
 
-use super::buffer::{Buffer, BufferDesc};
+use super::buffer::Buffer;
+use super::command::Access;
 use super::{Context, GpuError, GpuResult, VkContext};
 
 /// How to create an [`Image`].
@@ -57,16 +58,14 @@ impl ImageDesc {
 /// An image with one mip level and one layer, its memory and a full view.
 pub struct Image {
     ctx: Arc<Context>,
-    /// The raw image.
-    pub raw: vk::Image,
-    /// A view of the whole image.
-    pub view: vk::ImageView,
+    raw: vk::Image,
+    view: vk::ImageView,
     allocation: Option<Allocation>,
     /// Creation parameters.
     pub desc: ImageDesc,
 }
 
-fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
+pub(crate) fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
     match format {
         vk::Format::D32_SFLOAT | vk::Format::D16_UNORM => vk::ImageAspectFlags::DEPTH,
         _ => vk::ImageAspectFlags::COLOR,
@@ -138,10 +137,25 @@ impl Image {
                 vk::ImageViewType::TYPE_2D
             })
             .format(desc.format)
-            .subresource_range(Self::range(desc.format));
+            .subresource_range(
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(aspect(desc.format))
+                    .level_count(1)
+                    .layer_count(1),
+            );
         // SAFETY: view of a bound image.
-        let view =
-            unsafe { ctx.device.create_image_view(&view_info, None) }.ctx("create image view")?;
+        let view = match unsafe { ctx.device.create_image_view(&view_info, None) } {
+            Ok(v) => v,
+            Err(result) => {
+                // SAFETY: the image is unused; its memory is freed after it.
+                unsafe { ctx.device.destroy_image(raw, None) };
+                let _ = ctx.allocator().free(allocation);
+                return Err(GpuError::Vk {
+                    what: "create image view",
+                    result,
+                });
+            }
+        };
         ctx.name_object(raw, &desc.name);
         ctx.name_object(view, &desc.name);
         Ok(Image {
@@ -153,112 +167,49 @@ impl Image {
         })
     }
 
-    fn range(format: vk::Format) -> vk::ImageSubresourceRange {
+    pub(crate) fn full_range(&self) -> vk::ImageSubresourceRange {
         vk::ImageSubresourceRange::default()
-            .aspect_mask(aspect(format))
+            .aspect_mask(aspect(self.desc.format))
             .level_count(1)
             .layer_count(1)
     }
 
-    /// Record a layout transition with full stage/access masks (simple and correct).
-    pub fn transition(&self, cmd: vk::CommandBuffer, from: vk::ImageLayout, to: vk::ImageLayout) {
-        let barrier = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-            .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-            .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)
-            .old_layout(from)
-            .new_layout(to)
-            .image(self.raw)
-            .subresource_range(Self::range(self.desc.format))];
-        let dep = vk::DependencyInfo::default().image_memory_barriers(&barrier);
-        // SAFETY: recording into a command buffer in the recording state.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+    pub(crate) fn raw(&self) -> vk::Image {
+        self.raw
     }
 
-    /// Create a sampled image holding `data` (tightly packed texels), in
-    /// `SHADER_READ_ONLY_OPTIMAL` layout.
+    pub(crate) fn view(&self) -> vk::ImageView {
+        self.view
+    }
+
+    /// Bytes of the image's texels, tightly packed.
+    pub fn byte_size(&self) -> u64 {
+        let [w, h, d] = self.desc.extent;
+        w as u64 * h as u64 * d as u64 * texel_bytes(self.desc.format)
+    }
+
+    /// Create a sampled image holding `data` (tightly packed texels), left in
+    /// [`Access::SampledRead`](super::command::Access::SampledRead). Blocks until uploaded.
     pub fn with_data(ctx: &Arc<Context>, desc: &ImageDesc, data: &[u8]) -> GpuResult<Self> {
-        let [w, h, d] = desc.extent;
-        let expected = w as u64 * h as u64 * d as u64 * texel_bytes(desc.format);
-        if expected != data.len() as u64 {
-            return Err(GpuError::Unsupported(format!(
-                "{}: {} bytes for a {expected}-byte image",
-                desc.name,
-                data.len()
-            )));
-        }
         let desc = desc
             .clone()
             .usage(vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST);
         let image = Image::new(ctx, &desc)?;
+        if image.byte_size() != data.len() as u64 || image.byte_size() == 0 {
+            return Err(GpuError::Unsupported(format!(
+                "{}: {} bytes for a {}-byte image",
+                desc.name,
+                data.len(),
+                image.byte_size()
+            )));
+        }
         let staging = Buffer::with_data(ctx, "staging", vk::BufferUsageFlags::TRANSFER_SRC, data)?;
-        ctx.submit_and_wait(|cmd| {
-            image.transition(
-                cmd,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            );
-            let region = [vk::BufferImageCopy::default()
-                .image_subresource(
-                    vk::ImageSubresourceLayers::default()
-                        .aspect_mask(vk::ImageAspectFlags::COLOR)
-                        .layer_count(1),
-                )
-                .image_extent(vk::Extent3D {
-                    width: w,
-                    height: h,
-                    depth: d,
-                })];
-            // SAFETY: staging holds exactly the image's texels; layouts set above.
-            unsafe {
-                ctx.device.cmd_copy_buffer_to_image(
-                    cmd,
-                    staging.raw,
-                    image.raw,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &region,
-                )
-            };
-            image.transition(
-                cmd,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            );
+        ctx.submit_and_wait(|rec| {
+            rec.image_barrier(&image, Access::Nothing, Access::TransferWrite);
+            rec.copy_buffer_to_image(&staging, &image);
+            rec.image_barrier(&image, Access::TransferWrite, Access::SampledRead);
         })?;
         Ok(image)
-    }
-
-    /// Record a copy of this 2D image (in `TRANSFER_SRC_OPTIMAL`) into a new readback buffer.
-    pub fn record_readback(&self, cmd: vk::CommandBuffer) -> GpuResult<Buffer> {
-        let [w, h, _] = self.desc.extent;
-        let size = w as u64 * h as u64 * texel_bytes(self.desc.format);
-        let buffer = Buffer::new(
-            &self.ctx,
-            &BufferDesc::new("readback", size, vk::BufferUsageFlags::TRANSFER_DST).readback(),
-        )?;
-        let region = [vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(aspect(self.desc.format))
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: w,
-                height: h,
-                depth: 1,
-            })];
-        // SAFETY: buffer is large enough; image is in TRANSFER_SRC_OPTIMAL.
-        unsafe {
-            self.ctx.device.cmd_copy_image_to_buffer(
-                cmd,
-                self.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                buffer.raw,
-                &region,
-            )
-        };
-        Ok(buffer)
     }
 }
 
@@ -278,8 +229,13 @@ impl Drop for Image {
 /// A linear, clamp-to-edge sampler (the texture filtering the hair mesh texture relies on).
 pub struct Sampler {
     ctx: Arc<Context>,
-    /// The raw handle.
-    pub raw: vk::Sampler,
+    raw: vk::Sampler,
+}
+
+impl Sampler {
+    pub(crate) fn raw(&self) -> vk::Sampler {
+        self.raw
+    }
 }
 
 impl Sampler {

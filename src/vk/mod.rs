@@ -2,16 +2,23 @@
 //! function. Objects are described by small `*Desc` values.
 
 pub mod buffer;
+pub mod command;
 pub mod context;
 pub mod descriptor;
 pub mod image;
 pub mod pipeline;
 pub mod profiler;
 pub mod shader;
+pub mod sync;
 
 pub use buffer::{Buffer, BufferDesc};
-pub use context::{Context, ContextDesc};
-pub use image::{Image, ImageDesc};
+pub use command::{Access, Attachment, CommandBuffer, CommandRecorder};
+pub use context::{Context, ContextDesc, DeviceInfo, MemoryReport};
+pub use descriptor::{BindingDesc, DescriptorKind, DescriptorSet, DescriptorSetLayout};
+pub use image::{Image, ImageDesc, Sampler};
+pub use pipeline::{BlendMode, CullMode, DepthMode, GraphicsDesc, Pipeline, PipelineLayout};
+pub use profiler::{MeshPrimitivesQuery, Profiler};
+pub use sync::Fence;
 
 /// Errors of the GPU layer.
 #[derive(Debug, thiserror::Error)]

@@ -1,56 +1,174 @@
 //! Pipeline layouts, compute pipelines and graphics pipelines (dynamic rendering, no vertex
-//! input: every draw pulls its data from buffers and textures).
+//! input: every draw pulls its data from buffers and textures). Fixed-function state is part
+//! of the description ([`GraphicsDesc`]), so transparent or depth-only passes are one field away.
 
 use std::sync::Arc;
 
 use ash::vk;
 
+use super::descriptor::DescriptorSetLayout;
 use super::{Context, GpuResult, VkContext};
 
-/// Push constant bytes shared by every pipeline (a `mat4` model transform).
-pub const PUSH_CONSTANT_BYTES: u32 = 64;
+/// Push constant bytes of every pipeline layout (all stages).
+pub const PUSH_CONSTANT_BYTES: u32 = 16;
 
-/// A pipeline and its layout.
-pub struct Pipeline {
+/// A pipeline layout: descriptor set layouts (set `i` = element `i`) and the push constants.
+pub struct PipelineLayout {
     ctx: Arc<Context>,
-    /// The pipeline.
-    pub raw: vk::Pipeline,
-    /// Its layout.
-    pub layout: vk::PipelineLayout,
-    /// Compute or graphics.
-    pub bind_point: vk::PipelineBindPoint,
+    raw: vk::PipelineLayout,
+    _sets: Vec<Arc<DescriptorSetLayout>>,
 }
 
-fn module(ctx: &Context, spirv: &[u32]) -> GpuResult<vk::ShaderModule> {
-    let info = vk::ShaderModuleCreateInfo::default().code(spirv);
-    // SAFETY: SPIR-V produced by shaderc.
-    unsafe { ctx.device.create_shader_module(&info, None) }.ctx("create shader module")
+impl PipelineLayout {
+    /// A layout with `sets` and [`PUSH_CONSTANT_BYTES`] of push constants.
+    pub fn new(ctx: &Arc<Context>, sets: &[Arc<DescriptorSetLayout>]) -> GpuResult<Arc<Self>> {
+        let raw_sets: Vec<_> = sets.iter().map(|s| s.raw()).collect();
+        let push = [vk::PushConstantRange {
+            stage_flags: vk::ShaderStageFlags::ALL,
+            offset: 0,
+            size: PUSH_CONSTANT_BYTES,
+        }];
+        let info = vk::PipelineLayoutCreateInfo::default()
+            .set_layouts(&raw_sets)
+            .push_constant_ranges(&push);
+        // SAFETY: valid create info.
+        let raw = unsafe { ctx.device.create_pipeline_layout(&info, None) }
+            .ctx("create pipeline layout")?;
+        Ok(Arc::new(PipelineLayout {
+            ctx: ctx.clone(),
+            raw,
+            _sets: sets.to_vec(),
+        }))
+    }
 }
 
-fn layout(ctx: &Context, set_layout: vk::DescriptorSetLayout) -> GpuResult<vk::PipelineLayout> {
-    let sets = [set_layout];
-    let push = [vk::PushConstantRange {
-        stage_flags: vk::ShaderStageFlags::ALL,
-        offset: 0,
-        size: PUSH_CONSTANT_BYTES,
-    }];
-    let info = vk::PipelineLayoutCreateInfo::default()
-        .set_layouts(&sets)
-        .push_constant_ranges(&push);
-    // SAFETY: valid create info.
-    unsafe { ctx.device.create_pipeline_layout(&info, None) }.ctx("create pipeline layout")
+impl Drop for PipelineLayout {
+    fn drop(&mut self) {
+        // SAFETY: pipelines hold an Arc to their layout, so none is alive.
+        unsafe { self.ctx.device.destroy_pipeline_layout(self.raw, None) };
+    }
+}
+
+/// Depth test of a graphics pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthMode {
+    /// No depth test or write.
+    Off,
+    /// Test `LESS` and write (opaque geometry).
+    TestWrite,
+    /// Test `LESS_OR_EQUAL`, no write (transparent geometry over opaque depth).
+    TestOnly,
+}
+
+/// Colour blending of a graphics pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlendMode {
+    /// Replace.
+    Opaque,
+    /// Premultiplied alpha over.
+    PremultipliedOver,
+    /// Additive.
+    Additive,
+}
+
+/// Face culling of a graphics pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CullMode {
+    /// Two-sided.
+    None,
+    /// Cull back faces (counter-clockwise front).
+    Back,
 }
 
 /// How to build a graphics pipeline.
 pub struct GraphicsDesc<'a> {
     /// Debug name.
     pub name: &'a str,
-    /// `(stage, SPIR-V)` for each stage (vertex or task+mesh, and fragment).
+    /// `(stage, SPIR-V)` for each stage (vertex or task + mesh, and fragment).
     pub stages: Vec<(vk::ShaderStageFlags, &'a [u32])>,
     /// Colour attachment format.
     pub color_format: vk::Format,
     /// Depth attachment format.
     pub depth_format: vk::Format,
+    /// Depth state.
+    pub depth: DepthMode,
+    /// Blend state.
+    pub blend: BlendMode,
+    /// Culling.
+    pub cull: CullMode,
+}
+
+impl<'a> GraphicsDesc<'a> {
+    /// Opaque, depth-tested, two-sided triangles.
+    pub fn new(name: &'a str, color_format: vk::Format, depth_format: vk::Format) -> Self {
+        GraphicsDesc {
+            name,
+            stages: Vec::new(),
+            color_format,
+            depth_format,
+            depth: DepthMode::TestWrite,
+            blend: BlendMode::Opaque,
+            cull: CullMode::None,
+        }
+    }
+
+    /// Add a shader stage.
+    pub fn stage(mut self, stage: vk::ShaderStageFlags, spirv: &'a [u32]) -> Self {
+        self.stages.push((stage, spirv));
+        self
+    }
+
+    /// Set the depth mode.
+    pub fn depth(mut self, depth: DepthMode) -> Self {
+        self.depth = depth;
+        self
+    }
+
+    /// Set the blend mode.
+    pub fn blend(mut self, blend: BlendMode) -> Self {
+        self.blend = blend;
+        self
+    }
+
+    /// Set the cull mode.
+    pub fn cull(mut self, cull: CullMode) -> Self {
+        self.cull = cull;
+        self
+    }
+}
+
+/// A compute or graphics pipeline.
+pub struct Pipeline {
+    ctx: Arc<Context>,
+    raw: vk::Pipeline,
+    layout: Arc<PipelineLayout>,
+    bind_point: vk::PipelineBindPoint,
+}
+
+/// Shader modules destroyed when dropped (after pipeline creation, or on an error path).
+struct Modules<'a> {
+    ctx: &'a Context,
+    raw: Vec<vk::ShaderModule>,
+}
+
+impl Modules<'_> {
+    fn add(&mut self, spirv: &[u32]) -> GpuResult<vk::ShaderModule> {
+        let info = vk::ShaderModuleCreateInfo::default().code(spirv);
+        // SAFETY: SPIR-V produced by shaderc.
+        let m = unsafe { self.ctx.device.create_shader_module(&info, None) }
+            .ctx("create shader module")?;
+        self.raw.push(m);
+        Ok(m)
+    }
+}
+
+impl Drop for Modules<'_> {
+    fn drop(&mut self) {
+        for &m in &self.raw {
+            // SAFETY: modules are not needed after pipeline creation.
+            unsafe { self.ctx.device.destroy_shader_module(m, None) };
+        }
+    }
 }
 
 impl Pipeline {
@@ -58,58 +176,57 @@ impl Pipeline {
     pub fn compute(
         ctx: &Arc<Context>,
         name: &str,
-        set_layout: vk::DescriptorSetLayout,
+        layout: &Arc<PipelineLayout>,
         spirv: &[u32],
     ) -> GpuResult<Self> {
-        let m = module(ctx, spirv)?;
-        let layout = layout(ctx, set_layout)?;
+        let mut modules = Modules {
+            ctx,
+            raw: Vec::new(),
+        };
+        let m = modules.add(spirv)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(m)
             .name(c"main");
         let info = [vk::ComputePipelineCreateInfo::default()
             .stage(stage)
-            .layout(layout)];
-        // SAFETY: module and layout are valid; the module may be destroyed after creation.
-        let result = unsafe {
+            .layout(layout.raw)];
+        // SAFETY: module and layout are valid.
+        let raw = unsafe {
             ctx.device
                 .create_compute_pipelines(vk::PipelineCache::null(), &info, None)
-        };
-        // SAFETY: no longer needed after pipeline creation.
-        unsafe { ctx.device.destroy_shader_module(m, None) };
-        let raw = result.map_err(|(_, e)| e).ctx("create compute pipeline")?[0];
+        }
+        .map_err(|(_, e)| e)
+        .ctx("create compute pipeline")?[0];
         ctx.name_object(raw, name);
         Ok(Pipeline {
             ctx: ctx.clone(),
             raw,
-            layout,
+            layout: layout.clone(),
             bind_point: vk::PipelineBindPoint::COMPUTE,
         })
     }
 
-    /// A graphics pipeline: triangle lists, no culling, depth test less, opaque.
+    /// A graphics pipeline as described (triangle lists, dynamic viewport and scissor).
     pub fn graphics(
         ctx: &Arc<Context>,
-        set_layout: vk::DescriptorSetLayout,
+        layout: &Arc<PipelineLayout>,
         desc: &GraphicsDesc,
     ) -> GpuResult<Self> {
-        let modules: Vec<_> = desc
-            .stages
-            .iter()
-            .map(|(_, s)| module(ctx, s))
-            .collect::<GpuResult<_>>()?;
-        let layout = layout(ctx, set_layout)?;
-        let stages: Vec<_> = desc
-            .stages
-            .iter()
-            .zip(&modules)
-            .map(|((stage, _), m)| {
+        let mut modules = Modules {
+            ctx,
+            raw: Vec::new(),
+        };
+        let mut stages = Vec::new();
+        for (stage, spirv) in &desc.stages {
+            let m = modules.add(spirv)?;
+            stages.push(
                 vk::PipelineShaderStageCreateInfo::default()
                     .stage(*stage)
-                    .module(*m)
-                    .name(c"main")
-            })
-            .collect();
+                    .module(m)
+                    .name(c"main"),
+            );
+        }
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
         let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
             .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
@@ -118,16 +235,46 @@ impl Pipeline {
             .scissor_count(1);
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(vk::CullModeFlags::NONE)
+            .cull_mode(match desc.cull {
+                CullMode::None => vk::CullModeFlags::NONE,
+                CullMode::Back => vk::CullModeFlags::BACK,
+            })
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(true)
-            .depth_write_enable(true)
-            .depth_compare_op(vk::CompareOp::LESS);
-        let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
-            .color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let depth = match desc.depth {
+            DepthMode::Off => vk::PipelineDepthStencilStateCreateInfo::default(),
+            DepthMode::TestWrite => vk::PipelineDepthStencilStateCreateInfo::default()
+                .depth_test_enable(true)
+                .depth_write_enable(true)
+                .depth_compare_op(vk::CompareOp::LESS),
+            DepthMode::TestOnly => vk::PipelineDepthStencilStateCreateInfo::default()
+                .depth_test_enable(true)
+                .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL),
+        };
+        let blend_attachment = vk::PipelineColorBlendAttachmentState::default()
+            .color_write_mask(vk::ColorComponentFlags::RGBA);
+        let blend_attachment = match desc.blend {
+            BlendMode::Opaque => blend_attachment,
+            BlendMode::PremultipliedOver => blend_attachment
+                .blend_enable(true)
+                .src_color_blend_factor(vk::BlendFactor::ONE)
+                .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+                .color_blend_op(vk::BlendOp::ADD)
+                .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+                .alpha_blend_op(vk::BlendOp::ADD),
+            BlendMode::Additive => blend_attachment
+                .blend_enable(true)
+                .src_color_blend_factor(vk::BlendFactor::ONE)
+                .dst_color_blend_factor(vk::BlendFactor::ONE)
+                .color_blend_op(vk::BlendOp::ADD)
+                .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                .alpha_blend_op(vk::BlendOp::ADD),
+        };
+        let blend_attachments = [blend_attachment];
         let blend =
             vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
@@ -148,7 +295,7 @@ impl Pipeline {
             .depth_stencil_state(&depth)
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
-            .layout(layout)
+            .layout(layout.raw)
             .push_next(&mut rendering);
         if !mesh {
             info = info
@@ -156,56 +303,37 @@ impl Pipeline {
                 .input_assembly_state(&assembly);
         }
         // SAFETY: all state structs live until the call returns.
-        let result = unsafe {
+        let raw = unsafe {
             ctx.device
                 .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
-        };
-        for m in modules {
-            // SAFETY: not needed after creation.
-            unsafe { ctx.device.destroy_shader_module(m, None) };
         }
-        let raw = result.map_err(|(_, e)| e).ctx("create graphics pipeline")?[0];
+        .map_err(|(_, e)| e)
+        .ctx("create graphics pipeline")?[0];
         ctx.name_object(raw, desc.name);
         Ok(Pipeline {
             ctx: ctx.clone(),
             raw,
-            layout,
+            layout: layout.clone(),
             bind_point: vk::PipelineBindPoint::GRAPHICS,
         })
     }
 
-    /// Bind this pipeline, descriptor set 0 and the model-transform push constant.
-    pub fn bind(&self, cmd: vk::CommandBuffer, set: vk::DescriptorSet, model: &[f32; 16]) {
-        // SAFETY: recording; the set was created with this pipeline's set layout.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_bind_pipeline(cmd, self.bind_point, self.raw);
-            self.ctx.device.cmd_bind_descriptor_sets(
-                cmd,
-                self.bind_point,
-                self.layout,
-                0,
-                &[set],
-                &[],
-            );
-            self.ctx.device.cmd_push_constants(
-                cmd,
-                self.layout,
-                vk::ShaderStageFlags::ALL,
-                0,
-                bytemuck::cast_slice(model),
-            );
-        }
+    pub(crate) fn raw(&self) -> vk::Pipeline {
+        self.raw
+    }
+
+    pub(crate) fn layout_raw(&self) -> vk::PipelineLayout {
+        self.layout.raw
+    }
+
+    pub(crate) fn bind_point(&self) -> vk::PipelineBindPoint {
+        self.bind_point
     }
 }
 
 impl Drop for Pipeline {
     fn drop(&mut self) {
-        // SAFETY: not in use once dropped.
-        unsafe {
-            self.ctx.device.destroy_pipeline(self.raw, None);
-            self.ctx.device.destroy_pipeline_layout(self.layout, None);
-        }
+        // SAFETY: owners drop pipelines after the frames using them retired.
+        unsafe { self.ctx.device.destroy_pipeline(self.raw, None) };
     }
 }

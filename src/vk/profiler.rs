@@ -1,82 +1,79 @@
-//! GPU timestamps per pass.
+//! GPU timestamps per pass and mesh-primitive counts, one query pool per frame in flight,
+//! reset at the start of every frame.
 
 use std::sync::Arc;
 
 use ash::vk;
 
+use super::command::CommandRecorder;
 use super::{Context, GpuResult, VkContext};
 
-/// Timestamp queries: `begin(name)` / `end()` pairs around passes.
+/// Most timed passes in one frame.
+pub const MAX_TIMED_PASSES: u32 = 32;
+
+/// Timestamp queries: `begin(name)` / `end()` pairs around the passes of one frame.
 pub struct Profiler {
     ctx: Arc<Context>,
     pool: vk::QueryPool,
-    names: Vec<String>,
-    capacity: u32,
+    names: Vec<&'static str>,
 }
 
 impl Profiler {
-    /// Room for `passes` timed passes.
-    pub fn new(ctx: &Arc<Context>, passes: u32) -> GpuResult<Self> {
+    /// Room for [`MAX_TIMED_PASSES`] passes.
+    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
         let info = vk::QueryPoolCreateInfo::default()
             .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(passes * 2);
+            .query_count(MAX_TIMED_PASSES * 2);
         // SAFETY: valid create info.
         let pool = unsafe { ctx.device.create_query_pool(&info, None) }.ctx("create query pool")?;
         Ok(Profiler {
             ctx: ctx.clone(),
             pool,
             names: Vec::new(),
-            capacity: passes,
         })
     }
 
-    /// Reset all queries (record at the start of a frame).
-    pub fn reset(&mut self, cmd: vk::CommandBuffer) {
+    /// Reset every query (record first in the frame, outside rendering).
+    pub fn reset(&mut self, rec: &mut CommandRecorder) {
         self.names.clear();
-        // SAFETY: recording; the range is within the pool.
+        // SAFETY: recording outside rendering; the range is the whole pool.
         unsafe {
             self.ctx
                 .device
-                .cmd_reset_query_pool(cmd, self.pool, 0, self.capacity * 2)
+                .cmd_reset_query_pool(rec.raw(), self.pool, 0, MAX_TIMED_PASSES * 2)
         };
     }
 
-    /// Timestamp the start of pass `name`.
-    pub fn begin(&mut self, cmd: vk::CommandBuffer, name: &str) {
-        if self.names.len() as u32 >= self.capacity {
-            return;
-        }
-        let q = self.names.len() as u32 * 2;
-        self.names.push(name.to_string());
-        // SAFETY: recording; query was reset this frame.
+    fn stamp(&self, rec: &mut CommandRecorder, query: u32) {
+        // SAFETY: recording; the query was reset this frame and is written once.
         unsafe {
             self.ctx.device.cmd_write_timestamp2(
-                cmd,
+                rec.raw(),
                 vk::PipelineStageFlags2::ALL_COMMANDS,
                 self.pool,
-                q,
+                query,
             )
         };
+    }
+
+    /// Timestamp the start of pass `name`. Passes past [`MAX_TIMED_PASSES`] are not timed.
+    pub fn begin(&mut self, rec: &mut CommandRecorder, name: &'static str) {
+        if self.names.len() as u32 >= MAX_TIMED_PASSES {
+            return;
+        }
+        self.names.push(name);
+        self.stamp(rec, (self.names.len() as u32 - 1) * 2);
     }
 
     /// Timestamp the end of the pass begun last.
-    pub fn end(&mut self, cmd: vk::CommandBuffer) {
-        let Some(n) = self.names.len().checked_sub(1) else {
-            return;
-        };
-        // SAFETY: recording; query was reset this frame.
-        unsafe {
-            self.ctx.device.cmd_write_timestamp2(
-                cmd,
-                vk::PipelineStageFlags2::ALL_COMMANDS,
-                self.pool,
-                n as u32 * 2 + 1,
-            )
-        };
+    pub fn end(&mut self, rec: &mut CommandRecorder) {
+        if let Some(n) = self.names.len().checked_sub(1) {
+            self.stamp(rec, n as u32 * 2 + 1);
+        }
     }
 
     /// `(pass, milliseconds)` after the frame completed.
-    pub fn results(&self) -> GpuResult<Vec<(String, f64)>> {
+    pub fn results(&self) -> GpuResult<Vec<(&'static str, f64)>> {
         let n = self.names.len();
         if n == 0 {
             return Ok(Vec::new());
@@ -99,7 +96,7 @@ impl Profiler {
             .enumerate()
             .map(|(i, name)| {
                 (
-                    name.clone(),
+                    *name,
                     data[2 * i + 1].saturating_sub(data[2 * i]) as f64 * period / 1e6,
                 )
             })
@@ -109,79 +106,76 @@ impl Profiler {
 
 impl Drop for Profiler {
     fn drop(&mut self) {
-        // SAFETY: not in use once dropped.
+        // SAFETY: owners drop it after its frame retired.
         unsafe { self.ctx.device.destroy_query_pool(self.pool, None) };
     }
 }
 
-/// A `MESH_PRIMITIVES_GENERATED_EXT` query per slot (VK_EXT_mesh_shader queries): counts the
-/// primitives mesh shaders emit between `begin` and `end`.
+/// One `MESH_PRIMITIVES_GENERATED_EXT` query (VK_EXT_mesh_shader queries): the primitives
+/// mesh shaders emit between `begin` and `end`.
 pub struct MeshPrimitivesQuery {
     ctx: Arc<Context>,
     pool: vk::QueryPool,
-    slots: u32,
+    used: bool,
 }
 
 impl MeshPrimitivesQuery {
-    /// `slots` queries; `None` where the device has no mesh shader queries.
-    pub fn new(ctx: &Arc<Context>, slots: u32) -> GpuResult<Option<Self>> {
-        if !ctx.info.mesh_queries || slots == 0 {
+    /// `None` where the device has no mesh shader queries.
+    pub fn new(ctx: &Arc<Context>) -> GpuResult<Option<Self>> {
+        if !ctx.info.mesh_queries {
             return Ok(None);
         }
         let info = vk::QueryPoolCreateInfo::default()
             .query_type(vk::QueryType::MESH_PRIMITIVES_GENERATED_EXT)
-            .query_count(slots);
+            .query_count(1);
         // SAFETY: valid create info; the query type is enabled (meshShaderQueries).
         let pool =
             unsafe { ctx.device.create_query_pool(&info, None) }.ctx("create mesh query pool")?;
         Ok(Some(MeshPrimitivesQuery {
             ctx: ctx.clone(),
             pool,
-            slots,
+            used: false,
         }))
     }
 
-    /// Reset all slots (outside a render pass instance).
-    pub fn reset(&self, cmd: vk::CommandBuffer) {
-        // SAFETY: recording; range within the pool.
+    /// Reset (record outside rendering, every frame).
+    pub fn reset(&mut self, rec: &mut CommandRecorder) {
+        self.used = false;
+        // SAFETY: recording outside rendering.
         unsafe {
             self.ctx
                 .device
-                .cmd_reset_query_pool(cmd, self.pool, 0, self.slots)
+                .cmd_reset_query_pool(rec.raw(), self.pool, 0, 1)
         };
     }
 
-    /// Start counting into `slot`.
-    pub fn begin(&self, cmd: vk::CommandBuffer, slot: u32) {
-        // SAFETY: recording; slot reset this frame.
+    /// Start counting (inside rendering).
+    pub fn begin(&mut self, rec: &mut CommandRecorder) {
+        self.used = true;
+        // SAFETY: recording; reset this frame.
         unsafe {
             self.ctx.device.cmd_begin_query(
-                cmd,
+                rec.raw(),
                 self.pool,
-                slot.min(self.slots - 1),
+                0,
                 vk::QueryControlFlags::empty(),
             )
         };
     }
 
-    /// Stop counting into `slot`.
-    pub fn end(&self, cmd: vk::CommandBuffer, slot: u32) {
-        // SAFETY: matches `begin` in the same render pass instance.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_end_query(cmd, self.pool, slot.min(self.slots - 1))
-        };
+    /// Stop counting (same rendering instance as `begin`).
+    pub fn end(&mut self, rec: &mut CommandRecorder) {
+        // SAFETY: matches begin.
+        unsafe { self.ctx.device.cmd_end_query(rec.raw(), self.pool, 0) };
     }
 
-    /// Sum of the first `used` slots after the submission completed.
-    pub fn total(&self, used: u32) -> GpuResult<u64> {
-        let used = used.min(self.slots);
-        if used == 0 {
-            return Ok(0);
+    /// The count after the frame completed; `None` if it was not used this frame.
+    pub fn result(&self) -> GpuResult<Option<u64>> {
+        if !self.used {
+            return Ok(None);
         }
-        let mut data = vec![0u64; used as usize];
-        // SAFETY: the submission completed; WAIT makes results available.
+        let mut data = [0u64; 1];
+        // SAFETY: the submission completed; WAIT makes the result available.
         unsafe {
             self.ctx.device.get_query_pool_results(
                 self.pool,
@@ -191,13 +185,13 @@ impl MeshPrimitivesQuery {
             )
         }
         .ctx("mesh query results")?;
-        Ok(data.iter().sum())
+        Ok(Some(data[0]))
     }
 }
 
 impl Drop for MeshPrimitivesQuery {
     fn drop(&mut self) {
-        // SAFETY: not in use once dropped.
+        // SAFETY: owners drop it after its frame retired.
         unsafe { self.ctx.device.destroy_query_pool(self.pool, None) };
     }
 }

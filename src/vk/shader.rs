@@ -1,5 +1,6 @@
 //! GLSL -> SPIR-V with shaderc. Sources are embedded from `glsl/` at build time (so binaries run
-//! anywhere); `#include "x.glsl"` resolves against the same set. Errors name file and line.
+//! anywhere); `#include "x.glsl"` resolves against generated includes (ShaderOptions), then
+//! the same set. Errors name file and line.
 
 use super::{GpuError, GpuResult};
 
@@ -7,27 +8,17 @@ use super::{GpuError, GpuResult};
 pub const SOURCES: &[(&str, &str)] = &[
     ("bindings.glsl", include_str!("../../glsl/bindings.glsl")),
     ("common.glsl", include_str!("../../glsl/common.glsl")),
-    (
-        "hair_types.glsl",
-        include_str!("../../glsl/hair_types.glsl"),
-    ),
-    (
-        "strand_eval.glsl",
-        include_str!("../../glsl/strand_eval.glsl"),
-    ),
-    (
-        "bundle_lod.glsl",
-        include_str!("../../glsl/bundle_lod.glsl"),
-    ),
-    (
-        "strand_build.glsl",
-        include_str!("../../glsl/strand_build.glsl"),
-    ),
+    ("strand_eval.glsl", include_str!("../../glsl/strand_eval.glsl")),
+    ("bundle_lod.glsl", include_str!("../../glsl/bundle_lod.glsl")),
+    ("bundle_sizes.glsl", include_str!("../../glsl/bundle_sizes.glsl")),
+    ("strand_build.glsl", include_str!("../../glsl/strand_build.glsl")),
     ("strip.glsl", include_str!("../../glsl/strip.glsl")),
     ("strands.task", include_str!("../../glsl/strands.task")),
     ("strands.mesh", include_str!("../../glsl/strands.mesh")),
     ("cull.comp", include_str!("../../glsl/cull.comp")),
     ("scan.comp", include_str!("../../glsl/scan.comp")),
+    ("scan_add.comp", include_str!("../../glsl/scan_add.comp")),
+    ("finalize.comp", include_str!("../../glsl/finalize.comp")),
     ("generate.comp", include_str!("../../glsl/generate.comp")),
     ("strands.vert", include_str!("../../glsl/strands.vert")),
     ("strands.frag", include_str!("../../glsl/strands.frag")),
@@ -39,8 +30,31 @@ fn source(name: &str) -> Option<&'static str> {
     SOURCES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
 }
 
+/// Preprocessor definitions and generated include files for one compilation.
+#[derive(Clone, Debug, Default)]
+pub struct ShaderOptions {
+    /// `#define NAME VALUE` pairs.
+    pub defines: Vec<(String, String)>,
+    /// Include files made at run time (`#include "name"` finds them before `glsl/`).
+    pub generated: Vec<(String, String)>,
+}
+
+impl ShaderOptions {
+    /// Add a definition.
+    pub fn define(mut self, name: &str, value: impl ToString) -> Self {
+        self.defines.push((name.into(), value.to_string()));
+        self
+    }
+
+    /// Add a generated include file.
+    pub fn include(mut self, name: &str, text: String) -> Self {
+        self.generated.push((name.into(), text));
+        self
+    }
+}
+
 /// Compile embedded shader `name` (stage from its extension) to SPIR-V.
-pub fn compile(name: &str) -> GpuResult<Vec<u32>> {
+pub fn compile(name: &str, opts: &ShaderOptions) -> GpuResult<Vec<u32>> {
     let kind = match name.rsplit('.').next() {
         Some("comp") => shaderc::ShaderKind::Compute,
         Some("vert") => shaderc::ShaderKind::Vertex,
@@ -64,11 +78,20 @@ pub fn compile(name: &str) -> GpuResult<Vec<u32>> {
     );
     options.set_target_spirv(shaderc::SpirvVersion::V1_6);
     options.set_optimization_level(shaderc::OptimizationLevel::Performance);
-    options.set_include_callback(|requested, _ty, _from, _depth| {
-        source(requested)
+    for (k, v) in &opts.defines {
+        options.add_macro_definition(k, Some(v));
+    }
+    let generated = opts.generated.clone();
+    options.set_include_callback(move |requested, _ty, _from, _depth| {
+        let content = generated
+            .iter()
+            .find(|(n, _)| n == requested)
+            .map(|(_, t)| t.clone())
+            .or_else(|| source(requested).map(str::to_string));
+        content
             .map(|content| shaderc::ResolvedInclude {
                 resolved_name: requested.to_string(),
-                content: content.to_string(),
+                content,
             })
             .ok_or_else(|| format!("include '{requested}' not found in glsl/"))
     });

@@ -1,0 +1,17 @@
+// What one bundle's LoD decision costs: strands, vertex slots (strands x (2^e + 1)), draw
+// vertices (strands x 2^e x 6) and strand workgroups (strand_build.glsl packs
+// max(S / 2^e, 1) strands per workgroup). Shared by scan.comp and finalize.comp.
+#ifndef BUNDLE_SIZES_GLSL
+#define BUNDLE_SIZES_GLSL
+
+uint strands_per_workgroup(uint segments) {
+    return max(uint(STRAND_GROUP_SIZE) / segments, 1u);
+}
+
+uvec4 bundle_sizes(uvec4 lod) {
+    uint segments = 1u << lod.y;
+    uint per = strands_per_workgroup(segments);
+    return uvec4(lod.x, lod.x * (segments + 1u), lod.x * segments * 6u, (lod.x + per - 1u) / per);
+}
+
+#endif

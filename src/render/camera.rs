@@ -1,0 +1,191 @@
+//! Camera, LoD settings and the per-view data of a frame ([`View`] -> [`FrameBlock`]).
+
+use glam::{Mat4, Vec3, Vec4};
+
+use super::shared::FrameBlock;
+
+/// Default viewing direction (target toward eye) of `render`, `bench` and the tests: a 3/4 view
+/// from behind and above, where the sample heads show their hair.
+pub const DEFAULT_VIEW_DIR: Vec3 = Vec3::new(0.7, 0.35, -1.0);
+
+/// A perspective look-at camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub eye: Vec3,
+    /// Point looked at.
+    pub target: Vec3,
+    /// Up direction.
+    pub up: Vec3,
+    /// Vertical field of view, radians.
+    pub fov_y: f32,
+    /// Near plane distance.
+    pub near: f32,
+    /// Far plane distance.
+    pub far: f32,
+}
+
+impl Camera {
+    /// Look from `eye` at `target` with a vertical field of view in degrees.
+    pub fn look_at(eye: Vec3, target: Vec3, fov_y_degrees: f32) -> Self {
+        let dist = eye.distance(target).max(1e-3);
+        Camera {
+            eye,
+            target,
+            up: Vec3::Y,
+            fov_y: fov_y_degrees.to_radians(),
+            near: dist * 0.01,
+            far: dist * 20.0,
+        }
+    }
+
+    /// Frame a bounding box from direction `dir` (from the target toward the eye).
+    pub fn framing(lo: Vec3, hi: Vec3, dir: Vec3, fov_y_degrees: f32) -> Self {
+        let centre = (lo + hi) * 0.5;
+        let radius = ((hi - lo) * 0.5).length().max(1e-3);
+        let dist = radius / (fov_y_degrees.to_radians() * 0.5).tan() * 1.1;
+        Camera::look_at(
+            centre + dir.normalize_or(Vec3::Z) * dist,
+            centre,
+            fov_y_degrees,
+        )
+    }
+
+    /// Vulkan clip-space view-projection (y down, depth 0..1).
+    pub fn view_proj(&self, aspect: f32) -> Mat4 {
+        // Right-handed view, Vulkan projection: y down in clip space, depth in [0, 1].
+        let f = (self.target - self.eye).normalize_or(Vec3::NEG_Z);
+        let s = f.cross(self.up).normalize_or(Vec3::X);
+        let u = s.cross(f);
+        let view = Mat4::from_cols(
+            Vec4::new(s.x, u.x, -f.x, 0.0),
+            Vec4::new(s.y, u.y, -f.y, 0.0),
+            Vec4::new(s.z, u.z, -f.z, 0.0),
+            Vec4::new(-s.dot(self.eye), -u.dot(self.eye), f.dot(self.eye), 1.0),
+        );
+        let g = 1.0 / (self.fov_y * 0.5).tan();
+        let (n, fa) = (self.near, self.far);
+        let proj = Mat4::from_cols(
+            Vec4::new(g / aspect, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, -g, 0.0, 0.0),
+            Vec4::new(0.0, 0.0, fa / (n - fa), -1.0),
+            Vec4::new(0.0, 0.0, n * fa / (n - fa), 0.0),
+        );
+        proj * view
+    }
+}
+
+/// Level-of-detail settings (paper 003 sec. 3.6): separate alphas for strands and vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LodSettings {
+    /// LoD on; off renders every bundle at full detail.
+    pub enabled: bool,
+    /// Alpha of eq. 7 for strand LoD.
+    pub alpha_strands: f32,
+    /// Alpha of eq. 7 for vertex LoD.
+    pub alpha_verts: f32,
+    /// Geomorph transition window lambda of eq. 10-12, in `(0, 1]`.
+    pub lambda: f32,
+}
+
+impl Default for LodSettings {
+    fn default() -> Self {
+        LodSettings {
+            enabled: true,
+            alpha_strands: 0.1,
+            alpha_verts: 0.1,
+            lambda: 0.5,
+        }
+    }
+}
+
+impl LodSettings {
+    /// Every bundle at full detail.
+    pub fn off() -> Self {
+        LodSettings {
+            enabled: false,
+            ..Default::default()
+        }
+    }
+}
+
+/// Frustum planes of a Vulkan view-projection matrix (Gribb-Hartmann), normalised.
+pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
+    let row = |i: usize| Vec4::new(m.x_axis[i], m.y_axis[i], m.z_axis[i], m.w_axis[i]);
+    let (r0, r1, r2, r3) = (row(0), row(1), row(2), row(3));
+    [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2].map(|p| {
+        let n = p.truncate().length().max(1e-20);
+        (p / n).to_array()
+    })
+}
+
+/// Everything per-view a frame needs: camera, light, image size and LoD settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// The camera.
+    pub camera: Camera,
+    /// Direction toward the light.
+    pub light_dir: Vec3,
+    /// LoD settings.
+    pub lod: LodSettings,
+}
+
+impl View {
+    /// The frame block for `width x height` pixels, `bundles` bundles in `characters`
+    /// character slots and a vertex pool of `vertex_budget` slots.
+    pub fn frame_block(
+        &self,
+        width: u32,
+        height: u32,
+        bundles: u32,
+        characters: u32,
+        vertex_budget: u32,
+    ) -> FrameBlock {
+        let camera = &self.camera;
+        let vp = camera.view_proj(width as f32 / height as f32);
+        FrameBlock {
+            view_proj: vp.to_cols_array_2d(),
+            camera_pos: camera.eye.extend(height as f32).to_array(),
+            light_dir: self
+                .light_dir
+                .normalize_or(Vec3::Y)
+                .extend(1.0 / (camera.fov_y * 0.5).tan())
+                .to_array(),
+            viewport: [
+                width as f32,
+                height as f32,
+                1.0 / width as f32,
+                1.0 / height as f32,
+            ],
+            planes: frustum_planes(vp),
+            lod: [
+                self.lod.alpha_strands,
+                self.lod.alpha_verts,
+                self.lod.lambda,
+                camera.fov_y.tan(),
+            ],
+            lod_ortho: [0.0; 4],
+            counts: [bundles, characters, self.lod.enabled as u32, vertex_budget],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frustum_contains_target_not_behind() {
+        let cam = Camera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, 45.0);
+        let planes = frustum_planes(cam.view_proj(1.0));
+        let inside = |p: Vec3| {
+            planes
+                .iter()
+                .all(|pl| Vec3::from_slice(&pl[..3]).dot(p) + pl[3] >= 0.0)
+        };
+        assert!(inside(Vec3::ZERO));
+        assert!(!inside(Vec3::new(0.0, 0.0, 10.0)), "behind the camera");
+        assert!(!inside(Vec3::new(100.0, 0.0, 0.0)), "far to the side");
+        assert_eq!(size_of::<FrameBlock>(), 256);
+    }
+}

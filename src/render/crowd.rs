@@ -1,0 +1,386 @@
+//! The characters on the GPU: each character's five textures in one element of the bindless
+//! texture arrays (descriptor indexing), its [`CharacterRecord`] (placement, style, strand
+//! settings) and its bundles in the crowd's bundle table. Adding or removing a character never
+//! waits for frames in flight: a removed character's textures and texture slot are retired
+//! with the frame that last used them.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::Mat4;
+
+use super::shared::{
+    CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, TextureBinding,
+};
+use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
+use crate::bake::{BakedHairMesh, MeshInfo};
+use crate::model::style::HairStyle;
+use crate::vk::{
+    BindingDesc, Buffer, BufferDesc, Context, DescriptorKind, DescriptorSet, DescriptorSetLayout,
+    GpuError, GpuResult, Image, ImageDesc, Sampler,
+};
+
+/// The formats of the five textures, in Table 1 order (as [`TextureBinding::ALL`]).
+pub const TEXTURE_FORMATS: [vk::Format; 5] = [
+    vk::Format::R16G16B16A16_UNORM,
+    vk::Format::R16G16_UNORM,
+    vk::Format::R16_UNORM,
+    vk::Format::R16G16B16A16_SNORM,
+    vk::Format::R16G16B16A16_SNORM,
+];
+
+/// What to generate for a character.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StrandParams {
+    /// Strands per (average) bundle, `1..=4096`.
+    pub strands_per_bundle: u32,
+    /// Vertices per strand are `2^verts_log2 + 1`, `verts_log2 <= 6`.
+    pub verts_log2: u32,
+}
+
+impl StrandParams {
+    /// Check the ranges the shaders rely on.
+    pub fn validate(&self) -> GpuResult<()> {
+        if self.strands_per_bundle == 0
+            || self.strands_per_bundle > MAX_STRANDS_PER_BUNDLE as u32
+            || self.verts_log2 > MAX_VERTS_LOG2
+        {
+            return Err(GpuError::Unsupported(format!(
+                "strands per bundle must be 1..={MAX_STRANDS_PER_BUNDLE} and verts-log2 <= {MAX_VERTS_LOG2} (got {} and {})",
+                self.strands_per_bundle, self.verts_log2
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// A character handle (slot + generation, so a stale handle is refused).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct CharacterId {
+    slot: u32,
+    generation: u32,
+}
+
+impl CharacterId {
+    /// The character's slot (its index in the character table and texture arrays).
+    pub fn slot(&self) -> u32 {
+        self.slot
+    }
+}
+
+/// The five textures of one character.
+pub struct CharacterTextures {
+    _images: Vec<Image>,
+    bytes: u64,
+}
+
+struct Character {
+    generation: u32,
+    info: MeshInfo,
+    style: HairStyle,
+    params: StrandParams,
+    model: Mat4,
+    visible: bool,
+    bundles: Vec<crate::bake::BundleDesc>,
+    first_bundle: u32,
+    textures: CharacterTextures,
+}
+
+/// Something a removed character leaves for the frame retirement list.
+pub struct RemovedCharacter {
+    /// Its textures (drop after the frames using them retired).
+    pub textures: CharacterTextures,
+    /// Its slot (reuse after the frames using it retired, [`Crowd::free_slot`]).
+    pub slot: u32,
+}
+
+/// All characters and their GPU tables.
+pub struct Crowd {
+    ctx: Arc<Context>,
+    sampler: Sampler,
+    texture_layout: Arc<DescriptorSetLayout>,
+    texture_set: DescriptorSet,
+    slots: Vec<Option<Character>>,
+    generations: Vec<u32>,
+    free: Vec<u32>,
+    capacity: u32,
+    bundle_table: Option<Buffer>,
+    bundle_count: u32,
+    dirty: bool,
+}
+
+impl Crowd {
+    /// Room for `capacity` characters; fails with a clear message when the device's
+    /// descriptor-indexing limits cannot hold five textures per character.
+    pub fn new(ctx: &Arc<Context>, capacity: u32) -> GpuResult<Self> {
+        let limit = ctx.info.max_bindless_sampled_images / 5;
+        if capacity == 0 || capacity > limit {
+            return Err(GpuError::Unsupported(format!(
+                "{}: room for {capacity} characters needs {} bindless sampled images; the device allows {} ({limit} characters)",
+                ctx.info.name,
+                capacity as u64 * 5,
+                ctx.info.max_bindless_sampled_images
+            )));
+        }
+        for f in TEXTURE_FORMATS {
+            if !ctx.supports_linear_filter(f) {
+                return Err(GpuError::Unsupported(format!(
+                    "{}: {f:?} cannot be sampled with linear filtering",
+                    ctx.info.name
+                )));
+            }
+        }
+        let bindings: Vec<BindingDesc> = TextureBinding::ALL
+            .iter()
+            .map(|(b, _)| BindingDesc::bindless(*b as u32, DescriptorKind::SampledImage, capacity))
+            .collect();
+        let texture_layout = DescriptorSetLayout::new(ctx, &bindings)?;
+        let texture_set = DescriptorSet::new(ctx, "character textures", &texture_layout)?;
+        Ok(Crowd {
+            ctx: ctx.clone(),
+            sampler: Sampler::linear_clamp(ctx)?,
+            texture_layout,
+            texture_set,
+            slots: Vec::new(),
+            generations: Vec::new(),
+            free: Vec::new(),
+            capacity,
+            bundle_table: None,
+            bundle_count: 0,
+            dirty: false,
+        })
+    }
+
+    /// Layout of the texture set (set 1 of every pipeline).
+    pub fn texture_layout(&self) -> &Arc<DescriptorSetLayout> {
+        &self.texture_layout
+    }
+
+    /// The texture set.
+    pub fn texture_set(&self) -> &DescriptorSet {
+        &self.texture_set
+    }
+
+    /// Upload `baked` and add a character. Blocks until its textures are uploaded.
+    pub fn add(
+        &mut self,
+        baked: &BakedHairMesh,
+        style: &HairStyle,
+        params: StrandParams,
+        model: Mat4,
+    ) -> GpuResult<CharacterId> {
+        params.validate()?;
+        if !model.is_finite() {
+            return Err(GpuError::Unsupported("character transform is not finite".into()));
+        }
+        let slot = match self.free.pop() {
+            Some(s) => s,
+            None if (self.slots.len() as u32) < self.capacity => {
+                self.slots.push(None);
+                self.generations.push(0);
+                self.slots.len() as u32 - 1
+            }
+            None => {
+                return Err(GpuError::Unsupported(format!(
+                    "the crowd is full ({} characters; raise RendererDesc::max_characters)",
+                    self.capacity
+                )));
+            }
+        };
+        let textures = match self.upload(slot, baked) {
+            Ok(t) => t,
+            Err(e) => {
+                self.free.push(slot);
+                return Err(e);
+            }
+        };
+        self.generations[slot as usize] += 1;
+        let generation = self.generations[slot as usize];
+        self.slots[slot as usize] = Some(Character {
+            generation,
+            info: baked.info,
+            style: *style,
+            params,
+            model,
+            visible: true,
+            bundles: baked.bundles.clone(),
+            first_bundle: 0,
+            textures,
+        });
+        self.dirty = true;
+        Ok(CharacterId { slot, generation })
+    }
+
+    fn upload(&self, slot: u32, baked: &BakedHairMesh) -> GpuResult<CharacterTextures> {
+        let mut images = Vec::new();
+        let mut bytes = 0;
+        for ((t, format), (binding, _)) in baked
+            .textures()
+            .iter()
+            .zip(TEXTURE_FORMATS)
+            .zip(TextureBinding::ALL)
+        {
+            let desc = if binding == TextureBinding::Uv {
+                ImageDesc::new_2d(t.name, format, t.extent[0], t.extent[1])
+            } else {
+                ImageDesc::new_3d(t.name, format, t.extent)
+            };
+            let image = Image::with_data(&self.ctx, &desc, t.bytes)?;
+            bytes += image.byte_size();
+            images.push(image);
+        }
+        // The slot is free: no pending frame reads it (freed slots retire with their frames).
+        for (image, (binding, _)) in images.iter().zip(TextureBinding::ALL) {
+            self.texture_set
+                .write_image(binding as u32, slot, image, &self.sampler)?;
+        }
+        Ok(CharacterTextures {
+            _images: images,
+            bytes,
+        })
+    }
+
+    fn get_mut(&mut self, id: CharacterId) -> GpuResult<&mut Character> {
+        self.slots
+            .get_mut(id.slot as usize)
+            .and_then(|c| c.as_mut())
+            .filter(|c| c.generation == id.generation)
+            .ok_or_else(|| GpuError::Unsupported(format!("no character {id:?}")))
+    }
+
+    /// Remove a character; its textures and slot must be retired with the last frame that
+    /// may use them.
+    pub fn remove(&mut self, id: CharacterId) -> GpuResult<RemovedCharacter> {
+        self.get_mut(id)?;
+        let c = self.slots[id.slot as usize]
+            .take()
+            .expect("checked by get_mut");
+        self.dirty = true;
+        Ok(RemovedCharacter {
+            textures: c.textures,
+            slot: id.slot,
+        })
+    }
+
+    /// Make a retired slot available again.
+    pub fn free_slot(&mut self, slot: u32) {
+        self.free.push(slot);
+    }
+
+    /// Move a character.
+    pub fn set_model(&mut self, id: CharacterId, model: Mat4) -> GpuResult<()> {
+        if !model.is_finite() {
+            return Err(GpuError::Unsupported("character transform is not finite".into()));
+        }
+        self.get_mut(id)?.model = model;
+        Ok(())
+    }
+
+    /// Show or hide a character.
+    pub fn set_visible(&mut self, id: CharacterId, visible: bool) -> GpuResult<()> {
+        self.get_mut(id)?.visible = visible;
+        Ok(())
+    }
+
+    /// Change a character's strand settings.
+    pub fn set_params(&mut self, id: CharacterId, params: StrandParams) -> GpuResult<()> {
+        params.validate()?;
+        self.get_mut(id)?.params = params;
+        Ok(())
+    }
+
+    /// Live characters.
+    pub fn len(&self) -> usize {
+        self.slots.iter().flatten().count()
+    }
+
+    /// Whether there are no characters.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Character slots in use (the record table's length).
+    pub fn slot_count(&self) -> u32 {
+        self.slots.len() as u32
+    }
+
+    /// Bundles of all characters.
+    pub fn bundle_count(&self) -> u32 {
+        self.bundle_count
+    }
+
+    /// Texture bytes of all characters.
+    pub fn texture_bytes(&self) -> u64 {
+        self.slots.iter().flatten().map(|c| c.textures.bytes).sum()
+    }
+
+    /// The bundle table (after [`Crowd::update_bundle_table`]).
+    pub fn bundle_table(&self) -> Option<&Buffer> {
+        self.bundle_table.as_ref()
+    }
+
+    /// Rebuild the bundle table if characters were added or removed; returns the old table,
+    /// which frames in flight may still read (retire it).
+    pub fn update_bundle_table(&mut self) -> GpuResult<Option<Buffer>> {
+        if !self.dirty {
+            return Ok(None);
+        }
+        let mut table = Vec::new();
+        for (slot, c) in self.slots.iter_mut().enumerate() {
+            if let Some(c) = c {
+                c.first_bundle = table.len() as u32;
+                table.extend(
+                    c.bundles
+                        .iter()
+                        .enumerate()
+                        .map(|(i, b)| GpuBundle::new(b, slot as u32, i as u32)),
+                );
+            }
+        }
+        let old = self.bundle_table.take();
+        self.bundle_count = table.len() as u32;
+        self.dirty = false;
+        if !table.is_empty() {
+            let bytes: &[u8] = bytemuck::cast_slice(&table);
+            let buffer = Buffer::new(
+                &self.ctx,
+                &BufferDesc::new(
+                    "bundle table",
+                    bytes.len() as u64,
+                    vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                ),
+            )?;
+            let staging =
+                Buffer::with_data(&self.ctx, "staging", vk::BufferUsageFlags::TRANSFER_SRC, bytes)?;
+            self.ctx.submit_and_wait(|rec| {
+                rec.copy_buffer(&staging, 0, &buffer, 0, bytes.len() as u64);
+            })?;
+            self.bundle_table = Some(buffer);
+        }
+        Ok(old)
+    }
+
+    /// The character records of every slot (empty slots are invisible, with no bundles).
+    pub fn records(&self) -> Vec<CharacterRecord> {
+        self.slots
+            .iter()
+            .enumerate()
+            .map(|(slot, c)| match c {
+                Some(c) => CharacterRecord {
+                    model: c.model.to_cols_array_2d(),
+                    mesh: c.info,
+                    style: c.style,
+                    texture_slot: slot as u32,
+                    first_bundle: c.first_bundle,
+                    bundle_count: c.bundles.len() as u32,
+                    strands_per_bundle: c.params.strands_per_bundle,
+                    verts_log2: c.params.verts_log2,
+                    flags: if c.visible { CHARACTER_VISIBLE } else { 0 },
+                    model_scale: c.model.x_axis.truncate().length(),
+                    _pad: 0,
+                },
+                None => bytemuck::Zeroable::zeroed(),
+            })
+            .collect()
+    }
+}

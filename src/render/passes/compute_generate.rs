@@ -1,0 +1,147 @@
+//! Compute path generation for the whole crowd: cull (one invocation per bundle), a
+//! multi-level exclusive scan over all bundles, finalize (totals, vertex-pool budget, indirect
+//! arguments), generate (strand workgroups into the vertex pool).
+//! Reads: frame block, character records, bundle table, root samples, textures.
+//! Writes: bundle LoDs, bundle offsets, scan scratch, `GenerateArgs`, the vertex pool.
+
+use std::sync::Arc;
+
+use super::{PassSets, dispatch_2d, shader_options};
+use crate::render::shared::{CULL_GROUP_SIZE, GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
+use crate::vk::shader::compile;
+use crate::vk::{Access, Buffer, CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout, Profiler};
+
+/// One level of the scan: `count` elements at `input` (level 0: the bundles), block sums at
+/// `sums` in the scratch buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ScanLevel {
+    /// Elements scanned.
+    pub count: u32,
+    /// Offset of the elements in the scratch buffer (level > 0).
+    pub input: u32,
+    /// Offset of the block sums in the scratch buffer.
+    pub sums: u32,
+}
+
+/// The levels that scan `bundles` elements (up to one block sum at the top, the grand
+/// total), and the scratch elements they need.
+pub fn scan_plan(bundles: u32) -> (Vec<ScanLevel>, u32) {
+    let mut levels = Vec::new();
+    let (mut count, mut input, mut next) = (bundles.max(1), 0, 0);
+    loop {
+        let blocks = count.div_ceil(SCAN_BLOCK);
+        levels.push(ScanLevel {
+            count,
+            input,
+            sums: next,
+        });
+        input = next;
+        next += blocks;
+        if blocks == 1 {
+            return (levels, next);
+        }
+        count = blocks;
+    }
+}
+
+/// The five compute pipelines of the generation pass.
+pub struct ComputeGenerate {
+    cull: Pipeline,
+    scan: Pipeline,
+    scan_add: Pipeline,
+    finalize: Pipeline,
+    generate: Pipeline,
+}
+
+impl ComputeGenerate {
+    /// Compile the pipelines.
+    pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
+        let opts = shader_options(1);
+        let p = |name: &str, file: &str| Pipeline::compute(ctx, name, layout, &compile(file, &opts)?);
+        Ok(ComputeGenerate {
+            cull: p("cull", "cull.comp")?,
+            scan: p("scan", "scan.comp")?,
+            scan_add: p("scan add", "scan_add.comp")?,
+            finalize: p("finalize", "finalize.comp")?,
+            generate: p("generate", "generate.comp")?,
+        })
+    }
+
+    /// Record generation of every visible strand of the `bundles` bundles into the vertex
+    /// pool. `args` must have been cleared before (statistics accumulate).
+    pub fn record(
+        &self,
+        rec: &mut CommandRecorder,
+        profiler: &mut Profiler,
+        sets: PassSets,
+        bundles: u32,
+        args: &Buffer,
+    ) {
+        let rw = [Access::ComputeReadWrite];
+        // Earlier frames' draws read the pool and the offsets: finish them first.
+        rec.barrier(
+            &[Access::VertexRead, Access::IndirectRead, Access::TransferWrite],
+            &rw,
+        );
+        profiler.begin(rec, "cull");
+        rec.bind(&self.cull, &sets.both());
+        let (x, y) = dispatch_2d(bundles.div_ceil(CULL_GROUP_SIZE));
+        rec.dispatch(x, y, 1);
+        profiler.end(rec);
+        rec.barrier(&rw, &rw);
+
+        profiler.begin(rec, "scan");
+        let (levels, _) = scan_plan(bundles);
+        for (i, l) in levels.iter().enumerate() {
+            rec.bind(&self.scan, &sets.both());
+            rec.push_constants(&self.scan, &[l.count, l.input, l.sums, (i > 0) as u32]);
+            let (x, y) = dispatch_2d(l.count.div_ceil(SCAN_BLOCK));
+            rec.dispatch(x, y, 1);
+            rec.barrier(&rw, &rw);
+        }
+        for (i, l) in levels.iter().enumerate().rev() {
+            if l.count <= SCAN_BLOCK {
+                continue; // one block: its scanned block sum is 0
+            }
+            rec.bind(&self.scan_add, &sets.both());
+            rec.push_constants(&self.scan_add, &[l.count, l.input, l.sums, (i > 0) as u32]);
+            let (x, y) = dispatch_2d(l.count.div_ceil(SCAN_THREADS));
+            rec.dispatch(x, y, 1);
+            rec.barrier(&rw, &rw);
+        }
+        let total = levels.last().map_or(0, |l| l.sums);
+        rec.bind(&self.finalize, &sets.both());
+        rec.push_constants(&self.finalize, &[total, 0u32, 0, 0]);
+        rec.dispatch(1, 1, 1);
+        profiler.end(rec);
+        rec.barrier(&rw, &[Access::ComputeReadWrite, Access::IndirectRead]);
+
+        profiler.begin(rec, "generate");
+        rec.bind(&self.generate, &sets.both());
+        rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);
+        profiler.end(rec);
+        rec.barrier(
+            &rw,
+            &[Access::VertexRead, Access::IndirectRead, Access::TransferRead],
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scan_plan_reaches_one_block() {
+        let (l, scratch) = scan_plan(100);
+        assert_eq!(l.len(), 1);
+        assert_eq!(scratch, 1);
+        let (l, scratch) = scan_plan(50_400);
+        assert_eq!(l.len(), 2);
+        assert_eq!((l[0].count, l[0].sums, l[1].count, l[1].input, l[1].sums), (50_400, 0, 50, 0, 50));
+        assert_eq!(scratch, 51);
+        let (l, _) = scan_plan(3 * 1024 * 1024 + 1);
+        assert_eq!(l.len(), 3);
+        assert_eq!(l.last().unwrap().count.div_ceil(SCAN_BLOCK), 1);
+    }
+}

@@ -1,0 +1,116 @@
+//! Strand strips: the compute path's vertex-pulling draw (one indirect draw for the crowd) and
+//! the mesh path's task + mesh pipeline (one task dispatch for the crowd, `TASK_BUNDLES`
+//! bundles per task workgroup). Reads: frame block, records, bundles, LoDs and offsets,
+//! the vertex pool (compute) or the textures (mesh). Writes: colour, depth, and on the mesh
+//! path the frame statistics.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{PassSets, dispatch_2d, shader_options};
+use crate::render::shared::{
+    DISPATCH_ROW, GenerateArgs, MAX_SEGMENTS, STRAND_GROUP_SIZE, TASK_PAYLOAD_BUNDLES, TaskPayload,
+};
+use crate::vk::shader::compile;
+use crate::vk::{
+    Buffer, CommandRecorder, Context, GpuError, GpuResult, GraphicsDesc, Pipeline, PipelineLayout,
+};
+
+/// Whether the device's mesh shader limits fit `strands.task` / `strands.mesh`.
+pub fn mesh_path_supported(ctx: &Context) -> bool {
+    let max_groups_per_task =
+        TASK_PAYLOAD_BUNDLES * crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE as u32;
+    ctx.info.mesh_limits.is_some_and(|l| {
+        l.max_mesh_output_vertices >= 2 * (MAX_SEGMENTS + 1)
+            && l.max_mesh_output_primitives >= 2 * MAX_SEGMENTS
+            && l.max_task_payload_size as usize >= size_of::<TaskPayload>()
+            && l.max_mesh_work_group_invocations >= STRAND_GROUP_SIZE
+            && l.max_task_work_group_invocations >= TASK_PAYLOAD_BUNDLES
+            && l.max_mesh_work_group_total_count >= max_groups_per_task
+            && l.max_mesh_work_group_count[0] >= DISPATCH_ROW
+            && l.max_mesh_work_group_count[1] >= max_groups_per_task.div_ceil(DISPATCH_ROW)
+            && l.max_task_work_group_count[0] >= DISPATCH_ROW
+            && l.max_task_work_group_count[1] >= DISPATCH_ROW
+    })
+}
+
+/// Strand pipelines.
+pub struct StrandDraw {
+    pulled: Pipeline,
+    mesh: Option<Pipeline>,
+    task_bundles: u32,
+}
+
+impl StrandDraw {
+    /// Compile the pulled-strand pipeline and, where the device supports it, the mesh path
+    /// with `task_bundles` (1..=32) bundles per task workgroup.
+    pub fn new(
+        ctx: &Arc<Context>,
+        layout: &Arc<PipelineLayout>,
+        color: vk::Format,
+        depth: vk::Format,
+        task_bundles: u32,
+    ) -> GpuResult<Self> {
+        if !(1..=TASK_PAYLOAD_BUNDLES).contains(&task_bundles) {
+            return Err(GpuError::Unsupported(format!(
+                "task bundles per workgroup must be 1..={TASK_PAYLOAD_BUNDLES}"
+            )));
+        }
+        let opts = shader_options(task_bundles);
+        let (v, f) = (compile("strands.vert", &opts)?, compile("strands.frag", &opts)?);
+        let pulled = Pipeline::graphics(
+            ctx,
+            layout,
+            &GraphicsDesc::new("pulled strands", color, depth)
+                .stage(vk::ShaderStageFlags::VERTEX, &v)
+                .stage(vk::ShaderStageFlags::FRAGMENT, &f),
+        )?;
+        let mesh = if mesh_path_supported(ctx) {
+            let (t, m) = (compile("strands.task", &opts)?, compile("strands.mesh", &opts)?);
+            Some(Pipeline::graphics(
+                ctx,
+                layout,
+                &GraphicsDesc::new("mesh strands", color, depth)
+                    .stage(vk::ShaderStageFlags::TASK_EXT, &t)
+                    .stage(vk::ShaderStageFlags::MESH_EXT, &m)
+                    .stage(vk::ShaderStageFlags::FRAGMENT, &f),
+            )?)
+        } else {
+            None
+        };
+        Ok(StrandDraw {
+            pulled,
+            mesh,
+            task_bundles,
+        })
+    }
+
+    /// Whether the mesh path is available.
+    pub fn has_mesh_path(&self) -> bool {
+        self.mesh.is_some()
+    }
+
+    /// Compute path: draw the strands in the vertex pool (inside rendering).
+    pub fn record_pulled(&self, rec: &mut CommandRecorder, sets: PassSets, args: &Buffer) {
+        rec.bind(&self.pulled, &sets.both());
+        rec.draw_indirect(args, GenerateArgs::DRAW_OFFSET);
+    }
+
+    /// Mesh path: cull, pick LoD, generate and draw the strands of `bundles` bundles (inside
+    /// rendering; the statistics in `GenerateArgs` must be cleared before).
+    pub fn record_mesh(
+        &self,
+        rec: &mut CommandRecorder,
+        sets: PassSets,
+        bundles: u32,
+    ) -> GpuResult<()> {
+        let p = self
+            .mesh
+            .as_ref()
+            .ok_or_else(|| GpuError::Unsupported("no usable VK_EXT_mesh_shader".into()))?;
+        rec.bind(p, &sets.both());
+        let (x, y) = dispatch_2d(bundles.div_ceil(self.task_bundles));
+        rec.draw_mesh_tasks(x, y, 1)
+    }
+}

@@ -1,0 +1,484 @@
+//! The CPU/GPU contract, defined once: constants, binding numbers and every struct the shaders
+//! share with Rust. [`glsl_header`] emits them as the GLSL include `shared.glsl` that every
+//! shader is compiled with (a copy is kept in `glsl/generated/shared.glsl` for reading; a test
+//! keeps it current). `tests/glsl_layout.rs` checks that the std430 layout of each emitted
+//! struct equals the Rust `#[repr(C)]` layout, field by field.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
+use crate::bake::{BundleDesc, MeshInfo, SLICES_PER_SEGMENT};
+use crate::model::style::HairStyle;
+
+/// Threads of a strand-building workgroup (`s` of paper 003 sec. 3.6.2), both paths.
+pub const STRAND_GROUP_SIZE: u32 = 32;
+/// Largest vertex level: `2^6 = 64` segments (2 vertices per thread of a strand workgroup).
+pub const MAX_VERTS_LOG2: u32 = 6;
+/// Segments of a strand at the largest vertex level.
+pub const MAX_SEGMENTS: u32 = 1 << MAX_VERTS_LOG2;
+/// Bundles one task-shader workgroup can cull and compact (payload capacity).
+pub const TASK_PAYLOAD_BUNDLES: u32 = 32;
+/// Invocations of a cull workgroup (one bundle each).
+pub const CULL_GROUP_SIZE: u32 = 64;
+/// Threads of a scan workgroup.
+pub const SCAN_THREADS: u32 = 256;
+/// Elements one scan workgroup sums (4 per thread).
+pub const SCAN_BLOCK: u32 = 1024;
+/// Workgroups per dispatch row (Vulkan guarantees 65535 in x); larger counts use y.
+pub const DISPATCH_ROW: u32 = 65535;
+/// `CharacterRecord::flags`: the character is drawn this frame.
+pub const CHARACTER_VISIBLE: u32 = 1;
+
+/// Descriptor set 0: per-frame data and the crowd's tables.
+pub const SET_FRAME: u32 = 0;
+/// Descriptor set 1: the bindless texture arrays (one element per character slot).
+pub const SET_TEXTURES: u32 = 1;
+
+/// Bindings of set 0 ([`SET_FRAME`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum FrameBinding {
+    /// `FrameBlock` uniform: camera, planes, LoD settings, light, counts.
+    Frame = 0,
+    /// `CharacterRecord[]`: one per character slot.
+    Characters = 1,
+    /// `GpuBundle[]`: every bundle of every character.
+    Bundles = 2,
+    /// `vec2[]` root samples: quad set, then triangle set.
+    RootSamples = 3,
+    /// `uvec4[]` per-bundle LoD decision (strands, e, gamma bits, thickness bits).
+    BundleLods = 4,
+    /// `uvec4[]` per-bundle exclusive prefix sums (strand, vertex slot, draw vertex, group).
+    BundleOffsets = 5,
+    /// `uvec4[]` block sums of the multi-level scan.
+    ScanScratch = 6,
+    /// `GenerateArgs`: indirect arguments and frame statistics.
+    Args = 7,
+    /// `HairVertex[]`: the compute path's generated-vertex pool.
+    Vertices = 8,
+}
+
+impl FrameBinding {
+    /// Every binding, with its GLSL macro name.
+    pub const ALL: [(FrameBinding, &'static str); 9] = [
+        (FrameBinding::Frame, "BINDING_FRAME"),
+        (FrameBinding::Characters, "BINDING_CHARACTERS"),
+        (FrameBinding::Bundles, "BINDING_BUNDLES"),
+        (FrameBinding::RootSamples, "BINDING_ROOT_SAMPLES"),
+        (FrameBinding::BundleLods, "BINDING_BUNDLE_LODS"),
+        (FrameBinding::BundleOffsets, "BINDING_BUNDLE_OFFSETS"),
+        (FrameBinding::ScanScratch, "BINDING_SCAN_SCRATCH"),
+        (FrameBinding::Args, "BINDING_ARGS"),
+        (FrameBinding::Vertices, "BINDING_VERTICES"),
+    ];
+}
+
+/// Bindings of set 1 ([`SET_TEXTURES`]): the five textures of paper 003 Table 1, each a
+/// bindless array indexed by the character's texture slot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum TextureBinding {
+    /// Hair mesh texture (3D).
+    Position = 0,
+    /// uv-texture (2D).
+    Uv = 1,
+    /// w-texture (3D).
+    W = 2,
+    /// u-texture (3D).
+    U = 3,
+    /// v-texture (3D).
+    V = 4,
+}
+
+impl TextureBinding {
+    /// Every binding in Table 1 order, with its GLSL macro name.
+    pub const ALL: [(TextureBinding, &'static str); 5] = [
+        (TextureBinding::Position, "BINDING_TEX_POSITION"),
+        (TextureBinding::Uv, "BINDING_TEX_UV"),
+        (TextureBinding::W, "BINDING_TEX_W"),
+        (TextureBinding::U, "BINDING_TEX_U"),
+        (TextureBinding::V, "BINDING_TEX_V"),
+    ];
+}
+
+/// One field of a struct shared with GLSL.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GpuField {
+    /// Field name (same in Rust and GLSL).
+    pub name: &'static str,
+    /// GLSL type: a scalar/vector/matrix type or another shared struct's name.
+    pub glsl: &'static str,
+    /// Array length, 0 for a plain field.
+    pub array: usize,
+    /// Byte offset in the Rust `#[repr(C)]` struct.
+    pub offset: usize,
+}
+
+/// A `#[repr(C)]` struct that GLSL declares from [`GpuStruct::fields`].
+pub trait GpuStruct: Pod {
+    /// GLSL struct name.
+    const GLSL_NAME: &'static str;
+    /// Fields in declaration order.
+    fn fields() -> Vec<GpuField>;
+}
+
+/// Implement [`GpuStruct`] for a `#[repr(C)]` type from its field list; field names are
+/// checked by `offset_of!` at compile time, offsets and size by `tests/glsl_layout.rs`.
+macro_rules! gpu_struct {
+    ($ty:ty as $name:literal { $($field:ident : $glsl:literal $([$n:expr])?),* $(,)? }) => {
+        impl GpuStruct for $ty {
+            const GLSL_NAME: &'static str = $name;
+            fn fields() -> Vec<GpuField> {
+                vec![$(GpuField {
+                    name: stringify!($field),
+                    glsl: $glsl,
+                    array: gpu_struct!(@len $($n)?),
+                    offset: std::mem::offset_of!($ty, $field),
+                }),*]
+            }
+        }
+    };
+    (@len) => { 0 };
+    (@len $n:expr) => { $n as usize };
+}
+
+gpu_struct!(MeshInfo as "MeshInfo" {
+    pos_origin: "vec4", pos_extent: "vec4", uv_origin_extent: "vec4", root_size: "uvec2",
+    layers: "uint", bundle_count: "uint",
+});
+
+gpu_struct!(HairStyle as "HairStyle" {
+    seed: "uint", strand_width: "float", tip_width_ratio: "float", taper_power: "float",
+    length_variation: "float", root_ramp: "float", clump_strength: "float", clump_power: "float",
+    curl_radius: "float", curl_frequency: "float", curl_phase_jitter: "float",
+    wave_amplitude: "float", wave_frequency: "float", wave_angle: "float",
+    wave_phase_jitter: "float", frizz_amplitude: "float", frizz_frequency: "float",
+    frizz_power: "float", density_by_area: "uint", color: "float"[3], _pad: "uint"[2],
+});
+
+gpu_struct!(BundleDesc as "BundleDesc" {
+    origin: "uvec2", flags: "uint", rest_size: "float", density: "float", _pad: "uint"[3],
+});
+
+/// Per-view data of one frame (uniform block, identical in std140 and std430 because every
+/// field is a vec4, uvec4 or mat4).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameBlock {
+    /// World to clip.
+    pub view_proj: [[f32; 4]; 4],
+    /// xyz eye, w vertical resolution in pixels.
+    pub camera_pos: [f32; 4],
+    /// xyz direction toward the light, w `1 / tan(fov_y / 2)` (0: orthographic).
+    pub light_dir: [f32; 4],
+    /// width, height, 1/width, 1/height.
+    pub viewport: [f32; 4],
+    /// Frustum planes (inside where `dot(n, p) + d >= 0`).
+    pub planes: [[f32; 4]; 6],
+    /// x alpha strands, y alpha vertices, z lambda, w `tan(fov_y)` of eq. 7 (0: orthographic).
+    pub lod: [f32; 4],
+    /// x view height of orthographic views; yzw unused.
+    pub lod_ortho: [f32; 4],
+    /// x bundles of all characters, y character slots, z LoD on, w vertex pool budget
+    /// (compute path, in `HairVertex` slots).
+    pub counts: [u32; 4],
+}
+
+gpu_struct!(FrameBlock as "FrameBlock" {
+    view_proj: "mat4", camera_pos: "vec4", light_dir: "vec4", viewport: "vec4",
+    planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4",
+});
+
+/// One character: where its bundles and textures are, how it is placed and styled.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CharacterRecord {
+    /// Object to world.
+    pub model: [[f32; 4]; 4],
+    /// Texture decode constants.
+    pub mesh: MeshInfo,
+    /// Styling.
+    pub style: HairStyle,
+    /// Element of the bindless texture arrays.
+    pub texture_slot: u32,
+    /// First bundle in the crowd's bundle table.
+    pub first_bundle: u32,
+    /// Number of bundles.
+    pub bundle_count: u32,
+    /// Strands per average bundle (`N` of eq. 8).
+    pub strands_per_bundle: u32,
+    /// Full-detail vertex level `e` (`2^e` segments).
+    pub verts_log2: u32,
+    /// [`CHARACTER_VISIBLE`].
+    pub flags: u32,
+    /// Uniform scale of `model` (widths and styling margins).
+    pub model_scale: f32,
+    /// Padding to 256 bytes.
+    pub _pad: u32,
+}
+
+gpu_struct!(CharacterRecord as "CharacterRecord" {
+    model: "mat4", mesh: "MeshInfo", style: "HairStyle", texture_slot: "uint",
+    first_bundle: "uint", bundle_count: "uint", strands_per_bundle: "uint", verts_log2: "uint",
+    flags: "uint", model_scale: "float", _pad: "uint",
+});
+
+/// One bundle of the crowd's bundle table: the baked [`BundleDesc`] plus its owner.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuBundle {
+    /// Root-slice texel of the cell corner `(0, 0)`.
+    pub origin: [u32; 2],
+    /// Bit 0: triangle bundle.
+    pub flags: u32,
+    /// `h` of eq. 7.
+    pub rest_size: f32,
+    /// Strand density weight.
+    pub density: f32,
+    /// Character slot.
+    pub character: u32,
+    /// Bundle index within its mesh (seeds per-strand randomness, as in the CPU oracle).
+    pub local_index: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+gpu_struct!(GpuBundle as "GpuBundle" {
+    origin: "uvec2", flags: "uint", rest_size: "float", density: "float", character: "uint",
+    local_index: "uint", _pad: "uint",
+});
+
+impl GpuBundle {
+    /// Bundle `local_index` of a mesh, owned by character slot `character`.
+    pub fn new(b: &BundleDesc, character: u32, local_index: u32) -> Self {
+        GpuBundle {
+            origin: b.origin,
+            flags: b.flags,
+            rest_size: b.rest_size,
+            density: b.density,
+            character,
+            local_index,
+            _pad: 0,
+        }
+    }
+}
+
+/// What one frame generated; written by the GPU, read back after the frame.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct FrameStats {
+    /// Bundles that passed culling.
+    pub bundles_visible: u32,
+    /// Strands LoD asked for.
+    pub strands_demanded: u32,
+    /// Strands drawn (less than demanded when the compute path's vertex pool overflowed).
+    pub strands_drawn: u32,
+    /// Strand triangles LoD asked for.
+    pub triangles_demanded: u32,
+    /// Strand triangles drawn.
+    pub triangles_drawn: u32,
+    /// Compute path: vertex slots asked for.
+    pub vertex_slots_demanded: u32,
+    /// Compute path: vertex slots written (<= the budget).
+    pub vertex_slots_written: u32,
+    /// Compute path: strand workgroups dispatched.
+    pub groups: u32,
+}
+
+gpu_struct!(FrameStats as "FrameStats" {
+    bundles_visible: "uint", strands_demanded: "uint", strands_drawn: "uint",
+    triangles_demanded: "uint", triangles_drawn: "uint", vertex_slots_demanded: "uint",
+    vertex_slots_written: "uint", groups: "uint",
+});
+
+/// Indirect arguments of the compute path and the frame statistics of both paths.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GenerateArgs {
+    /// `VkDispatchIndirectCommand` of `generate.comp` (xyz; w unused).
+    pub dispatch: [u32; 4],
+    /// `VkDrawIndirectCommand` of `strands.vert`.
+    pub draw: [u32; 4],
+    /// Statistics.
+    pub stats: FrameStats,
+}
+
+gpu_struct!(GenerateArgs as "GenerateArgs" {
+    dispatch: "uvec4", draw: "uvec4", stats: "FrameStats",
+});
+
+impl GenerateArgs {
+    /// Byte offset of the dispatch arguments.
+    pub const DISPATCH_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, dispatch) as u64;
+    /// Byte offset of the draw arguments.
+    pub const DRAW_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, draw) as u64;
+}
+
+/// A generated strand vertex (compute path).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct HairVertex {
+    /// xyz world position, w strand width.
+    pub pos_width: [f32; 4],
+    /// xyz unit tangent, w parameter `s` along the strand.
+    pub tangent_s: [f32; 4],
+}
+
+gpu_struct!(HairVertex as "HairVertex" { pos_width: "vec4", tangent_s: "vec4" });
+
+/// Task shader -> mesh shader payload: up to [`TASK_PAYLOAD_BUNDLES`] visible bundles of one
+/// task workgroup, compacted, with the first mesh workgroup of each.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TaskPayload {
+    /// Per visible bundle: strands, vertex level e, gamma bits, thickness bits.
+    pub lods: [[u32; 4]; TASK_PAYLOAD_BUNDLES as usize],
+    /// Global bundle index of each visible bundle.
+    pub bundle: [u32; TASK_PAYLOAD_BUNDLES as usize],
+    /// First mesh workgroup of each visible bundle; element `count` is the total.
+    pub first_group: [u32; TASK_PAYLOAD_BUNDLES as usize + 1],
+    /// Visible bundles.
+    pub count: u32,
+}
+
+gpu_struct!(TaskPayload as "TaskPayload" {
+    lods: "uvec4"[TASK_PAYLOAD_BUNDLES], bundle: "uint"[TASK_PAYLOAD_BUNDLES],
+    first_group: "uint"[TASK_PAYLOAD_BUNDLES + 1], count: "uint",
+});
+
+/// std430 `(size, alignment)` of a GLSL scalar, vector or matrix type.
+pub fn std430_type(ty: &str) -> Option<(usize, usize)> {
+    Some(match ty {
+        "float" | "uint" | "int" => (4, 4),
+        "vec2" | "uvec2" | "ivec2" => (8, 8),
+        "vec3" | "uvec3" => (12, 16),
+        "vec4" | "uvec4" => (16, 16),
+        "mat4" => (64, 16),
+        _ => return None,
+    })
+}
+
+/// A struct's name and fields, for layout checks and emission.
+pub struct StructInfo {
+    /// GLSL name.
+    pub name: &'static str,
+    /// Fields.
+    pub fields: Vec<GpuField>,
+    /// Rust `size_of`.
+    pub rust_size: usize,
+}
+
+fn info<T: GpuStruct>() -> StructInfo {
+    StructInfo {
+        name: T::GLSL_NAME,
+        fields: T::fields(),
+        rust_size: size_of::<T>(),
+    }
+}
+
+/// Every shared struct, dependencies first.
+pub fn shared_structs() -> Vec<StructInfo> {
+    vec![
+        info::<MeshInfo>(),
+        info::<HairStyle>(),
+        info::<BundleDesc>(),
+        info::<FrameBlock>(),
+        info::<CharacterRecord>(),
+        info::<GpuBundle>(),
+        info::<FrameStats>(),
+        info::<GenerateArgs>(),
+        info::<HairVertex>(),
+        info::<TaskPayload>(),
+    ]
+}
+
+/// std430 layout of `s`: `(field offsets, size, alignment)`, using the layouts of the structs
+/// before it in `known`.
+pub fn std430_layout(s: &StructInfo, known: &[(String, usize, usize)]) -> (Vec<usize>, usize, usize) {
+    let (mut offset, mut align_max, mut offsets) = (0usize, 4usize, Vec::new());
+    for f in &s.fields {
+        let (size, align) = std430_type(f.glsl)
+            .or_else(|| {
+                known
+                    .iter()
+                    .find(|(n, ..)| n == f.glsl)
+                    .map(|(_, s, a)| (*s, *a))
+            })
+            .unwrap_or_else(|| panic!("{}: unknown GLSL type {}", s.name, f.glsl));
+        offset = offset.next_multiple_of(align);
+        offsets.push(offset);
+        // std430 arrays: stride is the element size rounded up to its alignment.
+        offset += if f.array > 0 {
+            size.next_multiple_of(align) * f.array
+        } else {
+            size
+        };
+        align_max = align_max.max(align);
+    }
+    (offsets, offset.next_multiple_of(align_max), align_max)
+}
+
+/// The GLSL include `shared.glsl`: constants, binding numbers and shared structs.
+pub fn glsl_header() -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "// GENERATED from src/render/shared.rs by render::shared::glsl_header(); do not edit.\n\
+         // Shaders are compiled with this text; this copy is for reading.\n\
+         #ifndef SHARED_GLSL\n#define SHARED_GLSL\n"
+    );
+    let consts: [(&str, u32); 14] = [
+        ("STRAND_GROUP_SIZE", STRAND_GROUP_SIZE),
+        ("MAX_VERTS_LOG2", MAX_VERTS_LOG2),
+        ("MAX_SEGMENTS", MAX_SEGMENTS),
+        ("MAX_STRANDS_PER_BUNDLE", MAX_STRANDS_PER_BUNDLE as u32),
+        ("SLICES_PER_SEGMENT", SLICES_PER_SEGMENT),
+        ("BUNDLE_TRIANGLE", crate::bake::BUNDLE_TRIANGLE),
+        ("TASK_PAYLOAD_BUNDLES", TASK_PAYLOAD_BUNDLES),
+        ("CULL_GROUP_SIZE", CULL_GROUP_SIZE),
+        ("SCAN_THREADS", SCAN_THREADS),
+        ("SCAN_BLOCK", SCAN_BLOCK),
+        ("DISPATCH_ROW", DISPATCH_ROW),
+        ("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
+        ("SET_FRAME", SET_FRAME),
+        ("SET_TEXTURES", SET_TEXTURES),
+    ];
+    for (name, v) in consts {
+        // Set numbers and local sizes must be int constants in layout qualifiers.
+        let suffix = if name.starts_with("SET_")
+            || name.ends_with("_GROUP_SIZE")
+            || name == "SCAN_THREADS"
+            || name == "TASK_PAYLOAD_BUNDLES"
+        {
+            ""
+        } else {
+            "u"
+        };
+        let _ = writeln!(out, "#define {name} {v}{suffix}");
+    }
+    for (b, name) in FrameBinding::ALL {
+        let _ = writeln!(out, "#define {name} {}", b as u32);
+    }
+    for (b, name) in TextureBinding::ALL {
+        let _ = writeln!(out, "#define {name} {}", b as u32);
+    }
+    let _ = writeln!(
+        out,
+        "// Depth of the hair mesh texture: SLICES_PER_SEGMENT (L - 1) + 1 slices.\n\
+         #define POSITION_DEPTH(layers) (SLICES_PER_SEGMENT * ((layers) - 1u) + 1u)\n"
+    );
+    for s in shared_structs() {
+        let _ = writeln!(out, "struct {} {{", s.name);
+        for f in &s.fields {
+            if f.array > 0 {
+                let _ = writeln!(out, "    {} {}[{}];", f.glsl, f.name, f.array);
+            } else {
+                let _ = writeln!(out, "    {} {};", f.glsl, f.name);
+            }
+        }
+        let _ = writeln!(out, "}};\n");
+    }
+    out.push_str("#endif\n");
+    out
+}

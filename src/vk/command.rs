@@ -1,0 +1,538 @@
+//! Command buffers and the typed recorder the passes use: bind, push constants, dispatch, draw,
+//! mesh tasks, dynamic rendering, copies and barriers expressed as [`Access`] types. Nothing
+//! outside `vk/` records raw Vulkan commands.
+
+use std::sync::Arc;
+
+use ash::vk;
+use bytemuck::Pod;
+
+use super::buffer::Buffer;
+use super::descriptor::DescriptorSet;
+use super::image::{Image, aspect};
+use super::pipeline::Pipeline;
+use super::{Context, GpuError, GpuResult, VkContext};
+
+/// How a resource is used by a command; barriers are written between two uses. One small
+/// table (stage, access, image layout) in the spirit of vk-sync, for the uses this project has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    /// No previous use (contents may be discarded).
+    Nothing,
+    /// Read as indirect dispatch/draw arguments.
+    IndirectRead,
+    /// Storage read/write in compute shaders.
+    ComputeReadWrite,
+    /// Storage read in vertex shaders.
+    VertexRead,
+    /// Storage read/write in task shaders.
+    TaskReadWrite,
+    /// Storage read in mesh shaders.
+    MeshRead,
+    /// Storage/uniform read in fragment shaders.
+    FragmentRead,
+    /// Sampled by any shader stage (image in `SHADER_READ_ONLY_OPTIMAL`).
+    SampledRead,
+    /// Written as a colour attachment.
+    ColorAttachment,
+    /// Read and written as a depth attachment.
+    DepthAttachment,
+    /// Source of a transfer.
+    TransferRead,
+    /// Destination of a transfer (copy, fill).
+    TransferWrite,
+    /// Read by the host after the submission completed.
+    HostRead,
+}
+
+struct AccessInfo {
+    stage: vk::PipelineStageFlags2,
+    access: vk::AccessFlags2,
+    layout: vk::ImageLayout,
+    writes: bool,
+}
+
+impl Access {
+    fn info(self) -> AccessInfo {
+        use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+        let (stage, access, layout, writes) = match self {
+            Access::Nothing => (S::NONE, A::NONE, L::UNDEFINED, false),
+            Access::IndirectRead => (
+                S::DRAW_INDIRECT,
+                A::INDIRECT_COMMAND_READ,
+                L::UNDEFINED,
+                false,
+            ),
+            Access::ComputeReadWrite => (
+                S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                L::GENERAL,
+                true,
+            ),
+            Access::VertexRead => (
+                S::VERTEX_SHADER,
+                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
+                L::UNDEFINED,
+                false,
+            ),
+            Access::TaskReadWrite => (
+                S::TASK_SHADER_EXT,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                L::GENERAL,
+                true,
+            ),
+            Access::MeshRead => (
+                S::MESH_SHADER_EXT,
+                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
+                L::UNDEFINED,
+                false,
+            ),
+            Access::FragmentRead => (
+                S::FRAGMENT_SHADER,
+                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
+                L::UNDEFINED,
+                false,
+            ),
+            Access::SampledRead => (
+                S::ALL_COMMANDS,
+                A::SHADER_SAMPLED_READ,
+                L::SHADER_READ_ONLY_OPTIMAL,
+                false,
+            ),
+            Access::ColorAttachment => (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+                true,
+            ),
+            Access::DepthAttachment => (
+                S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
+                A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                L::DEPTH_ATTACHMENT_OPTIMAL,
+                true,
+            ),
+            Access::TransferRead => (S::TRANSFER, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL, false),
+            Access::TransferWrite => (
+                S::TRANSFER,
+                A::TRANSFER_WRITE,
+                L::TRANSFER_DST_OPTIMAL,
+                true,
+            ),
+            Access::HostRead => (S::HOST, A::HOST_READ, L::GENERAL, false),
+        };
+        AccessInfo {
+            stage,
+            access,
+            layout,
+            writes,
+        }
+    }
+}
+
+/// Source and destination masks of a barrier from `prev` uses to `next` uses. Only writes are
+/// made available; a read-after-read needs just the execution dependency.
+fn masks(
+    prev: &[Access],
+    next: &[Access],
+) -> (
+    vk::PipelineStageFlags2,
+    vk::AccessFlags2,
+    vk::PipelineStageFlags2,
+    vk::AccessFlags2,
+) {
+    let mut src = (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE);
+    for a in prev {
+        let i = a.info();
+        src.0 |= i.stage;
+        if i.writes {
+            src.1 |= i.access
+                & (vk::AccessFlags2::SHADER_STORAGE_WRITE
+                    | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
+                    | vk::AccessFlags2::TRANSFER_WRITE);
+        }
+    }
+    let mut dst = (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE);
+    for a in next {
+        let i = a.info();
+        dst.0 |= i.stage;
+        dst.1 |= i.access;
+    }
+    (src.0, src.1, dst.0, dst.1)
+}
+
+/// A primary command buffer with its own pool, re-recorded every time it is used.
+pub struct CommandBuffer {
+    ctx: Arc<Context>,
+    pool: vk::CommandPool,
+    raw: vk::CommandBuffer,
+}
+
+impl CommandBuffer {
+    /// A resettable command buffer on the context's queue family.
+    pub fn new(ctx: &Arc<Context>, name: &str) -> GpuResult<Self> {
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(ctx.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        // SAFETY: valid device and create info.
+        let pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
+            .ctx("create command pool")?;
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        // SAFETY: the pool was just created on this device.
+        let raw = match unsafe { ctx.device.allocate_command_buffers(&alloc) } {
+            Ok(v) => v[0],
+            Err(e) => {
+                // SAFETY: the pool has no buffers in use.
+                unsafe { ctx.device.destroy_command_pool(pool, None) };
+                return Err(GpuError::Vk {
+                    what: "allocate command buffer",
+                    result: e,
+                });
+            }
+        };
+        ctx.name_object(raw, name);
+        Ok(CommandBuffer {
+            ctx: ctx.clone(),
+            pool,
+            raw,
+        })
+    }
+
+    /// Begin recording (the previous submission of this buffer must have completed).
+    pub fn begin(&mut self) -> GpuResult<CommandRecorder<'_>> {
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: the caller waited for the previous submission (fence of its frame).
+        unsafe {
+            self.ctx
+                .device
+                .reset_command_buffer(self.raw, vk::CommandBufferResetFlags::empty())
+                .ctx("reset command buffer")?;
+            self.ctx
+                .device
+                .begin_command_buffer(self.raw, &begin)
+                .ctx("begin command buffer")?;
+        }
+        Ok(CommandRecorder {
+            ctx: &self.ctx,
+            raw: self.raw,
+            rendering: false,
+        })
+    }
+
+    /// Finish recording.
+    pub fn end(&mut self) -> GpuResult<()> {
+        // SAFETY: the buffer is in the recording state (begin succeeded).
+        unsafe { self.ctx.device.end_command_buffer(self.raw) }.ctx("end command buffer")
+    }
+
+    pub(crate) fn raw(&self) -> vk::CommandBuffer {
+        self.raw
+    }
+}
+
+impl Drop for CommandBuffer {
+    fn drop(&mut self) {
+        // SAFETY: owners wait for the submission before dropping (frames retire first).
+        unsafe { self.ctx.device.destroy_command_pool(self.pool, None) };
+    }
+}
+
+/// A colour or depth attachment of a dynamic rendering instance.
+#[derive(Clone, Copy)]
+pub struct Attachment<'a> {
+    /// The image (in the layout of [`Access::ColorAttachment`] / [`Access::DepthAttachment`]).
+    pub image: &'a Image,
+    /// Clear to this value, or keep the contents when `None`.
+    pub clear: Option<[f32; 4]>,
+}
+
+/// Records commands into a command buffer; every method is a safe wrapper of one Vulkan call.
+pub struct CommandRecorder<'a> {
+    ctx: &'a Context,
+    raw: vk::CommandBuffer,
+    rendering: bool,
+}
+
+impl CommandRecorder<'_> {
+    pub(crate) fn raw(&self) -> vk::CommandBuffer {
+        self.raw
+    }
+
+    /// Bind `pipeline` and its descriptor sets (set `i` = `sets[i]`).
+    pub fn bind(&mut self, pipeline: &Pipeline, sets: &[&DescriptorSet]) {
+        let raw_sets: Vec<vk::DescriptorSet> = sets.iter().map(|s| s.raw()).collect();
+        // SAFETY: recording; the sets were created from the pipeline's set layouts.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_bind_pipeline(self.raw, pipeline.bind_point(), pipeline.raw());
+            if !raw_sets.is_empty() {
+                self.ctx.device.cmd_bind_descriptor_sets(
+                    self.raw,
+                    pipeline.bind_point(),
+                    pipeline.layout_raw(),
+                    0,
+                    &raw_sets,
+                    &[],
+                );
+            }
+        }
+    }
+
+    /// Set push constants of `pipeline` (all stages, offset 0).
+    pub fn push_constants<T: Pod>(&mut self, pipeline: &Pipeline, data: &T) {
+        let bytes = bytemuck::bytes_of(data);
+        debug_assert!(bytes.len() as u32 <= super::pipeline::PUSH_CONSTANT_BYTES);
+        // SAFETY: recording; the range lies within the layout's push constant range.
+        unsafe {
+            self.ctx.device.cmd_push_constants(
+                self.raw,
+                pipeline.layout_raw(),
+                vk::ShaderStageFlags::ALL,
+                0,
+                bytes,
+            )
+        };
+    }
+
+    /// Dispatch a bound compute pipeline.
+    pub fn dispatch(&mut self, x: u32, y: u32, z: u32) {
+        // SAFETY: recording with a bound compute pipeline.
+        unsafe { self.ctx.device.cmd_dispatch(self.raw, x, y, z) };
+    }
+
+    /// Dispatch with `VkDispatchIndirectCommand` at `offset` of `args`.
+    pub fn dispatch_indirect(&mut self, args: &Buffer, offset: u64) {
+        // SAFETY: recording; the buffer has INDIRECT_BUFFER usage (checked by validation).
+        unsafe {
+            self.ctx
+                .device
+                .cmd_dispatch_indirect(self.raw, args.raw(), offset)
+        };
+    }
+
+    /// Draw `vertices` vertices of one instance (no vertex input; shaders pull their data).
+    pub fn draw(&mut self, vertices: u32) {
+        // SAFETY: recording inside a rendering instance with a bound graphics pipeline.
+        unsafe { self.ctx.device.cmd_draw(self.raw, vertices, 1, 0, 0) };
+    }
+
+    /// Draw with one `VkDrawIndirectCommand` at `offset` of `args`.
+    pub fn draw_indirect(&mut self, args: &Buffer, offset: u64) {
+        // SAFETY: recording inside a rendering instance.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_draw_indirect(self.raw, args.raw(), offset, 1, 16)
+        };
+    }
+
+    /// Launch task workgroups of a bound task/mesh pipeline.
+    pub fn draw_mesh_tasks(&mut self, x: u32, y: u32, z: u32) -> GpuResult<()> {
+        let ext = self
+            .ctx
+            .mesh_ext
+            .as_ref()
+            .ok_or_else(|| GpuError::Unsupported("VK_EXT_mesh_shader is not enabled".into()))?;
+        // SAFETY: recording inside a rendering instance; counts checked by the caller against
+        // maxTaskWorkGroupCount.
+        unsafe { ext.cmd_draw_mesh_tasks(self.raw, x, y, z) };
+        Ok(())
+    }
+
+    /// Begin dynamic rendering into `color` and `depth` over their full extent, with viewport
+    /// and scissor covering it.
+    pub fn begin_rendering(&mut self, color: Attachment, depth: Attachment) {
+        let [w, h, _] = color.image.desc.extent;
+        let att = |a: &Attachment, layout| {
+            let mut info = vk::RenderingAttachmentInfo::default()
+                .image_view(a.image.view())
+                .image_layout(layout)
+                .store_op(vk::AttachmentStoreOp::STORE);
+            info = match a.clear {
+                Some(c) => info.load_op(vk::AttachmentLoadOp::CLEAR).clear_value(
+                    if layout == vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL {
+                        vk::ClearValue {
+                            depth_stencil: vk::ClearDepthStencilValue {
+                                depth: c[0],
+                                stencil: 0,
+                            },
+                        }
+                    } else {
+                        vk::ClearValue {
+                            color: vk::ClearColorValue { float32: c },
+                        }
+                    },
+                ),
+                None => info.load_op(vk::AttachmentLoadOp::LOAD),
+            };
+            info
+        };
+        let color_att = [att(&color, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)];
+        let depth_att = att(&depth, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+        let area = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D {
+                width: w,
+                height: h,
+            },
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&color_att)
+            .depth_attachment(&depth_att);
+        // SAFETY: attachments are in the layouts named above (the caller's barriers).
+        unsafe {
+            self.ctx.device.cmd_begin_rendering(self.raw, &info);
+            self.ctx.device.cmd_set_viewport(
+                self.raw,
+                0,
+                &[vk::Viewport {
+                    x: 0.0,
+                    y: 0.0,
+                    width: w as f32,
+                    height: h as f32,
+                    min_depth: 0.0,
+                    max_depth: 1.0,
+                }],
+            );
+            self.ctx.device.cmd_set_scissor(self.raw, 0, &[area]);
+        }
+        self.rendering = true;
+    }
+
+    /// End the rendering instance begun last.
+    pub fn end_rendering(&mut self) {
+        if self.rendering {
+            // SAFETY: matches begin_rendering.
+            unsafe { self.ctx.device.cmd_end_rendering(self.raw) };
+            self.rendering = false;
+        }
+    }
+
+    /// Global memory barrier between buffer uses `prev` and `next`.
+    pub fn barrier(&mut self, prev: &[Access], next: &[Access]) {
+        let (ss, sa, ds, da) = masks(prev, next);
+        let b = [vk::MemoryBarrier2::default()
+            .src_stage_mask(ss)
+            .src_access_mask(sa)
+            .dst_stage_mask(ds)
+            .dst_access_mask(da)];
+        let dep = vk::DependencyInfo::default().memory_barriers(&b);
+        // SAFETY: recording outside a rendering instance.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.raw, &dep) };
+    }
+
+    /// Image barrier with layout transition from use `prev` to use `next`.
+    pub fn image_barrier(&mut self, image: &Image, prev: Access, next: Access) {
+        let (ss, sa, ds, da) = masks(&[prev], &[next]);
+        let b = [vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(ss)
+            .src_access_mask(sa)
+            .dst_stage_mask(ds)
+            .dst_access_mask(da)
+            .old_layout(prev.info().layout)
+            .new_layout(next.info().layout)
+            .image(image.raw())
+            .subresource_range(image.full_range())];
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&b);
+        // SAFETY: recording outside a rendering instance.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.raw, &dep) };
+    }
+
+    /// Fill `size` bytes at `offset` of `buffer` with the word `value`.
+    pub fn fill_buffer(&mut self, buffer: &Buffer, offset: u64, size: u64, value: u32) {
+        // SAFETY: recording outside rendering; range checked by validation (multiple of 4).
+        unsafe {
+            self.ctx
+                .device
+                .cmd_fill_buffer(self.raw, buffer.raw(), offset, size, value)
+        };
+    }
+
+    /// Copy `size` bytes from `src` at `src_offset` to `dst` at `dst_offset`.
+    pub fn copy_buffer(
+        &mut self,
+        src: &Buffer,
+        src_offset: u64,
+        dst: &Buffer,
+        dst_offset: u64,
+        size: u64,
+    ) {
+        let region = [vk::BufferCopy {
+            src_offset,
+            dst_offset,
+            size,
+        }];
+        // SAFETY: recording outside rendering; ranges checked by validation.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_copy_buffer(self.raw, src.raw(), dst.raw(), &region)
+        };
+    }
+
+    /// Copy tightly packed texels from `src` into all of `dst` (in [`Access::TransferWrite`]).
+    pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
+        let [w, h, d] = dst.desc.extent;
+        let region = [vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(aspect(dst.desc.format))
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: w,
+                height: h,
+                depth: d,
+            })];
+        // SAFETY: the image is in TRANSFER_DST_OPTIMAL; the buffer size is checked by the caller.
+        unsafe {
+            self.ctx.device.cmd_copy_buffer_to_image(
+                self.raw,
+                src.raw(),
+                dst.raw(),
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+            )
+        };
+    }
+
+    /// Copy all of 2D image `src` (in [`Access::TransferRead`]) into `dst`, tightly packed.
+    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
+        let [w, h, _] = src.desc.extent;
+        let region = [vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(aspect(src.desc.format))
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: w,
+                height: h,
+                depth: 1,
+            })];
+        // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer size is checked by the caller.
+        unsafe {
+            self.ctx.device.cmd_copy_image_to_buffer(
+                self.raw,
+                src.raw(),
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw(),
+                &region,
+            )
+        };
+    }
+}
+
+impl Drop for CommandRecorder<'_> {
+    fn drop(&mut self) {
+        // A recorder dropped inside rendering (an error path) still leaves valid commands.
+        self.end_rendering();
+    }
+}
