@@ -1,82 +1,60 @@
-//! The GLSL structs in `glsl/hair_types.glsl` have the same std430 layout as their Rust twins.
+//! The CPU/GPU contract: every struct emitted into `shared.glsl` (src/render/shared.rs) has the
+//! same std430 layout as its Rust `#[repr(C)]` twin, field by field, and the copy of the
+//! generated header in `glsl/generated/` is current.
 
-use hairmesh::{BundleDesc, HairStyle, MeshInfo};
+use hairmesh::render::shared::{glsl_header, shared_structs, std430_layout, std430_type};
 
-/// std430 (size, alignment) of the scalar/vector types used in shared structs.
-fn std430(ty: &str) -> (usize, usize) {
-    match ty {
-        "float" | "uint" | "int" => (4, 4),
-        "vec2" | "uvec2" | "ivec2" => (8, 8),
-        "vec3" | "uvec3" => (12, 16),
-        "vec4" | "uvec4" => (16, 16),
-        _ => panic!("type {ty} not supported in shared structs"),
-    }
-}
-
-/// `(name, offset)` of each field of `struct name` in the GLSL source, and the struct size.
-fn glsl_layout(src: &str, name: &str) -> (Vec<(String, usize)>, usize) {
-    let start = src
-        .find(&format!("struct {name} {{"))
-        .unwrap_or_else(|| panic!("struct {name} missing"));
-    let body = &src[start..];
-    let body = &body[body.find('{').unwrap() + 1..body.find("};").unwrap()];
-    let (mut offset, mut align_max, mut fields) = (0usize, 4usize, Vec::new());
-    for line in body.lines() {
-        let line = line.split("//").next().unwrap().trim();
-        if line.is_empty() {
-            continue;
+#[test]
+fn every_shared_struct_has_the_rust_layout() {
+    let mut known: Vec<(String, usize, usize)> = Vec::new();
+    let structs = shared_structs();
+    assert!(structs.len() >= 10, "every shared struct is registered");
+    for s in &structs {
+        let (offsets, size, align) = std430_layout(s, &known);
+        for (f, off) in s.fields.iter().zip(&offsets) {
+            assert_eq!(
+                f.offset, *off,
+                "{}.{}: Rust offset {} but std430 offset {}",
+                s.name, f.name, f.offset, off
+            );
         }
-        let decl = line.trim_end_matches(';');
-        let (ty, var) = decl.split_once(' ').unwrap();
-        let (var, count) = match var.split_once('[') {
-            Some((v, n)) => (v.trim(), n.trim_end_matches(']').parse::<usize>().unwrap()),
-            None => (var.trim(), 1),
-        };
-        let (size, align) = std430(ty);
-        // std430 arrays of scalars/vectors: stride = element alignment-rounded size.
-        let stride = size.next_multiple_of(align);
-        offset = offset.next_multiple_of(align);
-        fields.push((var.to_string(), offset));
-        offset += if count > 1 { stride * count } else { size };
-        align_max = align_max.max(align);
+        assert_eq!(size, s.rust_size, "{}: std430 size differs from Rust", s.name);
+        known.push((s.name.to_string(), size, align));
     }
-    (fields, offset.next_multiple_of(align_max))
 }
 
-fn check(name: &str, rust: Vec<(&'static str, usize)>, rust_size: usize) {
-    let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl/hair_types.glsl"))
+#[test]
+fn the_frame_block_is_the_same_in_std140() {
+    // Uniform blocks use std140; with only 16-byte-aligned vec4/uvec4/mat4 fields (and arrays
+    // of vec4) std140 and std430 agree.
+    let s = shared_structs()
+        .into_iter()
+        .find(|s| s.name == "FrameBlock")
         .unwrap();
-    let (glsl, size) = glsl_layout(&src, name);
-    let rust: Vec<(String, usize)> = rust.into_iter().map(|(n, o)| (n.to_string(), o)).collect();
-    assert_eq!(
-        glsl, rust,
-        "{name}: GLSL and Rust field names/offsets differ"
-    );
-    assert_eq!(size, rust_size, "{name}: std430 size differs");
+    for f in &s.fields {
+        assert_eq!(std430_type(f.glsl).unwrap().1, 16, "FrameBlock.{}", f.name);
+    }
 }
 
 #[test]
-fn hair_style_layout() {
-    check(
-        "HairStyle",
-        HairStyle::field_offsets(),
-        size_of::<HairStyle>(),
-    );
-    assert_eq!(size_of::<HairStyle>() % 16, 0);
+fn a_wrong_offset_is_caught() {
+    // The check above can fail: shifting one field breaks it.
+    let mut s = shared_structs().remove(0);
+    s.fields[1].offset += 4;
+    let (offsets, ..) = std430_layout(&s, &[]);
+    assert_ne!(offsets[1], s.fields[1].offset);
 }
 
 #[test]
-fn mesh_info_layout() {
-    check("MeshInfo", MeshInfo::field_offsets(), size_of::<MeshInfo>());
-    assert_eq!(size_of::<MeshInfo>(), 64);
-}
-
-#[test]
-fn bundle_desc_layout() {
-    check(
-        "BundleDesc",
-        BundleDesc::field_offsets(),
-        size_of::<BundleDesc>(),
+fn generated_header_copy_is_current() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/glsl/generated/shared.glsl");
+    let text = glsl_header();
+    if std::env::var("HAIRMESH_BLESS").is_ok_and(|v| v == "1") {
+        std::fs::write(path, &text).unwrap();
+    }
+    let copy = std::fs::read_to_string(path).unwrap_or_default();
+    assert!(
+        copy == text,
+        "glsl/generated/shared.glsl is stale: run HAIRMESH_BLESS=1 cargo test --release --test glsl_layout"
     );
-    assert_eq!(size_of::<BundleDesc>(), 32);
 }

@@ -5,7 +5,6 @@ mod common;
 use common::*;
 use glam::Vec3;
 use hairmesh::CpuGenerator;
-use hairmesh::render::Renderer;
 
 #[test]
 fn gpu_strands_match_cpu_oracle() {
@@ -17,22 +16,15 @@ fn gpu_strands_match_cpu_oracle() {
         ("sphere_fur.obj", 4, 3),
     ] {
         let (baked, style) = sample(name);
-        let mut r = Renderer::new(&ctx).unwrap();
-        let hair = upload(&ctx, &r, &baked, &style, n, e);
+        let mut r = renderer(&ctx, 64);
+        upload(&mut r, &baked, &style, n, e);
         // Far camera: every bundle is inside the frustum, nothing is culled.
         let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
         let ext = Vec3::from_slice(&baked.info.pos_extent[..3]);
         let cam = hairmesh::render::Camera::framing(o, o + ext, Vec3::new(0.3, 0.5, 1.0), 60.0);
-        r.render(
-            std::slice::from_ref(&hair),
-            &cam,
-            light(),
-            64,
-            64,
-            &compute_full(),
-        )
-        .unwrap();
-        let (gpu, strands) = r.read_vertices(&hair).unwrap();
+        let out = render(&mut r, &cam, &compute_full());
+        let strands = out.stats.strands_drawn;
+        let gpu = r.read_vertices(out.stats.vertex_slots_written).unwrap();
         let cpu = CpuGenerator::new(&baked, style).generate(n, e);
         assert_eq!(strands as usize, cpu.strand_count(), "{name}: strand count");
         assert_eq!(gpu.len(), cpu.positions.len(), "{name}: vertex count");
@@ -46,12 +38,12 @@ fn gpu_strands_match_cpu_oracle() {
         let mut worst = 0.0f32;
         let mut worst_t = 0.0f32;
         for (i, v) in gpu.iter().enumerate() {
-            let p = Vec3::new(v[0], v[1], v[2]);
+            let p = Vec3::from_slice(&v.pos_width[..3]);
             worst = worst.max(p.distance(cpu.positions[i]));
-            let t = Vec3::new(v[4], v[5], v[6]);
+            let t = Vec3::from_slice(&v.tangent_s[..3]);
             worst_t = worst_t.max(1.0 - t.dot(cpu.tangents[i]));
             assert!(
-                (v[3] - cpu.widths[i]).abs() <= 1e-6 + 1e-4 * cpu.widths[i],
+                (v.pos_width[3] - cpu.widths[i]).abs() <= 1e-6 + 1e-4 * cpu.widths[i],
                 "{name}: width {i}"
             );
         }

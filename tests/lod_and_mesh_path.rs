@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use hairmesh::reference::lod::bundle_lod;
-use hairmesh::render::{Camera, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer};
+use hairmesh::render::{Camera, LodSettings, RenderPath};
 use hairmesh::{CpuGenerator, reference::generate::strands_in_bundle};
 
 const SIZE: u32 = 160;
@@ -176,19 +176,11 @@ fn gpu_lod_strands_match_cpu_oracle() {
     let (baked, style) = sample(name);
     let (n, e) = (8, 5);
     let cam = dolly(name, 3.0);
-    let mut r = Renderer::new(&ctx).unwrap();
-    let hair = upload(&ctx, &r, &baked, &style, n, e);
-
-    r.render(
-        std::slice::from_ref(&hair),
-        &cam,
-        light(),
-        SIZE,
-        SIZE,
-        &settings(RenderPath::Compute, true),
-    )
-    .unwrap();
-    let (gpu, strands) = r.read_vertices(&hair).unwrap();
+    let mut r = renderer(&ctx, SIZE);
+    upload(&mut r, &baked, &style, n, e);
+    let out = render(&mut r, &cam, &settings(RenderPath::Compute, true));
+    let strands = out.stats.strands_drawn;
+    let gpu = r.read_vertices(out.stats.vertex_slots_written).unwrap();
     let view = lod_view(&cam, SIZE);
     let (cpu, counts) = CpuGenerator::new(&baked, style).generate_lod(n, e, &baked, &view);
     assert_eq!(strands as usize, counts.len(), "strand count");
@@ -198,15 +190,16 @@ fn gpu_lod_strands_match_cpu_oracle() {
     let ext = Vec3::from_slice(&baked.info.pos_extent[..3]).length();
     let mut worst = 0.0f32;
     for (i, v) in gpu.iter().enumerate() {
-        worst = worst.max(Vec3::new(v[0], v[1], v[2]).distance(cpu.positions[i]));
+        let (p, t) = (v.pos_width, v.tangent_s);
+        worst = worst.max(Vec3::new(p[0], p[1], p[2]).distance(cpu.positions[i]));
         assert!(
-            (v[3] - cpu.widths[i]).abs() <= 1e-6 + 1e-3 * cpu.widths[i],
+            (p[3] - cpu.widths[i]).abs() <= 1e-6 + 1e-3 * cpu.widths[i],
             "width {i}: {} vs {}",
-            v[3],
+            p[3],
             cpu.widths[i]
         );
         assert!(
-            Vec3::new(v[4], v[5], v[6]).dot(cpu.tangents[i]) > 0.99,
+            Vec3::new(t[0], t[1], t[2]).dot(cpu.tangents[i]) > 0.99,
             "tangent {i}"
         );
     }

@@ -12,13 +12,13 @@ fn every_glsl_file_is_embedded_and_compiles() {
             "glsl/{name} is not listed in src/vk/shader.rs SOURCES"
         );
         if !name.ends_with(".glsl") {
-            compile(&name).unwrap_or_else(|e| panic!("{e}"));
+            compile(&name, &hairmesh::render::passes::shader_options(32)).unwrap_or_else(|e| panic!("{e}"));
         }
     }
 }
 
 #[test]
 fn unknown_shader_is_an_error_naming_it() {
-    let e = compile("nope.comp").unwrap_err().to_string();
+    let e = compile("nope.comp", &Default::default()).unwrap_err().to_string();
     assert!(e.contains("glsl/nope.comp"), "{e}");
 }

@@ -18,7 +18,7 @@ use glam::{Mat4, Vec3};
 use hairmesh::model::obj_io::load_hair_mesh_obj;
 use hairmesh::render::scene::load_mesh;
 use hairmesh::render::{
-    Camera, HairGpu, LodSettings, RenderPath, RenderSettings, Renderer, StrandParams,
+    Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakeOptions, CpuGenerator, HairStyle, bake};
@@ -87,10 +87,8 @@ fn bench_lod(
     }
     let (baked, style) = load_mesh(&mesh, None)?;
     let ctx = Arc::new(Context::new(&ContextDesc::default().device(device))?);
-    let mut renderer = Renderer::new(&ctx)?;
-    let hair = HairGpu::new(
-        &ctx,
-        &renderer.sampler,
+    let mut renderer = Renderer::new(&ctx, &RendererDesc::default().size(width, height))?;
+    renderer.add_character(
         &baked,
         &style,
         StrandParams {
@@ -101,7 +99,7 @@ fn bench_lod(
     )?;
     let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
     let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    let frame = Camera::framing(o, o + e, hairmesh::render::frame::DEFAULT_VIEW_DIR, 40.0);
+    let frame = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
     let at = |k: f32| {
         Camera::look_at(
             frame.target + (frame.eye - frame.target) * k,
@@ -117,46 +115,37 @@ fn bench_lod(
     println!("| view | path | LoD | strands | triangles | GPU ms (median of {runs}) |");
     println!("|---|---|---|---|---|---|");
     let mut paths = vec![RenderPath::Compute];
-    if ctx.info.mesh_shader {
+    if renderer.has_mesh_path() {
         paths.insert(0, RenderPath::Mesh);
     }
     let mut pics = Vec::new();
     for (label, cam) in &views {
         for &path in &paths {
             for lod_on in [true, false] {
-                let settings = RenderSettings {
-                    path: Some(path),
+                let view = View {
+                    camera: *cam,
+                    light_dir: Vec3::new(0.4, 1.0, 0.6),
                     lod: if lod_on {
                         LodSettings::default()
                     } else {
                         LodSettings::off()
                     },
                 };
-                let first = renderer.render(
-                    std::slice::from_ref(&hair),
-                    cam,
-                    Vec3::new(0.4, 1.0, 0.6),
-                    width,
-                    height,
-                    &settings,
-                )?;
+                let opts = FrameOptions {
+                    path: Some(path),
+                    read_image: true,
+                    ..Default::default()
+                };
+                let first = renderer.render_one(&view, &opts)?;
                 let mut times = Vec::new();
                 for _ in 0..runs {
-                    let out = renderer.render(
-                        std::slice::from_ref(&hair),
-                        cam,
-                        Vec3::new(0.4, 1.0, 0.6),
-                        width,
-                        height,
-                        &settings,
-                    )?;
-                    times.push(out.pass_ms.iter().map(|p| p.1).sum::<f64>());
+                    times.push(renderer.render_one(&view, &FrameOptions { read_image: false, ..opts })?.gpu_ms());
                 }
                 println!(
                     "| {label} | {path:?} | {} | {} | {} | {:.2} |",
                     if lod_on { "on" } else { "off" },
-                    first.strands,
-                    first.triangles,
+                    first.stats.strands_drawn,
+                    first.stats.triangles_drawn,
                     median(times)
                 );
                 if lod_on && path == paths[0] {
@@ -168,8 +157,8 @@ fn bench_lod(
     if let Some(p) = picture {
         let mut strip = image::RgbaImage::new(width * 3, height);
         for (i, out) in pics.iter().enumerate() {
-            let img =
-                image::RgbaImage::from_raw(width, height, out.rgba.clone()).context("size")?;
+            let rgba = out.rgba.clone().context("no image")?;
+            let img = image::RgbaImage::from_raw(width, height, rgba).context("size")?;
             image::imageops::replace(&mut strip, &img, (i as u32 * width) as i64, 0);
         }
         let mut png = Vec::new();

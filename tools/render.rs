@@ -14,7 +14,7 @@ use clap::Parser;
 use glam::{Mat4, Vec3};
 use hairmesh::render::scene::{SceneDesc, load_mesh};
 use hairmesh::render::{
-    Camera, HairGpu, LodSettings, RenderPath, RenderSettings, Renderer, StrandParams,
+    Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
 
@@ -65,6 +65,10 @@ struct Args {
     /// Geomorph window lambda of eq. 10-12, in (0, 1].
     #[arg(long, default_value_t = 0.5)]
     lod_lambda: f32,
+    /// Size of the compute path's vertex pool in MiB (frames that need more keep whole strands
+    /// up to it and report the overflow).
+    #[arg(long, default_value_t = 96)]
+    vertex_pool_mib: u64,
     /// Enable Vulkan validation layers.
     #[arg(long)]
     validation: bool,
@@ -114,16 +118,16 @@ fn run(args: Args) -> Result<()> {
     if !(lod.lambda > 0.0 && lod.lambda <= 1.0) {
         bail!("--lod-lambda must be in (0, 1]");
     }
-    let settings = RenderSettings {
-        path: args.path.as_deref().map(|p| {
-            if p == "mesh" {
-                RenderPath::Mesh
-            } else {
-                RenderPath::Compute
-            }
-        }),
-        lod,
-    };
+    let path = args.path.as_deref().map(|p| {
+        if p == "mesh" {
+            RenderPath::Mesh
+        } else {
+            RenderPath::Compute
+        }
+    });
+    if args.vertex_pool_mib == 0 || args.vertex_pool_mib > 4096 {
+        bail!("--vertex-pool-mib must be 1..=4096");
+    }
     // Load and validate every input before touching the GPU.
     struct Character {
         baked: hairmesh::BakedHairMesh,
@@ -195,7 +199,7 @@ fn run(args: Args) -> Result<()> {
                     hi = hi.max(p);
                 }
             }
-            Camera::framing(lo, hi, hairmesh::render::frame::DEFAULT_VIEW_DIR, args.fov)
+            Camera::framing(lo, hi, hairmesh::render::DEFAULT_VIEW_DIR, args.fov)
         }
     };
 
@@ -205,23 +209,35 @@ fn run(args: Args) -> Result<()> {
             .validation(args.validation)
             .device(args.device.clone()),
     )?);
-    let mut renderer = Renderer::new(&ctx)?;
-    let hairs: Vec<HairGpu> = characters
-        .iter()
-        .map(|c| {
-            HairGpu::new(
-                &ctx,
-                &renderer.sampler,
-                &c.baked,
-                &c.style,
-                c.params,
-                c.model,
-            )
-        })
-        .collect::<Result<_, _>>()?;
-    let out = renderer.render(&hairs, &camera, light, width, height, &settings)?;
+    let mut renderer = Renderer::new(
+        &ctx,
+        &RendererDesc::default()
+            .size(width, height)
+            .path(path)
+            .vertex_pool_bytes(args.vertex_pool_mib << 20),
+    )?;
+    for c in &characters {
+        renderer.add_character(&c.baked, &c.style, c.params, c.model)?;
+    }
+    let view = View {
+        camera,
+        light_dir: light,
+        lod,
+    };
+    let out = renderer.render_one(
+        &view,
+        &FrameOptions {
+            read_image: true,
+            ..Default::default()
+        },
+    )?;
     let wall = start.elapsed().as_secs_f64();
-    let img = image::RgbaImage::from_raw(width, height, out.rgba).context("image size mismatch")?;
+    // Nothing is written unless the frame succeeded and validation reported nothing.
+    if ctx.validation_errors() > 0 {
+        bail!("{} Vulkan validation error(s); no image written", ctx.validation_errors());
+    }
+    let rgba = out.rgba.clone().context("no image read back")?;
+    let img = image::RgbaImage::from_raw(width, height, rgba).context("image size mismatch")?;
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
     hairmesh::fsutil::write_atomic(&args.output, &png)?;
@@ -230,14 +246,23 @@ fn run(args: Args) -> Result<()> {
         "{:?} path, LoD {}, {} character(s), {} strands (up to {} vertices each), {} strand triangles, {}x{}",
         out.path,
         args.lod,
-        hairs.len(),
-        out.strands,
+        characters.len(),
+        out.stats.strands_drawn,
         (1u32 << args.verts_log2) + 1,
-        out.triangles,
+        out.stats.triangles_drawn,
         width,
         height
     );
-    if let Some(q) = out.mesh_primitives_query {
+    if out.stats.strands_drawn < out.stats.strands_demanded {
+        println!(
+            "  vertex pool overflow: drew {} of {} strands ({} of {} vertex slots); raise --vertex-pool-mib or use LoD",
+            out.stats.strands_drawn,
+            out.stats.strands_demanded,
+            out.stats.vertex_slots_written,
+            out.stats.vertex_slots_demanded
+        );
+    }
+    if let Some(q) = out.mesh_primitives {
         println!("  mesh primitives generated (VK_EXT_mesh_shader query): {q}");
     }
     for (pass, ms) in &out.pass_ms {
@@ -245,12 +270,9 @@ fn run(args: Args) -> Result<()> {
     }
     println!(
         "  total gpu  {:9.3} ms; wall (incl. setup, shader compile) {:.2} s",
-        out.pass_ms.iter().map(|p| p.1).sum::<f64>(),
+        out.gpu_ms(),
         wall
     );
-    if ctx.validation_errors() > 0 {
-        bail!("{} Vulkan validation error(s)", ctx.validation_errors());
-    }
     println!("wrote {}", args.output.display());
     Ok(())
 }

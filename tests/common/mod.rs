@@ -9,10 +9,63 @@ use std::sync::Arc;
 use glam::{Mat4, Vec3};
 use hairmesh::render::scene::load_mesh;
 use hairmesh::render::{
-    Camera, HairGpu, LodSettings, RenderOutput, RenderPath, RenderSettings, Renderer, StrandParams,
+    Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakedHairMesh, HairStyle};
+
+/// Path and LoD of a test render.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    pub path: Option<RenderPath>,
+    pub lod: LodSettings,
+}
+
+/// What a test render produced.
+pub struct RenderOutput {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+    pub strands: u64,
+    pub triangles: u64,
+    pub path: RenderPath,
+    pub mesh_primitives_query: Option<u64>,
+    pub stats: hairmesh::render::FrameStats,
+}
+
+/// A renderer with a `size` x `size` target.
+pub fn renderer(ctx: &Arc<Context>, size: u32) -> Renderer {
+    Renderer::new(ctx, &RendererDesc::default().size(size, size)).unwrap()
+}
+
+/// Render one frame of everything in `r` and read it back.
+pub fn render(r: &mut Renderer, cam: &Camera, settings: &RenderSettings) -> RenderOutput {
+    let view = View {
+        camera: *cam,
+        light_dir: light(),
+        lod: settings.lod,
+    };
+    let report = r
+        .render_one(
+            &view,
+            &FrameOptions {
+                path: settings.path,
+                read_image: true,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    RenderOutput {
+        width: report.width,
+        height: report.height,
+        rgba: report.rgba.unwrap(),
+        strands: report.stats.strands_drawn as u64,
+        triangles: report.stats.triangles_drawn as u64,
+        path: report.path,
+        mesh_primitives_query: report.mesh_primitives,
+        stats: report.stats,
+    }
+}
 
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -42,7 +95,7 @@ pub fn sample(name: &str) -> (BakedHairMesh, HairStyle) {
 pub fn framing(baked: &BakedHairMesh) -> Camera {
     let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
     let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    Camera::framing(o, o + e, hairmesh::render::frame::DEFAULT_VIEW_DIR, 40.0)
+    Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0)
 }
 
 pub fn light() -> Vec3 {
@@ -80,11 +133,10 @@ pub fn render_sample_with(
     settings: &RenderSettings,
 ) -> RenderOutput {
     let (baked, style) = sample(name);
-    let mut r = Renderer::new(ctx).unwrap();
-    let hair = upload(ctx, &r, &baked, &style, n, e);
+    let mut r = renderer(ctx, size);
+    upload(&mut r, &baked, &style, n, e);
     let cam = camera.unwrap_or_else(|| framing(&baked));
-    r.render(&[hair], &cam, light(), size, size, settings)
-        .unwrap()
+    render(&mut r, &cam, settings)
 }
 
 pub fn output_dir() -> PathBuf {
@@ -100,20 +152,19 @@ pub fn save_png(path: &Path, w: u32, h: u32, rgba: &[u8]) {
         .unwrap();
 }
 
-/// Upload a mesh with `n` strands per bundle and `2^e + 1` vertices, identity transform.
+/// Add a mesh with `n` strands per bundle and `2^e + 1` vertices, identity transform.
 pub fn upload(
-    ctx: &Arc<Context>,
-    r: &Renderer,
+    r: &mut Renderer,
     baked: &BakedHairMesh,
     style: &HairStyle,
     n: u32,
     e: u32,
-) -> HairGpu {
+) -> hairmesh::render::CharacterId {
     let params = StrandParams {
         strands_per_bundle: n,
         verts_log2: e,
     };
-    HairGpu::new(ctx, &r.sampler, baked, style, params, Mat4::IDENTITY).unwrap()
+    r.add_character(baked, style, params, Mat4::IDENTITY).unwrap()
 }
 
 /// The LoD inputs the shaders see for `cam` at `size` pixels with default LoD settings.
