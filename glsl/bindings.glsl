@@ -50,10 +50,15 @@ void bind_character(uint c) {
     ch_visible = (characters[c].flags & CHARACTER_VISIBLE) != 0u;
 }
 
+// The hair mesh texture is read where neighbouring invocations belong to different characters
+// (cull, task, scalp): non-uniform index. The w, u and v textures are read only by the strand
+// builders (generate.comp, strands.mesh), whose whole workgroup works on one bundle, so their
+// index is dynamically uniform. (Marking those non-uniform too made lavapipe 25.0 return the
+// u-texture's value for the v-texture: caught by tests/gpu_oracle.rs.)
 #define TEX_POSITION tex_position[nonuniformEXT(tex_slot)]
-#define TEX_W tex_w[nonuniformEXT(tex_slot)]
-#define TEX_U tex_u[nonuniformEXT(tex_slot)]
-#define TEX_V tex_v[nonuniformEXT(tex_slot)]
+#define TEX_W tex_w[tex_slot]
+#define TEX_U tex_u[tex_slot]
+#define TEX_V tex_v[tex_slot]
 
 vec3 style_color() {
     return vec3(style.color[0], style.color[1], style.color[2]);

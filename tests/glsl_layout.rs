@@ -18,7 +18,11 @@ fn every_shared_struct_has_the_rust_layout() {
                 s.name, f.name, f.offset, off
             );
         }
-        assert_eq!(size, s.rust_size, "{}: std430 size differs from Rust", s.name);
+        assert_eq!(
+            size, s.rust_size,
+            "{}: std430 size differs from Rust",
+            s.name
+        );
         known.push((s.name.to_string(), size, align));
     }
 }

@@ -139,7 +139,17 @@ fn bench_lod(
                 let first = renderer.render_one(&view, &opts)?;
                 let mut times = Vec::new();
                 for _ in 0..runs {
-                    times.push(renderer.render_one(&view, &FrameOptions { read_image: false, ..opts })?.gpu_ms());
+                    times.push(
+                        renderer
+                            .render_one(
+                                &view,
+                                &FrameOptions {
+                                    read_image: false,
+                                    ..opts
+                                },
+                            )?
+                            .gpu_ms(),
+                    );
                 }
                 println!(
                     "| {label} | {path:?} | {} | {} | {} | {:.2} |",

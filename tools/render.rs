@@ -234,7 +234,10 @@ fn run(args: Args) -> Result<()> {
     let wall = start.elapsed().as_secs_f64();
     // Nothing is written unless the frame succeeded and validation reported nothing.
     if ctx.validation_errors() > 0 {
-        bail!("{} Vulkan validation error(s); no image written", ctx.validation_errors());
+        bail!(
+            "{} Vulkan validation error(s); no image written",
+            ctx.validation_errors()
+        );
     }
     let rgba = out.rgba.clone().context("no image read back")?;
     let img = image::RgbaImage::from_raw(width, height, rgba).context("image size mismatch")?;

@@ -171,7 +171,9 @@ impl Crowd {
     ) -> GpuResult<CharacterId> {
         params.validate()?;
         if !model.is_finite() {
-            return Err(GpuError::Unsupported("character transform is not finite".into()));
+            return Err(GpuError::Unsupported(
+                "character transform is not finite".into(),
+            ));
         }
         let slot = match self.free.pop() {
             Some(s) => s,
@@ -270,7 +272,9 @@ impl Crowd {
     /// Move a character.
     pub fn set_model(&mut self, id: CharacterId, model: Mat4) -> GpuResult<()> {
         if !model.is_finite() {
-            return Err(GpuError::Unsupported("character transform is not finite".into()));
+            return Err(GpuError::Unsupported(
+                "character transform is not finite".into(),
+            ));
         }
         self.get_mut(id)?.model = model;
         Ok(())
@@ -350,8 +354,12 @@ impl Crowd {
                     vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
                 ),
             )?;
-            let staging =
-                Buffer::with_data(&self.ctx, "staging", vk::BufferUsageFlags::TRANSFER_SRC, bytes)?;
+            let staging = Buffer::with_data(
+                &self.ctx,
+                "staging",
+                vk::BufferUsageFlags::TRANSFER_SRC,
+                bytes,
+            )?;
             self.ctx.submit_and_wait(|rec| {
                 rec.copy_buffer(&staging, 0, &buffer, 0, bytes.len() as u64);
             })?;

@@ -380,14 +380,19 @@ impl Renderer {
     /// compute path first needs it. Replaced buffers are retired with frame slot `i`.
     fn prepare_workspace(&mut self, i: usize, path: RenderPath) -> GpuResult<()> {
         if let Some(old) = self.crowd.update_bundle_table()? {
-            self.frames[i].retired.push(Retired::Resource(Box::new(old)));
+            self.frames[i]
+                .retired
+                .push(Retired::Resource(Box::new(old)));
         }
         let bundles = self.crowd.bundle_count();
         if bundles > self.work.bundles {
             let n = bundles.max(self.work.bundles + self.work.bundles / 2);
             let (_, scratch) = scan_plan(n);
             let retired = [
-                std::mem::replace(&mut self.work.lods, storage(&self.ctx, "bundle lods", 16 * n as u64)?),
+                std::mem::replace(
+                    &mut self.work.lods,
+                    storage(&self.ctx, "bundle lods", 16 * n as u64)?,
+                ),
                 std::mem::replace(
                     &mut self.work.offsets,
                     storage(&self.ctx, "bundle offsets", 16 * n as u64)?,
@@ -397,14 +402,19 @@ impl Renderer {
                     storage(&self.ctx, "scan scratch", 16 * scratch as u64)?,
                 ),
             ];
-            self.frames[i].retired.push(Retired::Resource(Box::new(retired)));
+            self.frames[i]
+                .retired
+                .push(Retired::Resource(Box::new(retired)));
             self.work.bundles = n;
         }
         if path == RenderPath::Compute && self.work.pool.is_none() {
-            self.work.pool = Some(storage(
+            self.work.pool = Some(Buffer::new(
                 &self.ctx,
-                "vertex pool",
-                self.desc.vertex_pool_bytes,
+                &BufferDesc::new(
+                    "vertex pool",
+                    self.desc.vertex_pool_bytes,
+                    vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+                ),
             )?);
         }
         let slots = self.crowd.slot_count();
@@ -445,7 +455,9 @@ impl Renderer {
         if !(c.eye.is_finite() && c.target.is_finite() && c.fov_y.is_finite())
             || !view.light_dir.is_finite()
         {
-            return Err(GpuError::Unsupported("camera or light is not finite".into()));
+            return Err(GpuError::Unsupported(
+                "camera or light is not finite".into(),
+            ));
         }
         let path = opts.path.unwrap_or(self.default_path());
         if path == RenderPath::Mesh && !self.strands.has_mesh_path() {
@@ -472,12 +484,20 @@ impl Renderer {
             slot.frame_ubo.write(0, bytemuck::bytes_of(&block))?;
             slot.records.write(0, bytemuck::cast_slice(&records))?;
             let image_bytes = width as u64 * height as u64 * 4;
-            if opts.read_image && slot.image_readback.as_ref().is_none_or(|b| b.size != image_bytes)
+            if opts.read_image
+                && slot
+                    .image_readback
+                    .as_ref()
+                    .is_none_or(|b| b.size != image_bytes)
             {
                 slot.image_readback = Some(Buffer::new(
                     &self.ctx,
-                    &BufferDesc::new("image readback", image_bytes, vk::BufferUsageFlags::TRANSFER_DST)
-                        .readback(),
+                    &BufferDesc::new(
+                        "image readback",
+                        image_bytes,
+                        vk::BufferUsageFlags::TRANSFER_DST,
+                    )
+                    .readback(),
                 )?);
             }
         }
@@ -555,7 +575,11 @@ impl Renderer {
         let clear = |v: [f32; 4]| opts.clear.then_some(v);
         slot.profiler.begin(
             &mut rec,
-            if path == RenderPath::Mesh { "mesh draw" } else { "draw" },
+            if path == RenderPath::Mesh {
+                "mesh draw"
+            } else {
+                "draw"
+            },
         );
         rec.begin_rendering(
             Attachment {
@@ -601,7 +625,11 @@ impl Renderer {
         if opts.read_image
             && let Some(readback) = &slot.image_readback
         {
-            rec.image_barrier(&targets.color, Access::ColorAttachment, Access::TransferRead);
+            rec.image_barrier(
+                &targets.color,
+                Access::ColorAttachment,
+                Access::TransferRead,
+            );
             rec.copy_image_to_buffer(&targets.color, readback);
             targets.color_access = Access::TransferRead;
         }
@@ -612,9 +640,12 @@ impl Renderer {
 
     /// Wait for a submitted frame and return its report.
     pub fn wait(&mut self, ticket: FrameTicket) -> GpuResult<FrameReport> {
-        if let Some(i) = (0..FRAMES_IN_FLIGHT)
-            .find(|&i| self.frames[i].pending.as_ref().is_some_and(|p| p.frame == ticket.0))
-        {
+        if let Some(i) = (0..FRAMES_IN_FLIGHT).find(|&i| {
+            self.frames[i]
+                .pending
+                .as_ref()
+                .is_some_and(|p| p.frame == ticket.0)
+        }) {
             // Frames complete in order: retire the older pending frame first.
             let other = (i + 1) % FRAMES_IN_FLIGHT;
             if self.frames[other]
@@ -662,10 +693,14 @@ impl Renderer {
         }
         let mut readback = Buffer::new(
             &self.ctx,
-            &BufferDesc::new("vertex readback", bytes, vk::BufferUsageFlags::TRANSFER_DST).readback(),
+            &BufferDesc::new("vertex readback", bytes, vk::BufferUsageFlags::TRANSFER_DST)
+                .readback(),
         )?;
         self.ctx.submit_and_wait(|rec| {
-            rec.barrier(&[Access::VertexRead, Access::ComputeReadWrite], &[Access::TransferRead]);
+            rec.barrier(
+                &[Access::VertexRead, Access::ComputeReadWrite],
+                &[Access::TransferRead],
+            );
             rec.copy_buffer(pool, 0, &readback, 0, bytes);
             rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
         })?;

@@ -339,11 +339,13 @@ pub struct TaskPayload {
     pub first_group: [u32; TASK_PAYLOAD_BUNDLES as usize + 1],
     /// Visible bundles.
     pub count: u32,
+    /// Padding to a 16-byte multiple (std430 struct size).
+    pub _pad: [u32; 2],
 }
 
 gpu_struct!(TaskPayload as "TaskPayload" {
     lods: "uvec4"[TASK_PAYLOAD_BUNDLES], bundle: "uint"[TASK_PAYLOAD_BUNDLES],
-    first_group: "uint"[TASK_PAYLOAD_BUNDLES + 1], count: "uint",
+    first_group: "uint"[TASK_PAYLOAD_BUNDLES + 1], count: "uint", _pad: "uint"[2],
 });
 
 /// std430 `(size, alignment)` of a GLSL scalar, vector or matrix type.
@@ -394,7 +396,10 @@ pub fn shared_structs() -> Vec<StructInfo> {
 
 /// std430 layout of `s`: `(field offsets, size, alignment)`, using the layouts of the structs
 /// before it in `known`.
-pub fn std430_layout(s: &StructInfo, known: &[(String, usize, usize)]) -> (Vec<usize>, usize, usize) {
+pub fn std430_layout(
+    s: &StructInfo,
+    known: &[(String, usize, usize)],
+) -> (Vec<usize>, usize, usize) {
     let (mut offset, mut align_max, mut offsets) = (0usize, 4usize, Vec::new());
     for f in &s.fields {
         let (size, align) = std430_type(f.glsl)

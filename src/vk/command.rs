@@ -111,7 +111,12 @@ impl Access {
                 L::DEPTH_ATTACHMENT_OPTIMAL,
                 true,
             ),
-            Access::TransferRead => (S::TRANSFER, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL, false),
+            Access::TransferRead => (
+                S::TRANSFER,
+                A::TRANSFER_READ,
+                L::TRANSFER_SRC_OPTIMAL,
+                false,
+            ),
             Access::TransferWrite => (
                 S::TRANSFER,
                 A::TRANSFER_WRITE,

@@ -194,8 +194,7 @@ impl Context {
         desc: &ContextDesc,
     ) -> GpuResult<Self> {
         // SAFETY: plain enumeration/query calls on a valid instance.
-        let physicals =
-            unsafe { instance.enumerate_physical_devices() }.unwrap_or_default();
+        let physicals = unsafe { instance.enumerate_physical_devices() }.unwrap_or_default();
         let mut candidates = Vec::new();
         for &pd in &physicals {
             // SAFETY: valid physical device handle.
@@ -243,8 +242,8 @@ impl Context {
         };
         let queue_family = queue_family as u32;
         // SAFETY: valid physical device.
-        let exts = unsafe { instance.enumerate_device_extension_properties(physical) }
-            .unwrap_or_default();
+        let exts =
+            unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
         let has_mesh = exts.iter().any(|e| {
             e.extension_name_as_c_str()
                 .is_ok_and(|n| n == ash::ext::mesh_shader::NAME)

@@ -150,7 +150,11 @@ pub struct DescriptorSet {
 
 impl DescriptorSet {
     /// Allocate a set of `layout`.
-    pub fn new(ctx: &Arc<Context>, name: &str, layout: &Arc<DescriptorSetLayout>) -> GpuResult<Self> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        name: &str,
+        layout: &Arc<DescriptorSetLayout>,
+    ) -> GpuResult<Self> {
         let sizes: Vec<_> = layout
             .bindings
             .iter()

@@ -154,12 +154,9 @@ impl MeshPrimitivesQuery {
         self.used = true;
         // SAFETY: recording; reset this frame.
         unsafe {
-            self.ctx.device.cmd_begin_query(
-                rec.raw(),
-                self.pool,
-                0,
-                vk::QueryControlFlags::empty(),
-            )
+            self.ctx
+                .device
+                .cmd_begin_query(rec.raw(), self.pool, 0, vk::QueryControlFlags::empty())
         };
     }
 

@@ -8,10 +8,22 @@ use super::{GpuError, GpuResult};
 pub const SOURCES: &[(&str, &str)] = &[
     ("bindings.glsl", include_str!("../../glsl/bindings.glsl")),
     ("common.glsl", include_str!("../../glsl/common.glsl")),
-    ("strand_eval.glsl", include_str!("../../glsl/strand_eval.glsl")),
-    ("bundle_lod.glsl", include_str!("../../glsl/bundle_lod.glsl")),
-    ("bundle_sizes.glsl", include_str!("../../glsl/bundle_sizes.glsl")),
-    ("strand_build.glsl", include_str!("../../glsl/strand_build.glsl")),
+    (
+        "strand_eval.glsl",
+        include_str!("../../glsl/strand_eval.glsl"),
+    ),
+    (
+        "bundle_lod.glsl",
+        include_str!("../../glsl/bundle_lod.glsl"),
+    ),
+    (
+        "bundle_sizes.glsl",
+        include_str!("../../glsl/bundle_sizes.glsl"),
+    ),
+    (
+        "strand_build.glsl",
+        include_str!("../../glsl/strand_build.glsl"),
+    ),
     ("strip.glsl", include_str!("../../glsl/strip.glsl")),
     ("strands.task", include_str!("../../glsl/strands.task")),
     ("strands.mesh", include_str!("../../glsl/strands.mesh")),

@@ -164,7 +164,8 @@ pub fn upload(
         strands_per_bundle: n,
         verts_log2: e,
     };
-    r.add_character(baked, style, params, Mat4::IDENTITY).unwrap()
+    r.add_character(baked, style, params, Mat4::IDENTITY)
+        .unwrap()
 }
 
 /// The LoD inputs the shaders see for `cam` at `size` pixels with default LoD settings.

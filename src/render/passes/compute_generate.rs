@@ -9,7 +9,9 @@ use std::sync::Arc;
 use super::{PassSets, dispatch_2d, shader_options};
 use crate::render::shared::{CULL_GROUP_SIZE, GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
 use crate::vk::shader::compile;
-use crate::vk::{Access, Buffer, CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout, Profiler};
+use crate::vk::{
+    Access, Buffer, CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout, Profiler,
+};
 
 /// One level of the scan: `count` elements at `input` (level 0: the bundles), block sums at
 /// `sums` in the scratch buffer.
@@ -57,7 +59,8 @@ impl ComputeGenerate {
     /// Compile the pipelines.
     pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
         let opts = shader_options(1);
-        let p = |name: &str, file: &str| Pipeline::compute(ctx, name, layout, &compile(file, &opts)?);
+        let p =
+            |name: &str, file: &str| Pipeline::compute(ctx, name, layout, &compile(file, &opts)?);
         Ok(ComputeGenerate {
             cull: p("cull", "cull.comp")?,
             scan: p("scan", "scan.comp")?,
@@ -80,7 +83,11 @@ impl ComputeGenerate {
         let rw = [Access::ComputeReadWrite];
         // Earlier frames' draws read the pool and the offsets: finish them first.
         rec.barrier(
-            &[Access::VertexRead, Access::IndirectRead, Access::TransferWrite],
+            &[
+                Access::VertexRead,
+                Access::IndirectRead,
+                Access::TransferWrite,
+            ],
             &rw,
         );
         profiler.begin(rec, "cull");
@@ -122,7 +129,11 @@ impl ComputeGenerate {
         profiler.end(rec);
         rec.barrier(
             &rw,
-            &[Access::VertexRead, Access::IndirectRead, Access::TransferRead],
+            &[
+                Access::VertexRead,
+                Access::IndirectRead,
+                Access::TransferRead,
+            ],
         );
     }
 }
@@ -138,7 +149,10 @@ mod tests {
         assert_eq!(scratch, 1);
         let (l, scratch) = scan_plan(50_400);
         assert_eq!(l.len(), 2);
-        assert_eq!((l[0].count, l[0].sums, l[1].count, l[1].input, l[1].sums), (50_400, 0, 50, 0, 50));
+        assert_eq!(
+            (l[0].count, l[0].sums, l[1].count, l[1].input, l[1].sums),
+            (50_400, 0, 50, 0, 50)
+        );
         assert_eq!(scratch, 51);
         let (l, _) = scan_plan(3 * 1024 * 1024 + 1);
         assert_eq!(l.len(), 3);

@@ -58,7 +58,10 @@ impl StrandDraw {
             )));
         }
         let opts = shader_options(task_bundles);
-        let (v, f) = (compile("strands.vert", &opts)?, compile("strands.frag", &opts)?);
+        let (v, f) = (
+            compile("strands.vert", &opts)?,
+            compile("strands.frag", &opts)?,
+        );
         let pulled = Pipeline::graphics(
             ctx,
             layout,
@@ -67,7 +70,10 @@ impl StrandDraw {
                 .stage(vk::ShaderStageFlags::FRAGMENT, &f),
         )?;
         let mesh = if mesh_path_supported(ctx) {
-            let (t, m) = (compile("strands.task", &opts)?, compile("strands.mesh", &opts)?);
+            let (t, m) = (
+                compile("strands.task", &opts)?,
+                compile("strands.mesh", &opts)?,
+            );
             Some(Pipeline::graphics(
                 ctx,
                 layout,

@@ -1,0 +1,143 @@
+// GENERATED from src/render/shared.rs by render::shared::glsl_header(); do not edit.
+// Shaders are compiled with this text; this copy is for reading.
+#ifndef SHARED_GLSL
+#define SHARED_GLSL
+
+#define STRAND_GROUP_SIZE 32
+#define MAX_VERTS_LOG2 6u
+#define MAX_SEGMENTS 64u
+#define MAX_STRANDS_PER_BUNDLE 4096u
+#define SLICES_PER_SEGMENT 4u
+#define BUNDLE_TRIANGLE 1u
+#define TASK_PAYLOAD_BUNDLES 32
+#define CULL_GROUP_SIZE 64
+#define SCAN_THREADS 256
+#define SCAN_BLOCK 1024u
+#define DISPATCH_ROW 65535u
+#define CHARACTER_VISIBLE 1u
+#define SET_FRAME 0
+#define SET_TEXTURES 1
+#define BINDING_FRAME 0
+#define BINDING_CHARACTERS 1
+#define BINDING_BUNDLES 2
+#define BINDING_ROOT_SAMPLES 3
+#define BINDING_BUNDLE_LODS 4
+#define BINDING_BUNDLE_OFFSETS 5
+#define BINDING_SCAN_SCRATCH 6
+#define BINDING_ARGS 7
+#define BINDING_VERTICES 8
+#define BINDING_TEX_POSITION 0
+#define BINDING_TEX_UV 1
+#define BINDING_TEX_W 2
+#define BINDING_TEX_U 3
+#define BINDING_TEX_V 4
+// Depth of the hair mesh texture: SLICES_PER_SEGMENT (L - 1) + 1 slices.
+#define POSITION_DEPTH(layers) (SLICES_PER_SEGMENT * ((layers) - 1u) + 1u)
+
+struct MeshInfo {
+    vec4 pos_origin;
+    vec4 pos_extent;
+    vec4 uv_origin_extent;
+    uvec2 root_size;
+    uint layers;
+    uint bundle_count;
+};
+
+struct HairStyle {
+    uint seed;
+    float strand_width;
+    float tip_width_ratio;
+    float taper_power;
+    float length_variation;
+    float root_ramp;
+    float clump_strength;
+    float clump_power;
+    float curl_radius;
+    float curl_frequency;
+    float curl_phase_jitter;
+    float wave_amplitude;
+    float wave_frequency;
+    float wave_angle;
+    float wave_phase_jitter;
+    float frizz_amplitude;
+    float frizz_frequency;
+    float frizz_power;
+    uint density_by_area;
+    float color[3];
+    uint _pad[2];
+};
+
+struct BundleDesc {
+    uvec2 origin;
+    uint flags;
+    float rest_size;
+    float density;
+    uint _pad[3];
+};
+
+struct FrameBlock {
+    mat4 view_proj;
+    vec4 camera_pos;
+    vec4 light_dir;
+    vec4 viewport;
+    vec4 planes[6];
+    vec4 lod;
+    vec4 lod_ortho;
+    uvec4 counts;
+};
+
+struct CharacterRecord {
+    mat4 model;
+    MeshInfo mesh;
+    HairStyle style;
+    uint texture_slot;
+    uint first_bundle;
+    uint bundle_count;
+    uint strands_per_bundle;
+    uint verts_log2;
+    uint flags;
+    float model_scale;
+    uint _pad;
+};
+
+struct GpuBundle {
+    uvec2 origin;
+    uint flags;
+    float rest_size;
+    float density;
+    uint character;
+    uint local_index;
+    uint _pad;
+};
+
+struct FrameStats {
+    uint bundles_visible;
+    uint strands_demanded;
+    uint strands_drawn;
+    uint triangles_demanded;
+    uint triangles_drawn;
+    uint vertex_slots_demanded;
+    uint vertex_slots_written;
+    uint groups;
+};
+
+struct GenerateArgs {
+    uvec4 dispatch;
+    uvec4 draw;
+    FrameStats stats;
+};
+
+struct HairVertex {
+    vec4 pos_width;
+    vec4 tangent_s;
+};
+
+struct TaskPayload {
+    uvec4 lods[32];
+    uint bundle[32];
+    uint first_group[33];
+    uint count;
+    uint _pad[2];
+};
+
+#endif
