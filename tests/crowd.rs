@@ -206,20 +206,20 @@ fn repeated_frames_and_character_churn_leak_nothing() {
     assert_eq!(r.crowd().len(), ids.len());
     // After the first frames (lazy pool, readback buffers), usage is flat, except while the
     // resized targets of frames 25-26 are retiring.
-    // Re-created targets may land at other offsets (a few bytes of alignment), so the bound
-    // after the resize is the settled usage plus 4 KiB, and constant from then on.
+    // Allocations land at other offsets from frame to frame (a few bytes of alignment), so
+    // the bound is the settled usage plus 4 KiB: less than one leaked character (8 KB of
+    // small_patch textures) or one leaked buffer per frame would add within a few frames.
     let settled = usage[4];
     for (i, u) in usage.iter().enumerate().skip(4) {
-        let base = if i < 25 { settled } else { usage[29] };
         if (25..29).contains(&i) {
             continue;
         }
         assert!(
-            u.allocated_bytes <= base.allocated_bytes && u.allocations <= settled.allocations,
-            "frame {i}: {u:?} vs {base:?}"
+            u.allocated_bytes <= settled.allocated_bytes + 4096
+                && u.allocations <= settled.allocations,
+            "frame {i}: {u:?} vs frame 4: {settled:?}"
         );
     }
-    assert!(usage[29].allocated_bytes <= settled.allocated_bytes + 4096);
     let end = ctx.memory_report();
     assert!(end.allocated_bytes < settled.allocated_bytes, "the churned character is gone: {end:?}");
     println!("GPU memory after 50 frames: {:?}", usage.last().unwrap());
