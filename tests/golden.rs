@@ -16,15 +16,21 @@ use common::*;
 const MEAN_MAX: f32 = 0.02;
 const P99_MAX: f32 = 0.25;
 
-fn check(name: &str, mesh: &str, n: u32, e: u32) {
+/// Render sample `mesh` (style changed by `edit`) as the golden scene.
+fn render_golden(mesh: &str, n: u32, e: u32, edit: impl Fn(&mut hairmesh::HairStyle)) -> RenderOutput {
     let ctx = context();
-    let out = render_sample(&ctx, mesh, n, e, 256, None);
+    let (baked, mut style) = sample(mesh);
+    edit(&mut style);
+    let mut r = renderer(&ctx, 256);
+    upload(&mut r, &baked, &style, n, e);
+    let out = render(&mut r, &framing(&baked), &compute_full());
     assert_no_validation_errors(&ctx);
+    out
+}
+
+/// FLIP error image, mean and 99th percentile of `out` against the golden `name`.
+fn flip_against(name: &str, out: &RenderOutput) -> (nv_flip::FlipImageFloat, f32, f32) {
     let reference = root().join("tests/golden").join(format!("{name}.png"));
-    if std::env::var("HAIRMESH_BLESS").is_ok_and(|v| v == "1") {
-        save_png(&reference, out.width, out.height, &out.rgba);
-        return;
-    }
     let expected = image::open(&reference)
         .unwrap_or_else(|e| panic!("{}: {e} (bless with HAIRMESH_BLESS=1)", reference.display()))
         .to_rgb8();
@@ -41,8 +47,18 @@ fn check(name: &str, mesh: &str, n: u32, e: u32) {
     let test_img = nv_flip::FlipImageRgb8::with_data(out.width, out.height, &actual_rgb);
     let err = nv_flip::flip(ref_img, test_img, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
     let mut pool = nv_flip::FlipPool::from_image(&err);
-    let mean = pool.mean();
-    let p99 = pool.get_percentile(0.99, true);
+    let (mean, p99) = (pool.mean(), pool.get_percentile(0.99, true));
+    (err, mean, p99)
+}
+
+fn check(name: &str, mesh: &str, n: u32, e: u32) {
+    let out = render_golden(mesh, n, e, |_| {});
+    let reference = root().join("tests/golden").join(format!("{name}.png"));
+    if std::env::var("HAIRMESH_BLESS").is_ok_and(|v| v == "1") {
+        save_png(&reference, out.width, out.height, &out.rgba);
+        return;
+    }
+    let (err, mean, p99) = flip_against(name, &out);
     println!("{name}: FLIP mean {mean:.5}, p99 {p99:.5}");
     if mean > MEAN_MAX || p99 > P99_MAX {
         let dir = output_dir();
@@ -59,6 +75,26 @@ fn check(name: &str, mesh: &str, n: u32, e: u32) {
             .unwrap();
         panic!(
             "{name}: FLIP mean {mean} (max {MEAN_MAX}), p99 {p99} (max {P99_MAX}); see tests/output/"
+        );
+    }
+}
+
+/// The thresholds can fail: one changed style value (stronger clumping) on each golden scene
+/// exceeds them.
+#[test]
+fn thresholds_catch_a_changed_style_value() {
+    for (name, mesh, n, e) in [
+        ("head_long", "head_long.obj", 32, 5),
+        ("sphere_fur", "sphere_fur.obj", 24, 3),
+        ("small_patch", "small_patch.obj", 64, 5),
+        ("triangle_tuft", "triangle_tuft.obj", 64, 4),
+    ] {
+        let out = render_golden(mesh, n, e, |s| s.clump_strength = (s.clump_strength + 0.3).min(1.0));
+        let (_, mean, p99) = flip_against(name, &out);
+        println!("{name} with clump_strength + 0.3: FLIP mean {mean:.5}, p99 {p99:.5}");
+        assert!(
+            mean > MEAN_MAX || p99 > P99_MAX,
+            "{name}: a changed style passes the golden thresholds (mean {mean}, p99 {p99})"
         );
     }
 }
