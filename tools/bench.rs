@@ -71,6 +71,35 @@ enum Cmd {
         #[arg(long)]
         picture: Option<PathBuf>,
     },
+    /// A crowd of mixed sample meshes on a ground plane seen from human height: GPU ms per
+    /// pass, CPU ms to record a frame, peak RSS and GPU memory, for N characters, LoD on/off,
+    /// both paths (and the mesh path with 1 vs 32 bundles per task workgroup).
+    Crowd {
+        /// Character counts.
+        #[arg(long, value_delimiter = ',', default_value = "1,16,64,256")]
+        counts: Vec<usize>,
+        /// Image width.
+        #[arg(long, default_value_t = 1280)]
+        width: u32,
+        /// Image height.
+        #[arg(long, default_value_t = 720)]
+        height: u32,
+        /// Strands per bundle.
+        #[arg(long, default_value_t = 16)]
+        strands_per_bundle: u32,
+        /// Vertex level e (2^e + 1 vertices at full detail).
+        #[arg(long, default_value_t = 4)]
+        verts_log2: u32,
+        /// Timed frames per configuration (after one warm-up).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Choose the GPU by name substring.
+        #[arg(long)]
+        device: Option<String>,
+        /// Write the largest crowd's frame (mesh path or compute, LoD on) here.
+        #[arg(long)]
+        picture: Option<PathBuf>,
+    },
 }
 
 fn bench_lod(
@@ -179,6 +208,174 @@ fn bench_lod(
     Ok(())
 }
 
+/// Peak resident set size of this process in MiB (Linux `VmHWM`).
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<f64>().ok())
+        })
+        .map_or(0.0, |kb| kb / 1024.0)
+}
+
+const CROWD_MESHES: [&str; 4] = [
+    "hairmeshes/head_long.obj",
+    "hairmeshes/sphere_fur.obj",
+    "hairmeshes/small_patch.obj",
+    "hairmeshes/triangle_tuft.obj",
+];
+
+/// Model transform of character `i` of a crowd: a grid on the ground with 1 m spacing, each
+/// mesh scaled to 0.3 m at head height (1.6 m), turned a little differently.
+fn crowd_model(i: usize, side: usize, baked: &hairmesh::BakedHairMesh) -> Mat4 {
+    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+    let ext = Vec3::from_slice(&baked.info.pos_extent[..3]);
+    let scale = 0.3 / ext.max_element();
+    let x = (i % side) as f32 - (side as f32 - 1.0) * 0.5;
+    let z = 2.0 + (i / side) as f32;
+    Mat4::from_scale_rotation_translation(
+        Vec3::splat(scale),
+        glam::Quat::from_rotation_y(i as f32 * 2.4),
+        Vec3::new(x, 1.6, z) - (o + ext * 0.5) * scale,
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn bench_crowd(
+    counts: Vec<usize>,
+    width: u32,
+    height: u32,
+    n: u32,
+    e: u32,
+    runs: usize,
+    device: Option<String>,
+    picture: Option<PathBuf>,
+) -> Result<()> {
+    if runs == 0 || counts.is_empty() || counts.iter().any(|&c| c == 0 || c > 1024) {
+        bail!("runs must be >= 1 and counts 1..=1024");
+    }
+    let meshes = CROWD_MESHES
+        .iter()
+        .map(|m| load_mesh(std::path::Path::new(m), None))
+        .collect::<Result<Vec<_>, _>>()?;
+    let params = StrandParams {
+        strands_per_bundle: n,
+        verts_log2: e,
+    };
+    params.validate()?;
+    let ctx = Arc::new(Context::new(&ContextDesc::default().device(device))?);
+    println!(
+        "device: {} ({}), {width}x{height}, {n} strands/bundle, {} vertices at full detail, median of {runs}",
+        ctx.info.name,
+        ctx.info.driver,
+        (1u32 << e) + 1
+    );
+    println!(
+        "| N | path | LoD | strands drawn (demanded) | triangles | GPU ms per pass | GPU ms | CPU record ms | GPU MiB | per-character KiB (textures) | peak RSS MiB |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
+    let mut last_picture = None;
+    for &count in &counts {
+        let side = (count as f32).sqrt().ceil() as usize;
+        let mut configs: Vec<(String, Option<u32>, RenderPath)> = Vec::new();
+        let base_ctx = ctx.clone();
+        let mut probe = Renderer::new(&base_ctx, &RendererDesc::default().size(width, height))?;
+        if probe.has_mesh_path() {
+            configs.push(("mesh (32/task)".into(), Some(32), RenderPath::Mesh));
+            configs.push(("mesh (1/task)".into(), Some(1), RenderPath::Mesh));
+        }
+        configs.push(("compute".into(), None, RenderPath::Compute));
+        drop(probe.finish());
+        drop(probe);
+        for (label, task_bundles, path) in configs {
+            let before = ctx.memory_report().allocated_bytes;
+            let desc = RendererDesc {
+                task_bundles: task_bundles.unwrap_or(32),
+                ..RendererDesc::default().size(width, height)
+            };
+            let mut renderer = Renderer::new(&ctx, &desc)?;
+            let empty = ctx.memory_report().allocated_bytes;
+            for i in 0..count {
+                let (baked, style) = &meshes[i % meshes.len()];
+                renderer.add_character(baked, style, params, crowd_model(i, side, baked))?;
+            }
+            let full = ctx.memory_report().allocated_bytes;
+            let per_char = (full - empty) as f64 / count as f64 / 1024.0;
+            let tex_per_char = renderer.crowd().texture_bytes() as f64 / count as f64 / 1024.0;
+            for lod_on in [true, false] {
+                let view = View {
+                    camera,
+                    light_dir: Vec3::new(0.4, 1.0, 0.6),
+                    lod: if lod_on {
+                        LodSettings::default()
+                    } else {
+                        LodSettings::off()
+                    },
+                };
+                let opts = FrameOptions {
+                    path: Some(path),
+                    ..Default::default()
+                };
+                let first = renderer.render_one(
+                    &view,
+                    &FrameOptions {
+                        read_image: picture.is_some(),
+                        ..opts
+                    },
+                )?;
+                let mut reports = Vec::new();
+                for _ in 0..runs {
+                    reports.push(renderer.render_one(&view, &opts)?);
+                }
+                let mut passes: Vec<(&str, f64)> = Vec::new();
+                for (name, _) in &first.pass_ms {
+                    passes.push((
+                        name,
+                        median(
+                            reports
+                                .iter()
+                                .map(|r| {
+                                    r.pass_ms.iter().find(|p| p.0 == *name).map_or(0.0, |p| p.1)
+                                })
+                                .collect(),
+                        ),
+                    ));
+                }
+                let gpu = median(reports.iter().map(|r| r.gpu_ms()).collect());
+                let record = median(reports.iter().map(|r| r.record_ms).collect());
+                let pass_text: Vec<String> =
+                    passes.iter().map(|(n, ms)| format!("{n} {ms:.1}")).collect();
+                let used = ctx.memory_report().allocated_bytes - before;
+                println!(
+                    "| {count} | {label} | {} | {} ({}) | {} | {} | {gpu:.1} | {record:.3} | {:.1} | {per_char:.1} ({tex_per_char:.1}) | {:.0} |",
+                    if lod_on { "on" } else { "off" },
+                    first.stats.strands_drawn,
+                    first.stats.strands_demanded,
+                    first.stats.triangles_drawn,
+                    pass_text.join(", "),
+                    used as f64 / (1 << 20) as f64,
+                    peak_rss_mib()
+                );
+                if lod_on && first.rgba.is_some() {
+                    last_picture = first.rgba.clone().map(|p| (p, width, height));
+                }
+            }
+        }
+    }
+    if let (Some(path), Some((rgba, w, h))) = (picture, last_picture) {
+        let img = image::RgbaImage::from_raw(w, h, rgba).context("size")?;
+        let mut png = Vec::new();
+        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+        hairmesh::fsutil::write_atomic(&path, &png)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -186,6 +383,25 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn main() -> Result<()> {
     match Args::parse().cmd {
+        Cmd::Crowd {
+            counts,
+            width,
+            height,
+            strands_per_bundle,
+            verts_log2,
+            runs,
+            device,
+            picture,
+        } => bench_crowd(
+            counts,
+            width,
+            height,
+            strands_per_bundle,
+            verts_log2,
+            runs,
+            device,
+            picture,
+        )?,
         Cmd::Lod {
             mesh,
             width,
