@@ -115,7 +115,10 @@ fn three_hundred_characters_in_one_frame_match_one_at_a_time() {
             all.stats.triangles_drawn,
             all.gpu_ms()
         );
-        assert_eq!(strands, all.stats.strands_drawn as u64, "{path:?}: strand totals");
+        assert_eq!(
+            strands, all.stats.strands_drawn as u64,
+            "{path:?}: strand totals"
+        );
         assert!(d <= 1.0 / 255.0, "{path:?}: mean absolute difference {d}");
         if path == RenderPath::Compute {
             save_png(
@@ -221,7 +224,10 @@ fn repeated_frames_and_character_churn_leak_nothing() {
         );
     }
     let end = ctx.memory_report();
-    assert!(end.allocated_bytes < settled.allocated_bytes, "the churned character is gone: {end:?}");
+    assert!(
+        end.allocated_bytes < settled.allocated_bytes,
+        "the churned character is gone: {end:?}"
+    );
     println!("GPU memory after 50 frames: {:?}", usage.last().unwrap());
     assert_no_validation_errors(&ctx);
 }

@@ -17,7 +17,12 @@ const MEAN_MAX: f32 = 0.02;
 const P99_MAX: f32 = 0.25;
 
 /// Render sample `mesh` (style changed by `edit`) as the golden scene.
-fn render_golden(mesh: &str, n: u32, e: u32, edit: impl Fn(&mut hairmesh::HairStyle)) -> RenderOutput {
+fn render_golden(
+    mesh: &str,
+    n: u32,
+    e: u32,
+    edit: impl Fn(&mut hairmesh::HairStyle),
+) -> RenderOutput {
     let ctx = context();
     let (baked, mut style) = sample(mesh);
     edit(&mut style);
@@ -89,7 +94,9 @@ fn thresholds_catch_a_changed_style_value() {
         ("small_patch", "small_patch.obj", 64, 5),
         ("triangle_tuft", "triangle_tuft.obj", 64, 4),
     ] {
-        let out = render_golden(mesh, n, e, |s| s.clump_strength = (s.clump_strength + 0.3).min(1.0));
+        let out = render_golden(mesh, n, e, |s| {
+            s.clump_strength = (s.clump_strength + 0.3).min(1.0)
+        });
         let (_, mean, p99) = flip_against(name, &out);
         println!("{name} with clump_strength + 0.3: FLIP mean {mean:.5}, p99 {p99:.5}");
         assert!(

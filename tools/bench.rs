@@ -347,8 +347,10 @@ fn bench_crowd(
                 }
                 let gpu = median(reports.iter().map(|r| r.gpu_ms()).collect());
                 let record = median(reports.iter().map(|r| r.record_ms).collect());
-                let pass_text: Vec<String> =
-                    passes.iter().map(|(n, ms)| format!("{n} {ms:.1}")).collect();
+                let pass_text: Vec<String> = passes
+                    .iter()
+                    .map(|(n, ms)| format!("{n} {ms:.1}"))
+                    .collect();
                 let used = ctx.memory_report().allocated_bytes - before;
                 println!(
                     "| {count} | {label} | {} | {} ({}) | {} | {} | {gpu:.1} | {record:.3} | {:.1} | {per_char:.1} ({tex_per_char:.1}) | {:.0} |",

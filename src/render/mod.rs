@@ -9,8 +9,10 @@ pub mod frame;
 pub mod passes;
 pub mod renderer;
 pub mod scene;
+pub mod settings;
 pub mod shared;
 pub mod targets;
+pub mod workspace;
 
 pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
 pub use crowd::{CharacterId, Crowd, StrandParams};

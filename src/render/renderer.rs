@@ -8,122 +8,22 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use ash::vk;
-use glam::{Mat4, Vec2};
+use glam::Mat4;
 
 use super::camera::View;
 use super::crowd::{CharacterId, Crowd, StrandParams};
 use super::frame::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Pending, Retired, records_buffer};
-use super::passes::PassSets;
-use super::passes::compute_generate::{ComputeGenerate, scan_plan};
-use super::passes::scalp::ScalpPass;
-use super::passes::strands::StrandDraw;
+use super::passes::{FrameInputs, FramePasses, PassSets};
+pub use super::settings::{FrameOptions, FrameTicket, RenderPath, RendererDesc};
 use super::shared::{FrameBinding, GenerateArgs, HairVertex, SET_FRAME, SET_TEXTURES};
-use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets};
+use super::targets::RenderTargets;
+use super::workspace::Workspace;
 use crate::bake::BakedHairMesh;
-use crate::bake::blue_noise::{quad_samples, triangle_samples};
 use crate::model::style::HairStyle;
 use crate::vk::{
-    Access, Attachment, BindingDesc, Buffer, BufferDesc, Context, DescriptorKind,
-    DescriptorSetLayout, GpuError, GpuResult, PipelineLayout,
+    Access, BindingDesc, Buffer, BufferDesc, Context, DescriptorKind, DescriptorSetLayout,
+    GpuError, GpuResult, PipelineLayout,
 };
-
-/// Which generation path draws the strands.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RenderPath {
-    /// Task + mesh shaders (VK_EXT_mesh_shader).
-    Mesh,
-    /// Compute generation + vertex pulling.
-    Compute,
-}
-
-/// How to create a [`Renderer`].
-#[derive(Clone, Debug)]
-pub struct RendererDesc {
-    /// Default path; `None` picks mesh where available, else compute.
-    pub path: Option<RenderPath>,
-    /// Size of the compute path's generated-vertex pool in bytes (<= the device's
-    /// `maxStorageBufferRange`). Frames that need more keep whole strands up to it.
-    pub vertex_pool_bytes: u64,
-    /// Bundles one task workgroup culls (1..=32).
-    pub task_bundles: u32,
-    /// Most characters at once (five bindless textures each).
-    pub max_characters: u32,
-    /// Initial target size.
-    pub width: u32,
-    /// Initial target size.
-    pub height: u32,
-}
-
-impl Default for RendererDesc {
-    fn default() -> Self {
-        RendererDesc {
-            path: None,
-            vertex_pool_bytes: 96 << 20,
-            task_bundles: super::shared::TASK_PAYLOAD_BUNDLES,
-            max_characters: 1024,
-            width: 1280,
-            height: 720,
-        }
-    }
-}
-
-impl RendererDesc {
-    /// Set the initial target size.
-    pub fn size(mut self, width: u32, height: u32) -> Self {
-        self.width = width;
-        self.height = height;
-        self
-    }
-
-    /// Set the default path.
-    pub fn path(mut self, path: Option<RenderPath>) -> Self {
-        self.path = path;
-        self
-    }
-
-    /// Set the vertex pool size in bytes.
-    pub fn vertex_pool_bytes(mut self, bytes: u64) -> Self {
-        self.vertex_pool_bytes = bytes;
-        self
-    }
-}
-
-/// Per-frame choices.
-#[derive(Clone, Copy, Debug)]
-pub struct FrameOptions {
-    /// Path for this frame (`None`: the renderer's default).
-    pub path: Option<RenderPath>,
-    /// Clear colour and depth first (else draw over the previous frame's contents).
-    pub clear: bool,
-    /// Read the colour target back into the report.
-    pub read_image: bool,
-}
-
-impl Default for FrameOptions {
-    fn default() -> Self {
-        FrameOptions {
-            path: None,
-            clear: true,
-            read_image: false,
-        }
-    }
-}
-
-/// A submitted frame, to [`Renderer::wait`] for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct FrameTicket(pub u64);
-
-/// GPU working buffers sized by the crowd's bundle count (grown, never shrunk).
-struct Workspace {
-    root_samples: Buffer,
-    lods: Buffer,
-    offsets: Buffer,
-    scan: Buffer,
-    args: Buffer,
-    pool: Option<Buffer>,
-    placeholder: Buffer,
-    bundles: u32,
-}
 
 /// Renders every character of the crowd in one frame.
 pub struct Renderer {
@@ -131,9 +31,7 @@ pub struct Renderer {
     desc: RendererDesc,
     crowd: Crowd,
     frame_layout: Arc<DescriptorSetLayout>,
-    generate: ComputeGenerate,
-    scalp: ScalpPass,
-    strands: StrandDraw,
+    passes: FramePasses,
     frames: Vec<FrameSlot>,
     next: usize,
     frame_number: u64,
@@ -142,13 +40,6 @@ pub struct Renderer {
     completed: VecDeque<FrameReport>,
     /// Background colour (linear RGB).
     pub background: [f32; 3],
-}
-
-fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(name, bytes, vk::BufferUsageFlags::STORAGE_BUFFER),
-    )
 }
 
 fn check_size(width: u32, height: u32) -> GpuResult<()> {
@@ -191,10 +82,8 @@ impl Renderer {
         set_layouts[SET_FRAME as usize] = frame_layout.clone();
         set_layouts[SET_TEXTURES as usize] = crowd.texture_layout().clone();
         let layout = PipelineLayout::new(ctx, &set_layouts)?;
-        let generate = ComputeGenerate::new(ctx, &layout)?;
-        let scalp = ScalpPass::new(ctx, &layout, COLOR_FORMAT, DEPTH_FORMAT)?;
-        let strands = StrandDraw::new(ctx, &layout, COLOR_FORMAT, DEPTH_FORMAT, desc.task_bundles)?;
-        if desc.path == Some(RenderPath::Mesh) && !strands.has_mesh_path() {
+        let passes = FramePasses::new(ctx, &layout, desc.task_bundles)?;
+        if desc.path == Some(RenderPath::Mesh) && !passes.has_mesh_path() {
             return Err(GpuError::Unsupported(format!(
                 "{}: no usable VK_EXT_mesh_shader for the mesh path",
                 ctx.info.name
@@ -203,45 +92,13 @@ impl Renderer {
         let frames = (0..FRAMES_IN_FLIGHT)
             .map(|_| FrameSlot::new(ctx, &frame_layout))
             .collect::<GpuResult<_>>()?;
-        let samples: Vec<Vec2> = quad_samples()
-            .iter()
-            .chain(triangle_samples())
-            .copied()
-            .collect();
-        let args = Buffer::new(
-            ctx,
-            &BufferDesc::new(
-                "generate args",
-                size_of::<GenerateArgs>() as u64,
-                vk::BufferUsageFlags::STORAGE_BUFFER
-                    | vk::BufferUsageFlags::INDIRECT_BUFFER
-                    | vk::BufferUsageFlags::TRANSFER_SRC
-                    | vk::BufferUsageFlags::TRANSFER_DST,
-            ),
-        )?;
-        let work = Workspace {
-            root_samples: Buffer::with_data(
-                ctx,
-                "root samples",
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                bytemuck::cast_slice(&samples),
-            )?,
-            lods: storage(ctx, "bundle lods", 16)?,
-            offsets: storage(ctx, "bundle offsets", 16)?,
-            scan: storage(ctx, "scan scratch", 16)?,
-            args,
-            pool: None,
-            placeholder: storage(ctx, "vertex pool (unused)", 16)?,
-            bundles: 0,
-        };
+        let work = Workspace::new(ctx)?;
         Ok(Renderer {
             ctx: ctx.clone(),
             desc: desc.clone(),
             crowd,
             frame_layout,
-            generate,
-            scalp,
-            strands,
+            passes,
             frames,
             next: 0,
             frame_number: 0,
@@ -256,14 +113,14 @@ impl Renderer {
     pub fn default_path(&self) -> RenderPath {
         match self.desc.path {
             Some(p) => p,
-            None if self.strands.has_mesh_path() => RenderPath::Mesh,
+            None if self.passes.has_mesh_path() => RenderPath::Mesh,
             None => RenderPath::Compute,
         }
     }
 
     /// Whether the mesh path is available.
     pub fn has_mesh_path(&self) -> bool {
-        self.strands.has_mesh_path()
+        self.passes.has_mesh_path()
     }
 
     /// The characters.
@@ -384,83 +241,43 @@ impl Renderer {
                 .retired
                 .push(Retired::Resource(Box::new(old)));
         }
-        let bundles = self.crowd.bundle_count();
-        if bundles > self.work.bundles {
-            let n = bundles.max(self.work.bundles + self.work.bundles / 2);
-            let (_, scratch) = scan_plan(n);
-            let retired = [
-                std::mem::replace(
-                    &mut self.work.lods,
-                    storage(&self.ctx, "bundle lods", 16 * n as u64)?,
-                ),
-                std::mem::replace(
-                    &mut self.work.offsets,
-                    storage(&self.ctx, "bundle offsets", 16 * n as u64)?,
-                ),
-                std::mem::replace(
-                    &mut self.work.scan,
-                    storage(&self.ctx, "scan scratch", 16 * scratch as u64)?,
-                ),
-            ];
+        if let Some(old) = self.work.grow(self.crowd.bundle_count())? {
             self.frames[i]
                 .retired
-                .push(Retired::Resource(Box::new(retired)));
-            self.work.bundles = n;
+                .push(Retired::Resource(Box::new(old)));
         }
-        if path == RenderPath::Compute && self.work.pool.is_none() {
-            self.work.pool = Some(Buffer::new(
-                &self.ctx,
-                &BufferDesc::new(
-                    "vertex pool",
-                    self.desc.vertex_pool_bytes,
-                    vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-                ),
-            )?);
+        if path == RenderPath::Compute {
+            self.work.ensure_pool(self.desc.vertex_pool_bytes)?;
         }
         let slots = self.crowd.slot_count();
         let slot = &mut self.frames[i];
         if slot.records.size < slots as u64 * size_of::<super::shared::CharacterRecord>() as u64 {
             slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
         }
-        Ok(())
-    }
-
-    /// Write frame slot `i`'s descriptor set 0 (its previous frame has completed).
-    fn write_frame_set(&self, i: usize) -> GpuResult<()> {
         let slot = &self.frames[i];
-        let w = &self.work;
-        let bundles = self.crowd.bundle_table().unwrap_or(&w.placeholder);
-        let pool = w.pool.as_ref().unwrap_or(&w.placeholder);
-        for (b, _) in FrameBinding::ALL {
-            let buffer = match b {
-                FrameBinding::Frame => &slot.frame_ubo,
-                FrameBinding::Characters => &slot.records,
-                FrameBinding::Bundles => bundles,
-                FrameBinding::RootSamples => &w.root_samples,
-                FrameBinding::BundleLods => &w.lods,
-                FrameBinding::BundleOffsets => &w.offsets,
-                FrameBinding::ScanScratch => &w.scan,
-                FrameBinding::Args => &w.args,
-                FrameBinding::Vertices => pool,
-            };
-            slot.set.write_buffer(b as u32, buffer)?;
-        }
-        Ok(())
+        self.work.write_set(
+            &slot.set,
+            &slot.frame_ubo,
+            &slot.records,
+            self.crowd.bundle_table(),
+        )
     }
 
     /// Record and submit one frame of every visible character seen from `view`. Waits only
     /// for the frame submitted [`FRAMES_IN_FLIGHT`] frames ago.
     pub fn render_frame(&mut self, view: &View, opts: &FrameOptions) -> GpuResult<FrameTicket> {
         let c = &view.camera;
-        if !(c.eye.is_finite() && c.target.is_finite() && c.fov_y.is_finite())
-            || !view.light_dir.is_finite()
-        {
+        let finite = c.eye.is_finite()
+            && c.target.is_finite()
+            && c.fov_y.is_finite()
+            && view.light_dir.is_finite();
+        if !finite {
             return Err(GpuError::Unsupported(
                 "camera or light is not finite".into(),
             ));
         }
         let path = opts.path.unwrap_or(self.default_path());
-        if path == RenderPath::Mesh && !self.strands.has_mesh_path() {
+        if path == RenderPath::Mesh && !self.passes.has_mesh_path() {
             return Err(GpuError::Unsupported(format!(
                 "{}: no usable VK_EXT_mesh_shader for the mesh path",
                 self.ctx.info.name
@@ -501,7 +318,6 @@ impl Renderer {
                 )?);
             }
         }
-        self.write_frame_set(i)?;
         let start = Instant::now();
         self.record(i, path, bundles, opts)?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -526,6 +342,7 @@ impl Renderer {
         Ok(FrameTicket(frame))
     }
 
+    /// Record frame slot `i`: the passes, then the statistics and (optionally) image readback.
     fn record(
         &mut self,
         i: usize,
@@ -534,104 +351,42 @@ impl Renderer {
         opts: &FrameOptions,
     ) -> GpuResult<()> {
         let slot = &mut self.frames[i];
-        let work = &self.work;
-        let targets = &mut self.targets;
-        let sets = PassSets {
-            frame: &slot.set,
-            textures: self.crowd.texture_set(),
-        };
+        let bg = self.background;
         let mut rec = slot.cmd.begin()?;
         slot.profiler.reset(&mut rec);
         if let Some(q) = &mut slot.mesh_query {
             q.reset(&mut rec);
         }
-        // Statistics accumulate from zero every frame.
-        rec.barrier(
-            &[
-                Access::ComputeReadWrite,
-                Access::TaskReadWrite,
-                Access::IndirectRead,
-                Access::TransferRead,
-            ],
-            &[Access::TransferWrite],
-        );
-        rec.fill_buffer(&work.args, 0, size_of::<GenerateArgs>() as u64, 0);
-        rec.barrier(
-            &[Access::TransferWrite],
-            &[Access::ComputeReadWrite, Access::TaskReadWrite],
-        );
-        if bundles > 0 && path == RenderPath::Compute {
-            self.generate
-                .record(&mut rec, &mut slot.profiler, sets, bundles, &work.args);
-        }
-        let (color_from, depth_from) = if opts.clear {
-            (Access::Nothing, Access::Nothing)
-        } else {
-            (targets.color_access, targets.depth_access)
+        let inputs = FrameInputs {
+            sets: PassSets {
+                frame: &slot.set,
+                textures: self.crowd.texture_set(),
+            },
+            bundles,
+            path,
+            args: &self.work.args,
+            targets: &mut self.targets,
+            clear: opts.clear.then_some([bg[0], bg[1], bg[2], 1.0]),
         };
-        rec.image_barrier(&targets.color, color_from, Access::ColorAttachment);
-        rec.image_barrier(&targets.depth, depth_from, Access::DepthAttachment);
-        let bg = self.background;
-        let clear = |v: [f32; 4]| opts.clear.then_some(v);
-        slot.profiler.begin(
+        self.passes.record(
             &mut rec,
-            if path == RenderPath::Mesh {
-                "mesh draw"
-            } else {
-                "draw"
-            },
-        );
-        rec.begin_rendering(
-            Attachment {
-                image: &targets.color,
-                clear: clear([bg[0], bg[1], bg[2], 1.0]),
-            },
-            Attachment {
-                image: &targets.depth,
-                clear: clear([1.0; 4]),
-            },
-        );
-        if bundles > 0 {
-            self.scalp.record(&mut rec, sets, bundles);
-            match path {
-                RenderPath::Compute => self.strands.record_pulled(&mut rec, sets, &work.args),
-                RenderPath::Mesh => {
-                    if let Some(q) = &mut slot.mesh_query {
-                        q.begin(&mut rec);
-                    }
-                    let r = self.strands.record_mesh(&mut rec, sets, bundles);
-                    if let Some(q) = &mut slot.mesh_query {
-                        q.end(&mut rec);
-                    }
-                    r?;
-                }
-            }
-        }
-        rec.end_rendering();
-        slot.profiler.end(&mut rec);
-        targets.depth_access = Access::DepthAttachment;
+            &mut slot.profiler,
+            slot.mesh_query.as_mut(),
+            inputs,
+        )?;
         rec.barrier(
             &[Access::ComputeReadWrite, Access::TaskReadWrite],
             &[Access::TransferRead],
         );
-        rec.copy_buffer(
-            &work.args,
-            0,
-            &slot.stats_readback,
-            0,
-            size_of::<GenerateArgs>() as u64,
-        );
-        targets.color_access = Access::ColorAttachment;
+        let args_bytes = size_of::<GenerateArgs>() as u64;
+        rec.copy_buffer(&self.work.args, 0, &slot.stats_readback, 0, args_bytes);
         if opts.read_image
             && let Some(readback) = &slot.image_readback
         {
-            rec.image_barrier(
-                &targets.color,
-                Access::ColorAttachment,
-                Access::TransferRead,
-            );
-            rec.copy_image_to_buffer(&targets.color, readback);
-            targets.color_access = Access::TransferRead;
+            let color = &self.targets.color;
+            rec.image_barrier(color, Access::ColorAttachment, Access::TransferRead);
+            rec.copy_image_to_buffer(color, readback);
+            self.targets.color_access = Access::TransferRead;
         }
         rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
         drop(rec);

@@ -6,8 +6,8 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 use gpu_allocator::vulkan::Allocation;
 
+use super::access::Access;
 use super::buffer::Buffer;
-use super::command::Access;
 use super::{Context, GpuError, GpuResult, VkContext};
 
 /// How to create an [`Image`].

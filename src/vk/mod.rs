@@ -1,6 +1,7 @@
 //! Thin Vulkan layer: one file per object kind, every `unsafe` ash call behind a small safe
 //! function. Objects are described by small `*Desc` values.
 
+pub mod access;
 pub mod buffer;
 pub mod command;
 pub mod context;
@@ -11,8 +12,9 @@ pub mod profiler;
 pub mod shader;
 pub mod sync;
 
+pub use access::Access;
 pub use buffer::{Buffer, BufferDesc};
-pub use command::{Access, Attachment, CommandBuffer, CommandRecorder};
+pub use command::{Attachment, CommandBuffer, CommandRecorder};
 pub use context::{Context, ContextDesc, DeviceInfo, MemoryReport};
 pub use descriptor::{BindingDesc, DescriptorKind, DescriptorSet, DescriptorSetLayout};
 pub use image::{Image, ImageDesc, Sampler};

@@ -5,7 +5,18 @@ pub mod compute_generate;
 pub mod scalp;
 pub mod strands;
 
-use crate::vk::{DescriptorSet, shader::ShaderOptions};
+use std::sync::Arc;
+
+use super::RenderPath;
+use super::shared::GenerateArgs;
+use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets};
+use crate::vk::{
+    Access, Attachment, Buffer, CommandRecorder, Context, DescriptorSet, GpuResult,
+    MeshPrimitivesQuery, PipelineLayout, Profiler, shader::ShaderOptions,
+};
+use compute_generate::ComputeGenerate;
+use scalp::ScalpPass;
+use strands::StrandDraw;
 
 /// The two descriptor sets every pass binds: set 0 (frame and crowd tables) and set 1 (the
 /// bindless textures).
@@ -36,4 +47,118 @@ pub fn shader_options(task_bundles: u32) -> ShaderOptions {
 pub fn dispatch_2d(groups: u32) -> (u32, u32) {
     let row = super::shared::DISPATCH_ROW;
     (groups.min(row), groups.div_ceil(row))
+}
+
+/// What one frame's passes read and write.
+pub struct FrameInputs<'a> {
+    /// Descriptor sets.
+    pub sets: PassSets<'a>,
+    /// Bundles of all characters.
+    pub bundles: u32,
+    /// Generation path.
+    pub path: RenderPath,
+    /// `GenerateArgs` (cleared here, then written by generation).
+    pub args: &'a Buffer,
+    /// Colour and depth targets.
+    pub targets: &'a mut RenderTargets,
+    /// Clear colour, or `None` to draw over the previous contents.
+    pub clear: Option<[f32; 4]>,
+}
+
+/// The passes of a frame, in order: statistics reset, generation (compute path), the opaque
+/// hair pass (scalps + strands; the mesh path generates inside it).
+pub struct FramePasses {
+    generate: ComputeGenerate,
+    scalp: ScalpPass,
+    strands: StrandDraw,
+}
+
+impl FramePasses {
+    /// Compile every pipeline; the mesh path with `task_bundles` bundles per task workgroup.
+    pub fn new(
+        ctx: &Arc<Context>,
+        layout: &Arc<PipelineLayout>,
+        task_bundles: u32,
+    ) -> GpuResult<Self> {
+        Ok(FramePasses {
+            generate: ComputeGenerate::new(ctx, layout)?,
+            scalp: ScalpPass::new(ctx, layout, COLOR_FORMAT, DEPTH_FORMAT)?,
+            strands: StrandDraw::new(ctx, layout, COLOR_FORMAT, DEPTH_FORMAT, task_bundles)?,
+        })
+    }
+
+    /// Whether the mesh path is available.
+    pub fn has_mesh_path(&self) -> bool {
+        self.strands.has_mesh_path()
+    }
+
+    /// Record the frame's passes. Leaves the targets as colour / depth attachments and
+    /// `args` written by the last generating stage.
+    pub fn record(
+        &self,
+        rec: &mut CommandRecorder,
+        profiler: &mut Profiler,
+        mesh_query: Option<&mut MeshPrimitivesQuery>,
+        inp: FrameInputs,
+    ) -> GpuResult<()> {
+        // Statistics accumulate from zero every frame.
+        rec.barrier(
+            &[
+                Access::ComputeReadWrite,
+                Access::TaskReadWrite,
+                Access::IndirectRead,
+                Access::TransferRead,
+            ],
+            &[Access::TransferWrite],
+        );
+        rec.fill_buffer(inp.args, 0, size_of::<GenerateArgs>() as u64, 0);
+        rec.barrier(
+            &[Access::TransferWrite],
+            &[Access::ComputeReadWrite, Access::TaskReadWrite],
+        );
+        if inp.bundles > 0 && inp.path == RenderPath::Compute {
+            self.generate
+                .record(rec, profiler, inp.sets, inp.bundles, inp.args);
+        }
+        let targets = inp.targets;
+        let (color_from, depth_from) = match inp.clear {
+            Some(_) => (Access::Nothing, Access::Nothing),
+            None => (targets.color_access, targets.depth_access),
+        };
+        rec.image_barrier(&targets.color, color_from, Access::ColorAttachment);
+        rec.image_barrier(&targets.depth, depth_from, Access::DepthAttachment);
+        let mesh = inp.path == RenderPath::Mesh;
+        profiler.begin(rec, if mesh { "mesh draw" } else { "draw" });
+        rec.begin_rendering(
+            Attachment {
+                image: &targets.color,
+                clear: inp.clear,
+            },
+            Attachment {
+                image: &targets.depth,
+                clear: inp.clear.map(|_| [1.0; 4]),
+            },
+        );
+        let mut result = Ok(());
+        if inp.bundles > 0 {
+            self.scalp.record(rec, inp.sets, inp.bundles);
+            if mesh {
+                let mut query = mesh_query;
+                if let Some(q) = query.as_deref_mut() {
+                    q.begin(rec);
+                }
+                result = self.strands.record_mesh(rec, inp.sets, inp.bundles);
+                if let Some(q) = query {
+                    q.end(rec);
+                }
+            } else {
+                self.strands.record_pulled(rec, inp.sets, inp.args);
+            }
+        }
+        rec.end_rendering();
+        profiler.end(rec);
+        targets.color_access = Access::ColorAttachment;
+        targets.depth_access = Access::DepthAttachment;
+        result
+    }
 }

@@ -1,0 +1,87 @@
+//! Renderer and frame settings.
+
+/// Which generation path draws the strands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RenderPath {
+    /// Task + mesh shaders (VK_EXT_mesh_shader).
+    Mesh,
+    /// Compute generation + vertex pulling.
+    Compute,
+}
+
+/// How to create a [`Renderer`].
+#[derive(Clone, Debug)]
+pub struct RendererDesc {
+    /// Default path; `None` picks mesh where available, else compute.
+    pub path: Option<RenderPath>,
+    /// Size of the compute path's generated-vertex pool in bytes (<= the device's
+    /// `maxStorageBufferRange`). Frames that need more keep whole strands up to it.
+    pub vertex_pool_bytes: u64,
+    /// Bundles one task workgroup culls (1..=32).
+    pub task_bundles: u32,
+    /// Most characters at once (five bindless textures each).
+    pub max_characters: u32,
+    /// Initial target size.
+    pub width: u32,
+    /// Initial target size.
+    pub height: u32,
+}
+
+impl Default for RendererDesc {
+    fn default() -> Self {
+        RendererDesc {
+            path: None,
+            vertex_pool_bytes: 96 << 20,
+            task_bundles: super::shared::TASK_PAYLOAD_BUNDLES,
+            max_characters: 1024,
+            width: 1280,
+            height: 720,
+        }
+    }
+}
+
+impl RendererDesc {
+    /// Set the initial target size.
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.width = width;
+        self.height = height;
+        self
+    }
+
+    /// Set the default path.
+    pub fn path(mut self, path: Option<RenderPath>) -> Self {
+        self.path = path;
+        self
+    }
+
+    /// Set the vertex pool size in bytes.
+    pub fn vertex_pool_bytes(mut self, bytes: u64) -> Self {
+        self.vertex_pool_bytes = bytes;
+        self
+    }
+}
+
+/// Per-frame choices.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameOptions {
+    /// Path for this frame (`None`: the renderer's default).
+    pub path: Option<RenderPath>,
+    /// Clear colour and depth first (else draw over the previous frame's contents).
+    pub clear: bool,
+    /// Read the colour target back into the report.
+    pub read_image: bool,
+}
+
+impl Default for FrameOptions {
+    fn default() -> Self {
+        FrameOptions {
+            path: None,
+            clear: true,
+            read_image: false,
+        }
+    }
+}
+
+/// A submitted frame, to [`Renderer::wait`] for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameTicket(pub u64);

@@ -1,0 +1,137 @@
+//! GPU working buffers shared by the frames: root samples, per-bundle LoD decisions and prefix
+//! sums, scan scratch, indirect arguments + statistics, and the compute path's vertex pool.
+//! Sized by the crowd's bundle count (grown by half again when too small, never shrunk); the
+//! pool is allocated when the compute path is first used.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::Vec2;
+
+use super::passes::compute_generate::scan_plan;
+use super::shared::{FrameBinding, GenerateArgs};
+use crate::bake::blue_noise::{quad_samples, triangle_samples};
+use crate::vk::{Buffer, BufferDesc, Context, DescriptorSet, GpuResult};
+
+fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(name, bytes, vk::BufferUsageFlags::STORAGE_BUFFER),
+    )
+}
+
+/// The working buffers.
+pub struct Workspace {
+    ctx: Arc<Context>,
+    root_samples: Buffer,
+    lods: Buffer,
+    offsets: Buffer,
+    scan: Buffer,
+    /// `GenerateArgs`: indirect arguments and statistics.
+    pub args: Buffer,
+    /// The compute path's vertex pool, once used.
+    pub pool: Option<Buffer>,
+    placeholder: Buffer,
+    bundles: u32,
+}
+
+/// Buffers replaced by a resize, to retire with the current frame.
+pub type ReplacedBuffers = [Buffer; 3];
+
+impl Workspace {
+    /// Minimal buffers (nothing to draw yet).
+    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
+        let samples: Vec<Vec2> = quad_samples()
+            .iter()
+            .chain(triangle_samples())
+            .copied()
+            .collect();
+        Ok(Workspace {
+            ctx: ctx.clone(),
+            root_samples: Buffer::with_data(
+                ctx,
+                "root samples",
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                bytemuck::cast_slice(&samples),
+            )?,
+            lods: storage(ctx, "bundle lods", 16)?,
+            offsets: storage(ctx, "bundle offsets", 16)?,
+            scan: storage(ctx, "scan scratch", 16)?,
+            args: Buffer::new(
+                ctx,
+                &BufferDesc::new(
+                    "generate args",
+                    size_of::<GenerateArgs>() as u64,
+                    vk::BufferUsageFlags::STORAGE_BUFFER
+                        | vk::BufferUsageFlags::INDIRECT_BUFFER
+                        | vk::BufferUsageFlags::TRANSFER_SRC
+                        | vk::BufferUsageFlags::TRANSFER_DST,
+                ),
+            )?,
+            pool: None,
+            placeholder: storage(ctx, "vertex pool (unused)", 16)?,
+            bundles: 0,
+        })
+    }
+
+    /// Make room for `bundles` bundles; returns the replaced buffers, which frames in flight
+    /// may still use.
+    pub fn grow(&mut self, bundles: u32) -> GpuResult<Option<ReplacedBuffers>> {
+        if bundles <= self.bundles {
+            return Ok(None);
+        }
+        let n = bundles.max(self.bundles + self.bundles / 2);
+        let (_, scratch) = scan_plan(n);
+        let lods = storage(&self.ctx, "bundle lods", 16 * n as u64)?;
+        let offsets = storage(&self.ctx, "bundle offsets", 16 * n as u64)?;
+        let scan = storage(&self.ctx, "scan scratch", 16 * scratch as u64)?;
+        self.bundles = n;
+        Ok(Some([
+            std::mem::replace(&mut self.lods, lods),
+            std::mem::replace(&mut self.offsets, offsets),
+            std::mem::replace(&mut self.scan, scan),
+        ]))
+    }
+
+    /// Allocate the vertex pool of `bytes` if it is not there yet.
+    pub fn ensure_pool(&mut self, bytes: u64) -> GpuResult<()> {
+        if self.pool.is_none() {
+            self.pool = Some(Buffer::new(
+                &self.ctx,
+                &BufferDesc::new(
+                    "vertex pool",
+                    bytes,
+                    vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+                ),
+            )?);
+        }
+        Ok(())
+    }
+
+    /// Point every binding of a frame's set 0 at its buffer.
+    pub fn write_set(
+        &self,
+        set: &DescriptorSet,
+        frame_ubo: &Buffer,
+        records: &Buffer,
+        bundle_table: Option<&Buffer>,
+    ) -> GpuResult<()> {
+        let bundles = bundle_table.unwrap_or(&self.placeholder);
+        let pool = self.pool.as_ref().unwrap_or(&self.placeholder);
+        for (b, _) in FrameBinding::ALL {
+            let buffer = match b {
+                FrameBinding::Frame => frame_ubo,
+                FrameBinding::Characters => records,
+                FrameBinding::Bundles => bundles,
+                FrameBinding::RootSamples => &self.root_samples,
+                FrameBinding::BundleLods => &self.lods,
+                FrameBinding::BundleOffsets => &self.offsets,
+                FrameBinding::ScanScratch => &self.scan,
+                FrameBinding::Args => &self.args,
+                FrameBinding::Vertices => pool,
+            };
+            set.write_buffer(b as u32, buffer)?;
+        }
+        Ok(())
+    }
+}
