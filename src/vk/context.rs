@@ -1,4 +1,5 @@
-//! Instance, device selection, queue, memory allocator, validation and one-shot submission.
+//! The context: instance, device (chosen and created in `device.rs`), queue, memory allocator,
+//! validation messages and submission.
 
 use std::ffi::{CStr, CString, c_void};
 use std::mem::ManuallyDrop;
@@ -10,6 +11,7 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::command::{CommandBuffer, CommandRecorder};
+use super::device;
 use super::sync::Fence;
 use super::{GpuError, GpuResult, VkContext};
 
@@ -177,8 +179,17 @@ impl Context {
         let debug = if desc.validation {
             let loader = debug_utils::Instance::new(&entry, &instance);
             // SAFETY: messenger info is valid; the DebugState outlives the messenger (dropped after it).
-            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info, None) }
-                .ctx("create messenger")?;
+            let messenger =
+                match unsafe { loader.create_debug_utils_messenger(&messenger_info, None) } {
+                    Ok(m) => m,
+                    Err(result) => {
+                        destroy_instance(&instance, None);
+                        return Err(GpuError::Vk {
+                            what: "create messenger",
+                            result,
+                        });
+                    }
+                };
             Some((loader, messenger))
         } else {
             None
@@ -193,208 +204,44 @@ impl Context {
         debug_state: Arc<DebugState>,
         desc: &ContextDesc,
     ) -> GpuResult<Self> {
-        // SAFETY: plain enumeration/query calls on a valid instance.
-        let physicals = unsafe { instance.enumerate_physical_devices() }.unwrap_or_default();
-        let mut candidates = Vec::new();
-        for &pd in &physicals {
-            // SAFETY: valid physical device handle.
-            let props = unsafe { instance.get_physical_device_properties(pd) };
-            let name = props
-                .device_name_as_c_str()
-                .map(|c| c.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            if props.api_version < vk::API_VERSION_1_3 {
-                continue;
-            }
-            if let Some(want) = &desc.device
-                && !name.to_lowercase().contains(&want.to_lowercase())
-            {
-                continue;
-            }
-            let rank = match props.device_type {
-                vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-                vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-                vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-                vk::PhysicalDeviceType::CPU => 3,
-                _ => 4,
+        let created = (|| {
+            let (physical, name, queue_family) = device::pick_physical(&instance, desc)?;
+            let features = device::query_features(&instance, physical, &name)?;
+            let device = device::create_logical(&instance, physical, queue_family, &features)?;
+            let allocator = Allocator::new(&AllocatorCreateDesc {
+                instance: instance.clone(),
+                device: device.clone(),
+                physical_device: physical,
+                debug_settings: Default::default(),
+                buffer_device_address: false,
+                allocation_sizes: Default::default(),
+            });
+            let allocator = match allocator {
+                Ok(a) => a,
+                Err(e) => {
+                    // SAFETY: nothing was created on the device yet.
+                    unsafe { device.destroy_device(None) };
+                    return Err(GpuError::from(e));
+                }
             };
-            candidates.push((rank, pd, name));
-        }
-        candidates.sort_by_key(|c| c.0);
-        let Some((_, physical, name)) = candidates.into_iter().next() else {
-            destroy_instance(&instance, debug);
-            return Err(GpuError::Unsupported(match &desc.device {
-                Some(d) => format!("no Vulkan 1.3 device matches '{d}'"),
-                None => "no Vulkan 1.3 device found (run tools/setup.sh for lavapipe)".into(),
-            }));
-        };
-        // SAFETY: valid physical device.
-        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-        let Some(queue_family) = families.iter().position(|f| {
-            f.queue_flags
-                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-                && f.timestamp_valid_bits > 0
-        }) else {
-            destroy_instance(&instance, debug);
-            return Err(GpuError::Unsupported(format!(
-                "{name}: no graphics+compute queue with timestamps"
-            )));
-        };
-        let queue_family = queue_family as u32;
-        // SAFETY: valid physical device.
-        let exts =
-            unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
-        let has_mesh = exts.iter().any(|e| {
-            e.extension_name_as_c_str()
-                .is_ok_and(|n| n == ash::ext::mesh_shader::NAME)
-        });
-
-        let mut mesh_features = vk::PhysicalDeviceMeshShaderFeaturesEXT::default();
-        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-        let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
-        let mut features2 = vk::PhysicalDeviceFeatures2::default()
-            .push_next(&mut f13)
-            .push_next(&mut f12);
-        if has_mesh {
-            features2 = features2.push_next(&mut mesh_features);
-        }
-        // SAFETY: feature chain structs live on this stack frame.
-        unsafe { instance.get_physical_device_features2(physical, &mut features2) };
-        let base = features2.features;
-        if f13.dynamic_rendering == 0 || f13.synchronization2 == 0 {
-            destroy_instance(&instance, debug);
-            return Err(GpuError::Unsupported(format!(
-                "{name}: needs dynamicRendering and synchronization2"
-            )));
-        }
-        // Descriptor indexing: every character's textures are one bindless array element.
-        let indexing = [
-            ("runtimeDescriptorArray", f12.runtime_descriptor_array),
-            (
-                "descriptorBindingPartiallyBound",
-                f12.descriptor_binding_partially_bound,
-            ),
-            (
-                "descriptorBindingSampledImageUpdateAfterBind",
-                f12.descriptor_binding_sampled_image_update_after_bind,
-            ),
-            (
-                "descriptorBindingUpdateUnusedWhilePending",
-                f12.descriptor_binding_update_unused_while_pending,
-            ),
-            (
-                "shaderSampledImageArrayNonUniformIndexing",
-                f12.shader_sampled_image_array_non_uniform_indexing,
-            ),
-        ];
-        if let Some((missing, _)) = indexing.iter().find(|(_, on)| *on == 0) {
-            destroy_instance(&instance, debug);
-            return Err(GpuError::Unsupported(format!(
-                "{name}: needs descriptor indexing feature {missing}"
-            )));
-        }
-        let mesh_ok = has_mesh && mesh_features.mesh_shader != 0 && mesh_features.task_shader != 0;
-
-        let priorities = [1.0f32];
-        let queue_info = [vk::DeviceQueueCreateInfo::default()
-            .queue_family_index(queue_family)
-            .queue_priorities(&priorities)];
-        let mut ext_names = Vec::new();
-        if mesh_ok {
-            ext_names.push(ash::ext::mesh_shader::NAME.as_ptr());
-        }
-        let mut enable13 = vk::PhysicalDeviceVulkan13Features::default()
-            .dynamic_rendering(true)
-            .synchronization2(true)
-            .maintenance4(f13.maintenance4 != 0);
-        let mut enable12 = vk::PhysicalDeviceVulkan12Features::default()
-            .host_query_reset(f12.host_query_reset != 0)
-            .runtime_descriptor_array(true)
-            .descriptor_binding_partially_bound(true)
-            .descriptor_binding_sampled_image_update_after_bind(true)
-            .descriptor_binding_update_unused_while_pending(true)
-            .shader_sampled_image_array_non_uniform_indexing(true);
-        let mut enable_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default()
-            .mesh_shader(true)
-            .task_shader(true)
-            .mesh_shader_queries(mesh_features.mesh_shader_queries != 0);
-        let enable_base = vk::PhysicalDeviceFeatures::default()
-            .pipeline_statistics_query(base.pipeline_statistics_query != 0)
-            .fragment_stores_and_atomics(base.fragment_stores_and_atomics != 0);
-        let mut device_info = vk::DeviceCreateInfo::default()
-            .queue_create_infos(&queue_info)
-            .enabled_extension_names(&ext_names)
-            .enabled_features(&enable_base)
-            .push_next(&mut enable13)
-            .push_next(&mut enable12);
-        if mesh_ok {
-            device_info = device_info.push_next(&mut enable_mesh);
-        }
-        // SAFETY: every pointer in device_info lives until the call returns.
-        let device = match unsafe { instance.create_device(physical, &device_info, None) } {
-            Ok(d) => d,
-            Err(result) => {
-                destroy_instance(&instance, debug);
-                return Err(GpuError::Vk {
-                    what: "create device",
-                    result,
-                });
-            }
-        };
-        // SAFETY: the queue family/index were requested above.
-        let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        let allocator = match Allocator::new(&AllocatorCreateDesc {
-            instance: instance.clone(),
-            device: device.clone(),
-            physical_device: physical,
-            debug_settings: Default::default(),
-            buffer_device_address: false,
-            allocation_sizes: Default::default(),
-        }) {
-            Ok(a) => a,
+            let info = device::query_info(&instance, physical, name, &features);
+            Ok((physical, queue_family, device, allocator, info))
+        })();
+        let (physical, queue_family, device, allocator, info) = match created {
+            Ok(v) => v,
             Err(e) => {
-                // SAFETY: nothing was created on the device yet.
-                unsafe { device.destroy_device(None) };
                 destroy_instance(&instance, debug);
-                return Err(e.into());
+                return Err(e);
             }
         };
-
-        // SAFETY: property queries with a chain living on this frame.
-        let (props, driver, mesh_limits, indexing) = unsafe {
-            let mut driver = vk::PhysicalDeviceDriverProperties::default();
-            let mut mesh_props = vk::PhysicalDeviceMeshShaderPropertiesEXT::default();
-            let mut indexing = vk::PhysicalDeviceDescriptorIndexingProperties::default();
-            let mut p2 = vk::PhysicalDeviceProperties2::default()
-                .push_next(&mut driver)
-                .push_next(&mut indexing);
-            if mesh_ok {
-                p2 = p2.push_next(&mut mesh_props);
-            }
-            instance.get_physical_device_properties2(physical, &mut p2);
-            let props = p2.properties;
-            let driver_name = format!(
-                "{} {}",
-                driver
-                    .driver_name_as_c_str()
-                    .map(|c| c.to_string_lossy().into_owned())
-                    .unwrap_or_default(),
-                driver
-                    .driver_info_as_c_str()
-                    .map(|c| c.to_string_lossy().into_owned())
-                    .unwrap_or_default()
-            );
-            mesh_props.p_next = std::ptr::null_mut();
-            let bindless = indexing
-                .max_per_stage_descriptor_update_after_bind_sampled_images
-                .min(indexing.max_descriptor_set_update_after_bind_sampled_images)
-                .min(indexing.max_update_after_bind_descriptors_in_all_pools);
-            (props, driver_name, mesh_ok.then_some(mesh_props), bindless)
-        };
+        // SAFETY: the queue family/index were requested at device creation.
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let debug_device = debug
             .as_ref()
             .map(|_| debug_utils::Device::new(&instance, &device));
-        let mesh_ext = mesh_ok.then(|| ash::ext::mesh_shader::Device::new(&instance, &device));
+        let mesh_ext = info
+            .mesh_shader
+            .then(|| ash::ext::mesh_shader::Device::new(&instance, &device));
         Ok(Context {
             _entry: entry,
             instance,
@@ -407,17 +254,7 @@ impl Context {
             queue_family,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             mesh_ext,
-            info: DeviceInfo {
-                name,
-                driver,
-                timestamp_period: props.limits.timestamp_period,
-                mesh_shader: mesh_ok,
-                mesh_queries: mesh_ok && mesh_features.mesh_shader_queries != 0,
-                mesh_limits,
-                max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
-                max_bindless_sampled_images: indexing,
-                max_compute_groups_x: props.limits.max_compute_work_group_count[0],
-            },
+            info,
         })
     }
 

@@ -6,6 +6,7 @@ pub mod buffer;
 pub mod command;
 pub mod context;
 pub mod descriptor;
+mod device;
 pub mod image;
 pub mod pipeline;
 pub mod profiler;
