@@ -14,7 +14,8 @@ use clap::Parser;
 use glam::{Mat4, Vec3};
 use hairmesh::render::scene::{SceneDesc, load_mesh};
 use hairmesh::render::{
-    Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
+    Camera, FrameOptions, FrameReport, LodSettings, RenderPath, Renderer, RendererDesc,
+    StrandParams, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
 
@@ -100,8 +101,8 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
     Ok((w, h))
 }
 
-fn run(args: Args) -> Result<()> {
-    let (mut width, mut height) = parse_size(&args.size)?;
+/// Settings from the flags, checked.
+fn lod_settings(args: &Args) -> Result<LodSettings> {
     let lod = LodSettings {
         enabled: args.lod == "on",
         alpha_strands: args.lod_alpha_strands,
@@ -118,44 +119,50 @@ fn run(args: Args) -> Result<()> {
     if !(lod.lambda > 0.0 && lod.lambda <= 1.0) {
         bail!("--lod-lambda must be in (0, 1]");
     }
-    let path = args.path.as_deref().map(|p| {
-        if p == "mesh" {
-            RenderPath::Mesh
-        } else {
-            RenderPath::Compute
-        }
-    });
-    if args.vertex_pool_mib == 0 || args.vertex_pool_mib > 4096 {
-        bail!("--vertex-pool-mib must be 1..=4096");
-    }
-    // Load and validate every input before touching the GPU.
-    struct Character {
-        baked: hairmesh::BakedHairMesh,
-        style: hairmesh::HairStyle,
-        params: StrandParams,
-        model: Mat4,
-    }
-    let mut characters = Vec::new();
-    let mut scene_camera = None;
-    let mut light = Vec3::new(0.4, 1.0, 0.6);
+    Ok(lod)
+}
+
+/// One character to render.
+struct Character {
+    baked: hairmesh::BakedHairMesh,
+    style: hairmesh::HairStyle,
+    params: StrandParams,
+    model: Mat4,
+}
+
+/// Everything loaded from the flags and the scene file, before any GPU work.
+struct Inputs {
+    characters: Vec<Character>,
+    scene_camera: Option<Camera>,
+    light: Vec3,
+    size: (u32, u32),
+}
+
+fn load_inputs(args: &Args) -> Result<Inputs> {
+    let mut inputs = Inputs {
+        characters: Vec::new(),
+        scene_camera: None,
+        light: Vec3::new(0.4, 1.0, 0.6),
+        size: parse_size(&args.size)?,
+    };
     if let Some(scene_path) = &args.scene {
         let scene = SceneDesc::load(scene_path)?;
         if let Some([w, h]) = scene.size {
-            (width, height) = parse_size(&format!("{w}x{h}"))?;
+            inputs.size = parse_size(&format!("{w}x{h}"))?;
         }
         if let Some(c) = &scene.camera {
-            scene_camera = Some(Camera::look_at(
+            inputs.scene_camera = Some(Camera::look_at(
                 Vec3::from(c.eye),
                 Vec3::from(c.target),
                 c.fov_y_degrees,
             ));
         }
         if let Some(l) = &scene.light {
-            light = Vec3::from(l.direction);
+            inputs.light = Vec3::from(l.direction);
         }
         for c in &scene.characters {
             let (baked, style) = load_mesh(&c.mesh, c.style.as_deref())?;
-            characters.push(Character {
+            inputs.characters.push(Character {
                 baked,
                 style,
                 params: StrandParams {
@@ -170,7 +177,7 @@ fn run(args: Args) -> Result<()> {
             bail!("give --mesh or --scene")
         };
         let (baked, style) = load_mesh(mesh, args.style.as_deref())?;
-        characters.push(Character {
+        inputs.characters.push(Character {
             baked,
             style,
             params: StrandParams {
@@ -180,28 +187,93 @@ fn run(args: Args) -> Result<()> {
             model: Mat4::IDENTITY,
         });
     }
-    let camera = match (&args.camera, scene_camera) {
-        (Some(c), _) => {
-            let (eye, target) = c
-                .split_once(':')
-                .with_context(|| format!("bad camera '{c}': expected eye:target"))?;
-            Camera::look_at(parse_vec3(eye)?, parse_vec3(target)?, args.fov)
+    Ok(inputs)
+}
+
+/// `--camera`, else the scene's camera, else a view framing every character.
+fn pick_camera(args: &Args, inputs: &Inputs) -> Result<Camera> {
+    if let Some(c) = &args.camera {
+        let (eye, target) = c
+            .split_once(':')
+            .with_context(|| format!("bad camera '{c}': expected eye:target"))?;
+        return Ok(Camera::look_at(
+            parse_vec3(eye)?,
+            parse_vec3(target)?,
+            args.fov,
+        ));
+    }
+    if let Some(c) = inputs.scene_camera {
+        return Ok(c);
+    }
+    let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+    for c in &inputs.characters {
+        let o = Vec3::from_slice(&c.baked.info.pos_origin[..3]);
+        let e = Vec3::from_slice(&c.baked.info.pos_extent[..3]);
+        for corner in [o, o + e] {
+            let p = c.model.transform_point3(corner);
+            lo = lo.min(p);
+            hi = hi.max(p);
         }
-        (None, Some(c)) => c,
-        (None, None) => {
-            let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-            for c in &characters {
-                let o = Vec3::from_slice(&c.baked.info.pos_origin[..3]);
-                let e = Vec3::from_slice(&c.baked.info.pos_extent[..3]);
-                for corner in [o, o + e] {
-                    let p = c.model.transform_point3(corner);
-                    lo = lo.min(p);
-                    hi = hi.max(p);
-                }
-            }
-            Camera::framing(lo, hi, hairmesh::render::DEFAULT_VIEW_DIR, args.fov)
+    }
+    Ok(Camera::framing(
+        lo,
+        hi,
+        hairmesh::render::DEFAULT_VIEW_DIR,
+        args.fov,
+    ))
+}
+
+fn print_report(ctx: &Context, args: &Args, characters: usize, out: &FrameReport, wall: f64) {
+    println!("device: {} ({})", ctx.info.name, ctx.info.driver);
+    println!(
+        "{:?} path, LoD {}, {} character(s), {} strands (up to {} vertices each), {} strand triangles, {}x{}",
+        out.path,
+        args.lod,
+        characters,
+        out.stats.strands_drawn,
+        (1u32 << args.verts_log2) + 1,
+        out.stats.triangles_drawn,
+        out.width,
+        out.height
+    );
+    if out.stats.strands_drawn < out.stats.strands_demanded {
+        println!(
+            "  vertex pool overflow: drew {} of {} strands ({} of {} vertex slots); raise --vertex-pool-mib or use LoD",
+            out.stats.strands_drawn,
+            out.stats.strands_demanded,
+            out.stats.vertex_slots_written,
+            out.stats.vertex_slots_demanded
+        );
+    }
+    if let Some(q) = out.mesh_primitives {
+        println!("  mesh primitives generated (VK_EXT_mesh_shader query): {q}");
+    }
+    for (pass, ms) in &out.pass_ms {
+        println!("  gpu {pass:<10} {ms:9.3} ms");
+    }
+    println!(
+        "  total gpu  {:9.3} ms; wall (incl. setup, shader compile) {:.2} s",
+        out.gpu_ms(),
+        wall
+    );
+}
+
+fn run(args: Args) -> Result<()> {
+    let lod = lod_settings(&args)?;
+    let path = args.path.as_deref().map(|p| {
+        if p == "mesh" {
+            RenderPath::Mesh
+        } else {
+            RenderPath::Compute
         }
-    };
+    });
+    if args.vertex_pool_mib == 0 || args.vertex_pool_mib > 4096 {
+        bail!("--vertex-pool-mib must be 1..=4096");
+    }
+    // Load and validate every input before touching the GPU.
+    let inputs = load_inputs(&args)?;
+    let camera = pick_camera(&args, &inputs)?;
+    let (width, height) = inputs.size;
 
     let start = Instant::now();
     let ctx = Arc::new(Context::new(
@@ -216,12 +288,12 @@ fn run(args: Args) -> Result<()> {
             .path(path)
             .vertex_pool_bytes(args.vertex_pool_mib << 20),
     )?;
-    for c in &characters {
+    for c in &inputs.characters {
         renderer.add_character(&c.baked, &c.style, c.params, c.model)?;
     }
     let view = View {
         camera,
-        light_dir: light,
+        light_dir: inputs.light,
         lod,
     };
     let out = renderer.render_one(
@@ -244,38 +316,7 @@ fn run(args: Args) -> Result<()> {
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
     hairmesh::fsutil::write_atomic(&args.output, &png)?;
-    println!("device: {} ({})", ctx.info.name, ctx.info.driver);
-    println!(
-        "{:?} path, LoD {}, {} character(s), {} strands (up to {} vertices each), {} strand triangles, {}x{}",
-        out.path,
-        args.lod,
-        characters.len(),
-        out.stats.strands_drawn,
-        (1u32 << args.verts_log2) + 1,
-        out.stats.triangles_drawn,
-        width,
-        height
-    );
-    if out.stats.strands_drawn < out.stats.strands_demanded {
-        println!(
-            "  vertex pool overflow: drew {} of {} strands ({} of {} vertex slots); raise --vertex-pool-mib or use LoD",
-            out.stats.strands_drawn,
-            out.stats.strands_demanded,
-            out.stats.vertex_slots_written,
-            out.stats.vertex_slots_demanded
-        );
-    }
-    if let Some(q) = out.mesh_primitives {
-        println!("  mesh primitives generated (VK_EXT_mesh_shader query): {q}");
-    }
-    for (pass, ms) in &out.pass_ms {
-        println!("  gpu {pass:<10} {ms:9.3} ms");
-    }
-    println!(
-        "  total gpu  {:9.3} ms; wall (incl. setup, shader compile) {:.2} s",
-        out.gpu_ms(),
-        wall
-    );
+    print_report(&ctx, &args, inputs.characters.len(), &out, wall);
     println!("wrote {}", args.output.display());
     Ok(())
 }

@@ -137,6 +137,50 @@ impl<'a> GraphicsDesc<'a> {
     }
 }
 
+fn raster_state(cull: CullMode) -> vk::PipelineRasterizationStateCreateInfo<'static> {
+    vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(match cull {
+            CullMode::None => vk::CullModeFlags::NONE,
+            CullMode::Back => vk::CullModeFlags::BACK,
+        })
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+        .line_width(1.0)
+}
+
+fn depth_state(mode: DepthMode) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
+    let d = vk::PipelineDepthStencilStateCreateInfo::default();
+    match mode {
+        DepthMode::Off => d,
+        DepthMode::TestWrite => d
+            .depth_test_enable(true)
+            .depth_write_enable(true)
+            .depth_compare_op(vk::CompareOp::LESS),
+        DepthMode::TestOnly => d
+            .depth_test_enable(true)
+            .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL),
+    }
+}
+
+fn blend_attachment(mode: BlendMode) -> vk::PipelineColorBlendAttachmentState {
+    let b = vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA);
+    let (src, dst) = match mode {
+        BlendMode::Opaque => return b,
+        BlendMode::PremultipliedOver => {
+            (vk::BlendFactor::ONE, vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+        }
+        BlendMode::Additive => (vk::BlendFactor::ONE, vk::BlendFactor::ONE),
+    };
+    b.blend_enable(true)
+        .src_color_blend_factor(src)
+        .dst_color_blend_factor(dst)
+        .color_blend_op(vk::BlendOp::ADD)
+        .src_alpha_blend_factor(src)
+        .dst_alpha_blend_factor(dst)
+        .alpha_blend_op(vk::BlendOp::ADD)
+}
+
 /// A compute or graphics pipeline.
 pub struct Pipeline {
     ctx: Arc<Context>,
@@ -233,47 +277,11 @@ impl Pipeline {
         let viewport = vk::PipelineViewportStateCreateInfo::default()
             .viewport_count(1)
             .scissor_count(1);
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
-            .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(match desc.cull {
-                CullMode::None => vk::CullModeFlags::NONE,
-                CullMode::Back => vk::CullModeFlags::BACK,
-            })
-            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-            .line_width(1.0);
+        let raster = raster_state(desc.cull);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let depth = match desc.depth {
-            DepthMode::Off => vk::PipelineDepthStencilStateCreateInfo::default(),
-            DepthMode::TestWrite => vk::PipelineDepthStencilStateCreateInfo::default()
-                .depth_test_enable(true)
-                .depth_write_enable(true)
-                .depth_compare_op(vk::CompareOp::LESS),
-            DepthMode::TestOnly => vk::PipelineDepthStencilStateCreateInfo::default()
-                .depth_test_enable(true)
-                .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL),
-        };
-        let blend_attachment = vk::PipelineColorBlendAttachmentState::default()
-            .color_write_mask(vk::ColorComponentFlags::RGBA);
-        let blend_attachment = match desc.blend {
-            BlendMode::Opaque => blend_attachment,
-            BlendMode::PremultipliedOver => blend_attachment
-                .blend_enable(true)
-                .src_color_blend_factor(vk::BlendFactor::ONE)
-                .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-                .color_blend_op(vk::BlendOp::ADD)
-                .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-                .alpha_blend_op(vk::BlendOp::ADD),
-            BlendMode::Additive => blend_attachment
-                .blend_enable(true)
-                .src_color_blend_factor(vk::BlendFactor::ONE)
-                .dst_color_blend_factor(vk::BlendFactor::ONE)
-                .color_blend_op(vk::BlendOp::ADD)
-                .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-                .alpha_blend_op(vk::BlendOp::ADD),
-        };
+        let depth = depth_state(desc.depth);
+        let blend_attachment = blend_attachment(desc.blend);
         let blend_attachments = [blend_attachment];
         let blend =
             vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
