@@ -18,7 +18,8 @@ use glam::{Mat4, Vec3};
 use hairmesh::model::obj_io::load_hair_mesh_obj;
 use hairmesh::render::scene::load_mesh;
 use hairmesh::render::{
-    Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
+    Camera, FrameOptions, FrameReport, LodSettings, RenderPath, Renderer, RendererDesc,
+    StrandParams, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakeOptions, CpuGenerator, HairStyle, bake};
@@ -200,10 +201,7 @@ fn bench_lod(
             let img = image::RgbaImage::from_raw(width, height, rgba).context("size")?;
             image::imageops::replace(&mut strip, &img, (i as u32 * width) as i64, 0);
         }
-        let mut png = Vec::new();
-        strip.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-        hairmesh::fsutil::write_atomic(&p, &png)?;
-        println!("wrote {}", p.display());
+        write_png(&p, strip.into_raw(), width * 3, height)?;
     }
     Ok(())
 }
@@ -243,6 +241,88 @@ fn crowd_model(i: usize, side: usize, baked: &hairmesh::BakedHairMesh) -> Mat4 {
     )
 }
 
+/// One `bench crowd` configuration set: what every measured row shares.
+struct CrowdRun<'a> {
+    ctx: &'a Arc<Context>,
+    meshes: &'a [(hairmesh::BakedHairMesh, hairmesh::HairStyle)],
+    params: StrandParams,
+    size: (u32, u32),
+    runs: usize,
+    camera: Camera,
+    read_image: bool,
+}
+
+impl CrowdRun<'_> {
+    /// Print the LoD-on and LoD-off rows of `count` characters on `path`; returns the LoD-on
+    /// image when asked for.
+    fn measure(
+        &self,
+        count: usize,
+        label: &str,
+        task_bundles: u32,
+        path: RenderPath,
+    ) -> Result<Option<Vec<u8>>> {
+        let ctx = self.ctx;
+        let side = (count as f32).sqrt().ceil() as usize;
+        let before = ctx.memory_report().allocated_bytes;
+        let desc = RendererDesc {
+            task_bundles,
+            ..RendererDesc::default().size(self.size.0, self.size.1)
+        };
+        let mut renderer = Renderer::new(ctx, &desc)?;
+        let empty = ctx.memory_report().allocated_bytes;
+        for i in 0..count {
+            let (baked, style) = &self.meshes[i % self.meshes.len()];
+            renderer.add_character(baked, style, self.params, crowd_model(i, side, baked))?;
+        }
+        let full = ctx.memory_report().allocated_bytes;
+        let per_char = (full - empty) as f64 / count as f64 / 1024.0;
+        let tex_per_char = renderer.crowd().texture_bytes() as f64 / count as f64 / 1024.0;
+        let mut picture = None;
+        for lod_on in [true, false] {
+            let view = View {
+                camera: self.camera,
+                light_dir: Vec3::new(0.4, 1.0, 0.6),
+                lod: if lod_on {
+                    LodSettings::default()
+                } else {
+                    LodSettings::off()
+                },
+            };
+            let opts = FrameOptions {
+                path: Some(path),
+                ..Default::default()
+            };
+            let read_image = self.read_image && lod_on;
+            let first = renderer.render_one(&view, &FrameOptions { read_image, ..opts })?;
+            let reports = (0..self.runs)
+                .map(|_| renderer.render_one(&view, &opts))
+                .collect::<Result<Vec<_>, _>>()?;
+            let passes: Vec<String> = median_passes(&first, &reports)
+                .iter()
+                .map(|(n, ms)| format!("{n} {ms:.1}"))
+                .collect();
+            let gpu = median(reports.iter().map(|r| r.gpu_ms()).collect());
+            let record = median(reports.iter().map(|r| r.record_ms).collect());
+            let used = ctx.memory_report().allocated_bytes - before;
+            println!(
+                "| {count} | {label} | {} | {} ({}) | {} | {} | {gpu:.1} | {record:.3} | {:.1} | {per_char:.1} ({tex_per_char:.1}) | {:.0} |",
+                if lod_on { "on" } else { "off" },
+                first.stats.strands_drawn,
+                first.stats.strands_demanded,
+                first.stats.triangles_drawn,
+                passes.join(", "),
+                used as f64 / (1 << 20) as f64,
+                peak_rss_mib()
+            );
+            if read_image {
+                picture = first.rgba;
+            }
+        }
+        Ok(picture)
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn bench_crowd(
     counts: Vec<usize>,
@@ -278,103 +358,57 @@ fn bench_crowd(
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
+    let mut configs = Vec::new();
+    if hairmesh::render::passes::strands::mesh_path_supported(&ctx) {
+        configs.push(("mesh (32/task)", 32, RenderPath::Mesh));
+        configs.push(("mesh (1/task)", 1, RenderPath::Mesh));
+    }
+    configs.push(("compute", 32, RenderPath::Compute));
+    let run = CrowdRun {
+        ctx: &ctx,
+        meshes: &meshes,
+        params,
+        size: (width, height),
+        runs,
+        camera,
+        read_image: picture.is_some(),
+    };
     let mut last_picture = None;
     for &count in &counts {
-        let side = (count as f32).sqrt().ceil() as usize;
-        let mut configs: Vec<(String, Option<u32>, RenderPath)> = Vec::new();
-        let base_ctx = ctx.clone();
-        let mut probe = Renderer::new(&base_ctx, &RendererDesc::default().size(width, height))?;
-        if probe.has_mesh_path() {
-            configs.push(("mesh (32/task)".into(), Some(32), RenderPath::Mesh));
-            configs.push(("mesh (1/task)".into(), Some(1), RenderPath::Mesh));
-        }
-        configs.push(("compute".into(), None, RenderPath::Compute));
-        drop(probe.finish());
-        drop(probe);
-        for (label, task_bundles, path) in configs {
-            let before = ctx.memory_report().allocated_bytes;
-            let desc = RendererDesc {
-                task_bundles: task_bundles.unwrap_or(32),
-                ..RendererDesc::default().size(width, height)
-            };
-            let mut renderer = Renderer::new(&ctx, &desc)?;
-            let empty = ctx.memory_report().allocated_bytes;
-            for i in 0..count {
-                let (baked, style) = &meshes[i % meshes.len()];
-                renderer.add_character(baked, style, params, crowd_model(i, side, baked))?;
-            }
-            let full = ctx.memory_report().allocated_bytes;
-            let per_char = (full - empty) as f64 / count as f64 / 1024.0;
-            let tex_per_char = renderer.crowd().texture_bytes() as f64 / count as f64 / 1024.0;
-            for lod_on in [true, false] {
-                let view = View {
-                    camera,
-                    light_dir: Vec3::new(0.4, 1.0, 0.6),
-                    lod: if lod_on {
-                        LodSettings::default()
-                    } else {
-                        LodSettings::off()
-                    },
-                };
-                let opts = FrameOptions {
-                    path: Some(path),
-                    ..Default::default()
-                };
-                let first = renderer.render_one(
-                    &view,
-                    &FrameOptions {
-                        read_image: picture.is_some(),
-                        ..opts
-                    },
-                )?;
-                let mut reports = Vec::new();
-                for _ in 0..runs {
-                    reports.push(renderer.render_one(&view, &opts)?);
-                }
-                let mut passes: Vec<(&str, f64)> = Vec::new();
-                for (name, _) in &first.pass_ms {
-                    passes.push((
-                        name,
-                        median(
-                            reports
-                                .iter()
-                                .map(|r| {
-                                    r.pass_ms.iter().find(|p| p.0 == *name).map_or(0.0, |p| p.1)
-                                })
-                                .collect(),
-                        ),
-                    ));
-                }
-                let gpu = median(reports.iter().map(|r| r.gpu_ms()).collect());
-                let record = median(reports.iter().map(|r| r.record_ms).collect());
-                let pass_text: Vec<String> = passes
-                    .iter()
-                    .map(|(n, ms)| format!("{n} {ms:.1}"))
-                    .collect();
-                let used = ctx.memory_report().allocated_bytes - before;
-                println!(
-                    "| {count} | {label} | {} | {} ({}) | {} | {} | {gpu:.1} | {record:.3} | {:.1} | {per_char:.1} ({tex_per_char:.1}) | {:.0} |",
-                    if lod_on { "on" } else { "off" },
-                    first.stats.strands_drawn,
-                    first.stats.strands_demanded,
-                    first.stats.triangles_drawn,
-                    pass_text.join(", "),
-                    used as f64 / (1 << 20) as f64,
-                    peak_rss_mib()
-                );
-                if lod_on && first.rgba.is_some() {
-                    last_picture = first.rgba.clone().map(|p| (p, width, height));
-                }
+        for &(label, task_bundles, path) in &configs {
+            if let Some(p) = run.measure(count, label, task_bundles, path)? {
+                last_picture = Some(p);
             }
         }
     }
-    if let (Some(path), Some((rgba, w, h))) = (picture, last_picture) {
-        let img = image::RgbaImage::from_raw(w, h, rgba).context("size")?;
-        let mut png = Vec::new();
-        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-        hairmesh::fsutil::write_atomic(&path, &png)?;
-        println!("wrote {}", path.display());
+    if let (Some(path), Some(rgba)) = (picture, last_picture) {
+        write_png(&path, rgba, width, height)?;
     }
+    Ok(())
+}
+
+/// Median GPU ms of each pass of `first` over `reports`.
+fn median_passes<'a>(first: &'a FrameReport, reports: &[FrameReport]) -> Vec<(&'a str, f64)> {
+    first
+        .pass_ms
+        .iter()
+        .map(|(name, _)| {
+            let ms = reports
+                .iter()
+                .map(|r| r.pass_ms.iter().find(|p| p.0 == *name).map_or(0.0, |p| p.1))
+                .collect();
+            (*name, median(ms))
+        })
+        .collect()
+}
+
+/// Write RGBA pixels as a PNG (atomically).
+fn write_png(path: &std::path::Path, rgba: Vec<u8>, width: u32, height: u32) -> Result<()> {
+    let img = image::RgbaImage::from_raw(width, height, rgba).context("size")?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    hairmesh::fsutil::write_atomic(path, &png)?;
+    println!("wrote {}", path.display());
     Ok(())
 }
 
