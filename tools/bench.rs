@@ -152,15 +152,7 @@ fn bench_lod(
     for (label, cam) in &views {
         for &path in &paths {
             for lod_on in [true, false] {
-                let view = View {
-                    camera: *cam,
-                    light_dir: Vec3::new(0.4, 1.0, 0.6),
-                    lod: if lod_on {
-                        LodSettings::default()
-                    } else {
-                        LodSettings::off()
-                    },
-                };
+                let view = bench_view(*cam, lod_on);
                 let opts = FrameOptions {
                     path: Some(path),
                     read_image: true,
@@ -280,15 +272,7 @@ impl CrowdRun<'_> {
         let tex_per_char = renderer.crowd().texture_bytes() as f64 / count as f64 / 1024.0;
         let mut picture = None;
         for lod_on in [true, false] {
-            let view = View {
-                camera: self.camera,
-                light_dir: Vec3::new(0.4, 1.0, 0.6),
-                lod: if lod_on {
-                    LodSettings::default()
-                } else {
-                    LodSettings::off()
-                },
-            };
+            let view = bench_view(self.camera, lod_on);
             let opts = FrameOptions {
                 path: Some(path),
                 ..Default::default()
@@ -385,6 +369,19 @@ fn bench_crowd(
         write_png(&path, rgba, width, height)?;
     }
     Ok(())
+}
+
+/// The benchmarks' view: `camera`, a fixed light, default LoD on or LoD off.
+fn bench_view(camera: Camera, lod_on: bool) -> View {
+    View {
+        camera,
+        light_dir: Vec3::new(0.4, 1.0, 0.6),
+        lod: if lod_on {
+            LodSettings::default()
+        } else {
+            LodSettings::off()
+        },
+    }
 }
 
 /// Median GPU ms of each pass of `first` over `reports`.
