@@ -1,4 +1,4 @@
-// Hashes and noise shared by every shader; bit-exact twins of src/rng.rs and src/generate.rs.
+// Hashes and noise shared by every shader; bit-exact twins of src/rng.rs and src/reference/generate.rs.
 #ifndef COMMON_GLSL
 #define COMMON_GLSL
 
@@ -14,7 +14,7 @@ float hash_f32(uint x) {
     return float(hash_u32(x) >> 8u) * (1.0 / 16777216.0);
 }
 
-// src/generate.rs: strand_key / strand_rand / value_noise.
+// src/reference/generate.rs: strand_key / strand_rand / value_noise.
 uint strand_key(uint seed, uint bundle, uint strand) {
     return hash_u32(hash_u32(bundle ^ hash_u32(seed)) + strand);
 }

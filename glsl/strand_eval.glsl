@@ -1,4 +1,4 @@
-// Strand evaluation from the five textures: the GPU twin of src/generate.rs (CPU oracle).
+// Strand evaluation from the five textures: the GPU twin of src/reference/generate.rs (CPU oracle).
 // Included unchanged by the compute path (generate.comp) and the mesh path.
 // Requires bindings.glsl and common.glsl.
 #ifndef STRAND_EVAL_GLSL
@@ -71,7 +71,7 @@ float smoothstep_safe(float e0, float e1, float x) {
     return smoothstep(e0, e1, x);
 }
 
-// Styling offset in the u v w frame (sec. 3.4; src/generate.rs: styling_offset).
+// Styling offset in the u v w frame (sec. 3.4; src/reference/generate.rs: styling_offset).
 vec3 styling_offset(uint key, float s, float w) {
     const float TAU = 6.28318530718;
     float ramp = smoothstep_safe(0.0, style.root_ramp, w);
