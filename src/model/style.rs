@@ -4,8 +4,8 @@
 //!
 //! [`HairStyle`] is `#[repr(C)]`; `src/render/shared.rs` emits it field for field as
 //! `struct HairStyle` into the generated `shared.glsl` (std430), and a test checks the layouts
-//! agree. Operations, applied to strand vertex `k` of `ns` (`s = k / ns`, `w` the styling coordinate, `ramp` =
-//! `smoothstep(0, root_ramp, w)`):
+//! agree. Operations, applied to strand vertex `k` of `ns` (`s = k / ns`, `w` the styling
+//! coordinate, `ramp` = `smoothstep(0, root_ramp, w)`):
 //! - **length variation**: the strand ends at `(1 - length_variation * rand)` of the bundle length;
 //! - **clumping**: `p += clump_strength * s^clump_power * (centre(r) - p)` toward the bundle's
 //!   centre curve;

@@ -54,6 +54,22 @@ impl StrandParams {
     }
 }
 
+/// Draw vertices of a character's strands at full detail (6 per segment).
+fn max_draw_vertices(
+    bundles: &[crate::bake::BundleDesc],
+    style: &HairStyle,
+    params: StrandParams,
+) -> u64 {
+    let strands: u64 = bundles
+        .iter()
+        .map(|b| {
+            crate::reference::generate::strands_in_bundle(b, style, params.strands_per_bundle)
+                as u64
+        })
+        .sum();
+    strands * (1u64 << params.verts_log2) * 6
+}
+
 /// A character handle (slot + generation, so a stale handle is refused).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CharacterId {
@@ -76,6 +92,7 @@ pub struct CharacterTextures {
 
 struct Character {
     generation: u32,
+    max_draw_vertices: u64,
     info: MeshInfo,
     style: HairStyle,
     params: StrandParams,
@@ -200,6 +217,7 @@ impl Crowd {
         let generation = self.generations[slot as usize];
         self.slots[slot as usize] = Some(Character {
             generation,
+            max_draw_vertices: max_draw_vertices(&baked.bundles, style, params),
             info: baked.info,
             style: *style,
             params,
@@ -289,8 +307,20 @@ impl Crowd {
     /// Change a character's strand settings.
     pub fn set_params(&mut self, id: CharacterId, params: StrandParams) -> GpuResult<()> {
         params.validate()?;
-        self.get_mut(id)?.params = params;
+        let c = self.get_mut(id)?;
+        c.params = params;
+        c.max_draw_vertices = max_draw_vertices(&c.bundles, &c.style, params);
         Ok(())
+    }
+
+    /// Draw vertices (6 per strand segment) of every character at full detail: the largest
+    /// value the frame's 32-bit prefix sums can reach.
+    pub fn max_draw_vertices(&self) -> u64 {
+        self.slots
+            .iter()
+            .flatten()
+            .map(|c| c.max_draw_vertices)
+            .sum()
     }
 
     /// Live characters.

@@ -283,6 +283,14 @@ impl Renderer {
                 self.ctx.info.name
             )));
         }
+        // Prefix sums and statistics are 32-bit: refuse a crowd that could wrap them (LoD
+        // usually needs far less, but a frame without LoD must not produce garbage).
+        let worst = self.crowd.max_draw_vertices();
+        if worst > u32::MAX as u64 {
+            return Err(GpuError::Unsupported(format!(
+                "the crowd needs up to {worst} strand draw vertices at full detail, more than 32-bit frame counters hold; lower strands per bundle or vertex level"
+            )));
+        }
         let i = self.next;
         self.retire_slot(i)?;
         self.prepare_workspace(i, path)?;
