@@ -5,13 +5,14 @@ use std::path::PathBuf;
 /// Everything that can go wrong while loading, validating, baking or reading hair meshes.
 #[derive(Debug, thiserror::Error)]
 pub enum HairError {
-    /// Reading or writing a file failed.
-    #[error("{path}: {source}")]
+    /// Reading or writing a file failed. The OS message is part of this error's text (not a
+    /// separate source), so `{:#}` chains print it once.
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file involved.
         path: PathBuf,
         /// The underlying I/O error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The input is malformed or inconsistent; `what` says where (line, face, vertex) and why.
     #[error("{source_name}: {what}")]
@@ -36,7 +37,7 @@ impl HairError {
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         HairError::Io {
             path: path.into(),
-            source,
+            error: source,
         }
     }
 }

@@ -1,11 +1,172 @@
-//! File helpers: atomic writes so a failed run never leaves a half-written output.
+//! Files in and out, with one policy for every tool.
+//!
+//! **Inputs** are read only when they are regular files (a FIFO without a writer would block,
+//! a device could stream forever) and no larger than a stated cap.
+//!
+//! **Outputs** ([`OutputPath`]) are checked before any work: an output that is one of the
+//! inputs (the same file, also through links) is refused; a symbolic link, folder, FIFO,
+//! socket or block device is refused; a character device (`/dev/null`) is written in place;
+//! a regular file or a new path is written atomically (temporary file next to it, synced,
+//! renamed), so a failed run never leaves a half-written file. Tools write only after their
+//! work (and the GPU frame's validation) succeeded.
 
-use std::io::Write;
-use std::path::Path;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
 
 use crate::error::{HairError, Result};
 
+/// Largest OBJ or baked `.hmb` file read, in bytes.
+pub const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
+/// Largest style or scene TOML read, in bytes.
+pub const MAX_TEXT_FILE_BYTES: u64 = 1 << 20;
+
+/// Read `path` whole if it is a regular file of at most `max_bytes`.
+pub fn read_input(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
+    let meta = std::fs::metadata(path).map_err(|e| HairError::io(path, e))?;
+    if !meta.is_file() {
+        return Err(HairError::invalid(
+            path.display().to_string(),
+            "not a regular file (folders, FIFOs and devices are not read)",
+        ));
+    }
+    let too_big = || {
+        HairError::invalid(
+            path.display().to_string(),
+            format!("larger than the {max_bytes}-byte limit for this kind of file"),
+        )
+    };
+    if meta.len() > max_bytes {
+        return Err(too_big());
+    }
+    let file = std::fs::File::open(path).map_err(|e| HairError::io(path, e))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| HairError::io(path, e))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_big());
+    }
+    Ok(bytes)
+}
+
+/// [`read_input`] as UTF-8 text.
+pub fn read_text_input(path: &Path, max_bytes: u64) -> Result<String> {
+    String::from_utf8(read_input(path, max_bytes)?).map_err(|e| {
+        HairError::invalid(
+            path.display().to_string(),
+            format!("not UTF-8 text: {}", e.utf8_error()),
+        )
+    })
+}
+
+/// How an output is written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum OutputKind {
+    /// New or regular file: atomically (temporary file + rename).
+    Atomic,
+    /// Character device such as `/dev/null`: in place.
+    Device,
+}
+
+/// A checked output path ([`OutputPath::check`]); write it with [`OutputPath::write`].
+#[derive(Clone, Debug)]
+pub struct OutputPath {
+    path: PathBuf,
+    kind: OutputKind,
+}
+
+#[cfg(unix)]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    a.dev() == b.dev() && a.ino() == b.ino()
+}
+
+#[cfg(not(unix))]
+fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata) -> bool {
+    false
+}
+
+impl OutputPath {
+    /// Check `path` as an output of a run that reads `inputs` (missing inputs are ignored here;
+    /// reading them reports them).
+    pub fn check(path: &Path, inputs: &[&Path]) -> Result<Self> {
+        let name = path.display().to_string();
+        let refuse = |why: &str| Err(HairError::invalid(&name, format!("output {why}")));
+        let kind = match std::fs::symlink_metadata(path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                if path.file_name().is_none() {
+                    return refuse("is not a file path");
+                }
+                let parent = match path.parent() {
+                    Some(p) if !p.as_os_str().is_empty() => p,
+                    _ => Path::new("."),
+                };
+                if !std::fs::metadata(parent).is_ok_and(|m| m.is_dir()) {
+                    return refuse(&format!("folder {} does not exist", parent.display()));
+                }
+                return Ok(OutputPath {
+                    path: path.to_path_buf(),
+                    kind: OutputKind::Atomic,
+                });
+            }
+            Err(e) => return Err(HairError::io(path, e)),
+            Ok(m) if m.file_type().is_symlink() => {
+                return refuse("is a symbolic link; give the path it points to");
+            }
+            Ok(m) if m.is_dir() => return refuse("is a folder"),
+            Ok(m) if m.is_file() => OutputKind::Atomic,
+            Ok(m) if is_char_device(&m) => OutputKind::Device,
+            Ok(_) => return refuse("is a FIFO, socket or block device; not written"),
+        };
+        let out_meta = std::fs::metadata(path).map_err(|e| HairError::io(path, e))?;
+        for input in inputs {
+            if let Ok(m) = std::fs::metadata(input)
+                && m.is_file()
+                && same_file(&m, &out_meta)
+            {
+                return refuse(&format!(
+                    "is the input {}; refusing to overwrite it",
+                    input.display()
+                ));
+            }
+        }
+        Ok(OutputPath {
+            path: path.to_path_buf(),
+            kind,
+        })
+    }
+
+    /// The path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Write `bytes` by the policy of this module.
+    pub fn write(&self, bytes: &[u8]) -> Result<()> {
+        match self.kind {
+            OutputKind::Atomic => write_atomic(&self.path, bytes),
+            OutputKind::Device => std::fs::OpenOptions::new()
+                .write(true)
+                .open(&self.path)
+                .and_then(|mut f| f.write_all(bytes))
+                .map_err(|e| HairError::io(&self.path, e)),
+        }
+    }
+}
+
+#[cfg(unix)]
+fn is_char_device(m: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    m.file_type().is_char_device()
+}
+
+#[cfg(not(unix))]
+fn is_char_device(_: &std::fs::Metadata) -> bool {
+    false
+}
+
 /// Write `bytes` to `path` atomically: a temporary file in the same folder, synced, then renamed.
+/// Tools go through [`OutputPath`], which decides when this is the right way to write.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
@@ -30,4 +191,21 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         return Err(HairError::io(path, e));
     }
     Ok(())
+}
+
+/// `println!` that returns an error instead of panicking when stdout cannot be written
+/// (closed pipe, full disk): `outln!(...)?`.
+#[macro_export]
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout(), $($arg)*)
+            .map_err(|e| std::io::Error::new(e.kind(), format!("writing to stdout: {e}")))
+    }};
+}
+
+/// Print a tool's one-line error to stderr (ignoring a failure to do so) and exit with `code`.
+pub fn exit_with_error(tool: &str, error: &dyn std::fmt::Display, code: i32) -> ! {
+    let _ = writeln!(std::io::stderr(), "{tool}: {error:#}");
+    std::process::exit(code)
 }

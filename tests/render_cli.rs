@@ -84,7 +84,7 @@ fn bad_inputs_fail_before_the_gpu() {
                 "-o",
                 o,
             ],
-            "bad size",
+            "--size",
         ),
     ] {
         let r = render(&args);

@@ -5,12 +5,15 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::Result;
+use std::io::Write as _;
+
+use anyhow::{Result, bail};
 use clap::Parser;
 use hairmesh::bake::baked_file;
 use hairmesh::bake::{BakeOptions, texels_per_face};
+use hairmesh::fsutil::OutputPath;
 use hairmesh::model::obj_io::{load_hair_mesh_obj, load_scalp};
-use hairmesh::{ExtrudeDesc, HairStyle, extrude};
+use hairmesh::{ExtrudeDesc, HairStyle, extrude, outln};
 
 /// Bake a hair mesh into the five textures of the hair-meshes paper.
 #[derive(Parser)]
@@ -24,9 +27,9 @@ struct Args {
     /// Output file (.hmb).
     #[arg(short, long)]
     output: PathBuf,
-    /// Treat the input as a scalp and extrude it into N layers along its normals.
-    #[arg(long, value_name = "N")]
-    extrude: Option<usize>,
+    /// Treat the input as a scalp and extrude it into N layers (2..=512) along its normals.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(2..=hairmesh::model::hair_mesh::MAX_LAYERS as i64))]
+    extrude: Option<u16>,
     /// Layer step length for --extrude (object units).
     #[arg(long, default_value_t = 0.02)]
     step: f32,
@@ -40,8 +43,28 @@ struct Args {
 
 fn run(args: Args) -> Result<()> {
     let start = Instant::now();
+    if !(args.step.is_finite() && args.step > 0.0 && args.step <= 1e3) {
+        bail!("--step {} must be in (0, 1000]", args.step);
+    }
+    if !(args.gravity.is_finite() && (0.0..=1.0).contains(&args.gravity)) {
+        bail!("--gravity {} must be in [0, 1]", args.gravity);
+    }
+    if args.output.extension().is_none() {
+        bail!(
+            "{}: output needs an extension (e.g. .hmb)",
+            args.output.display()
+        );
+    }
+    let style_path = args
+        .style
+        .clone()
+        .or_else(|| HairStyle::beside(&args.input));
+    let mut inputs = vec![args.input.as_path()];
+    inputs.extend(style_path.as_deref());
+    let output = OutputPath::check(&args.output, &inputs)?;
     let mesh = match args.extrude {
         Some(layers) => {
+            let layers = layers as usize;
             let scalp = load_scalp(&args.input)?;
             extrude(
                 args.input.display().to_string(),
@@ -53,10 +76,6 @@ fn run(args: Args) -> Result<()> {
         }
         None => load_hair_mesh_obj(&args.input)?,
     };
-    let style_path = args
-        .style
-        .clone()
-        .or_else(|| HairStyle::beside(&args.input));
     let style = match &style_path {
         Some(p) => HairStyle::load(p)?,
         None => HairStyle::default(),
@@ -70,32 +89,35 @@ fn run(args: Args) -> Result<()> {
         },
         |done, total| {
             if big {
-                eprint!("\rbaking {:3}%", done * 100 / total.max(1));
+                let _ = write!(
+                    std::io::stderr(),
+                    "\rbaking {:3}%",
+                    done * 100 / total.max(1)
+                );
             }
         },
     )?;
     if big {
-        eprintln!();
+        let _ = writeln!(std::io::stderr());
     }
-    baked_file::save(&baked, &args.output)?;
-
-    println!("{}", args.input.display());
-    println!(
+    let bytes = baked_file::to_bytes(&baked);
+    outln!("{}", args.input.display())?;
+    outln!(
         "  {} vertices ({} per layer x {} layers), {} bundles, style {}",
         mesh.vertex_count(),
         mesh.vertices_per_layer(),
         mesh.layer_count(),
         mesh.faces.len(),
         style_path.map_or("defaults".into(), |p| p.display().to_string())
-    );
-    println!(
+    )?;
+    outln!(
         "  root slice {}x{} texels, {:.2} texels per face",
         baked.info.root_size[0],
         baked.info.root_size[1],
         texels_per_face(&baked)
-    );
+    )?;
     for t in baked.textures() {
-        println!(
+        outln!(
             "  {:<18} {:>4}x{:<4}x{:<4} {:<20} {:>10} bytes",
             t.name,
             t.extent[0],
@@ -103,37 +125,28 @@ fn run(args: Args) -> Result<()> {
             t.extent[2],
             t.format,
             t.bytes.len()
-        );
+        )?;
     }
     let total = baked.texture_bytes();
-    println!(
+    outln!(
         "  {:<18} {:>45} bytes ({:.1} KB)",
         "total textures",
         total,
         total as f64 / 1024.0
-    );
-    println!(
+    )?;
+    // Written only after the bake succeeded and the report could be printed.
+    output.write(&bytes)?;
+    outln!(
         "  wrote {} ({} bytes with bundle table and header) in {:.2} s",
         args.output.display(),
-        std::fs::metadata(&args.output)
-            .map(|m| m.len())
-            .unwrap_or(0),
+        bytes.len(),
         start.elapsed().as_secs_f32()
-    );
+    )?;
     Ok(())
 }
 
 fn main() {
-    let args = Args::parse();
-    if args.output.extension().is_none() {
-        eprintln!(
-            "bake: {}: output needs an extension (e.g. .hmb)",
-            args.output.display()
-        );
-        std::process::exit(2);
-    }
-    if let Err(e) = run(args) {
-        eprintln!("bake: {e:#}");
-        std::process::exit(1);
+    if let Err(e) = run(Args::parse()) {
+        hairmesh::fsutil::exit_with_error("bake", &e, 1);
     }
 }

@@ -15,7 +15,9 @@ use clap::{Parser, Subcommand};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
+use hairmesh::fsutil::OutputPath;
 use hairmesh::model::obj_io::load_hair_mesh_obj;
+use hairmesh::outln;
 use hairmesh::render::scene::load_mesh;
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, LodSettings, RenderPath, Renderer, RendererDesc,
@@ -39,14 +41,14 @@ enum Cmd {
         #[arg(long, default_value = "hairmeshes/head_long.obj")]
         mesh: PathBuf,
         /// Target total strand count.
-        #[arg(long, default_value_t = 100_000)]
+        #[arg(long, default_value_t = 100_000, value_parser = clap::value_parser!(u32).range(1..=10000000))]
         strands: u32,
         /// Vertices per strand are 2^e + 1.
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=10))]
         verts_log2: u32,
         /// Timed runs (after one warm-up).
-        #[arg(long, default_value_t = 7)]
-        runs: usize,
+        #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u16).range(1..=1000))]
+        runs: u16,
     },
     /// GPU LoD comparison at near / mid / far distances, both paths.
     Lod {
@@ -54,17 +56,17 @@ enum Cmd {
         #[arg(long, default_value = "hairmeshes/head_long.obj")]
         mesh: PathBuf,
         /// Image width.
-        #[arg(long, default_value_t = 1280)]
+        #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
         width: u32,
         /// Image height.
-        #[arg(long, default_value_t = 720)]
+        #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=8192))]
         height: u32,
         /// Strands per bundle.
-        #[arg(long, default_value_t = 64)]
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
         strands_per_bundle: u32,
         /// Timed runs per configuration (after one warm-up).
-        #[arg(long, default_value_t = 5)]
-        runs: usize,
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..=1000))]
+        runs: u16,
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
@@ -80,20 +82,20 @@ enum Cmd {
         #[arg(long, value_delimiter = ',', default_value = "1,16,64,256")]
         counts: Vec<usize>,
         /// Image width.
-        #[arg(long, default_value_t = 1280)]
+        #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
         width: u32,
         /// Image height.
-        #[arg(long, default_value_t = 720)]
+        #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=8192))]
         height: u32,
         /// Strands per bundle.
-        #[arg(long, default_value_t = 16)]
+        #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
         strands_per_bundle: u32,
         /// Vertex level e (2^e + 1 vertices at full detail).
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=6))]
         verts_log2: u32,
         /// Timed frames per configuration (after one warm-up).
-        #[arg(long, default_value_t = 3)]
-        runs: usize,
+        #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u16).range(1..=1000))]
+        runs: u16,
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
@@ -112,9 +114,9 @@ fn bench_lod(
     device: Option<String>,
     picture: Option<PathBuf>,
 ) -> Result<()> {
-    if runs == 0 || width == 0 || height == 0 || width > 8192 || height > 8192 {
-        bail!("runs must be >= 1 and sizes 1..=8192");
-    }
+    let picture = picture
+        .map(|p| OutputPath::check(&p, &[mesh.as_path()]))
+        .transpose()?;
     let (baked, style) = load_mesh(&mesh, None)?;
     let ctx = Arc::new(Context::new(&ContextDesc::default().device(device))?);
     let mut renderer = Renderer::new(&ctx, &RendererDesc::default().size(width, height))?;
@@ -138,12 +140,16 @@ fn bench_lod(
         )
     };
     let views = [("near", at(0.6)), ("mid", at(2.5)), ("far", at(8.0))];
-    println!(
+    outln!(
         "device: {} ({}), {}x{}, {} strands/bundle, 33 vertices at full detail",
-        ctx.info.name, ctx.info.driver, width, height, n
-    );
-    println!("| view | path | LoD | strands | triangles | GPU ms (median of {runs}) |");
-    println!("|---|---|---|---|---|---|");
+        ctx.info.name,
+        ctx.info.driver,
+        width,
+        height,
+        n
+    )?;
+    outln!("| view | path | LoD | strands | triangles | GPU ms (median of {runs}) |")?;
+    outln!("|---|---|---|---|---|---|")?;
     let mut paths = vec![RenderPath::Compute];
     if renderer.has_mesh_path() {
         paths.insert(0, RenderPath::Mesh);
@@ -173,13 +179,13 @@ fn bench_lod(
                             .gpu_ms(),
                     );
                 }
-                println!(
+                outln!(
                     "| {label} | {path:?} | {} | {} | {} | {:.2} |",
                     if lod_on { "on" } else { "off" },
                     first.stats.strands_drawn,
                     first.stats.triangles_drawn,
                     median(times)
-                );
+                )?;
                 if lod_on && path == paths[0] {
                     pics.push(first);
                 }
@@ -197,6 +203,9 @@ fn bench_lod(
     }
     Ok(())
 }
+
+/// Most vertices `bench cpu-generate` generates (about 0.9 GB of positions, tangents, widths).
+const MAX_CPU_VERTICES: u64 = 32 << 20;
 
 /// Peak resident set size of this process in MiB (Linux `VmHWM`).
 fn peak_rss_mib() -> f64 {
@@ -289,7 +298,7 @@ impl CrowdRun<'_> {
             let gpu = median(reports.iter().map(|r| r.gpu_ms()).collect());
             let record = median(reports.iter().map(|r| r.record_ms).collect());
             let used = ctx.memory_report().allocated_bytes - before;
-            println!(
+            outln!(
                 "| {count} | {label} | {} | {} ({}) | {} | {} | {gpu:.1} | {record:.3} | {:.1} | {per_char:.1} ({tex_per_char:.1}) | {:.0} |",
                 if lod_on { "on" } else { "off" },
                 first.stats.strands_drawn,
@@ -298,7 +307,7 @@ impl CrowdRun<'_> {
                 passes.join(", "),
                 used as f64 / (1 << 20) as f64,
                 peak_rss_mib()
-            );
+            )?;
             if read_image {
                 picture = first.rgba;
             }
@@ -318,9 +327,13 @@ fn bench_crowd(
     device: Option<String>,
     picture: Option<PathBuf>,
 ) -> Result<()> {
-    if runs == 0 || counts.is_empty() || counts.iter().any(|&c| c == 0 || c > 1024) {
-        bail!("runs must be >= 1 and counts 1..=1024");
+    if counts.is_empty() || counts.iter().any(|&c| c == 0 || c > 1024) {
+        bail!("--counts: every count must be in 1..=1024");
     }
+    let inputs: Vec<&std::path::Path> = CROWD_MESHES.iter().map(std::path::Path::new).collect();
+    let picture = picture
+        .map(|p| OutputPath::check(&p, &inputs))
+        .transpose()?;
     let meshes = CROWD_MESHES
         .iter()
         .map(|m| load_mesh(std::path::Path::new(m), None))
@@ -331,16 +344,16 @@ fn bench_crowd(
     };
     params.validate()?;
     let ctx = Arc::new(Context::new(&ContextDesc::default().device(device))?);
-    println!(
+    outln!(
         "device: {} ({}), {width}x{height}, {n} strands/bundle, {} vertices at full detail, median of {runs}",
         ctx.info.name,
         ctx.info.driver,
         (1u32 << e) + 1
-    );
-    println!(
+    )?;
+    outln!(
         "| N | path | LoD | strands drawn (demanded) | triangles | GPU ms per pass | GPU ms | CPU record ms | GPU MiB | per-character KiB (textures) | peak RSS MiB |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    )?;
+    outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
     let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
     let mut configs = Vec::new();
     if hairmesh::render::passes::strands::mesh_path_supported(&ctx) {
@@ -365,8 +378,8 @@ fn bench_crowd(
             }
         }
     }
-    if let (Some(path), Some(rgba)) = (picture, last_picture) {
-        write_png(&path, rgba, width, height)?;
+    if let (Some(out), Some(rgba)) = (picture, last_picture) {
+        write_png(&out, rgba, width, height)?;
     }
     Ok(())
 }
@@ -399,13 +412,13 @@ fn median_passes<'a>(first: &'a FrameReport, reports: &[FrameReport]) -> Vec<(&'
         .collect()
 }
 
-/// Write RGBA pixels as a PNG (atomically).
-fn write_png(path: &std::path::Path, rgba: Vec<u8>, width: u32, height: u32) -> Result<()> {
+/// Write RGBA pixels as a PNG by the output policy.
+fn write_png(out: &OutputPath, rgba: Vec<u8>, width: u32, height: u32) -> Result<()> {
     let img = image::RgbaImage::from_raw(width, height, rgba).context("size")?;
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    hairmesh::fsutil::write_atomic(path, &png)?;
-    println!("wrote {}", path.display());
+    out.write(&png)?;
+    outln!("wrote {}", out.path().display())?;
     Ok(())
 }
 
@@ -414,8 +427,14 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn main() -> Result<()> {
-    match Args::parse().cmd {
+fn main() {
+    if let Err(e) = run(Args::parse()) {
+        hairmesh::fsutil::exit_with_error("bench", &e, 1);
+    }
+}
+
+fn run(args: Args) -> Result<()> {
+    match args.cmd {
         Cmd::Crowd {
             counts,
             width,
@@ -431,7 +450,7 @@ fn main() -> Result<()> {
             height,
             strands_per_bundle,
             verts_log2,
-            runs,
+            runs as usize,
             device,
             picture,
         )?,
@@ -449,7 +468,7 @@ fn main() -> Result<()> {
                 width,
                 height,
                 strands_per_bundle,
-                runs,
+                runs as usize,
                 device,
                 picture,
             )?;
@@ -460,8 +479,12 @@ fn main() -> Result<()> {
             verts_log2,
             runs,
         } => {
-            if runs == 0 || verts_log2 > 10 {
-                bail!("runs must be >= 1 and verts-log2 <= 10");
+            let vertices = strands as u64 * ((1u64 << verts_log2) + 1);
+            if vertices > MAX_CPU_VERTICES {
+                bail!(
+                    "--strands {strands} x {} vertices = {vertices} vertices, more than the {MAX_CPU_VERTICES} this benchmark allocates",
+                    (1u64 << verts_log2) + 1
+                );
             }
             let m = load_hair_mesh_obj(&mesh)?;
             let style = match HairStyle::beside(&mesh) {
@@ -477,12 +500,12 @@ fn main() -> Result<()> {
                 let t = Instant::now();
                 let set = generator.generate(n, verts_log2);
                 let s = t.elapsed().as_secs_f64();
-                println!("run {i}: {:.3} s ({} strands)", s, set.strand_count());
+                outln!("run {i}: {:.3} s ({} strands)", s, set.strand_count())?;
                 times.push(s);
             }
             let med = median(times);
             let verts = warm.positions.len();
-            println!(
+            outln!(
                 "cpu-generate {}: {} strands x {} vertices = {} vertices, median {:.3} s, {:.1} M vertices/s (1 thread)",
                 mesh.display(),
                 warm.strand_count(),
@@ -490,7 +513,7 @@ fn main() -> Result<()> {
                 verts,
                 med,
                 verts as f64 / med / 1e6
-            );
+            )?;
         }
     }
     Ok(())

@@ -12,12 +12,14 @@ use std::time::Instant;
 use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::{Mat4, Vec3};
+use hairmesh::fsutil::OutputPath;
 use hairmesh::render::scene::{SceneDesc, load_mesh};
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, LodSettings, RenderPath, Renderer, RendererDesc,
     StrandParams, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
+use hairmesh::{HairStyle, outln};
 
 /// Render hair generated on the GPU from hair-mesh textures.
 #[derive(Parser)]
@@ -41,11 +43,11 @@ struct Args {
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720")]
     size: String,
-    /// Strands per average bundle.
-    #[arg(long, default_value_t = 64)]
+    /// Strands per average bundle (1..=4096).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
     strands_per_bundle: u32,
-    /// Vertices per strand are 2^e + 1.
-    #[arg(long, default_value_t = 5)]
+    /// Vertices per strand are 2^e + 1 (e in 0..=6).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=6))]
     verts_log2: u32,
     /// Choose the GPU by name substring (default: discrete, else integrated, else lavapipe).
     #[arg(long)]
@@ -68,7 +70,7 @@ struct Args {
     lod_lambda: f32,
     /// Size of the compute path's vertex pool in MiB (frames that need more keep whole strands
     /// up to it and report the overflow).
-    #[arg(long, default_value_t = 96)]
+    #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u64).range(1..=4096))]
     vertex_pool_mib: u64,
     /// Enable Vulkan validation layers.
     #[arg(long)]
@@ -79,24 +81,20 @@ struct Args {
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("bad vector '{s}'"))?;
-    if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
-        bail!("bad vector '{s}': expected x,y,z");
+    let v: Option<Vec<f32>> = s.split(',').map(|x| x.trim().parse::<f32>().ok()).collect();
+    match v.as_deref() {
+        Some(&[x, y, z]) if [x, y, z].iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
+        _ => bail!("--camera: bad vector '{s}': expected three finite numbers x,y,z"),
     }
-    Ok(Vec3::new(v[0], v[1], v[2]))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32)> {
-    let (w, h) = s
-        .split_once('x')
-        .with_context(|| format!("bad size '{s}': expected WIDTHxHEIGHT"))?;
-    let (w, h): (u32, u32) = (w.parse()?, h.parse()?);
-    if w == 0 || h == 0 || w > 8192 || h > 8192 {
-        bail!("bad size '{s}': 1..=8192 per side");
+    let max = hairmesh::render::scene::MAX_IMAGE_SIDE;
+    let bad = || anyhow::anyhow!("--size '{s}': expected WIDTHxHEIGHT with 1..={max} per side");
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    if w == 0 || h == 0 || w > max || h > max {
+        return Err(bad());
     }
     Ok((w, h))
 }
@@ -109,16 +107,8 @@ fn lod_settings(args: &Args) -> Result<LodSettings> {
         alpha_verts: args.lod_alpha_verts,
         lambda: args.lod_lambda,
     };
-    if !(lod.alpha_strands > 0.0
-        && lod.alpha_verts > 0.0
-        && lod.alpha_strands.is_finite()
-        && lod.alpha_verts.is_finite())
-    {
-        bail!("LoD alphas must be positive and finite");
-    }
-    if !(lod.lambda > 0.0 && lod.lambda <= 1.0) {
-        bail!("--lod-lambda must be in (0, 1]");
-    }
+    lod.validate()
+        .map_err(|e| anyhow::anyhow!("--lod-alpha-strands/--lod-alpha-verts/--lod-lambda: {e}"))?;
     Ok(lod)
 }
 
@@ -133,6 +123,8 @@ struct Character {
 /// Everything loaded from the flags and the scene file, before any GPU work.
 struct Inputs {
     characters: Vec<Character>,
+    /// Every file read (the output may be none of them).
+    files: Vec<PathBuf>,
     scene_camera: Option<Camera>,
     light: Vec3,
     size: (u32, u32),
@@ -141,12 +133,14 @@ struct Inputs {
 fn load_inputs(args: &Args) -> Result<Inputs> {
     let mut inputs = Inputs {
         characters: Vec::new(),
+        files: Vec::new(),
         scene_camera: None,
         light: Vec3::new(0.4, 1.0, 0.6),
         size: parse_size(&args.size)?,
     };
     if let Some(scene_path) = &args.scene {
         let scene = SceneDesc::load(scene_path)?;
+        inputs.files.push(scene_path.clone());
         if let Some([w, h]) = scene.size {
             inputs.size = parse_size(&format!("{w}x{h}"))?;
         }
@@ -161,6 +155,8 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
             inputs.light = Vec3::from(l.direction);
         }
         for c in &scene.characters {
+            inputs.files.push(c.mesh.clone());
+            inputs.files.extend(c.style.clone());
             let (baked, style) = load_mesh(&c.mesh, c.style.as_deref())?;
             inputs.characters.push(Character {
                 baked,
@@ -176,6 +172,9 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
         let Some(mesh) = &args.mesh else {
             bail!("give --mesh or --scene")
         };
+        inputs.files.push(mesh.clone());
+        inputs.files.extend(args.style.clone());
+        inputs.files.extend(HairStyle::beside(mesh));
         let (baked, style) = load_mesh(mesh, args.style.as_deref())?;
         inputs.characters.push(Character {
             baked,
@@ -223,9 +222,15 @@ fn pick_camera(args: &Args, inputs: &Inputs) -> Result<Camera> {
     ))
 }
 
-fn print_report(ctx: &Context, args: &Args, characters: usize, out: &FrameReport, wall: f64) {
-    println!("device: {} ({})", ctx.info.name, ctx.info.driver);
-    println!(
+fn print_report(
+    ctx: &Context,
+    args: &Args,
+    characters: usize,
+    out: &FrameReport,
+    wall: f64,
+) -> std::io::Result<()> {
+    outln!("device: {} ({})", ctx.info.name, ctx.info.driver)?;
+    outln!(
         "{:?} path, LoD {}, {} character(s), {} strands (up to {} vertices each), {} strand triangles, {}x{}",
         out.path,
         args.lod,
@@ -235,27 +240,27 @@ fn print_report(ctx: &Context, args: &Args, characters: usize, out: &FrameReport
         out.stats.triangles_drawn,
         out.width,
         out.height
-    );
+    )?;
     if out.stats.strands_drawn < out.stats.strands_demanded {
-        println!(
+        outln!(
             "  vertex pool overflow: drew {} of {} strands ({} of {} vertex slots); raise --vertex-pool-mib or use LoD",
             out.stats.strands_drawn,
             out.stats.strands_demanded,
             out.stats.vertex_slots_written,
             out.stats.vertex_slots_demanded
-        );
+        )?;
     }
     if let Some(q) = out.mesh_primitives {
-        println!("  mesh primitives generated (VK_EXT_mesh_shader query): {q}");
+        outln!("  mesh primitives generated (VK_EXT_mesh_shader query): {q}")?;
     }
     for (pass, ms) in &out.pass_ms {
-        println!("  gpu {pass:<10} {ms:9.3} ms");
+        outln!("  gpu {pass:<10} {ms:9.3} ms")?;
     }
-    println!(
+    outln!(
         "  total gpu  {:9.3} ms; wall (incl. setup, shader compile) {:.2} s",
         out.gpu_ms(),
         wall
-    );
+    )
 }
 
 fn run(args: Args) -> Result<()> {
@@ -267,12 +272,13 @@ fn run(args: Args) -> Result<()> {
             RenderPath::Compute
         }
     });
-    if args.vertex_pool_mib == 0 || args.vertex_pool_mib > 4096 {
-        bail!("--vertex-pool-mib must be 1..=4096");
-    }
-    // Load and validate every input before touching the GPU.
+    // Load and validate every input, and the output path, before touching the GPU.
     let inputs = load_inputs(&args)?;
     let camera = pick_camera(&args, &inputs)?;
+    let output = OutputPath::check(
+        &args.output,
+        &inputs.files.iter().map(|p| p.as_path()).collect::<Vec<_>>(),
+    )?;
     let (width, height) = inputs.size;
 
     let start = Instant::now();
@@ -315,15 +321,14 @@ fn run(args: Args) -> Result<()> {
     let img = image::RgbaImage::from_raw(width, height, rgba).context("image size mismatch")?;
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    hairmesh::fsutil::write_atomic(&args.output, &png)?;
-    print_report(&ctx, &args, inputs.characters.len(), &out, wall);
-    println!("wrote {}", args.output.display());
+    print_report(&ctx, &args, inputs.characters.len(), &out, wall)?;
+    output.write(&png)?;
+    outln!("wrote {}", args.output.display())?;
     Ok(())
 }
 
 fn main() {
     if let Err(e) = run(Args::parse()) {
-        eprintln!("render: {e:#}");
-        std::process::exit(1);
+        hairmesh::fsutil::exit_with_error("render", &e, 1);
     }
 }

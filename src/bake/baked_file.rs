@@ -59,7 +59,7 @@ pub fn save(baked: &BakedHairMesh, path: &Path) -> Result<()> {
 
 /// Read a bake from `path`.
 pub fn load(path: &Path) -> Result<BakedHairMesh> {
-    let bytes = std::fs::read(path).map_err(|e| HairError::io(path, e))?;
+    let bytes = crate::fsutil::read_input(path, crate::fsutil::MAX_MESH_FILE_BYTES)?;
     from_bytes(&path.display().to_string(), &bytes)
 }
 

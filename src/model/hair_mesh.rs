@@ -96,9 +96,9 @@ impl HairMesh {
         if self.faces.is_empty() || n == 0 {
             return Err(self.err("empty hair mesh: no root faces"));
         }
-        if self.layers.len() < 2 {
+        if self.layers.len() < 2 || self.layers.len() > MAX_LAYERS {
             return Err(self.err(format!(
-                "a hair mesh needs at least 2 layers, found {}",
+                "a hair mesh needs 2..={MAX_LAYERS} layers (at least 2 layers), found {}",
                 self.layers.len()
             )));
         }
@@ -293,6 +293,11 @@ pub fn split_polygon(degree: usize) -> Vec<Vec<usize>> {
     }
 }
 
+/// Most layers of a hair mesh: the hair mesh texture has `4 (L - 1) + 1` slices and a side
+/// holds at most [`MAX_TEXTURE_SIDE`](crate::bake::MAX_TEXTURE_SIDE) texels.
+pub const MAX_LAYERS: usize =
+    (crate::bake::MAX_TEXTURE_SIDE / crate::bake::SLICES_PER_SEGMENT) as usize;
+
 /// How a scalp is extruded into layers by [`extrude`].
 #[derive(Clone, Debug)]
 pub struct ExtrudeDesc {
@@ -363,14 +368,29 @@ pub fn extrude(
     desc: &ExtrudeDesc,
 ) -> Result<HairMesh> {
     let name = name.into();
-    if desc.layers < 2 {
+    if !(2..=MAX_LAYERS).contains(&desc.layers) {
         return Err(HairError::invalid(
             &name,
-            "extrusion needs at least 2 layers",
+            format!(
+                "extrusion needs 2..={MAX_LAYERS} layers, got {}",
+                desc.layers
+            ),
         ));
     }
-    if !(desc.step.is_finite() && desc.step > 0.0) {
-        return Err(HairError::invalid(&name, "extrusion step must be positive"));
+    if !(desc.step.is_finite() && desc.step > 0.0 && desc.step <= 1e3) {
+        return Err(HairError::invalid(
+            &name,
+            format!("extrusion step must be in (0, 1000], got {}", desc.step),
+        ));
+    }
+    let gravity_ok = desc.gravity.is_finite()
+        && (0.0..=1.0).contains(&desc.gravity)
+        && desc.gravity_dir.is_finite();
+    if !gravity_ok {
+        return Err(HairError::invalid(
+            &name,
+            format!("gravity must be in [0, 1], got {}", desc.gravity),
+        ));
     }
     let normals = vertex_normals(scalp, faces);
     let down = desc.gravity_dir.try_normalize().unwrap_or(Vec3::NEG_Y);

@@ -1,6 +1,7 @@
 //! The hair mesh model and its files: [`HairMesh`](hair_mesh::HairMesh) (scalp + layers), the
 //! OBJ layer convention ([`obj_io`]) and the styling parameters ([`style`]).
 
+pub mod exact_array;
 pub mod hair_mesh;
 pub mod obj_io;
 pub mod style;

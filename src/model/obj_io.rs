@@ -27,11 +27,48 @@ const UNSUPPORTED: &[&str] = &[
     "curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con",
 ];
 
+/// Largest coordinate magnitude accepted (positions, uv, w): beyond it, 32-bit floats lose
+/// the precision the bake needs and areas overflow.
+pub const MAX_COORDINATE: f32 = 1e6;
+
 /// Line numbers of statements, gathered before parsing so errors can name lines.
 struct LineIndex {
     vertex_lines: Vec<usize>,
     face_lines: Vec<usize>,
     all_vt_have_w: bool,
+    /// Line of the first face that comes before any `g layerK` group, if any.
+    face_before_layers: Option<usize>,
+}
+
+/// `Some(k)` for a layer group name `layerK` (K canonical decimal), `Err` for names that look
+/// like one but are not (`layer01`, `layer-1`, `layerX`), `None` otherwise.
+fn layer_group(name: &str) -> std::result::Result<Option<usize>, ()> {
+    let Some(k) = name.strip_prefix("layer") else {
+        return Ok(None);
+    };
+    let canonical = !k.is_empty()
+        && k.bytes().all(|b| b.is_ascii_digit())
+        && (k == "0" || !k.starts_with('0'))
+        && k.len() <= 6;
+    if canonical {
+        Ok(k.parse().ok())
+    } else {
+        Err(())
+    }
+}
+
+fn check_number(name: &str, line_no: usize, what: &str, a: &str) -> Result<()> {
+    match a.parse::<f32>() {
+        Ok(x) if x.is_finite() && x.abs() <= MAX_COORDINATE => Ok(()),
+        Ok(x) if x.is_finite() => Err(HairError::invalid(
+            name,
+            format!("line {line_no}: {what} '{a}' is out of range (|x| <= {MAX_COORDINATE:e})"),
+        )),
+        _ => Err(HairError::invalid(
+            name,
+            format!("line {line_no}: {what} '{a}' is not a finite number"),
+        )),
+    }
 }
 
 fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
@@ -39,8 +76,10 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
         vertex_lines: Vec::new(),
         face_lines: Vec::new(),
         all_vt_have_w: true,
+        face_before_layers: None,
     };
     let mut vt_count = 0;
+    let mut in_layer = false;
     for (n, line) in text.lines().enumerate() {
         let line_no = n + 1;
         let mut tok = line.split('#').next().unwrap_or("").split_whitespace();
@@ -49,19 +88,33 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
         match stmt {
             "v" => {
                 for a in &args {
-                    match a.parse::<f32>() {
-                        Ok(x) if x.is_finite() => {}
-                        _ => {
+                    check_number(name, line_no, "vertex coordinate", a)?;
+                }
+                idx.vertex_lines.push(line_no);
+            }
+            "g" => {
+                let mut layers = 0;
+                for g in &args {
+                    match layer_group(g) {
+                        Ok(Some(_)) => layers += 1,
+                        Ok(None) => {}
+                        Err(()) => {
                             return Err(HairError::invalid(
                                 name,
                                 format!(
-                                    "line {line_no}: vertex coordinate '{a}' is not a finite number"
+                                    "line {line_no}: group '{g}' is not a layer name (layer0, layer1, ... without leading zeros)"
                                 ),
                             ));
                         }
                     }
                 }
-                idx.vertex_lines.push(line_no);
+                if layers > 0 && args.len() > 1 {
+                    return Err(HairError::invalid(
+                        name,
+                        format!("line {line_no}: a layer group line must name one group"),
+                    ));
+                }
+                in_layer = layers > 0;
             }
             "vt" => {
                 vt_count += 1;
@@ -69,17 +122,15 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
                     idx.all_vt_have_w = false;
                 }
                 for a in &args {
-                    if !a.parse::<f32>().is_ok_and(f32::is_finite) {
-                        return Err(HairError::invalid(
-                            name,
-                            format!(
-                                "line {line_no}: texture coordinate '{a}' is not a finite number"
-                            ),
-                        ));
-                    }
+                    check_number(name, line_no, "texture coordinate", a)?;
                 }
             }
-            "f" | "fo" => idx.face_lines.push(line_no),
+            "f" | "fo" => {
+                if !in_layer && idx.face_before_layers.is_none() {
+                    idx.face_before_layers = Some(line_no);
+                }
+                idx.face_lines.push(line_no);
+            }
             s if UNSUPPORTED.contains(&s) => {
                 return Err(HairError::invalid(
                     name,
@@ -93,9 +144,8 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
     Ok(idx)
 }
 
-fn parse(name: &str, path: &Path) -> Result<(RawObj, LineIndex)> {
-    let bytes = std::fs::read(path).map_err(|e| HairError::io(path, e))?;
-    let text = std::str::from_utf8(&bytes)
+fn parse(name: &str, bytes: &[u8]) -> Result<(RawObj, LineIndex)> {
+    let text = std::str::from_utf8(bytes)
         .map_err(|e| HairError::invalid(name, format!("not UTF-8 text: {e}")))?;
     let lines = scan_lines(name, text)?;
     // obj-rs may panic on inputs it does not implement; never let that escape as a crash.
@@ -140,10 +190,17 @@ fn position(raw: &RawObj, i: usize) -> Vec3 {
     Vec3::new(p.0, p.1, p.2)
 }
 
-/// Load a hair mesh from an OBJ that follows the layer convention of this module.
+/// Load a hair mesh from an OBJ that follows the layer convention of this module (a regular
+/// file of at most [`MAX_MESH_FILE_BYTES`](crate::fsutil::MAX_MESH_FILE_BYTES)).
 pub fn load_hair_mesh_obj(path: &Path) -> Result<HairMesh> {
-    let name = path.display().to_string();
-    let (raw, lines) = parse(&name, path)?;
+    let bytes = crate::fsutil::read_input(path, crate::fsutil::MAX_MESH_FILE_BYTES)?;
+    parse_hair_mesh_obj(&path.display().to_string(), &bytes)
+}
+
+/// Parse a hair mesh OBJ held in memory; `name` names it in errors.
+pub fn parse_hair_mesh_obj(name: &str, bytes: &[u8]) -> Result<HairMesh> {
+    let name = name.to_string();
+    let (raw, lines) = parse(&name, bytes)?;
     let err = |what: String| HairError::invalid(&name, what);
     let layer_count = layer_group_count(&raw);
     if let Some(extra) = raw
@@ -163,9 +220,15 @@ pub fn load_hair_mesh_obj(path: &Path) -> Result<HairMesh> {
             "no layer groups: expected 'g layer0', 'g layer1', ... (a scalp without layers needs --extrude)".into()
         }));
     }
-    if layer_count < 2 {
+    if !(2..=crate::model::hair_mesh::MAX_LAYERS).contains(&layer_count) {
         return Err(err(format!(
-            "a hair mesh needs at least 2 layers, found {layer_count}"
+            "a hair mesh needs 2..={} layers (at least 2 layers), found {layer_count}",
+            crate::model::hair_mesh::MAX_LAYERS
+        )));
+    }
+    if let Some(line) = lines.face_before_layers {
+        return Err(err(format!(
+            "line {line}: face outside any layer group (every face belongs to a 'g layerK')"
         )));
     }
     let root_polys = group_polygons(&raw, "layer0");
@@ -288,8 +351,14 @@ pub struct Scalp {
 
 /// Load a scalp OBJ (every face, any groups) for extrusion into a hair mesh.
 pub fn load_scalp(path: &Path) -> Result<Scalp> {
-    let name = path.display().to_string();
-    let (raw, lines) = parse(&name, path)?;
+    let bytes = crate::fsutil::read_input(path, crate::fsutil::MAX_MESH_FILE_BYTES)?;
+    parse_scalp(&path.display().to_string(), &bytes)
+}
+
+/// Parse a scalp OBJ held in memory; `name` names it in errors.
+pub fn parse_scalp(name: &str, bytes: &[u8]) -> Result<Scalp> {
+    let name = name.to_string();
+    let (raw, lines) = parse(&name, bytes)?;
     if raw.polygons.is_empty() {
         return Err(HairError::invalid(&name, "empty scalp: no faces"));
     }

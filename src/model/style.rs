@@ -68,6 +68,7 @@ pub struct HairStyle {
     /// 1: strands per bundle proportional to root area (uniform density); 0: equal per bundle.
     pub density_by_area: u32,
     /// Base colour, linear RGB.
+    #[serde(deserialize_with = "crate::model::exact_array::exact")]
     pub color: [f32; 3],
     /// Padding to a 16-byte multiple (std430 arrays of this struct).
     #[serde(skip)]
@@ -113,7 +114,7 @@ impl HairStyle {
 
     /// Load a style TOML file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| HairError::io(path, e))?;
+        let text = crate::fsutil::read_text_input(path, crate::fsutil::MAX_TEXT_FILE_BYTES)?;
         Self::from_toml(&path.display().to_string(), &text)
     }
 

@@ -25,7 +25,42 @@ pub struct Camera {
     pub far: f32,
 }
 
+/// Check a camera: finite eye and target, eye != target, vertical field of view in degrees in
+/// `(0, 180)`. Used by `render`, scene files and the renderer alike.
+pub fn validate_camera(eye: Vec3, target: Vec3, fov_y_degrees: f32) -> Result<(), String> {
+    if !eye.is_finite() || !target.is_finite() {
+        return Err(format!(
+            "camera eye {eye} and target {target} must be finite"
+        ));
+    }
+    if eye.distance(target) <= 1e-6 * eye.length().max(1.0) {
+        return Err(format!("camera eye and target are the same point {eye}"));
+    }
+    if !(fov_y_degrees > 0.0 && fov_y_degrees < 180.0) {
+        return Err(format!(
+            "field of view {fov_y_degrees} degrees is outside (0, 180)"
+        ));
+    }
+    Ok(())
+}
+
+/// Check a light direction: finite and not zero.
+pub fn validate_light(direction: Vec3) -> Result<(), String> {
+    if !direction.is_finite() || direction.length() < 1e-12 {
+        return Err(format!(
+            "light direction {direction} must be finite and non-zero"
+        ));
+    }
+    Ok(())
+}
+
 impl Camera {
+    /// [`Camera::look_at`] after [`validate_camera`].
+    pub fn checked(eye: Vec3, target: Vec3, fov_y_degrees: f32) -> Result<Self, String> {
+        validate_camera(eye, target, fov_y_degrees)?;
+        Ok(Camera::look_at(eye, target, fov_y_degrees))
+    }
+
     /// Look from `eye` at `target` with a vertical field of view in degrees.
     pub fn look_at(eye: Vec3, target: Vec3, fov_y_degrees: f32) -> Self {
         let dist = eye.distance(target).max(1e-3);
@@ -100,6 +135,18 @@ impl Default for LodSettings {
 }
 
 impl LodSettings {
+    /// Check alphas (positive, finite) and lambda (in `(0, 1]`).
+    pub fn validate(&self) -> Result<(), String> {
+        let alpha_ok = |a: f32| a > 0.0 && a.is_finite();
+        if !alpha_ok(self.alpha_strands) || !alpha_ok(self.alpha_verts) {
+            return Err("LoD alphas must be positive and finite".into());
+        }
+        if !(self.lambda > 0.0 && self.lambda <= 1.0) {
+            return Err(format!("LoD lambda {} is outside (0, 1]", self.lambda));
+        }
+        Ok(())
+    }
+
     /// Every bundle at full detail.
     pub fn off() -> Self {
         LodSettings {
@@ -131,6 +178,21 @@ pub struct View {
 }
 
 impl View {
+    /// Check camera, light and LoD settings (finite, in range).
+    pub fn validate(&self) -> Result<(), String> {
+        let c = &self.camera;
+        validate_camera(c.eye, c.target, c.fov_y.to_degrees())?;
+        let planes_ok = c.near > 0.0 && c.far > c.near && c.far.is_finite() && c.up.is_finite();
+        if !planes_ok {
+            return Err(format!(
+                "camera near {} / far {} planes are invalid",
+                c.near, c.far
+            ));
+        }
+        validate_light(self.light_dir)?;
+        self.lod.validate()
+    }
+
     /// The frame block for `width x height` pixels, `bundles` bundles in `characters`
     /// character slots and a vertex pool of `vertex_budget` slots.
     pub fn frame_block(

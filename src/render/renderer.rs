@@ -266,16 +266,7 @@ impl Renderer {
     /// Record and submit one frame of every visible character seen from `view`. Waits only
     /// for the frame submitted [`FRAMES_IN_FLIGHT`] frames ago.
     pub fn render_frame(&mut self, view: &View, opts: &FrameOptions) -> GpuResult<FrameTicket> {
-        let c = &view.camera;
-        let finite = c.eye.is_finite()
-            && c.target.is_finite()
-            && c.fov_y.is_finite()
-            && view.light_dir.is_finite();
-        if !finite {
-            return Err(GpuError::Unsupported(
-                "camera or light is not finite".into(),
-            ));
-        }
+        view.validate().map_err(GpuError::Unsupported)?;
         let path = opts.path.unwrap_or(self.default_path());
         if path == RenderPath::Mesh && !self.passes.has_mesh_path() {
             return Err(GpuError::Unsupported(format!(

@@ -27,6 +27,7 @@ use crate::bake::baked_file;
 use crate::error::{HairError, Result};
 use crate::model::obj_io::load_hair_mesh_obj;
 use crate::model::style::HairStyle;
+use crate::render::camera::{validate_camera, validate_light};
 use crate::{BakeOptions, BakedHairMesh, bake};
 
 /// Camera block of a scene file.
@@ -34,8 +35,10 @@ use crate::{BakeOptions, BakedHairMesh, bake};
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
     /// Eye position.
+    #[serde(deserialize_with = "crate::model::exact_array::exact")]
     pub eye: [f32; 3],
     /// Target position.
+    #[serde(deserialize_with = "crate::model::exact_array::exact")]
     pub target: [f32; 3],
     /// Vertical field of view in degrees.
     #[serde(default = "default_fov")]
@@ -51,6 +54,7 @@ fn default_fov() -> f32 {
 #[serde(deny_unknown_fields)]
 pub struct LightDesc {
     /// Direction toward the light.
+    #[serde(deserialize_with = "crate::model::exact_array::exact")]
     pub direction: [f32; 3],
 }
 
@@ -63,7 +67,7 @@ pub struct CharacterDesc {
     /// Style TOML overriding the baked/beside style.
     pub style: Option<PathBuf>,
     /// World translation.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::model::exact_array::exact")]
     pub translation: [f32; 3],
     /// Rotation about +Y in degrees.
     #[serde(default)]
@@ -94,6 +98,7 @@ fn default_verts() -> u32 {
 #[serde(deny_unknown_fields)]
 pub struct SceneDesc {
     /// Image size.
+    #[serde(default, deserialize_with = "crate::model::exact_array::exact_option")]
     pub size: Option<[u32; 2]>,
     /// Camera (default: frame all characters).
     pub camera: Option<CameraDesc>,
@@ -104,37 +109,35 @@ pub struct SceneDesc {
     pub characters: Vec<CharacterDesc>,
 }
 
+/// Most characters in one scene file.
+pub const MAX_SCENE_CHARACTERS: usize = 4096;
+/// Largest image side of a scene file (as `render --size`).
+pub const MAX_IMAGE_SIDE: u32 = 8192;
+/// Largest uniform scale of a character.
+pub const MAX_SCALE: f32 = 1e4;
+/// Largest translation component of a character.
+pub const MAX_TRANSLATION: f32 = 1e6;
+
 impl SceneDesc {
     /// Load and validate a scene file; relative paths are resolved against its folder.
     pub fn load(path: &Path) -> Result<Self> {
-        let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| HairError::io(path, e))?;
-        let mut scene: SceneDesc = toml::from_str(&text)
-            .map_err(|e| HairError::invalid(&name, format!("bad scene: {}", e.message())))?;
-        if scene.characters.is_empty() {
-            return Err(HairError::invalid(&name, "scene has no [[character]]"));
-        }
-        let base = path.parent().unwrap_or(Path::new("."));
-        for (i, c) in scene.characters.iter_mut().enumerate() {
-            let finite = c
-                .translation
-                .iter()
-                .chain([&c.rotation_y_degrees, &c.scale])
-                .all(|x| x.is_finite());
-            if !finite || c.scale <= 0.0 {
-                return Err(HairError::invalid(
-                    &name,
-                    format!("character {i}: non-finite transform or scale <= 0"),
-                ));
-            }
-            if c.strands_per_bundle == 0 || c.strands_per_bundle > 4096 || c.verts_log2 > 6 {
-                return Err(HairError::invalid(
-                    &name,
-                    format!(
-                        "character {i}: strands_per_bundle must be 1..=4096 and verts_log2 <= 6"
-                    ),
-                ));
-            }
+        let text = crate::fsutil::read_text_input(path, crate::fsutil::MAX_TEXT_FILE_BYTES)?;
+        Self::parse(
+            &path.display().to_string(),
+            &text,
+            path.parent().unwrap_or(Path::new(".")),
+        )
+    }
+
+    /// Parse and validate scene TOML text; `name` names it in errors, relative paths are
+    /// resolved against `base`.
+    pub fn parse(name: &str, text: &str, base: &Path) -> Result<Self> {
+        let mut scene: SceneDesc = toml::from_str(text)
+            .map_err(|e| HairError::invalid(name, format!("bad scene: {}", e.message())))?;
+        scene
+            .validate()
+            .map_err(|what| HairError::invalid(name, what))?;
+        for c in &mut scene.characters {
             if c.mesh.is_relative() {
                 c.mesh = base.join(&c.mesh);
             }
@@ -145,6 +148,53 @@ impl SceneDesc {
             }
         }
         Ok(scene)
+    }
+
+    /// Every value in range: size, camera and light by the checks `render` uses, characters'
+    /// transforms and strand settings.
+    pub fn validate(&self) -> std::result::Result<(), String> {
+        if let Some([w, h]) = self.size
+            && (w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE)
+        {
+            return Err(format!("size {w}x{h}: 1..={MAX_IMAGE_SIDE} per side"));
+        }
+        if let Some(c) = &self.camera {
+            validate_camera(Vec3::from(c.eye), Vec3::from(c.target), c.fov_y_degrees)
+                .map_err(|e| format!("[camera]: {e}"))?;
+        }
+        if let Some(l) = &self.light {
+            validate_light(Vec3::from(l.direction)).map_err(|e| format!("[light]: {e}"))?;
+        }
+        if self.characters.is_empty() {
+            return Err("scene has no [[character]]".into());
+        }
+        if self.characters.len() > MAX_SCENE_CHARACTERS {
+            return Err(format!(
+                "{} characters, more than {MAX_SCENE_CHARACTERS}",
+                self.characters.len()
+            ));
+        }
+        for (i, c) in self.characters.iter().enumerate() {
+            let finite = c
+                .translation
+                .iter()
+                .all(|x| x.is_finite() && x.abs() <= MAX_TRANSLATION)
+                && c.rotation_y_degrees.is_finite();
+            let scale_ok = c.scale > 0.0 && c.scale <= MAX_SCALE;
+            if !finite || !scale_ok {
+                return Err(format!(
+                    "character {i}: transform must be finite (|translation| <= {MAX_TRANSLATION:e}) and scale in (0, {MAX_SCALE:e}]"
+                ));
+            }
+            let params = crate::render::StrandParams {
+                strands_per_bundle: c.strands_per_bundle,
+                verts_log2: c.verts_log2,
+            };
+            params
+                .validate()
+                .map_err(|e| format!("character {i}: {e}"))?;
+        }
+        Ok(())
     }
 }
 
