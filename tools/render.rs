@@ -191,15 +191,14 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
 
 /// `--camera`, else the scene's camera, else a view framing every character.
 fn pick_camera(args: &Args, inputs: &Inputs) -> Result<Camera> {
+    hairmesh::render::camera::validate_camera(Vec3::ZERO, Vec3::Z, args.fov)
+        .map_err(|e| anyhow::anyhow!("--fov: {e}"))?;
     if let Some(c) = &args.camera {
         let (eye, target) = c
             .split_once(':')
-            .with_context(|| format!("bad camera '{c}': expected eye:target"))?;
-        return Ok(Camera::look_at(
-            parse_vec3(eye)?,
-            parse_vec3(target)?,
-            args.fov,
-        ));
+            .with_context(|| format!("--camera '{c}': expected eye:target"))?;
+        return Camera::checked(parse_vec3(eye)?, parse_vec3(target)?, args.fov)
+            .map_err(|e| anyhow::anyhow!("--camera: {e}"));
     }
     if let Some(c) = inputs.scene_camera {
         return Ok(c);

@@ -103,11 +103,36 @@ impl Default for HairStyle {
     }
 }
 
+/// A TOML error as one line: `line N: message` (the key's line), without the source excerpt.
+pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
+    match e.span() {
+        Some(span) => {
+            let end = span.start.min(text.len());
+            let line = text.as_bytes()[..end]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1;
+            let key = text
+                .lines()
+                .nth(line - 1)
+                .and_then(|l| l.split('=').next())
+                .map(str::trim)
+                .filter(|k| !k.is_empty() && !k.starts_with('['))
+                .map(|k| format!(" ({k})"))
+                .unwrap_or_default();
+            format!("line {line}{key}: {}", e.message().trim())
+        }
+        None => e.message().trim().to_string(),
+    }
+}
+
 impl HairStyle {
     /// Parse a style from TOML text; `name` is used in errors.
     pub fn from_toml(name: &str, text: &str) -> Result<Self> {
-        let style: HairStyle = toml::from_str(text)
-            .map_err(|e| HairError::invalid(name, format!("bad style: {}", e.message())))?;
+        let style: HairStyle = toml::from_str(text).map_err(|e| {
+            HairError::invalid(name, format!("bad style: {}", toml_error(text, &e)))
+        })?;
         style.validate(name)?;
         Ok(style)
     }

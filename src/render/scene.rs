@@ -132,8 +132,12 @@ impl SceneDesc {
     /// Parse and validate scene TOML text; `name` names it in errors, relative paths are
     /// resolved against `base`.
     pub fn parse(name: &str, text: &str, base: &Path) -> Result<Self> {
-        let mut scene: SceneDesc = toml::from_str(text)
-            .map_err(|e| HairError::invalid(name, format!("bad scene: {}", e.message())))?;
+        let mut scene: SceneDesc = toml::from_str(text).map_err(|e| {
+            HairError::invalid(
+                name,
+                format!("bad scene: {}", crate::model::style::toml_error(text, &e)),
+            )
+        })?;
         scene
             .validate()
             .map_err(|what| HairError::invalid(name, what))?;

@@ -1,0 +1,337 @@
+//! Hostile use of the tools, through the real binaries: every bad output path, absurd argument,
+//! degenerate value and misleading input fails with a short message (at most three lines) that
+//! names the argument or file, a non-zero exit, no panic, and no output created or replaced.
+//! None of these cases reaches the GPU.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn run(bin: &str, args: &[&str]) -> Output {
+    // `timeout` turns a hang (e.g. a blocking FIFO) into a failure instead of a stuck test.
+    Command::new("timeout")
+        .arg("60")
+        .arg(bin)
+        .args(args)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap()
+}
+
+fn bake(args: &[&str]) -> Output {
+    run(env!("CARGO_BIN_EXE_bake"), args)
+}
+
+fn render(args: &[&str]) -> Output {
+    run(env!("CARGO_BIN_EXE_render"), args)
+}
+
+fn bench(args: &[&str]) -> Output {
+    run(env!("CARGO_BIN_EXE_bench"), args)
+}
+
+/// Failed with a non-zero exit (not a timeout), a short message naming `names`, no panic.
+#[track_caller]
+fn assert_fails(o: &Output, names: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    let code = o.status.code();
+    assert!(
+        code.is_some_and(|c| c != 0 && c != 124),
+        "exit {code:?} (124 = hang): {err}"
+    );
+    assert!(!err.contains("panicked"), "panic: {err}");
+    let lines = err.trim_end().lines().count();
+    assert!((1..=3).contains(&lines), "{lines} lines: {err}");
+    assert!(err.contains(names), "message should name '{names}': {err}");
+}
+
+/// A temporary folder with the small_patch sample (`m.obj`, `m.toml`) and its bake (`m.hmb`).
+fn workspace() -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("m.obj");
+    std::fs::copy(root().join("hairmeshes/small_patch.obj"), &obj).unwrap();
+    std::fs::copy(
+        root().join("hairmeshes/small_patch.toml"),
+        dir.path().join("m.toml"),
+    )
+    .unwrap();
+    let hmb = dir.path().join("m.hmb");
+    let o = bake(&[s(&obj), "-o", s(&hmb)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (dir, obj, hmb)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn mkfifo(p: &Path) {
+    assert!(Command::new("mkfifo").arg(p).status().unwrap().success());
+}
+
+#[test]
+fn outputs_never_replace_inputs_links_or_special_files() {
+    let (dir, obj, hmb) = workspace();
+    let obj_bytes = std::fs::read(&obj).unwrap();
+    let hmb_bytes = std::fs::read(&hmb).unwrap();
+    // The output is the input.
+    assert_fails(&bake(&[s(&obj), "-o", s(&obj)]), "is the input");
+    assert_fails(&render(&["--mesh", s(&hmb), "-o", s(&hmb)]), "is the input");
+    // ... through a hard link, and the style beside the mesh is an input too.
+    let hard = dir.path().join("hard.obj");
+    std::fs::hard_link(&obj, &hard).unwrap();
+    assert_fails(&bake(&[s(&obj), "-o", s(&hard)]), "is the input");
+    let style = dir.path().join("m.toml");
+    let style_bytes = std::fs::read(&style).unwrap();
+    assert_fails(&bake(&[s(&obj), "-o", s(&style)]), "is the input");
+    // A symbolic link given as the output is not followed or replaced.
+    let link = dir.path().join("link.hmb");
+    std::os::unix::fs::symlink(&hmb, &link).unwrap();
+    assert_fails(&bake(&[s(&obj), "-o", s(&link)]), "symbolic link");
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    // Folders and FIFOs are refused (a FIFO without a reader would block).
+    let sub = dir.path().join("sub.hmb");
+    std::fs::create_dir(&sub).unwrap();
+    assert_fails(&bake(&[s(&obj), "-o", s(&sub)]), "folder");
+    let fifo = dir.path().join("pipe.hmb");
+    mkfifo(&fifo);
+    assert_fails(&bake(&[s(&obj), "-o", s(&fifo)]), "FIFO");
+    // A missing output folder is named.
+    let nowhere = dir.path().join("no/such/out.hmb");
+    assert_fails(&bake(&[s(&obj), "-o", s(&nowhere)]), "does not exist");
+    assert_eq!(std::fs::read(&obj).unwrap(), obj_bytes);
+    assert_eq!(std::fs::read(&hmb).unwrap(), hmb_bytes);
+    assert_eq!(std::fs::read(&style).unwrap(), style_bytes);
+    // A character device such as /dev/null is written in place, not replaced.
+    let o = Command::new(env!("CARGO_BIN_EXE_bake"))
+        .args([s(&obj), "-o", "/dev/null"])
+        .output()
+        .unwrap();
+    // bake wants an extension; render does not.
+    assert_fails(&o, "extension");
+    let o = render(&["--mesh", s(&hmb), "--size", "16x16", "-o", "/dev/null"]);
+    assert!(
+        o.status.success(),
+        "render -o /dev/null: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let meta = std::fs::metadata("/dev/null").unwrap();
+    assert!(std::os::unix::fs::FileTypeExt::is_char_device(
+        &meta.file_type()
+    ));
+}
+
+#[test]
+fn a_stdout_that_cannot_be_written_is_an_error_not_a_panic() {
+    let (dir, obj, _) = workspace();
+    let out = dir.path().join("new.hmb");
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_bake"))
+        .args([s(&obj), "-o", s(&out)])
+        .stdout(full)
+        .output()
+        .unwrap();
+    assert_fails(&o, "stdout");
+    assert!(!out.exists(), "the report comes before the output file");
+}
+
+#[test]
+fn absurd_arguments_are_refused_before_allocating() {
+    let (dir, obj, _) = workspace();
+    let out = dir.path().join("x.hmb");
+    for (args, names) in [
+        (vec!["--extrude", "18446744073709551615"], "--extrude"),
+        (vec!["--extrude", "100000"], "--extrude"),
+        (vec!["--extrude", "4", "--gravity", "nan"], "--gravity"),
+        (vec!["--extrude", "4", "--step", "inf"], "--step"),
+        (vec!["--extrude", "4", "--step=-1"], "--step"),
+    ] {
+        let mut a = vec![s(&obj), "-o", s(&out)];
+        a.extend(args);
+        assert_fails(&bake(&a), names);
+        assert!(!out.exists());
+    }
+    let mesh = s(&obj);
+    for (args, names) in [
+        (
+            vec!["cpu-generate", "--mesh", mesh, "--strands", "4000000000"],
+            "--strands",
+        ),
+        (
+            vec![
+                "cpu-generate",
+                "--mesh",
+                mesh,
+                "--strands",
+                "10000000",
+                "--verts-log2",
+                "10",
+            ],
+            "--strands",
+        ),
+        (
+            vec!["cpu-generate", "--mesh", mesh, "--runs", "1000000"],
+            "--runs",
+        ),
+        (
+            vec!["cpu-generate", "--mesh", mesh, "--verts-log2", "40"],
+            "--verts-log2",
+        ),
+        (vec!["lod", "--mesh", mesh, "--width", "100000"], "--width"),
+        (vec!["crowd", "--counts", "0"], "--counts"),
+        (
+            vec!["crowd", "--strands-per-bundle", "5000"],
+            "--strands-per-bundle",
+        ),
+    ] {
+        assert_fails(&bench(&args), names);
+    }
+    for (args, names) in [
+        (
+            vec!["--strands-per-bundle", "100000"],
+            "--strands-per-bundle",
+        ),
+        (vec!["--verts-log2", "7"], "--verts-log2"),
+        (vec!["--vertex-pool-mib", "0"], "--vertex-pool-mib"),
+    ] {
+        let mut a = vec!["--mesh", mesh, "-o", s(&out)];
+        a.extend(args);
+        assert_fails(&render(&a), names);
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn special_and_oversized_input_files_are_refused() {
+    let (dir, _, _) = workspace();
+    let out = dir.path().join("x.hmb");
+    // A FIFO with no writer would block a reader forever.
+    let fifo = dir.path().join("pipe.obj");
+    mkfifo(&fifo);
+    assert_fails(&bake(&[s(&fifo), "-o", s(&out)]), "not a regular file");
+    assert_fails(
+        &bake(&[dir.path().to_str().unwrap(), "-o", s(&out)]),
+        "not a regular file",
+    );
+    // Style files are capped at 1 MiB.
+    let obj = dir.path().join("m.obj");
+    let big = dir.path().join("big.toml");
+    std::fs::write(&big, vec![b'#'; 2 << 20]).unwrap();
+    assert_fails(
+        &bake(&[s(&obj), "--style", s(&big), "-o", s(&out)]),
+        "limit",
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn degenerate_cameras_lights_and_scene_values_are_refused() {
+    let (dir, obj, hmb) = workspace();
+    let out = dir.path().join("x.png");
+    let mesh = s(&hmb);
+    for fov in ["0", "180", "nan", "inf", "-5"] {
+        let flag = format!("--fov={fov}");
+        assert_fails(&render(&["--mesh", mesh, &flag, "-o", s(&out)]), "--fov");
+    }
+    for cam in ["0,0,1:0,0,1", "nan,0,0:0,0,0", "0,0:0,0,1", "1,2,3,4:0,0,0"] {
+        let flag = format!("--camera={cam}");
+        assert_fails(&render(&["--mesh", mesh, &flag, "-o", s(&out)]), "--camera");
+    }
+    let scene = |body: &str| {
+        let p = dir.path().join("scene.toml");
+        std::fs::write(
+            &p,
+            format!("{body}\n[[character]]\nmesh = \"{}\"\n", obj.display()),
+        )
+        .unwrap();
+        p
+    };
+    for (body, names) in [
+        ("[light]\ndirection = [0.0, 0.0, 0.0]", "[light]"),
+        ("[light]\ndirection = [nan, 0.0, 1.0]", "[light]"),
+        ("size = [64, 64, 64]", "exactly 2"),
+        ("size = [0, 64]", "size"),
+        (
+            "[camera]\neye = [0.0, 0.0, 1.0]\ntarget = [0.0, 0.0, 1.0]",
+            "[camera]",
+        ),
+        (
+            "[camera]\neye = [0.0, 0.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y_degrees = 180.0",
+            "[camera]",
+        ),
+    ] {
+        let p = scene(body);
+        assert_fails(&render(&["--scene", s(&p), "-o", s(&out)]), names);
+    }
+    // A colour with four components is an error, not a dropped value.
+    let style = dir.path().join("four.toml");
+    std::fs::write(&style, "color = [0.1, 0.2, 0.3, 0.4]\n").unwrap();
+    let hmb_out = dir.path().join("y.hmb");
+    assert_fails(
+        &bake(&[s(&obj), "--style", s(&style), "-o", s(&hmb_out)]),
+        "exactly 3",
+    );
+    assert!(!out.exists() && !hmb_out.exists());
+}
+
+#[test]
+fn obj_layer_groups_and_coordinates_are_strict() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.hmb");
+    let quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+                vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+    let faces = "f 1/1 2/2 3/3 4/4\n";
+    let upper = "f 5/1 6/2 7/3 8/4\n";
+    for (name, text, names) in [
+        (
+            "leading_zero.obj",
+            format!("{quad}g layer0\n{faces}g layer01\n{upper}"),
+            "layer01",
+        ),
+        (
+            "outside.obj",
+            format!("{quad}{faces}g layer0\n{faces}g layer1\n{upper}"),
+            "outside any layer group",
+        ),
+        (
+            "huge.obj",
+            format!("v 1e25 0 0\n{quad}g layer0\n{faces}g layer1\n{upper}"),
+            "out of range",
+        ),
+    ] {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        assert_fails(&bake(&[s(&p), "-o", s(&out)]), names);
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn messages_name_the_argument_and_say_things_once() {
+    let (dir, _, hmb) = workspace();
+    let out = dir.path().join("x.png");
+    assert_fails(
+        &render(&["--mesh", s(&hmb), "--size", "10x10x10", "-o", s(&out)]),
+        "--size",
+    );
+    let missing = dir.path().join("missing.obj");
+    let o = bake(&[s(&missing), "-o", s(&dir.path().join("y.hmb"))]);
+    assert_fails(&o, "missing.obj");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        err.matches("No such file").count(),
+        1,
+        "the OS message once: {err}"
+    );
+}
