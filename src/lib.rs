@@ -8,6 +8,7 @@
 pub mod bake;
 pub mod error;
 pub mod fsutil;
+pub mod fuzz;
 pub mod model;
 pub mod reference;
 pub mod render;

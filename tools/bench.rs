@@ -74,6 +74,15 @@ enum Cmd {
         #[arg(long)]
         picture: Option<PathBuf>,
     },
+    /// Fuzz every reader (OBJ + bake, style TOML, scene TOML, .hmb) with seeded mutations.
+    Fuzz {
+        /// Inputs per reader.
+        #[arg(long, default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
+        iterations: u64,
+        /// Campaign seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// A crowd of mixed sample meshes on a ground plane seen from human height: GPU ms per
     /// pass, CPU ms to record a frame, peak RSS and GPU memory, for N characters, LoD on/off,
     /// both paths (and the mesh path with 1 vs 32 bundles per task workgroup).
@@ -435,6 +444,26 @@ fn main() {
 
 fn run(args: Args) -> Result<()> {
     match args.cmd {
+        Cmd::Fuzz { iterations, seed } => {
+            outln!("| reader | inputs | accepted | rejected | panics | slowest ms | seconds |")?;
+            outln!("|---|---|---|---|---|---|---|")?;
+            for reader in hairmesh::fuzz::Reader::ALL {
+                let start = Instant::now();
+                let r = hairmesh::fuzz::campaign(reader, iterations, seed);
+                outln!(
+                    "| {reader:?} | {} | {} | {} | {} | {:.1} | {:.1} |",
+                    r.inputs,
+                    r.accepted,
+                    r.rejected,
+                    r.panics.len(),
+                    r.slowest_ms,
+                    start.elapsed().as_secs_f64()
+                )?;
+                for (i, msg) in r.panics.iter().take(5) {
+                    outln!("  panic at input {i}: {msg}")?;
+                }
+            }
+        }
         Cmd::Crowd {
             counts,
             width,

@@ -1,0 +1,308 @@
+//! Structure-aware mutation fuzzing of every reader: the hair mesh OBJ reader (and the bake of
+//! what it accepts), style TOML, scene TOML and the baked `.hmb` reader.
+//!
+//! Valid seed files (the samples in `hairmeshes/`, a scene, a bake) are mutated with a seeded
+//! PCG: text readers get line edits (delete, duplicate, swap, insert statements from a
+//! dictionary of hostile lines), token replacement by hostile numbers (`nan`, `inf`, `1e38`,
+//! `-1`, `4294967296`, ...), truncation, byte flips and invalid UTF-8; `.hmb` files get header
+//! and `MeshInfo` fields set to extreme values, bit flips, truncation and growth, with the
+//! CRC recomputed half of the time so mutations reach the size checks behind it. Every input
+//! must be accepted or rejected with an error: a panic is a finding. `tests/fuzz.rs` runs a
+//! fixed-seed batch (with an allocation bound); `bench fuzz --iterations N` runs campaigns.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::Path;
+use std::time::Instant;
+
+use crate::rng::Pcg32;
+
+/// The readers under test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reader {
+    /// `obj_io::parse_hair_mesh_obj` (+ `bake` of small accepted meshes) and `parse_scalp`.
+    Obj,
+    /// `HairStyle::from_toml`.
+    Style,
+    /// `SceneDesc::parse`.
+    Scene,
+    /// `baked_file::from_bytes`.
+    Hmb,
+}
+
+impl Reader {
+    /// Every reader.
+    pub const ALL: [Reader; 4] = [Reader::Obj, Reader::Style, Reader::Scene, Reader::Hmb];
+}
+
+/// What a campaign found.
+#[derive(Clone, Debug, Default)]
+pub struct FuzzReport {
+    /// Inputs tried.
+    pub inputs: u64,
+    /// Inputs the reader accepted.
+    pub accepted: u64,
+    /// Inputs the reader rejected with an error.
+    pub rejected: u64,
+    /// Panic messages with the iteration that found them.
+    pub panics: Vec<(u64, String)>,
+    /// Slowest single input, milliseconds.
+    pub slowest_ms: f64,
+}
+
+const OBJ_SEEDS: [&str; 4] = [
+    include_str!("../hairmeshes/small_patch.obj"),
+    include_str!("../hairmeshes/triangle_tuft.obj"),
+    include_str!("../hairmeshes/sphere_fur.obj"),
+    include_str!("../hairmeshes/head_long.obj"),
+];
+const STYLE_SEEDS: [&str; 4] = [
+    include_str!("../hairmeshes/small_patch.toml"),
+    include_str!("../hairmeshes/triangle_tuft.toml"),
+    include_str!("../hairmeshes/sphere_fur.toml"),
+    include_str!("../hairmeshes/head_long.toml"),
+];
+const SCENE_SEED: &str = "size = [320, 240]\n[camera]\neye = [0.0, 0.1, 0.6]\n\
+    target = [0.0, -0.05, 0.0]\nfov_y_degrees = 40.0\n[light]\ndirection = [0.3, 1.0, 0.5]\n\
+    [[character]]\nmesh = \"a.obj\"\ntranslation = [0.1, 0.0, 0.0]\nrotation_y_degrees = 30.0\n\
+    scale = 1.5\nstrands_per_bundle = 64\nverts_log2 = 5\n[[character]]\nmesh = \"b.hmb\"\n\
+    style = \"b.toml\"\n";
+
+const HOSTILE_NUMBERS: [&str; 16] = [
+    "0",
+    "-0",
+    "-1",
+    "1",
+    "nan",
+    "inf",
+    "-inf",
+    "1e38",
+    "3.5e38",
+    "-1e38",
+    "1e-45",
+    "4294967295",
+    "4294967296",
+    "18446744073709551615",
+    "0.5",
+    "",
+];
+
+const HOSTILE_LINES: [&str; 24] = [
+    "g layer0",
+    "g layer1",
+    "g layer9",
+    "g layer01",
+    "g",
+    "g a b",
+    "f 1 2 3",
+    "f 1/1 2/2 3/3 4/4",
+    "f 1/1 99999/2 3/3",
+    "f -1/-1 -2/-2 -3/-3",
+    "f 1/1 1/1 1/1",
+    "v 0 0 0",
+    "v nan 0 0",
+    "v 1e30 1e30 1e30",
+    "vt 0 0 0",
+    "vt 0.5",
+    "curv 0 1 1 2",
+    "[[character]]",
+    "[camera]",
+    "size = [0, 0]",
+    "seed = -1",
+    "color = []",
+    "strands_per_bundle = 4294967295",
+    "mesh = \"/dev/zero\"",
+];
+
+fn pick<'a, T>(rng: &mut Pcg32, items: &'a [T]) -> &'a T {
+    &items[rng.next_u32() as usize % items.len()]
+}
+
+fn below(rng: &mut Pcg32, n: usize) -> usize {
+    if n == 0 {
+        0
+    } else {
+        rng.next_u32() as usize % n
+    }
+}
+
+/// One to four text mutations of `seed`.
+fn mutate_text(rng: &mut Pcg32, seed: &str) -> Vec<u8> {
+    let mut lines: Vec<String> = seed.lines().map(str::to_string).collect();
+    let rounds = 1 + below(rng, 4);
+    let mut bytes_mutation = None;
+    for _ in 0..rounds {
+        let n = lines.len();
+        match below(rng, 9) {
+            0 if n > 0 => {
+                lines.remove(below(rng, n));
+            }
+            1 if n > 0 => {
+                let i = below(rng, n);
+                let l = lines[i].clone();
+                lines.insert(below(rng, n + 1), l);
+            }
+            2 if n > 1 => {
+                let (a, b) = (below(rng, n), below(rng, n));
+                lines.swap(a, b);
+            }
+            3 => lines.insert(below(rng, n + 1), pick(rng, &HOSTILE_LINES).to_string()),
+            4..=6 if n > 0 => {
+                // Replace a token (number, key or index) with a hostile number.
+                let i = below(rng, n);
+                let mut toks: Vec<String> = lines[i].split(' ').map(str::to_string).collect();
+                let t = below(rng, toks.len());
+                let value = pick(rng, &HOSTILE_NUMBERS).to_string();
+                if let Some(slash) = toks[t].find('/')
+                    && rng.next_u32() % 2 == 0
+                {
+                    toks[t].replace_range(..slash, &value);
+                } else {
+                    toks[t] = value;
+                }
+                lines[i] = toks.join(" ");
+            }
+            7 => bytes_mutation = Some(below(rng, 3)),
+            _ => {
+                let n = lines.len();
+                lines.truncate(below(rng, n + 1));
+            }
+        }
+    }
+    let mut out = lines.join("\n").into_bytes();
+    out.push(b'\n');
+    match bytes_mutation {
+        Some(0) if !out.is_empty() => {
+            let i = below(rng, out.len());
+            out[i] ^= 1 << below(rng, 8);
+        }
+        Some(1) => {
+            let i = below(rng, out.len() + 1);
+            out.splice(i..i, [0xff, 0x00, 0xc3]);
+        }
+        Some(_) => {
+            let n = out.len();
+            out.truncate(below(rng, n + 1));
+        }
+        None => {}
+    }
+    out
+}
+
+/// One to three structure-aware mutations of a `.hmb` file.
+fn mutate_hmb(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
+    let mut out = seed.to_vec();
+    const EXTREMES: [u32; 8] = [0, 1, 2, 3, 0x7fff_ffff, 0xffff_ffff, 0x10000, 2049];
+    for _ in 0..1 + below(rng, 3) {
+        match below(rng, 6) {
+            // A u32 of the header or MeshInfo (offsets 8..24+64) set to an extreme.
+            0 | 1 => {
+                let at = 8 + 4 * below(rng, (24 + 64 - 8) / 4);
+                if at + 4 <= out.len() {
+                    let v = *pick(rng, &EXTREMES);
+                    out[at..at + 4].copy_from_slice(&v.to_le_bytes());
+                }
+            }
+            // A float field of MeshInfo or HairStyle set to NaN/inf/huge.
+            2 => {
+                let at = 24 + 4 * below(rng, (64 + 96) / 4);
+                let v = *pick(rng, &[f32::NAN, f32::INFINITY, -1e38, 1e38, 0.0, -1.0]);
+                if at + 4 <= out.len() {
+                    out[at..at + 4].copy_from_slice(&v.to_le_bytes());
+                }
+            }
+            3 if !out.is_empty() => {
+                let i = below(rng, out.len());
+                out[i] ^= 1 << below(rng, 8);
+            }
+            4 => {
+                let n = out.len();
+                out.truncate(below(rng, n + 1));
+            }
+            _ => out.extend((0..below(rng, 64)).map(|_| rng.next_u32() as u8)),
+        }
+    }
+    // Recompute length and CRC half of the time so the mutation reaches the checks behind them.
+    if out.len() >= 24 && rng.next_u32() % 2 == 0 {
+        let payload_len = (out.len() - 24) as u64;
+        out[16..24].copy_from_slice(&payload_len.to_le_bytes());
+        let crc = crc32fast::hash(&out[24..]);
+        out[12..16].copy_from_slice(&crc.to_le_bytes());
+    }
+    out
+}
+
+fn hmb_seed() -> Vec<u8> {
+    let mesh = crate::model::obj_io::parse_hair_mesh_obj("seed", OBJ_SEEDS[0].as_bytes())
+        .expect("sample OBJ parses");
+    let style = crate::HairStyle::from_toml("seed", STYLE_SEEDS[0]).expect("sample style");
+    let baked =
+        crate::bake(&mesh, &style, crate::BakeOptions::default(), |_, _| {}).expect("sample bakes");
+    crate::bake::baked_file::to_bytes(&baked)
+}
+
+/// Accepted (`true`), rejected (`false`) or a panic message.
+fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
+    let result = catch_unwind(AssertUnwindSafe(|| match reader {
+        Reader::Obj => {
+            let mesh = crate::model::obj_io::parse_hair_mesh_obj("fuzz.obj", input);
+            let _ = crate::model::obj_io::parse_scalp("fuzz.obj", input);
+            match mesh {
+                Ok(m) if m.vertex_count() <= 2000 => {
+                    let baked = crate::bake(
+                        &m,
+                        &crate::HairStyle::default(),
+                        crate::BakeOptions::default(),
+                        |_, _| {},
+                    );
+                    baked.is_ok()
+                }
+                Ok(_) => true,
+                Err(_) => false,
+            }
+        }
+        Reader::Style => std::str::from_utf8(input)
+            .ok()
+            .is_some_and(|t| crate::HairStyle::from_toml("fuzz.toml", t).is_ok()),
+        Reader::Scene => std::str::from_utf8(input).ok().is_some_and(|t| {
+            crate::render::scene::SceneDesc::parse("fuzz.toml", t, Path::new(".")).is_ok()
+        }),
+        Reader::Hmb => crate::bake::baked_file::from_bytes("fuzz.hmb", input).is_ok(),
+    }));
+    result.map_err(|p| {
+        p.downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| p.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "panic".into())
+    })
+}
+
+/// Run `iterations` mutated inputs through `reader`, seeded with `seed`.
+pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
+    let mut rng = Pcg32::new(seed ^ (reader as u64) << 32);
+    let hmb = (reader == Reader::Hmb).then(hmb_seed);
+    let mut report = FuzzReport::default();
+    for i in 0..iterations {
+        let input = match reader {
+            Reader::Obj => {
+                let seed = *pick(&mut rng, &OBJ_SEEDS);
+                mutate_text(&mut rng, seed)
+            }
+            Reader::Style => {
+                let seed = *pick(&mut rng, &STYLE_SEEDS);
+                mutate_text(&mut rng, seed)
+            }
+            Reader::Scene => mutate_text(&mut rng, SCENE_SEED),
+            Reader::Hmb => mutate_hmb(&mut rng, hmb.as_deref().unwrap_or_default()),
+        };
+        let start = Instant::now();
+        let outcome = run_one(reader, &input);
+        report.slowest_ms = report.slowest_ms.max(start.elapsed().as_secs_f64() * 1e3);
+        report.inputs += 1;
+        match outcome {
+            Ok(true) => report.accepted += 1,
+            Ok(false) => report.rejected += 1,
+            Err(msg) => report.panics.push((i, msg)),
+        }
+    }
+    report
+}
