@@ -153,7 +153,7 @@ fn mutate_text(rng: &mut Pcg32, seed: &str) -> Vec<u8> {
                 let t = below(rng, toks.len());
                 let value = pick(rng, &HOSTILE_NUMBERS).to_string();
                 if let Some(slash) = toks[t].find('/')
-                    && rng.next_u32() % 2 == 0
+                    && rng.next_u32().is_multiple_of(2)
                 {
                     toks[t].replace_range(..slash, &value);
                 } else {
@@ -222,7 +222,7 @@ fn mutate_hmb(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
         }
     }
     // Recompute length and CRC half of the time so the mutation reaches the checks behind them.
-    if out.len() >= 24 && rng.next_u32() % 2 == 0 {
+    if out.len() >= 24 && rng.next_u32().is_multiple_of(2) {
         let payload_len = (out.len() - 24) as u64;
         out[16..24].copy_from_slice(&payload_len.to_le_bytes());
         let crc = crc32fast::hash(&out[24..]);
