@@ -273,7 +273,7 @@ fn run() -> Result<()> {
     }
     for (name, style) in STYLES {
         let path: &Path = &out.join(format!("{name}.toml"));
-        hairmesh::fsutil::write_atomic(path, style.as_bytes())?;
+        hairmesh::fsutil::OutputPath::check(path, &[])?.write(style.as_bytes())?;
     }
     Ok(())
 }

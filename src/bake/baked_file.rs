@@ -52,9 +52,9 @@ pub fn to_bytes(baked: &BakedHairMesh) -> Vec<u8> {
     out
 }
 
-/// Write a bake to `path` atomically.
+/// Write a bake to `path` by the output policy of [`crate::fsutil::OutputPath`].
 pub fn save(baked: &BakedHairMesh, path: &Path) -> Result<()> {
-    crate::fsutil::write_atomic(path, &to_bytes(baked))
+    crate::fsutil::OutputPath::check(path, &[])?.write(&to_bytes(baked))
 }
 
 /// Read a bake from `path`.

@@ -434,5 +434,5 @@ pub fn write_hair_mesh_obj(mesh: &HairMesh, path: &Path, comment: &str) -> Resul
             writeln!(out).map_err(io)?;
         }
     }
-    crate::fsutil::write_atomic(path, &out)
+    crate::fsutil::OutputPath::check(path, &[])?.write(&out)
 }
