@@ -6,6 +6,7 @@
 //! shading, image) on the thin Vulkan layer [`vk`].
 
 pub mod bake;
+pub mod characters;
 pub mod error;
 pub mod fsutil;
 pub mod fuzz;

@@ -70,6 +70,7 @@ pub(crate) struct FrameSlot {
     pub fence: Fence,
     pub frame_ubo: Buffer,
     pub records: Buffer,
+    pub prop_instances: Buffer,
     pub stats_readback: Buffer,
     pub image_readback: Option<Buffer>,
     pub profiler: Profiler,
@@ -94,6 +95,7 @@ impl FrameSlot {
                 .host_visible(),
             )?,
             records: records_buffer(ctx, 1)?,
+            prop_instances: prop_instance_buffer(ctx, 1)?,
             stats_readback: Buffer::new(
                 ctx,
                 &BufferDesc::new(
@@ -111,6 +113,19 @@ impl FrameSlot {
             pending: None,
         })
     }
+}
+
+/// A host-visible buffer for `n` prop instances.
+pub(crate) fn prop_instance_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            "prop instances",
+            n.max(1) as u64 * size_of::<super::shared::PropInstance>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )
+        .host_visible(),
+    )
 }
 
 /// A host-visible buffer for `n` character records.

@@ -12,11 +12,17 @@ use glam::Mat4;
 
 use super::camera::View;
 use super::crowd::{CharacterId, Crowd, StrandParams};
-use super::frame::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Pending, Retired, records_buffer};
+use super::frame::{
+    FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Pending, Retired, prop_instance_buffer,
+    records_buffer,
+};
+use super::passes::props::PropDraw;
 use super::passes::{FrameInputs, FramePasses, PassSets};
 pub use super::settings::{FrameOptions, FrameTicket, RenderPath, RendererDesc};
 use super::shared::{FrameBinding, GenerateArgs, HairVertex, SET_FRAME, SET_TEXTURES};
+use super::shared::{PropInstance, PropVertex};
 use super::targets::RenderTargets;
+use super::workspace::FrameBuffers;
 use super::workspace::Workspace;
 use crate::bake::BakedHairMesh;
 use crate::model::style::HairStyle;
@@ -24,6 +30,35 @@ use crate::vk::{
     Access, BindingDesc, Buffer, BufferDesc, Context, DescriptorKind, DescriptorSetLayout,
     GpuError, GpuResult, PipelineLayout,
 };
+
+/// Prop meshes on the GPU and the instances placed for the next frames.
+#[derive(Default)]
+struct Props {
+    vertices: Option<Buffer>,
+    meshes: Vec<(u32, u32)>,
+    instances: Vec<(usize, PropInstance)>,
+}
+
+impl Props {
+    /// This frame's instance records (sorted by mesh) and one draw per mesh.
+    fn frame_lists(&self) -> (Vec<PropInstance>, Vec<PropDraw>) {
+        let records = self.instances.iter().map(|(_, i)| *i).collect();
+        let mut draws: Vec<PropDraw> = Vec::new();
+        for (k, (mesh, _)) in self.instances.iter().enumerate() {
+            let (first_vertex, vertex_count) = self.meshes[*mesh];
+            match draws.last_mut() {
+                Some(d) if d.first_vertex == first_vertex => d.instance_count += 1,
+                _ => draws.push(PropDraw {
+                    first_vertex,
+                    vertex_count,
+                    first_instance: k as u32,
+                    instance_count: 1,
+                }),
+            }
+        }
+        (records, draws)
+    }
+}
 
 /// Renders every character of the crowd in one frame.
 pub struct Renderer {
@@ -33,6 +68,7 @@ pub struct Renderer {
     frame_layout: Arc<DescriptorSetLayout>,
     passes: FramePasses,
     frames: Vec<FrameSlot>,
+    props: Props,
     next: usize,
     frame_number: u64,
     targets: RenderTargets,
@@ -100,6 +136,7 @@ impl Renderer {
             frame_layout,
             passes,
             frames,
+            props: Props::default(),
             next: 0,
             frame_number: 0,
             targets: RenderTargets::new(ctx, desc.width, desc.height)?,
@@ -165,6 +202,73 @@ impl Renderer {
     /// Change a character's strand settings.
     pub fn set_params(&mut self, id: CharacterId, params: StrandParams) -> GpuResult<()> {
         self.crowd.set_params(id, params)
+    }
+
+    /// Upload the prop meshes (triangle lists); instances refer to them by index. Replaces
+    /// earlier meshes and clears the instances.
+    pub fn set_prop_meshes(&mut self, meshes: &[Vec<PropVertex>]) -> GpuResult<()> {
+        let mut all = Vec::new();
+        let mut ranges = Vec::new();
+        for m in meshes {
+            if m.len() % 3 != 0 || m.iter().any(|v| !v.position.iter().all(|x| x.is_finite())) {
+                return Err(GpuError::Unsupported(
+                    "prop meshes are finite triangle lists".into(),
+                ));
+            }
+            ranges.push((all.len() as u32, m.len() as u32));
+            all.extend_from_slice(m);
+        }
+        let vertices = if all.is_empty() {
+            None
+        } else {
+            let bytes: &[u8] = bytemuck::cast_slice(&all);
+            let buffer = Buffer::new(
+                &self.ctx,
+                &BufferDesc::new(
+                    "prop vertices",
+                    bytes.len() as u64,
+                    vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                ),
+            )?;
+            let staging = Buffer::with_data(
+                &self.ctx,
+                "staging",
+                vk::BufferUsageFlags::TRANSFER_SRC,
+                bytes,
+            )?;
+            self.ctx.submit_and_wait(|rec| {
+                rec.copy_buffer(&staging, 0, &buffer, 0, bytes.len() as u64);
+            })?;
+            Some(buffer)
+        };
+        if let Some(old) = std::mem::replace(&mut self.props.vertices, vertices) {
+            self.retire(Retired::Resource(Box::new(old)));
+        }
+        self.props.meshes = ranges;
+        self.props.instances.clear();
+        Ok(())
+    }
+
+    /// Place props for the next frames: `(mesh index, instance)`.
+    pub fn set_prop_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
+        if let Some((m, _)) = instances
+            .iter()
+            .find(|(m, _)| *m >= self.props.meshes.len())
+        {
+            return Err(GpuError::Unsupported(format!("no prop mesh {m}")));
+        }
+        if instances.iter().any(|(_, i)| {
+            !i.model
+                .iter()
+                .flatten()
+                .chain(&i.color)
+                .all(|x| x.is_finite())
+        }) {
+            return Err(GpuError::Unsupported("prop transform is not finite".into()));
+        }
+        self.props.instances = instances.to_vec();
+        self.props.instances.sort_by_key(|(m, _)| *m);
+        Ok(())
     }
 
     /// Target size.
@@ -254,12 +358,20 @@ impl Renderer {
         if slot.records.size < slots as u64 * size_of::<super::shared::CharacterRecord>() as u64 {
             slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
         }
+        let instances = self.props.instances.len() as u32;
+        if slot.prop_instances.size < instances as u64 * size_of::<PropInstance>() as u64 {
+            slot.prop_instances = prop_instance_buffer(&self.ctx, instances.next_power_of_two())?;
+        }
         let slot = &self.frames[i];
         self.work.write_set(
             &slot.set,
-            &slot.frame_ubo,
-            &slot.records,
-            self.crowd.bundle_table(),
+            FrameBuffers {
+                frame_ubo: &slot.frame_ubo,
+                records: &slot.records,
+                prop_instances: &slot.prop_instances,
+                bundle_table: self.crowd.bundle_table(),
+                prop_vertices: self.props.vertices.as_ref(),
+            },
         )
     }
 
@@ -295,10 +407,13 @@ impl Renderer {
             self.vertex_budget(),
         );
         let records = self.crowd.records();
+        let (prop_instances, prop_draws) = self.props.frame_lists();
         {
             let slot = &mut self.frames[i];
             slot.frame_ubo.write(0, bytemuck::bytes_of(&block))?;
             slot.records.write(0, bytemuck::cast_slice(&records))?;
+            slot.prop_instances
+                .write(0, bytemuck::cast_slice(&prop_instances))?;
             let image_bytes = width as u64 * height as u64 * 4;
             if opts.read_image
                 && slot
@@ -318,7 +433,7 @@ impl Renderer {
             }
         }
         let start = Instant::now();
-        self.record(i, path, bundles, opts)?;
+        self.record(i, path, bundles, opts, &prop_draws)?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
         let slot = &mut self.frames[i];
         slot.fence.reset()?;
@@ -348,6 +463,7 @@ impl Renderer {
         path: RenderPath,
         bundles: u32,
         opts: &FrameOptions,
+        props: &[PropDraw],
     ) -> GpuResult<()> {
         let slot = &mut self.frames[i];
         let bg = self.background;
@@ -366,6 +482,7 @@ impl Renderer {
             args: &self.work.args,
             targets: &mut self.targets,
             clear: opts.clear.then_some([bg[0], bg[1], bg[2], 1.0]),
+            props,
         };
         self.passes.record(
             &mut rec,

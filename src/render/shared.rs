@@ -56,11 +56,15 @@ pub enum FrameBinding {
     Args = 7,
     /// `HairVertex[]`: the compute path's generated-vertex pool.
     Vertices = 8,
+    /// `PropVertex[]`: static triangle meshes (bodies, ground).
+    PropVertices = 9,
+    /// `PropInstance[]`: this frame's placed props.
+    PropInstances = 10,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 9] = [
+    pub const ALL: [(FrameBinding, &'static str); 11] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -70,6 +74,8 @@ impl FrameBinding {
         (FrameBinding::ScanScratch, "BINDING_SCAN_SCRATCH"),
         (FrameBinding::Args, "BINDING_ARGS"),
         (FrameBinding::Vertices, "BINDING_VERTICES"),
+        (FrameBinding::PropVertices, "BINDING_PROP_VERTICES"),
+        (FrameBinding::PropInstances, "BINDING_PROP_INSTANCES"),
     ];
 }
 
@@ -326,6 +332,30 @@ pub struct HairVertex {
 
 gpu_struct!(HairVertex as "HairVertex" { pos_width: "vec4", tangent_s: "vec4" });
 
+/// A vertex of a prop mesh (bodies, ground): triangle lists, object space.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct PropVertex {
+    /// xyz position, w 1.
+    pub position: [f32; 4],
+    /// xyz unit normal, w 0.
+    pub normal: [f32; 4],
+}
+
+gpu_struct!(PropVertex as "PropVertex" { position: "vec4", normal: "vec4" });
+
+/// One placed prop: transform and colour.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct PropInstance {
+    /// Object to world.
+    pub model: [[f32; 4]; 4],
+    /// rgb linear colour, a unused.
+    pub color: [f32; 4],
+}
+
+gpu_struct!(PropInstance as "PropInstance" { model: "mat4", color: "vec4" });
+
 /// Task shader -> mesh shader payload: up to [`TASK_PAYLOAD_BUNDLES`] visible bundles of one
 /// task workgroup, compacted, with the first mesh workgroup of each.
 #[repr(C)]
@@ -390,6 +420,8 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<FrameStats>(),
         info::<GenerateArgs>(),
         info::<HairVertex>(),
+        info::<PropVertex>(),
+        info::<PropInstance>(),
         info::<TaskPayload>(),
     ]
 }

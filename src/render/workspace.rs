@@ -20,6 +20,20 @@ fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
     )
 }
 
+/// The buffers of set 0 that are not the workspace's own.
+pub struct FrameBuffers<'a> {
+    /// The frame slot's `FrameBlock`.
+    pub frame_ubo: &'a Buffer,
+    /// The frame slot's character records.
+    pub records: &'a Buffer,
+    /// The frame slot's prop instances.
+    pub prop_instances: &'a Buffer,
+    /// The crowd's bundle table, once there are characters.
+    pub bundle_table: Option<&'a Buffer>,
+    /// The prop meshes, once set.
+    pub prop_vertices: Option<&'a Buffer>,
+}
+
 /// The working buffers.
 pub struct Workspace {
     ctx: Arc<Context>,
@@ -109,19 +123,14 @@ impl Workspace {
     }
 
     /// Point every binding of a frame's set 0 at its buffer.
-    pub fn write_set(
-        &self,
-        set: &DescriptorSet,
-        frame_ubo: &Buffer,
-        records: &Buffer,
-        bundle_table: Option<&Buffer>,
-    ) -> GpuResult<()> {
-        let bundles = bundle_table.unwrap_or(&self.placeholder);
+    pub fn write_set(&self, set: &DescriptorSet, frame: FrameBuffers) -> GpuResult<()> {
+        let bundles = frame.bundle_table.unwrap_or(&self.placeholder);
+        let prop_vertices = frame.prop_vertices.unwrap_or(&self.placeholder);
         let pool = self.pool.as_ref().unwrap_or(&self.placeholder);
         for (b, _) in FrameBinding::ALL {
             let buffer = match b {
-                FrameBinding::Frame => frame_ubo,
-                FrameBinding::Characters => records,
+                FrameBinding::Frame => frame.frame_ubo,
+                FrameBinding::Characters => frame.records,
                 FrameBinding::Bundles => bundles,
                 FrameBinding::RootSamples => &self.root_samples,
                 FrameBinding::BundleLods => &self.lods,
@@ -129,6 +138,8 @@ impl Workspace {
                 FrameBinding::ScanScratch => &self.scan,
                 FrameBinding::Args => &self.args,
                 FrameBinding::Vertices => pool,
+                FrameBinding::PropVertices => prop_vertices,
+                FrameBinding::PropInstances => frame.prop_instances,
             };
             set.write_buffer(b as u32, buffer)?;
         }

@@ -174,6 +174,23 @@ impl CommandRecorder<'_> {
         unsafe { self.ctx.device.cmd_draw(self.raw, vertices, 1, 0, 0) };
     }
 
+    /// Draw `instances` instances of `vertices` vertices starting at `first_vertex`, with
+    /// instance indices from `first_instance`.
+    pub fn draw_instanced(
+        &mut self,
+        vertices: u32,
+        instances: u32,
+        first_vertex: u32,
+        first_instance: u32,
+    ) {
+        // SAFETY: recording inside a rendering instance with a bound graphics pipeline.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_draw(self.raw, vertices, instances, first_vertex, first_instance)
+        };
+    }
+
     /// Draw with one `VkDrawIndirectCommand` at `offset` of `args`.
     pub fn draw_indirect(&mut self, args: &Buffer, offset: u64) {
         // SAFETY: recording inside a rendering instance.

@@ -36,6 +36,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("strands.frag", include_str!("../../glsl/strands.frag")),
     ("scalp.vert", include_str!("../../glsl/scalp.vert")),
     ("scalp.frag", include_str!("../../glsl/scalp.frag")),
+    ("props.vert", include_str!("../../glsl/props.vert")),
+    ("props.frag", include_str!("../../glsl/props.frag")),
 ];
 
 fn source(name: &str) -> Option<&'static str> {

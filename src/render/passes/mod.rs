@@ -2,6 +2,7 @@
 //! what it reads and writes.
 
 pub mod compute_generate;
+pub mod props;
 pub mod scalp;
 pub mod strands;
 
@@ -15,6 +16,7 @@ use crate::vk::{
     MeshPrimitivesQuery, PipelineLayout, Profiler, shader::ShaderOptions,
 };
 use compute_generate::ComputeGenerate;
+use props::{PropDraw, PropPass};
 use scalp::ScalpPass;
 use strands::StrandDraw;
 
@@ -63,12 +65,15 @@ pub struct FrameInputs<'a> {
     pub targets: &'a mut RenderTargets,
     /// Clear colour, or `None` to draw over the previous contents.
     pub clear: Option<[f32; 4]>,
+    /// Props to draw (bodies, ground).
+    pub props: &'a [PropDraw],
 }
 
 /// The passes of a frame, in order: statistics reset, generation (compute path), the opaque
-/// hair pass (scalps + strands; the mesh path generates inside it).
+/// pass (props, scalps, strands; the mesh path generates inside it).
 pub struct FramePasses {
     generate: ComputeGenerate,
+    props: PropPass,
     scalp: ScalpPass,
     strands: StrandDraw,
 }
@@ -82,6 +87,7 @@ impl FramePasses {
     ) -> GpuResult<Self> {
         Ok(FramePasses {
             generate: ComputeGenerate::new(ctx, layout)?,
+            props: PropPass::new(ctx, layout, COLOR_FORMAT, DEPTH_FORMAT)?,
             scalp: ScalpPass::new(ctx, layout, COLOR_FORMAT, DEPTH_FORMAT)?,
             strands: StrandDraw::new(ctx, layout, COLOR_FORMAT, DEPTH_FORMAT, task_bundles)?,
         })
@@ -140,6 +146,7 @@ impl FramePasses {
             },
         );
         let mut result = Ok(());
+        self.props.record(rec, inp.sets, inp.props);
         if inp.bundles > 0 {
             self.scalp.record(rec, inp.sets, inp.bundles);
             if mesh {

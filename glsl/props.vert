@@ -1,0 +1,20 @@
+#version 460
+// Props (bodies, ground): static triangle lists pulled from the prop vertex buffer, one
+// instance record (transform, colour) per placed prop.
+#extension GL_GOOGLE_include_directive : require
+#include "bindings.glsl"
+
+layout(set = SET_FRAME, binding = BINDING_PROP_VERTICES, std430) readonly buffer PropVertices { PropVertex prop_vertices[]; };
+layout(set = SET_FRAME, binding = BINDING_PROP_INSTANCES, std430) readonly buffer PropInstances { PropInstance prop_instances[]; };
+
+layout(location = 0) out vec3 out_normal;
+layout(location = 1) flat out vec3 out_color;
+
+void main() {
+    PropVertex v = prop_vertices[gl_VertexIndex];
+    PropInstance inst = prop_instances[gl_InstanceIndex];
+    vec4 world = inst.model * vec4(v.position.xyz, 1.0);
+    out_normal = normalize(mat3(inst.model) * v.normal.xyz);
+    out_color = inst.color.rgb;
+    gl_Position = frame.view_proj * world;
+}

@@ -1,0 +1,157 @@
+//! Crowd presets: `count` characters from a seed, each with its own hairstyle, placed on a grid
+//! on the ground with some jitter and a random heading, plus the props (ground, bodies) they
+//! stand on.
+
+use glam::{Mat4, Quat, Vec3};
+
+use super::hairstyle::{Hairstyle, StyleFamily, generate};
+use super::head::{HeadShape, body_mesh, ground_mesh};
+use crate::error::{HairError, Result};
+use crate::render::shared::{PropInstance, PropVertex};
+use crate::rng::Pcg32;
+
+/// Most characters a preset makes.
+pub const MAX_CROWD: usize = 4096;
+
+/// Which characters a crowd has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Preset {
+    /// People with the seven hairstyle families.
+    People,
+    /// People and furry balls.
+    Mixed,
+}
+
+impl std::str::FromStr for Preset {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "people" => Ok(Preset::People),
+            "mixed" => Ok(Preset::Mixed),
+            _ => Err(format!("unknown preset '{s}' (people, mixed)")),
+        }
+    }
+}
+
+/// What a character stands on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Body {
+    /// Head, neck, shoulders and body ([`body_mesh`]).
+    Person,
+    /// A ball the fur grows on.
+    Ball,
+}
+
+/// One character of a crowd.
+pub struct CrowdCharacter {
+    /// Its hairstyle (hair mesh + style), in the character's own frame.
+    pub hair: Hairstyle,
+    /// Character to world.
+    pub model: Mat4,
+    /// Its body.
+    pub body: Body,
+    /// Skin (or ball) colour, linear RGB.
+    pub skin: [f32; 3],
+}
+
+/// The head every person has.
+pub fn person_head() -> HeadShape {
+    HeadShape::default()
+}
+
+/// The ball furry characters are.
+pub fn ball_head() -> HeadShape {
+    HeadShape {
+        centre: Vec3::new(0.0, 0.17, 0.0),
+        radii: Vec3::splat(0.16),
+    }
+}
+
+/// Grid spacing in metres.
+pub const SPACING: f32 = 0.9;
+
+/// Build `count` characters of `preset` from `seed`.
+pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharacter>> {
+    if count == 0 || count > MAX_CROWD {
+        return Err(HairError::invalid(
+            "crowd",
+            format!("count {count} outside 1..={MAX_CROWD}"),
+        ));
+    }
+    let mut rng = Pcg32::new(seed as u64);
+    let side = (count as f32).sqrt().ceil() as usize;
+    const SKIN: [[f32; 3]; 5] = [
+        [0.62, 0.43, 0.33],
+        [0.45, 0.28, 0.18],
+        [0.25, 0.14, 0.08],
+        [0.7, 0.52, 0.42],
+        [0.55, 0.36, 0.24],
+    ];
+    let mut out = Vec::with_capacity(count);
+    for i in 0..count {
+        let ball = preset == Preset::Mixed && i % 4 == 3;
+        let character_seed = seed.wrapping_mul(0x9E37_79B9).wrapping_add(i as u32);
+        let (family, head, body) = if ball {
+            (StyleFamily::Fur, ball_head(), Body::Ball)
+        } else {
+            let f = StyleFamily::PEOPLE[(i + (seed as usize)) % StyleFamily::PEOPLE.len()];
+            (f, person_head(), Body::Person)
+        };
+        let hair = generate(family, character_seed, &head)?;
+        let x = (i % side) as f32 - (side as f32 - 1.0) * 0.5;
+        let z = (i / side) as f32;
+        let jitter = Vec3::new(rng.next_f32() - 0.5, 0.0, rng.next_f32() - 0.5) * 0.3;
+        let yaw = (rng.next_f32() - 0.5) * 2.4 + std::f32::consts::PI;
+        let model = Mat4::from_rotation_translation(
+            Quat::from_rotation_y(yaw),
+            Vec3::new(x, 0.0, z) * SPACING + jitter,
+        );
+        let skin = if ball {
+            hair.style.color.map(|c| c * 0.8)
+        } else {
+            SKIN[rng.next_u32() as usize % SKIN.len()]
+        };
+        out.push(CrowdCharacter {
+            hair,
+            model,
+            body,
+            skin,
+        });
+    }
+    Ok(out)
+}
+
+/// Prop meshes of crowds: 0 the ground, 1 a person's body, 2 a ball.
+pub fn prop_meshes() -> Vec<Vec<PropVertex>> {
+    let ball = ball_head();
+    vec![
+        ground_mesh(60.0),
+        body_mesh(&person_head()),
+        super::head::sphere_mesh(ball.centre, ball.radii * 0.985),
+    ]
+}
+
+/// Prop instances for `characters`: the ground and one body each.
+pub fn prop_instances(characters: &[CrowdCharacter]) -> Vec<(usize, PropInstance)> {
+    let mut out = vec![(
+        0,
+        PropInstance {
+            model: Mat4::IDENTITY.to_cols_array_2d(),
+            color: [0.32, 0.34, 0.3, 1.0],
+        },
+    )];
+    for c in characters {
+        let mesh = match c.body {
+            Body::Person => 1,
+            Body::Ball => 2,
+        };
+        out.push((
+            mesh,
+            PropInstance {
+                model: c.model.to_cols_array_2d(),
+                color: [c.skin[0], c.skin[1], c.skin[2], 1.0],
+            },
+        ));
+    }
+    out
+}

@@ -1,0 +1,63 @@
+//! Props: static triangle meshes placed by instance records (character bodies, the ground).
+//! Reads: frame block, prop vertices, prop instances. Writes: colour and depth.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{PassSets, shader_options};
+use crate::vk::shader::compile;
+use crate::vk::{CommandRecorder, Context, GpuResult, GraphicsDesc, Pipeline, PipelineLayout};
+
+/// One instanced draw: a mesh's vertex range and a run of instances.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PropDraw {
+    /// First vertex of the mesh in the prop vertex buffer.
+    pub first_vertex: u32,
+    /// Vertices of the mesh (a triangle list).
+    pub vertex_count: u32,
+    /// First instance record.
+    pub first_instance: u32,
+    /// Instances.
+    pub instance_count: u32,
+}
+
+/// The prop pipeline.
+pub struct PropPass {
+    pipeline: Pipeline,
+}
+
+impl PropPass {
+    /// Compile the pipeline for the given target formats.
+    pub fn new(
+        ctx: &Arc<Context>,
+        layout: &Arc<PipelineLayout>,
+        color: vk::Format,
+        depth: vk::Format,
+    ) -> GpuResult<Self> {
+        let opts = shader_options(1);
+        let (v, f) = (compile("props.vert", &opts)?, compile("props.frag", &opts)?);
+        let desc = GraphicsDesc::new("props", color, depth)
+            .stage(vk::ShaderStageFlags::VERTEX, &v)
+            .stage(vk::ShaderStageFlags::FRAGMENT, &f);
+        Ok(PropPass {
+            pipeline: Pipeline::graphics(ctx, layout, &desc)?,
+        })
+    }
+
+    /// Draw `draws` (inside rendering).
+    pub fn record(&self, rec: &mut CommandRecorder, sets: PassSets, draws: &[PropDraw]) {
+        if draws.is_empty() {
+            return;
+        }
+        rec.bind(&self.pipeline, &sets.both());
+        for d in draws {
+            rec.draw_instanced(
+                d.vertex_count,
+                d.instance_count,
+                d.first_vertex,
+                d.first_instance,
+            );
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! `crowd`: hundreds of characters, each with its own generated hairstyle, on the one-frame
+//! renderer. Headless mode renders an orbit around the crowd to PNGs plus a CSV of per-frame
+//! statistics:
+//!
+//! ```text
+//! crowd --headless --frames 3 --count 16 --size 640x360 --out frames/
+//! ```
+//!
+//! The window mode (winit + swapchain + control panel) is the next step of this tool.
+
+use std::io::Write as _;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result, bail};
+use clap::Parser;
+use glam::Vec3;
+use hairmesh::characters::preset::{self, Preset, SPACING};
+use hairmesh::fsutil::OutputPath;
+use hairmesh::render::{
+    Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
+};
+use hairmesh::vk::{Context, ContextDesc};
+use hairmesh::{BakeOptions, outln};
+
+/// A crowd of characters with unique generated hair.
+#[derive(Parser)]
+#[command(version, about)]
+struct Args {
+    /// Render without a window to PNG files (the window mode is not built yet).
+    #[arg(long)]
+    headless: bool,
+    /// Frames to render (headless).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    frames: u32,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "960x540")]
+    size: String,
+    /// Output folder for frame PNGs and stats.csv (headless).
+    #[arg(long, default_value = "crowd_frames")]
+    out: PathBuf,
+    /// Scene preset: people or mixed (people and furry balls).
+    #[arg(long, default_value = "people")]
+    preset: Preset,
+    /// Number of characters.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=preset::MAX_CROWD as i64))]
+    count: u32,
+    /// Seed of the hairstyles and placement.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Strands per average bundle.
+    #[arg(long, default_value_t = 24, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    strands_per_bundle: u32,
+    /// Vertices per strand are 2^e + 1 (e in 0..=6).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=6))]
+    verts_log2: u32,
+    /// Level of detail.
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    lod: String,
+    /// Generation path (default: mesh where supported).
+    #[arg(long, value_parser = ["mesh", "compute"])]
+    path: Option<String>,
+    /// Choose the GPU by name substring.
+    #[arg(long)]
+    device: Option<String>,
+    /// Enable Vulkan validation layers (any error fails the run).
+    #[arg(long)]
+    validation: bool,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let max = hairmesh::render::scene::MAX_IMAGE_SIDE;
+    let bad = || anyhow::anyhow!("--size '{s}': expected WIDTHxHEIGHT with 1..={max} per side");
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    if w == 0 || h == 0 || w > max || h > max {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+/// The camera of frame `f`: orbiting the crowd's centre at eye height, far enough to see it.
+fn orbit_camera(count: u32, f: u32) -> Camera {
+    let side = (count as f32).sqrt().ceil();
+    let centre = Vec3::new(0.0, 1.2, (side - 1.0) * 0.5 * SPACING);
+    let radius = (side * SPACING * 0.75).max(1.6);
+    let angle = std::f32::consts::PI + f as f32 * 0.05;
+    let eye = centre + Vec3::new(angle.sin() * radius, 0.6 + 0.1 * side, angle.cos() * radius);
+    Camera::look_at(eye, centre, 45.0)
+}
+
+fn run(args: Args) -> Result<()> {
+    if !args.headless {
+        bail!("the window mode is not built yet; run with --headless (see README)");
+    }
+    let (width, height) = parse_size(&args.size)?;
+    if args.out.exists() && !args.out.is_dir() {
+        bail!("--out {}: not a folder", args.out.display());
+    }
+    let start = Instant::now();
+    let characters = preset::build(args.preset, args.count as usize, args.seed)?;
+    let params = StrandParams {
+        strands_per_bundle: args.strands_per_bundle,
+        verts_log2: args.verts_log2,
+    };
+    let mut baked = Vec::with_capacity(characters.len());
+    for c in &characters {
+        baked.push(hairmesh::bake(
+            &c.hair.mesh,
+            &c.hair.style,
+            BakeOptions::default(),
+            |_, _| {},
+        )?);
+    }
+    let generate_s = start.elapsed().as_secs_f64();
+    let ctx = Arc::new(Context::new(
+        &ContextDesc::default()
+            .validation(args.validation)
+            .device(args.device.clone()),
+    )?);
+    let path = args.path.as_deref().map(|p| match p {
+        "mesh" => RenderPath::Mesh,
+        _ => RenderPath::Compute,
+    });
+    let mut renderer = Renderer::new(
+        &ctx,
+        &RendererDesc::default().size(width, height).path(path),
+    )?;
+    for (c, b) in characters.iter().zip(&baked) {
+        renderer.add_character(b, &c.hair.style, params, c.model)?;
+    }
+    renderer.set_prop_meshes(&preset::prop_meshes())?;
+    renderer.set_prop_instances(&preset::prop_instances(&characters))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("--out {}: cannot create the folder", args.out.display()))?;
+    let csv_path = args.out.join("stats.csv");
+    let csv_out = OutputPath::check(&csv_path, &[])?;
+    let mut csv = String::from(
+        "frame,gpu_ms,record_ms,wall_ms,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
+    );
+    outln!(
+        "device: {} ({}); {} characters ({:?}), generated and baked in {generate_s:.2} s, textures {:.1} MiB",
+        ctx.info.name,
+        ctx.info.driver,
+        characters.len(),
+        args.preset,
+        renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64
+    )?;
+    let lod = if args.lod == "on" {
+        LodSettings::default()
+    } else {
+        LodSettings::off()
+    };
+    for f in 0..args.frames {
+        let view = View {
+            camera: orbit_camera(args.count, f),
+            light_dir: Vec3::new(0.4, 1.0, 0.3),
+            lod,
+        };
+        let t = Instant::now();
+        let report = renderer.render_one(
+            &view,
+            &FrameOptions {
+                read_image: true,
+                ..Default::default()
+            },
+        )?;
+        let wall_ms = t.elapsed().as_secs_f64() * 1e3;
+        if ctx.validation_errors() > 0 {
+            bail!(
+                "{} Vulkan validation error(s) in frame {f}; no image written",
+                ctx.validation_errors()
+            );
+        }
+        let s = report.stats;
+        let passes: Vec<String> = report
+            .pass_ms
+            .iter()
+            .map(|(n, ms)| format!("{n}={ms:.2}"))
+            .collect();
+        csv.push_str(&format!(
+            "{f},{:.3},{:.3},{wall_ms:.1},{},{},{},{},{},{}\n",
+            report.gpu_ms(),
+            report.record_ms,
+            s.strands_drawn,
+            s.strands_demanded,
+            s.triangles_drawn,
+            s.vertex_slots_written,
+            s.vertex_slots_demanded,
+            passes.join(" ")
+        ));
+        outln!(
+            "frame {f}: {:?} path, {} strands, {} triangles, GPU {:.1} ms ({}), record {:.3} ms",
+            report.path,
+            s.strands_drawn,
+            s.triangles_drawn,
+            report.gpu_ms(),
+            passes.join(", "),
+            report.record_ms
+        )?;
+        let rgba = report.rgba.context("no image read back")?;
+        let img = image::RgbaImage::from_raw(width, height, rgba).context("image size")?;
+        let mut png = Vec::new();
+        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+        OutputPath::check(&args.out.join(format!("frame_{f:05}.png")), &[])?.write(&png)?;
+    }
+    csv_out.write(csv.as_bytes())?;
+    outln!("wrote {} frames and {}", args.frames, csv_path.display())?;
+    Ok(())
+}
+
+fn main() {
+    if let Err(e) = run(Args::parse()) {
+        let _ = std::io::stdout().flush();
+        hairmesh::fsutil::exit_with_error("crowd", &e, 1);
+    }
+}
