@@ -43,6 +43,9 @@ fn headless_crowd_renders_frames_and_stats() {
         // Non-empty: many pixels differ from the background colour of the top-left corner.
         let bg = *img.get_pixel(0, 0);
         let differ = img.pixels().filter(|p| **p != bg).count();
-        assert!(differ > 320 * 180 / 4, "frame {f}: only {differ} non-background pixels");
+        assert!(
+            differ > 320 * 180 / 4,
+            "frame {f}: only {differ} non-background pixels"
+        );
     }
 }

@@ -10,7 +10,13 @@ fn bakes(count: usize, seed: u32) -> Vec<Vec<u8>> {
         .unwrap()
         .iter()
         .map(|c| {
-            let b = bake(&c.hair.mesh, &c.hair.style, BakeOptions::default(), |_, _| {}).unwrap();
+            let b = bake(
+                &c.hair.mesh,
+                &c.hair.style,
+                BakeOptions::default(),
+                |_, _| {},
+            )
+            .unwrap();
             baked_file::to_bytes(&b)
         })
         .collect()

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One-time machine setup for building and testing (Debian 12 "bookworm"). Idempotent.
 #
-# Installs: Mesa's lavapipe (software Vulkan with VK_EXT_mesh_shader, from bookworm-backports),
+# Installs: Xvfb (the crowd window test runs under it), Mesa's lavapipe (software Vulkan with VK_EXT_mesh_shader, from bookworm-backports),
 # the Vulkan loader and validation layers, Debian's libshaderc (so the shaderc crate links it
 # instead of compiling glslang from source), and checks the Rust toolchain.
 #
@@ -55,7 +55,7 @@ $SUDO apt-get install -y -qq --no-install-recommends \
     -t "$codename-backports" mesa-vulkan-drivers >/dev/null
 $SUDO apt-get install -y -qq --no-install-recommends \
     libvulkan1 libvulkan-dev vulkan-validationlayers vulkan-tools \
-    libshaderc-dev glslang-dev spirv-tools pkg-config >/dev/null
+    libshaderc-dev glslang-dev spirv-tools pkg-config xvfb xauth >/dev/null
 
 # Lavapipe must advertise mesh shaders (Mesa >= 25 from backports).
 if command -v vulkaninfo >/dev/null; then

@@ -323,6 +323,20 @@ impl Crowd {
             .sum()
     }
 
+    /// Handles of every live character.
+    pub fn ids(&self) -> Vec<CharacterId> {
+        self.slots
+            .iter()
+            .enumerate()
+            .filter_map(|(slot, c)| {
+                c.as_ref().map(|c| CharacterId {
+                    slot: slot as u32,
+                    generation: c.generation,
+                })
+            })
+            .collect()
+    }
+
     /// Live characters.
     pub fn len(&self) -> usize {
         self.slots.iter().flatten().count()

@@ -17,5 +17,5 @@ pub mod workspace;
 pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use frame::{FRAMES_IN_FLIGHT, FrameReport};
-pub use renderer::{FrameOptions, FrameTicket, RenderPath, Renderer, RendererDesc};
+pub use renderer::{FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc};
 pub use shared::FrameStats;

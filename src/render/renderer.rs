@@ -28,8 +28,19 @@ use crate::bake::BakedHairMesh;
 use crate::model::style::HairStyle;
 use crate::vk::{
     Access, BindingDesc, Buffer, BufferDesc, Context, DescriptorKind, DescriptorSetLayout,
-    GpuError, GpuResult, PipelineLayout,
+    GpuError, GpuResult, PipelineLayout, Semaphore, SwapchainImage,
 };
+
+/// Where a windowed frame goes: a swapchain image, the semaphore its acquisition signals and
+/// the one presentation waits for.
+pub struct PresentTarget<'a> {
+    /// The acquired image.
+    pub image: &'a SwapchainImage,
+    /// Signalled when the image may be written.
+    pub wait: &'a Semaphore,
+    /// Signalled when the frame is done (presentation waits for it).
+    pub signal: &'a Semaphore,
+}
 
 /// Prop meshes on the GPU and the instances placed for the next frames.
 #[derive(Default)]
@@ -378,6 +389,24 @@ impl Renderer {
     /// Record and submit one frame of every visible character seen from `view`. Waits only
     /// for the frame submitted [`FRAMES_IN_FLIGHT`] frames ago.
     pub fn render_frame(&mut self, view: &View, opts: &FrameOptions) -> GpuResult<FrameTicket> {
+        self.render_frame_to(view, opts, None)
+    }
+
+    /// Wait until the frame slot the next frame will use is free (its previous frame
+    /// completed); a window loop calls this before acquiring a swapchain image, so the
+    /// semaphores it passes are no longer in use.
+    pub fn wait_for_free_slot(&mut self) -> GpuResult<()> {
+        self.retire_slot(self.next)
+    }
+
+    /// [`Renderer::render_frame`], then blit the image onto `present.image` (scaled to its
+    /// size) after `present.wait`, signalling `present.signal` for presentation.
+    pub fn render_frame_to(
+        &mut self,
+        view: &View,
+        opts: &FrameOptions,
+        present: Option<PresentTarget>,
+    ) -> GpuResult<FrameTicket> {
         view.validate().map_err(GpuError::Unsupported)?;
         let path = opts.path.unwrap_or(self.default_path());
         if path == RenderPath::Mesh && !self.passes.has_mesh_path() {
@@ -433,11 +462,15 @@ impl Renderer {
             }
         }
         let start = Instant::now();
-        self.record(i, path, bundles, opts, &prop_draws)?;
+        self.record(i, path, bundles, opts, &prop_draws, present.as_ref())?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
         let slot = &mut self.frames[i];
         slot.fence.reset()?;
-        if let Err(e) = self.ctx.submit(&slot.cmd, &slot.fence) {
+        let (wait, signal) = match &present {
+            Some(p) => (Some(p.wait), Some(p.signal)),
+            None => (None, None),
+        };
+        if let Err(e) = self.ctx.submit_with(&slot.cmd, &slot.fence, wait, signal) {
             // Keep the slot usable: a fence that will never be signalled would hang the next wait.
             slot.fence = crate::vk::Fence::new(&self.ctx, true)?;
             return Err(e);
@@ -464,6 +497,7 @@ impl Renderer {
         bundles: u32,
         opts: &FrameOptions,
         props: &[PropDraw],
+        present: Option<&PresentTarget>,
     ) -> GpuResult<()> {
         let slot = &mut self.frames[i];
         let bg = self.background;
@@ -503,6 +537,16 @@ impl Renderer {
             rec.image_barrier(color, Access::ColorAttachment, Access::TransferRead);
             rec.copy_image_to_buffer(color, readback);
             self.targets.color_access = Access::TransferRead;
+        }
+        if let Some(p) = present {
+            let color = &self.targets.color;
+            if self.targets.color_access != Access::TransferRead {
+                rec.image_barrier(color, Access::ColorAttachment, Access::TransferRead);
+                self.targets.color_access = Access::TransferRead;
+            }
+            rec.swapchain_barrier(p.image, Access::Nothing, Access::TransferWrite);
+            rec.blit_to_swapchain(color, p.image);
+            rec.swapchain_barrier(p.image, Access::TransferWrite, Access::Present);
         }
         rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
         drop(rec);

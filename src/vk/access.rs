@@ -33,6 +33,8 @@ pub enum Access {
     TransferWrite,
     /// Read by the host after the submission completed.
     HostRead,
+    /// Handed to the presentation engine (swapchain images).
+    Present,
 }
 
 pub(crate) struct AccessInfo {
@@ -114,6 +116,7 @@ impl Access {
                 true,
             ),
             Access::HostRead => (S::HOST, A::HOST_READ, L::GENERAL, false),
+            Access::Present => (S::NONE, A::NONE, L::PRESENT_SRC_KHR, false),
         };
         AccessInfo {
             stage,

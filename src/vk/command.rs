@@ -12,6 +12,7 @@ use super::buffer::Buffer;
 use super::descriptor::DescriptorSet;
 use super::image::{Image, aspect};
 use super::pipeline::Pipeline;
+use super::swapchain::SwapchainImage;
 use super::{Context, GpuError, GpuResult, VkContext};
 
 /// A primary command buffer with its own pool, re-recorded every time it is used.
@@ -313,6 +314,68 @@ impl CommandRecorder<'_> {
         let dep = vk::DependencyInfo::default().image_memory_barriers(&b);
         // SAFETY: recording outside a rendering instance.
         unsafe { self.ctx.device.cmd_pipeline_barrier2(self.raw, &dep) };
+    }
+
+    /// Layout transition of a swapchain image from use `prev` to use `next`.
+    pub fn swapchain_barrier(&mut self, image: &SwapchainImage, prev: Access, next: Access) {
+        let (ss, sa, ds, da) = masks(&[prev], &[next]);
+        let b = [vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(ss | vk::PipelineStageFlags2::TRANSFER)
+            .src_access_mask(sa)
+            .dst_stage_mask(ds | vk::PipelineStageFlags2::TRANSFER)
+            .dst_access_mask(da)
+            .old_layout(prev.info().layout)
+            .new_layout(next.info().layout)
+            .image(image.raw)
+            .subresource_range(
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .level_count(1)
+                    .layer_count(1),
+            )];
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&b);
+        // SAFETY: recording outside a rendering instance.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.raw, &dep) };
+    }
+
+    /// Scale-blit all of 2D image `src` (in [`Access::TransferRead`]) onto swapchain image
+    /// `dst` (in [`Access::TransferWrite`]), linear filtering.
+    pub fn blit_to_swapchain(&mut self, src: &Image, dst: &SwapchainImage) {
+        let [w, h, _] = src.desc.extent;
+        let layers = vk::ImageSubresourceLayers::default()
+            .aspect_mask(vk::ImageAspectFlags::COLOR)
+            .layer_count(1);
+        let region = [vk::ImageBlit::default()
+            .src_subresource(layers)
+            .src_offsets([
+                vk::Offset3D::default(),
+                vk::Offset3D {
+                    x: w as i32,
+                    y: h as i32,
+                    z: 1,
+                },
+            ])
+            .dst_subresource(layers)
+            .dst_offsets([
+                vk::Offset3D::default(),
+                vk::Offset3D {
+                    x: dst.extent[0] as i32,
+                    y: dst.extent[1] as i32,
+                    z: 1,
+                },
+            ])];
+        // SAFETY: layouts as documented; both are colour images of blit-capable formats.
+        unsafe {
+            self.ctx.device.cmd_blit_image(
+                self.raw,
+                src.raw(),
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+                vk::Filter::LINEAR,
+            )
+        };
     }
 
     /// Fill `size` bytes at `offset` of `buffer` with the word `value`.

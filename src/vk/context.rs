@@ -12,12 +12,24 @@ use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::command::{CommandBuffer, CommandRecorder};
 use super::device;
-use super::sync::Fence;
+use super::sync::{Fence, Semaphore};
 use super::{GpuError, GpuResult, VkContext};
+
+/// Raw handles of a window to present to (from winit through `raw-window-handle`).
+#[derive(Clone, Copy, Debug)]
+pub struct WindowHandles {
+    /// The display connection.
+    pub display: raw_window_handle::RawDisplayHandle,
+    /// The window.
+    pub window: raw_window_handle::RawWindowHandle,
+}
 
 /// How to create a [`Context`].
 #[derive(Clone, Debug, Default)]
 pub struct ContextDesc {
+    /// Present to this window: creates its surface, requires a queue that can present to it
+    /// and enables `VK_KHR_swapchain`.
+    pub window: Option<WindowHandles>,
     /// Enable `VK_LAYER_KHRONOS_validation`; validation errors are counted and printed.
     pub validation: bool,
     /// Pick the device whose name contains this string (case-insensitive).
@@ -34,6 +46,12 @@ impl ContextDesc {
     /// Choose a device by name substring.
     pub fn device(mut self, name: Option<String>) -> Self {
         self.device = name;
+        self
+    }
+
+    /// Present to `window`.
+    pub fn window(mut self, window: WindowHandles) -> Self {
+        self.window = Some(window);
         self
     }
 }
@@ -121,8 +139,16 @@ pub struct Context {
     pub(crate) queue_family: u32,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) mesh_ext: Option<ash::ext::mesh_shader::Device>,
+    pub(crate) surface: Option<Surface>,
+    pub(crate) swapchain_ext: Option<ash::khr::swapchain::Device>,
     /// Capabilities of the device.
     pub info: DeviceInfo,
+}
+
+/// A window surface and its instance-level functions.
+pub(crate) struct Surface {
+    pub(crate) loader: ash::khr::surface::Instance,
+    pub(crate) raw: vk::SurfaceKHR,
 }
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -150,7 +176,12 @@ impl Context {
             }
             layers.push(VALIDATION_LAYER.as_ptr());
         }
-        let extensions = [debug_utils::NAME.as_ptr()];
+        let mut extensions = vec![debug_utils::NAME.as_ptr()];
+        if let Some(w) = &desc.window {
+            let needed = ash_window::enumerate_required_extensions(w.display)
+                .ctx("window surface extensions")?;
+            extensions.extend_from_slice(needed);
+        }
         let debug_state = Arc::new(DebugState {
             errors: AtomicU32::new(0),
             messages: Mutex::new(Vec::new()),
@@ -204,10 +235,40 @@ impl Context {
         debug_state: Arc<DebugState>,
         desc: &ContextDesc,
     ) -> GpuResult<Self> {
+        let surface = match &desc.window {
+            Some(w) => {
+                // SAFETY: the handles come from a live window that outlives the context (the
+                // caller keeps the window until the context is dropped).
+                let raw = unsafe {
+                    ash_window::create_surface(&entry, &instance, w.display, w.window, None)
+                };
+                match raw {
+                    Ok(raw) => Some(Surface {
+                        loader: ash::khr::surface::Instance::new(&entry, &instance),
+                        raw,
+                    }),
+                    Err(result) => {
+                        destroy_instance(&instance, debug);
+                        return Err(GpuError::Vk {
+                            what: "create window surface",
+                            result,
+                        });
+                    }
+                }
+            }
+            None => None,
+        };
         let created = (|| {
-            let (physical, name, queue_family) = device::pick_physical(&instance, desc)?;
+            let (physical, name, queue_family) =
+                device::pick_physical(&instance, desc, surface.as_ref())?;
             let features = device::query_features(&instance, physical, &name)?;
-            let device = device::create_logical(&instance, physical, queue_family, &features)?;
+            let device = device::create_logical(
+                &instance,
+                physical,
+                queue_family,
+                &features,
+                surface.is_some(),
+            )?;
             let allocator = Allocator::new(&AllocatorCreateDesc {
                 instance: instance.clone(),
                 device: device.clone(),
@@ -230,6 +291,10 @@ impl Context {
         let (physical, queue_family, device, allocator, info) = match created {
             Ok(v) => v,
             Err(e) => {
+                if let Some(s) = &surface {
+                    // SAFETY: no swapchain was created from the surface.
+                    unsafe { s.loader.destroy_surface(s.raw, None) };
+                }
                 destroy_instance(&instance, debug);
                 return Err(e);
             }
@@ -242,6 +307,9 @@ impl Context {
         let mesh_ext = info
             .mesh_shader
             .then(|| ash::ext::mesh_shader::Device::new(&instance, &device));
+        let swapchain_ext = surface
+            .as_ref()
+            .map(|_| ash::khr::swapchain::Device::new(&instance, &device));
         Ok(Context {
             _entry: entry,
             instance,
@@ -254,6 +322,8 @@ impl Context {
             queue_family,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             mesh_ext,
+            surface,
+            swapchain_ext,
             info,
         })
     }
@@ -350,10 +420,42 @@ impl Context {
 
     /// Submit `cmd` to the queue; `fence` is signalled when it completes.
     pub fn submit(&self, cmd: &CommandBuffer, fence: &Fence) -> GpuResult<()> {
+        self.submit_with(cmd, fence, None, None)
+    }
+
+    /// Submit `cmd`, first waiting for `wait` (before colour output and transfers) and
+    /// signalling `signal` when done; `fence` is signalled when it completes.
+    pub fn submit_with(
+        &self,
+        cmd: &CommandBuffer,
+        fence: &Fence,
+        wait: Option<&Semaphore>,
+        signal: Option<&Semaphore>,
+    ) -> GpuResult<()> {
         let cmds = [cmd.raw()];
-        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-        // SAFETY: the command buffer finished recording; the fence is unsignalled.
+        let waits: Vec<vk::Semaphore> = wait.iter().map(|s| s.raw()).collect();
+        let stages = vec![
+            vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
+                | vk::PipelineStageFlags::TRANSFER;
+            waits.len()
+        ];
+        let signals: Vec<vk::Semaphore> = signal.iter().map(|s| s.raw()).collect();
+        let submit = [vk::SubmitInfo::default()
+            .command_buffers(&cmds)
+            .wait_semaphores(&waits)
+            .wait_dst_stage_mask(&stages)
+            .signal_semaphores(&signals)];
+        // SAFETY: the command buffer finished recording; the fence is unsignalled; the
+        // semaphores are owned by the caller and alive until the submission completes.
         unsafe { self.device.queue_submit(self.queue, &submit, fence.raw()) }.ctx("queue submit")
+    }
+
+    pub(crate) fn queue(&self) -> vk::Queue {
+        self.queue
+    }
+
+    pub(crate) fn physical(&self) -> vk::PhysicalDevice {
+        self.physical
     }
 
     /// Wait until the device is idle.
@@ -398,6 +500,9 @@ impl Drop for Context {
             let _ = self.device.device_wait_idle();
             ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_device(None);
+            if let Some(s) = self.surface.take() {
+                s.loader.destroy_surface(s.raw, None);
+            }
             if let Some((loader, messenger)) = self.debug.take() {
                 loader.destroy_debug_utils_messenger(messenger, None);
             }

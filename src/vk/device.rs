@@ -3,7 +3,7 @@
 
 use ash::vk;
 
-use super::context::{ContextDesc, DeviceInfo};
+use super::context::{ContextDesc, DeviceInfo, Surface};
 use super::{GpuError, GpuResult};
 
 /// The best Vulkan 1.3 device (discrete > integrated > virtual > CPU), optionally by name, and
@@ -11,6 +11,7 @@ use super::{GpuError, GpuResult};
 pub(super) fn pick_physical(
     instance: &ash::Instance,
     desc: &ContextDesc,
+    surface: Option<&Surface>,
 ) -> GpuResult<(vk::PhysicalDevice, String, u32)> {
     // SAFETY: plain enumeration/query calls on a valid instance.
     let physicals = unsafe { instance.enumerate_physical_devices() }.unwrap_or_default();
@@ -48,15 +49,34 @@ pub(super) fn pick_physical(
     };
     // SAFETY: valid physical device.
     let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+    let presents = |i: usize| {
+        surface.is_none_or(|s| {
+            // SAFETY: valid physical device, family index and surface.
+            unsafe {
+                s.loader
+                    .get_physical_device_surface_support(physical, i as u32, s.raw)
+            }
+            .unwrap_or(false)
+        })
+    };
     let queue_family = families
         .iter()
-        .position(|f| {
+        .enumerate()
+        .position(|(i, f)| {
             f.queue_flags
                 .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
                 && f.timestamp_valid_bits > 0
+                && presents(i)
         })
         .ok_or_else(|| {
-            GpuError::Unsupported(format!("{name}: no graphics+compute queue with timestamps"))
+            GpuError::Unsupported(format!(
+                "{name}: no graphics+compute queue with timestamps{}",
+                if surface.is_some() {
+                    " that can present to the window"
+                } else {
+                    ""
+                }
+            ))
         })?;
     Ok((physical, name, queue_family as u32))
 }
@@ -141,6 +161,7 @@ pub(super) fn create_logical(
     physical: vk::PhysicalDevice,
     queue_family: u32,
     f: &DeviceFeatures,
+    swapchain: bool,
 ) -> GpuResult<ash::Device> {
     let priorities = [1.0f32];
     let queue_info = [vk::DeviceQueueCreateInfo::default()
@@ -149,6 +170,9 @@ pub(super) fn create_logical(
     let mut ext_names = Vec::new();
     if f.mesh {
         ext_names.push(ash::ext::mesh_shader::NAME.as_ptr());
+    }
+    if swapchain {
+        ext_names.push(ash::khr::swapchain::NAME.as_ptr());
     }
     let mut enable13 = vk::PhysicalDeviceVulkan13Features::default()
         .dynamic_rendering(true)

@@ -11,17 +11,19 @@ pub mod image;
 pub mod pipeline;
 pub mod profiler;
 pub mod shader;
+pub mod swapchain;
 pub mod sync;
 
 pub use access::Access;
 pub use buffer::{Buffer, BufferDesc};
 pub use command::{Attachment, CommandBuffer, CommandRecorder};
-pub use context::{Context, ContextDesc, DeviceInfo, MemoryReport};
+pub use context::{Context, ContextDesc, DeviceInfo, MemoryReport, WindowHandles};
 pub use descriptor::{BindingDesc, DescriptorKind, DescriptorSet, DescriptorSetLayout};
 pub use image::{Image, ImageDesc, Sampler};
 pub use pipeline::{BlendMode, CullMode, DepthMode, GraphicsDesc, Pipeline, PipelineLayout};
 pub use profiler::{MeshPrimitivesQuery, Profiler};
-pub use sync::Fence;
+pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainImage};
+pub use sync::{Fence, Semaphore};
 
 /// Errors of the GPU layer.
 #[derive(Debug, thiserror::Error)]

@@ -1,4 +1,5 @@
-//! Fences (CPU waits for GPU work).
+//! Fences (CPU waits for GPU work) and semaphores (GPU waits for GPU work, e.g. a swapchain
+//! image).
 
 use std::sync::Arc;
 
@@ -54,5 +55,38 @@ impl Drop for Fence {
     fn drop(&mut self) {
         // SAFETY: owners wait for (or never submitted) the work this fence tracks.
         unsafe { self.ctx.device.destroy_fence(self.raw, None) };
+    }
+}
+
+/// A binary semaphore.
+pub struct Semaphore {
+    ctx: Arc<Context>,
+    raw: vk::Semaphore,
+}
+
+impl Semaphore {
+    /// Create a semaphore.
+    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
+        // SAFETY: valid device and create info.
+        let raw = unsafe {
+            ctx.device
+                .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+        }
+        .ctx("create semaphore")?;
+        Ok(Semaphore {
+            ctx: ctx.clone(),
+            raw,
+        })
+    }
+
+    pub(crate) fn raw(&self) -> vk::Semaphore {
+        self.raw
+    }
+}
+
+impl Drop for Semaphore {
+    fn drop(&mut self) {
+        // SAFETY: owners drop semaphores after the work using them completed.
+        unsafe { self.ctx.device.destroy_semaphore(self.raw, None) };
     }
 }

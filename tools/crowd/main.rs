@@ -6,7 +6,8 @@
 //! crowd --headless --frames 3 --count 16 --size 640x360 --out frames/
 //! ```
 //!
-//! The window mode (winit + swapchain + control panel) is the next step of this tool.
+//! Without `--headless` it opens a window (winit, swapchain) with an orbit / fly camera; keys
+//! switch LoD, path, present mode and strand settings (see `window.rs` and the README).
 
 use std::io::Write as _;
 use std::path::PathBuf;
@@ -24,13 +25,25 @@ use hairmesh::render::{
 use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakeOptions, outln};
 
+mod window;
+
 /// A crowd of characters with unique generated hair.
 #[derive(Parser)]
 #[command(version, about)]
-struct Args {
-    /// Render without a window to PNG files (the window mode is not built yet).
+pub struct Args {
+    /// Render without a window to PNG files.
     #[arg(long)]
     headless: bool,
+    /// Window mode: close after presenting this many frames (tests, screenshots).
+    #[arg(long)]
+    exit_after_frames: Option<u64>,
+    /// Window mode: resize the window to another size after 3 frames and simulate a zero-size
+    /// (minimised) window for 3 frames after 6 (tests).
+    #[arg(long)]
+    test_resize: bool,
+    /// Window mode: present mode fifo, mailbox or immediate (FIFO where not offered).
+    #[arg(long, default_value = "fifo", value_parser = ["fifo", "mailbox", "immediate"])]
+    present_mode: String,
     /// Frames to render (headless).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     frames: u32,
@@ -69,7 +82,7 @@ struct Args {
     validation: bool,
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32)> {
+pub fn parse_size(s: &str) -> Result<(u32, u32)> {
     let max = hairmesh::render::scene::MAX_IMAGE_SIDE;
     let bad = || anyhow::anyhow!("--size '{s}': expected WIDTHxHEIGHT with 1..={max} per side");
     let (w, h) = s.split_once('x').ok_or_else(bad)?;
@@ -81,7 +94,7 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
 }
 
 /// The camera of frame `f`: orbiting the crowd's centre at eye height, far enough to see it.
-fn orbit_camera(count: u32, f: u32) -> Camera {
+pub fn orbit_camera(count: u32, f: u32) -> Camera {
     let side = (count as f32).sqrt().ceil();
     let centre = Vec3::new(0.0, 1.2, (side - 1.0) * 0.5 * SPACING);
     let radius = (side * SPACING * 0.75).max(1.6);
@@ -90,48 +103,84 @@ fn orbit_camera(count: u32, f: u32) -> Camera {
     Camera::look_at(eye, centre, 45.0)
 }
 
+/// The crowd: generated characters and their bakes.
+pub struct Scene {
+    characters: Vec<preset::CrowdCharacter>,
+    baked: Vec<hairmesh::BakedHairMesh>,
+    /// Seconds to generate and bake.
+    pub generate_s: f64,
+}
+
+impl Scene {
+    /// Generate and bake the characters the flags ask for.
+    pub fn build(args: &Args) -> Result<Self> {
+        let start = Instant::now();
+        let characters = preset::build(args.preset, args.count as usize, args.seed)?;
+        let mut baked = Vec::with_capacity(characters.len());
+        for c in &characters {
+            baked.push(hairmesh::bake(
+                &c.hair.mesh,
+                &c.hair.style,
+                BakeOptions::default(),
+                |_, _| {},
+            )?);
+        }
+        Ok(Scene {
+            characters,
+            baked,
+            generate_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// A renderer of `width x height` holding every character and prop.
+    pub fn renderer(
+        &self,
+        ctx: &Arc<Context>,
+        args: &Args,
+        width: u32,
+        height: u32,
+    ) -> Result<Renderer> {
+        let path = args.path.as_deref().map(|p| match p {
+            "mesh" => RenderPath::Mesh,
+            _ => RenderPath::Compute,
+        });
+        let mut renderer =
+            Renderer::new(ctx, &RendererDesc::default().size(width, height).path(path))?;
+        let params = StrandParams {
+            strands_per_bundle: args.strands_per_bundle,
+            verts_log2: args.verts_log2,
+        };
+        for (c, b) in self.characters.iter().zip(&self.baked) {
+            renderer.add_character(b, &c.hair.style, params, c.model)?;
+        }
+        renderer.set_prop_meshes(&preset::prop_meshes())?;
+        renderer.set_prop_instances(&preset::prop_instances(&self.characters))?;
+        Ok(renderer)
+    }
+
+    /// Number of characters.
+    pub fn len(&self) -> usize {
+        self.characters.len()
+    }
+}
+
 fn run(args: Args) -> Result<()> {
+    let scene = Scene::build(&args)?;
     if !args.headless {
-        bail!("the window mode is not built yet; run with --headless (see README)");
+        return window::run(args, scene);
     }
     let (width, height) = parse_size(&args.size)?;
     if args.out.exists() && !args.out.is_dir() {
         bail!("--out {}: not a folder", args.out.display());
     }
-    let start = Instant::now();
-    let characters = preset::build(args.preset, args.count as usize, args.seed)?;
-    let params = StrandParams {
-        strands_per_bundle: args.strands_per_bundle,
-        verts_log2: args.verts_log2,
-    };
-    let mut baked = Vec::with_capacity(characters.len());
-    for c in &characters {
-        baked.push(hairmesh::bake(
-            &c.hair.mesh,
-            &c.hair.style,
-            BakeOptions::default(),
-            |_, _| {},
-        )?);
-    }
-    let generate_s = start.elapsed().as_secs_f64();
+    let generate_s = scene.generate_s;
+    let characters = &scene.characters;
     let ctx = Arc::new(Context::new(
         &ContextDesc::default()
             .validation(args.validation)
             .device(args.device.clone()),
     )?);
-    let path = args.path.as_deref().map(|p| match p {
-        "mesh" => RenderPath::Mesh,
-        _ => RenderPath::Compute,
-    });
-    let mut renderer = Renderer::new(
-        &ctx,
-        &RendererDesc::default().size(width, height).path(path),
-    )?;
-    for (c, b) in characters.iter().zip(&baked) {
-        renderer.add_character(b, &c.hair.style, params, c.model)?;
-    }
-    renderer.set_prop_meshes(&preset::prop_meshes())?;
-    renderer.set_prop_instances(&preset::prop_instances(&characters))?;
+    let mut renderer = scene.renderer(&ctx, &args, width, height)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("--out {}: cannot create the folder", args.out.display()))?;
     let csv_path = args.out.join("stats.csv");

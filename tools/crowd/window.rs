@@ -1,0 +1,484 @@
+//! The crowd in a window: winit 0.30 `ApplicationHandler`, a swapchain that survives resize,
+//! minimise (zero size), `OUT_OF_DATE` / `SUBOPTIMAL` and close, and an orbit / fly camera.
+//!
+//! Mouse: left-drag orbits, wheel zooms. Keys: W/A/S/D/Q/E move the orbit centre, Space pauses
+//! the automatic orbit, L toggles LoD, M switches mesh / compute path, V cycles the present
+//! mode, [ and ] halve / double strands per bundle, - and = lower / raise the vertex level,
+//! Escape closes. The title bar shows FPS, GPU ms per pass, strands and triangles, texture
+//! memory and the compute path's vertex-pool use.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result};
+use glam::Vec3;
+use hairmesh::outln;
+use hairmesh::render::{
+    Camera, FrameOptions, FrameReport, FrameTicket, LodSettings, PresentTarget, RenderPath,
+    Renderer, StrandParams, View,
+};
+use hairmesh::vk::{
+    Acquired, Context, ContextDesc, PresentMode, Semaphore, Swapchain, WindowHandles,
+};
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
+
+use super::{Args, Scene, parse_size};
+
+/// Orbit camera around a centre; the centre moves with the fly keys.
+struct OrbitCamera {
+    centre: Vec3,
+    yaw: f32,
+    pitch: f32,
+    distance: f32,
+}
+
+impl OrbitCamera {
+    fn camera(&self) -> Camera {
+        let dir = Vec3::new(
+            self.pitch.cos() * self.yaw.sin(),
+            self.pitch.sin(),
+            self.pitch.cos() * self.yaw.cos(),
+        );
+        Camera::look_at(self.centre + dir * self.distance, self.centre, 45.0)
+    }
+}
+
+/// Everything that exists while the window does. Field order is drop order: Vulkan objects
+/// first, the window last (the surface must not outlive it).
+struct Running {
+    swapchain: Option<Swapchain>,
+    acquire: Vec<Semaphore>,
+    renderer: Renderer,
+    ctx: Arc<Context>,
+    frame: u64,
+    size: (u32, u32),
+    recreate: bool,
+    present_mode: PresentMode,
+    camera: OrbitCamera,
+    params: StrandParams,
+    lod: bool,
+    path: RenderPath,
+    paused: bool,
+    dragging: Option<(f64, f64)>,
+    cursor: (f64, f64),
+    last_ticket: Option<FrameTicket>,
+    last_report: Option<FrameReport>,
+    fps_window: (Instant, u64),
+    fps: f64,
+    /// Swapchain (re)creations and frames skipped for a zero-size window.
+    recreations: u32,
+    zero_skips: u32,
+    window: Arc<Window>,
+}
+
+struct App {
+    args: Args,
+    scene: Scene,
+    running: Option<Running>,
+    error: Option<anyhow::Error>,
+    presented: u64,
+    simulated_zero: u32,
+    summary: String,
+}
+
+/// Open the window and run until it is closed (or `--exit-after-frames`).
+pub fn run(args: Args, scene: Scene) -> Result<()> {
+    parse_size(&args.size)?;
+    let event_loop =
+        EventLoop::new().context("cannot open a window (no display?); use --headless")?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        args,
+        scene,
+        running: None,
+        error: None,
+        presented: 0,
+        simulated_zero: 0,
+        summary: String::new(),
+    };
+    event_loop.run_app(&mut app)?;
+    if let Some(e) = app.error {
+        return Err(e);
+    }
+    outln!("presented {} frames{}", app.presented, app.summary)?;
+    Ok(())
+}
+
+fn present_mode(name: &str) -> PresentMode {
+    match name {
+        "mailbox" => PresentMode::Mailbox,
+        "immediate" => PresentMode::Immediate,
+        _ => PresentMode::Fifo,
+    }
+}
+
+impl App {
+    fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let (w, h) = parse_size(&self.args.size)?;
+        let window = Arc::new(
+            event_loop.create_window(
+                Window::default_attributes()
+                    .with_title("hairmesh crowd")
+                    .with_inner_size(PhysicalSize::new(w, h)),
+            )?,
+        );
+        let handles = WindowHandles {
+            display: window.display_handle()?.as_raw(),
+            window: window.window_handle()?.as_raw(),
+        };
+        let ctx = Arc::new(Context::new(
+            &ContextDesc::default()
+                .validation(self.args.validation)
+                .device(self.args.device.clone())
+                .window(handles),
+        )?);
+        let size = window.inner_size();
+        let renderer =
+            self.scene
+                .renderer(&ctx, &self.args, size.width.max(1), size.height.max(1))?;
+        let path = renderer.default_path();
+        let side = (self.scene.len() as f32).sqrt().ceil();
+        let acquire = (0..hairmesh::render::FRAMES_IN_FLIGHT)
+            .map(|_| Semaphore::new(&ctx))
+            .collect::<Result<_, _>>()?;
+        self.running = Some(Running {
+            swapchain: None,
+            acquire,
+            renderer,
+            ctx,
+            frame: 0,
+            size: (size.width, size.height),
+            recreate: true,
+            present_mode: present_mode(&self.args.present_mode),
+            camera: OrbitCamera {
+                centre: Vec3::new(0.0, 1.2, (side - 1.0) * 0.5 * 0.9),
+                yaw: std::f32::consts::PI,
+                pitch: 0.35,
+                distance: (side * 0.9 * 0.8).max(1.8),
+            },
+            params: StrandParams {
+                strands_per_bundle: self.args.strands_per_bundle,
+                verts_log2: self.args.verts_log2,
+            },
+            lod: self.args.lod == "on",
+            path,
+            paused: false,
+            dragging: None,
+            cursor: (0.0, 0.0),
+            last_ticket: None,
+            last_report: None,
+            fps_window: (Instant::now(), 0),
+            fps: 0.0,
+            recreations: 0,
+            zero_skips: 0,
+            window,
+        });
+        Ok(())
+    }
+
+    /// Test script of `--test-resize`: a new size after 3 frames, a zero-size (minimised)
+    /// window for 3 frames after 6.
+    fn scripted_resize(&mut self) {
+        let Some(r) = &mut self.running else { return };
+        if !self.args.test_resize {
+            return;
+        }
+        if self.presented == 3 && r.frame == 3 {
+            let _ = r
+                .window
+                .request_inner_size(PhysicalSize::new(r.size.0 / 2 + 17, r.size.1 / 2 + 9));
+        }
+        if self.presented == 6 && self.simulated_zero < 3 {
+            self.simulated_zero += 1;
+            r.size_changed(0, 0);
+        } else if self.simulated_zero == 3 {
+            self.simulated_zero += 1;
+            let s = r.window.inner_size();
+            r.size_changed(s.width, s.height);
+        }
+    }
+}
+
+impl Running {
+    fn size_changed(&mut self, width: u32, height: u32) {
+        self.size = (width, height);
+        self.recreate = true;
+    }
+
+    /// Draw and present one frame; returns whether an image was presented.
+    fn draw(&mut self, scene_len: usize) -> Result<bool> {
+        let (w, h) = self.size;
+        if w == 0 || h == 0 {
+            self.zero_skips += 1;
+            return Ok(false); // minimised: nothing to present to
+        }
+        if self.recreate || self.swapchain.is_none() {
+            let old = self.swapchain.take();
+            let chain = Swapchain::new(&self.ctx, w, h, self.present_mode, old)?;
+            let [cw, ch] = chain.extent();
+            if cw == 0 || ch == 0 {
+                return Ok(false);
+            }
+            self.renderer.resize(cw, ch)?;
+            self.swapchain = Some(chain);
+            self.recreate = false;
+            self.recreations += 1;
+        }
+        if !self.paused {
+            self.camera.yaw += 0.004;
+        }
+        self.renderer.wait_for_free_slot()?;
+        let chain = self.swapchain.as_ref().expect("created above");
+        let semaphore = &self.acquire[(self.frame % self.acquire.len() as u64) as usize];
+        let (image, suboptimal) = match chain.acquire(semaphore)? {
+            Acquired::Image(image, suboptimal) => (image, suboptimal),
+            Acquired::OutOfDate => {
+                self.recreate = true;
+                return Ok(false);
+            }
+        };
+        let view = View {
+            camera: self.camera.camera(),
+            light_dir: Vec3::new(0.4, 1.0, 0.3),
+            lod: if self.lod {
+                LodSettings::default()
+            } else {
+                LodSettings::off()
+            },
+        };
+        let ticket = self.renderer.render_frame_to(
+            &view,
+            &FrameOptions {
+                path: Some(self.path),
+                ..Default::default()
+            },
+            Some(PresentTarget {
+                image: &image,
+                wait: semaphore,
+                signal: chain.render_finished(image.index),
+            }),
+        )?;
+        let stale = chain.present(image.index)?;
+        self.recreate |= stale || suboptimal;
+        self.frame += 1;
+        // The previous frame has (nearly always) completed: its report costs no stall.
+        if let Some(t) = self.last_ticket.replace(ticket) {
+            self.last_report = Some(self.renderer.wait(t)?);
+        }
+        self.update_title(scene_len);
+        Ok(true)
+    }
+
+    fn update_title(&mut self, scene_len: usize) {
+        let (since, frames) = self.fps_window;
+        let elapsed = since.elapsed().as_secs_f64();
+        if elapsed < 0.5 {
+            return;
+        }
+        self.fps = (self.frame - frames) as f64 / elapsed;
+        self.fps_window = (Instant::now(), self.frame);
+        let Some(r) = &self.last_report else { return };
+        let passes: Vec<String> = r
+            .pass_ms
+            .iter()
+            .map(|(n, ms)| format!("{n} {ms:.1}"))
+            .collect();
+        let pool = if self.path == RenderPath::Compute {
+            format!(
+                ", pool {:.0}%{}",
+                100.0 * r.stats.vertex_slots_written as f64
+                    / self.renderer.vertex_budget().max(1) as f64,
+                if r.stats.strands_drawn < r.stats.strands_demanded {
+                    " OVERFLOW"
+                } else {
+                    ""
+                }
+            )
+        } else {
+            String::new()
+        };
+        self.window.set_title(&format!(
+            "hairmesh crowd - {scene_len} characters, {:.1} fps, GPU {} ms, CPU {:.2} ms, {} strands, {} tris, tex {:.1} MiB{pool}, {:?}, LoD {}, {:?}, N {} e {}",
+            self.fps,
+            passes.join(" / "),
+            r.record_ms,
+            r.stats.strands_drawn,
+            r.stats.triangles_drawn,
+            self.renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64,
+            self.path,
+            if self.lod { "on" } else { "off" },
+            self.swapchain.as_ref().map_or(self.present_mode, |s| s.present_mode),
+            self.params.strands_per_bundle,
+            self.params.verts_log2,
+        ));
+    }
+
+    fn set_params(&mut self, params: StrandParams) -> Result<()> {
+        if params.validate().is_err() {
+            return Ok(());
+        }
+        self.params = params;
+        let ids: Vec<_> = self.renderer.crowd().ids();
+        for id in ids {
+            self.renderer.set_params(id, params)?;
+        }
+        Ok(())
+    }
+
+    fn key(&mut self, code: KeyCode, event_loop: &ActiveEventLoop) -> Result<()> {
+        let step = self.camera.distance * 0.05;
+        let forward = Vec3::new(-self.camera.yaw.sin(), 0.0, -self.camera.yaw.cos());
+        let right = forward.cross(Vec3::Y);
+        match code {
+            KeyCode::Escape => event_loop.exit(),
+            KeyCode::KeyW => self.camera.centre += forward * step,
+            KeyCode::KeyS => self.camera.centre -= forward * step,
+            KeyCode::KeyD => self.camera.centre += right * step,
+            KeyCode::KeyA => self.camera.centre -= right * step,
+            KeyCode::KeyE => self.camera.centre.y += step,
+            KeyCode::KeyQ => self.camera.centre.y -= step,
+            KeyCode::Space => self.paused = !self.paused,
+            KeyCode::KeyL => self.lod = !self.lod,
+            KeyCode::KeyM => {
+                self.path = match self.path {
+                    RenderPath::Mesh => RenderPath::Compute,
+                    RenderPath::Compute if self.renderer.has_mesh_path() => RenderPath::Mesh,
+                    RenderPath::Compute => RenderPath::Compute,
+                }
+            }
+            KeyCode::KeyV => {
+                self.present_mode = match self.present_mode {
+                    PresentMode::Fifo => PresentMode::Mailbox,
+                    PresentMode::Mailbox => PresentMode::Immediate,
+                    PresentMode::Immediate => PresentMode::Fifo,
+                };
+                self.recreate = true;
+            }
+            KeyCode::BracketLeft => self.set_params(StrandParams {
+                strands_per_bundle: (self.params.strands_per_bundle / 2).max(1),
+                ..self.params
+            })?,
+            KeyCode::BracketRight => self.set_params(StrandParams {
+                strands_per_bundle: self.params.strands_per_bundle * 2,
+                ..self.params
+            })?,
+            KeyCode::Minus => self.set_params(StrandParams {
+                verts_log2: self.params.verts_log2.saturating_sub(1),
+                ..self.params
+            })?,
+            KeyCode::Equal => self.set_params(StrandParams {
+                verts_log2: self.params.verts_log2 + 1,
+                ..self.params
+            })?,
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.running.is_none()
+            && let Err(e) = self.start(event_loop)
+        {
+            self.error = Some(e);
+            event_loop.exit();
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let scene_len = self.scene.len();
+        let Some(r) = &mut self.running else { return };
+        let result = match event {
+            WindowEvent::CloseRequested => {
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(size) => {
+                r.size_changed(size.width, size.height);
+                Ok(())
+            }
+            WindowEvent::KeyboardInput { event, .. } => match (event.state, event.physical_key) {
+                (ElementState::Pressed, PhysicalKey::Code(code)) => r.key(code, event_loop),
+                _ => Ok(()),
+            },
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => {
+                r.dragging = (state == ElementState::Pressed).then_some(r.cursor);
+                Ok(())
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                if let Some((x, y)) = r.dragging {
+                    r.camera.yaw -= ((position.x - x) * 0.005) as f32;
+                    r.camera.pitch =
+                        (r.camera.pitch + ((position.y - y) * 0.005) as f32).clamp(-0.2, 1.4);
+                    r.dragging = Some((position.x, position.y));
+                }
+                r.cursor = (position.x, position.y);
+                Ok(())
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let d = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                r.camera.distance = (r.camera.distance * (1.0 - 0.1 * d)).clamp(0.3, 200.0);
+                Ok(())
+            }
+            WindowEvent::RedrawRequested => match r.draw(scene_len) {
+                Ok(true) => {
+                    self.presented += 1;
+                    if self
+                        .args
+                        .exit_after_frames
+                        .is_some_and(|n| self.presented >= n)
+                    {
+                        event_loop.exit();
+                    }
+                    Ok(())
+                }
+                Ok(false) => Ok(()),
+                Err(e) => Err(e),
+            },
+            _ => Ok(()),
+        };
+        if let Err(e) = result {
+            self.error = Some(e);
+            event_loop.exit();
+        }
+        self.scripted_resize();
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(r) = &self.running {
+            r.window.request_redraw();
+        }
+    }
+
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(r) = &mut self.running {
+            let _ = r.renderer.finish();
+            let s = r.window.inner_size();
+            self.summary = format!(
+                "; swapchain created {} times; {} frames skipped at zero size; final size {}x{}",
+                r.recreations, r.zero_skips, s.width, s.height
+            );
+            if r.ctx.validation_errors() > 0 && self.error.is_none() {
+                self.error = Some(anyhow::anyhow!(
+                    "{} Vulkan validation error(s)",
+                    r.ctx.validation_errors()
+                ));
+            }
+        }
+        self.running = None;
+    }
+}
