@@ -159,7 +159,7 @@ impl Scene {
     }
 
     /// Number of characters.
-    pub fn len(&self) -> usize {
+    pub fn character_count(&self) -> usize {
         self.characters.len()
     }
 }

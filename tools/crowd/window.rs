@@ -143,7 +143,7 @@ impl App {
             self.scene
                 .renderer(&ctx, &self.args, size.width.max(1), size.height.max(1))?;
         let path = renderer.default_path();
-        let side = (self.scene.len() as f32).sqrt().ceil();
+        let side = (self.scene.character_count() as f32).sqrt().ceil();
         let acquire = (0..hairmesh::render::FRAMES_IN_FLIGHT)
             .map(|_| Semaphore::new(&ctx))
             .collect::<Result<_, _>>()?;
@@ -393,7 +393,7 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
-        let scene_len = self.scene.len();
+        let scene_len = self.scene.character_count();
         let Some(r) = &mut self.running else { return };
         let result = match event {
             WindowEvent::CloseRequested => {
