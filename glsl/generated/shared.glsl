@@ -26,6 +26,8 @@
 #define BINDING_SCAN_SCRATCH 6
 #define BINDING_ARGS 7
 #define BINDING_VERTICES 8
+#define BINDING_PROP_VERTICES 9
+#define BINDING_PROP_INSTANCES 10
 #define BINDING_TEX_POSITION 0
 #define BINDING_TEX_UV 1
 #define BINDING_TEX_W 2
@@ -130,6 +132,16 @@ struct GenerateArgs {
 struct HairVertex {
     vec4 pos_width;
     vec4 tangent_s;
+};
+
+struct PropVertex {
+    vec4 position;
+    vec4 normal;
+};
+
+struct PropInstance {
+    mat4 model;
+    vec4 color;
 };
 
 struct TaskPayload {

@@ -27,8 +27,8 @@ use super::workspace::Workspace;
 use crate::bake::BakedHairMesh;
 use crate::model::style::HairStyle;
 use crate::vk::{
-    Access, BindingDesc, Buffer, BufferDesc, Context, DescriptorKind, DescriptorSetLayout,
-    GpuError, GpuResult, PipelineLayout, Semaphore, SwapchainImage,
+    Access, BindingDesc, Buffer, BufferDesc, CommandRecorder, Context, DescriptorKind,
+    DescriptorSetLayout, GpuError, GpuResult, Image, PipelineLayout, Semaphore, SwapchainImage,
 };
 
 /// Where a windowed frame goes: a swapchain image, the semaphore its acquisition signals and
@@ -40,6 +40,9 @@ pub struct PresentTarget<'a> {
     pub wait: &'a Semaphore,
     /// Signalled when the frame is done (presentation waits for it).
     pub signal: &'a Semaphore,
+    /// Drawn over the frame before it is presented (the control panel): called with the
+    /// colour target in colour-attachment use.
+    pub overlay: Option<&'a mut dyn FnMut(&mut CommandRecorder, &Image) -> GpuResult<()>>,
 }
 
 /// Prop meshes on the GPU and the instances placed for the next frames.
@@ -405,7 +408,7 @@ impl Renderer {
         &mut self,
         view: &View,
         opts: &FrameOptions,
-        present: Option<PresentTarget>,
+        mut present: Option<PresentTarget>,
     ) -> GpuResult<FrameTicket> {
         view.validate().map_err(GpuError::Unsupported)?;
         let path = opts.path.unwrap_or(self.default_path());
@@ -462,7 +465,7 @@ impl Renderer {
             }
         }
         let start = Instant::now();
-        self.record(i, path, bundles, opts, &prop_draws, present.as_ref())?;
+        self.record(i, path, bundles, opts, &prop_draws, present.as_mut())?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
         let slot = &mut self.frames[i];
         slot.fence.reset()?;
@@ -497,7 +500,7 @@ impl Renderer {
         bundles: u32,
         opts: &FrameOptions,
         props: &[PropDraw],
-        present: Option<&PresentTarget>,
+        present: Option<&mut PresentTarget>,
     ) -> GpuResult<()> {
         let slot = &mut self.frames[i];
         let bg = self.background;
@@ -524,6 +527,10 @@ impl Renderer {
             slot.mesh_query.as_mut(),
             inputs,
         )?;
+        let mut present = present;
+        if let Some(overlay) = present.as_mut().and_then(|p| p.overlay.as_mut()) {
+            overlay(&mut rec, &self.targets.color)?;
+        }
         rec.barrier(
             &[Access::ComputeReadWrite, Access::TaskReadWrite],
             &[Access::TransferRead],

@@ -277,6 +277,38 @@ impl CommandRecorder<'_> {
         self.rendering = true;
     }
 
+    /// Begin dynamic rendering into `color` only (overlays such as the control panel).
+    pub fn begin_rendering_color(&mut self, color: Attachment) {
+        let [w, h, _] = color.image.desc.extent;
+        let mut att = vk::RenderingAttachmentInfo::default()
+            .image_view(color.image.view())
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .store_op(vk::AttachmentStoreOp::STORE);
+        att = match color.clear {
+            Some(c) => att
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: c },
+                }),
+            None => att.load_op(vk::AttachmentLoadOp::LOAD),
+        };
+        let atts = [att];
+        let area = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D {
+                width: w,
+                height: h,
+            },
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&atts);
+        // SAFETY: the image is in COLOR_ATTACHMENT_OPTIMAL (the caller's barriers).
+        unsafe { self.ctx.device.cmd_begin_rendering(self.raw, &info) };
+        self.rendering = true;
+    }
+
     /// End the rendering instance begun last.
     pub fn end_rendering(&mut self) {
         if self.rendering {

@@ -458,6 +458,10 @@ impl Context {
         self.physical
     }
 
+    pub(crate) fn instance(&self) -> &ash::Instance {
+        &self.instance
+    }
+
     /// Wait until the device is idle.
     pub fn wait_idle(&self) {
         // SAFETY: valid device.

@@ -13,6 +13,7 @@ pub mod profiler;
 pub mod shader;
 pub mod swapchain;
 pub mod sync;
+pub mod ui;
 
 pub use access::Access;
 pub use buffer::{Buffer, BufferDesc};
@@ -24,6 +25,7 @@ pub use pipeline::{BlendMode, CullMode, DepthMode, GraphicsDesc, Pipeline, Pipel
 pub use profiler::{MeshPrimitivesQuery, Profiler};
 pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainImage};
 pub use sync::{Fence, Semaphore};
+pub use ui::UiRenderer;
 
 /// Errors of the GPU layer.
 #[derive(Debug, thiserror::Error)]

@@ -1,11 +1,12 @@
 //! The crowd in a window: winit 0.30 `ApplicationHandler`, a swapchain that survives resize,
 //! minimise (zero size), `OUT_OF_DATE` / `SUBOPTIMAL` and close, and an orbit / fly camera.
 //!
-//! Mouse: left-drag orbits, wheel zooms. Keys: W/A/S/D/Q/E move the orbit centre, Space pauses
-//! the automatic orbit, L toggles LoD, M switches mesh / compute path, V cycles the present
-//! mode, [ and ] halve / double strands per bundle, - and = lower / raise the vertex level,
-//! Escape closes. The title bar shows FPS, GPU ms per pass, strands and triangles, texture
-//! memory and the compute path's vertex-pool use.
+//! A control panel (egui) sets the character count, strands per bundle, vertex level, LoD and its
+//! alphas and lambda, the path, pause and the present mode, and shows the frame's statistics.
+//! Mouse: left-drag orbits (outside the panel), wheel zooms. Keys: W/A/S/D/Q/E move the orbit
+//! centre, Space pauses the automatic orbit, L toggles LoD, M switches mesh / compute path,
+//! V cycles the present mode, [ and ] halve / double strands per bundle, - and = lower / raise
+//! the vertex level, Escape closes. The title bar repeats the main figures.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -18,7 +19,7 @@ use hairmesh::render::{
     Renderer, StrandParams, View,
 };
 use hairmesh::vk::{
-    Acquired, Context, ContextDesc, PresentMode, Semaphore, Swapchain, WindowHandles,
+    Acquired, Context, ContextDesc, PresentMode, Semaphore, Swapchain, UiRenderer, WindowHandles,
 };
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::application::ApplicationHandler;
@@ -29,6 +30,67 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 use super::{Args, Scene, parse_size};
+
+/// What the control panel edits.
+struct Controls {
+    visible: usize,
+    params: StrandParams,
+    lod: LodSettings,
+    path: RenderPath,
+    paused: bool,
+    present_mode: PresentMode,
+}
+
+impl Controls {
+    fn show(&mut self, ctx: &egui::Context, total: usize, mesh_ok: bool, stats: &str) {
+        egui::Window::new("crowd")
+            .default_width(260.0)
+            .show(ctx, |ui| {
+                ui.add(egui::Slider::new(&mut self.visible, 1..=total.max(1)).text("characters"));
+                ui.add(
+                    egui::Slider::new(&mut self.params.strands_per_bundle, 1..=1024)
+                        .logarithmic(true)
+                        .text("strands per bundle"),
+                );
+                ui.add(
+                    egui::Slider::new(&mut self.params.verts_log2, 0..=6).text("vertex level e"),
+                );
+                ui.checkbox(&mut self.lod.enabled, "level of detail");
+                ui.add_enabled(
+                    self.lod.enabled,
+                    egui::Slider::new(&mut self.lod.alpha_strands, 0.01..=1.0)
+                        .logarithmic(true)
+                        .text("alpha strands"),
+                );
+                ui.add_enabled(
+                    self.lod.enabled,
+                    egui::Slider::new(&mut self.lod.alpha_verts, 0.01..=1.0)
+                        .logarithmic(true)
+                        .text("alpha vertices"),
+                );
+                ui.add_enabled(
+                    self.lod.enabled,
+                    egui::Slider::new(&mut self.lod.lambda, 0.05..=1.0).text("lambda"),
+                );
+                ui.horizontal(|ui| {
+                    ui.label("path");
+                    ui.add_enabled_ui(mesh_ok, |ui| {
+                        ui.radio_value(&mut self.path, RenderPath::Mesh, "mesh");
+                    });
+                    ui.radio_value(&mut self.path, RenderPath::Compute, "compute");
+                });
+                ui.horizontal(|ui| {
+                    ui.label("present");
+                    ui.radio_value(&mut self.present_mode, PresentMode::Fifo, "FIFO");
+                    ui.radio_value(&mut self.present_mode, PresentMode::Mailbox, "mailbox");
+                    ui.radio_value(&mut self.present_mode, PresentMode::Immediate, "immediate");
+                });
+                ui.checkbox(&mut self.paused, "pause orbit");
+                ui.separator();
+                ui.label(stats);
+            });
+    }
+}
 
 /// Orbit camera around a centre; the centre moves with the fly keys.
 struct OrbitCamera {
@@ -49,9 +111,21 @@ impl OrbitCamera {
     }
 }
 
+/// The control panel's state: what it edits and egui's own state.
+struct Panel {
+    ui: UiRenderer,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    /// Textures egui freed in a frame, released once that frame completed.
+    pending_free: Vec<(FrameTicket, Vec<egui::TextureId>)>,
+    visible: usize,
+    lod: LodSettings,
+}
+
 /// Everything that exists while the window does. Field order is drop order: Vulkan objects
 /// first, the window last (the surface must not outlive it).
 struct Running {
+    panel: Panel,
     swapchain: Option<Swapchain>,
     acquire: Vec<Semaphore>,
     renderer: Renderer,
@@ -62,7 +136,6 @@ struct Running {
     present_mode: PresentMode,
     camera: OrbitCamera,
     params: StrandParams,
-    lod: bool,
     path: RenderPath,
     paused: bool,
     dragging: Option<(f64, f64)>,
@@ -143,11 +216,37 @@ impl App {
             self.scene
                 .renderer(&ctx, &self.args, size.width.max(1), size.height.max(1))?;
         let path = renderer.default_path();
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(4096),
+        );
+        let panel = Panel {
+            ui: UiRenderer::new(
+                &ctx,
+                hairmesh::render::targets::COLOR_FORMAT,
+                hairmesh::render::FRAMES_IN_FLIGHT,
+            )?,
+            egui_ctx,
+            egui_state,
+            pending_free: Vec::new(),
+            visible: self.scene.character_count(),
+            lod: if self.args.lod == "on" {
+                LodSettings::default()
+            } else {
+                LodSettings::off()
+            },
+        };
         let side = (self.scene.character_count() as f32).sqrt().ceil();
         let acquire = (0..hairmesh::render::FRAMES_IN_FLIGHT)
             .map(|_| Semaphore::new(&ctx))
             .collect::<Result<_, _>>()?;
         self.running = Some(Running {
+            panel,
             swapchain: None,
             acquire,
             renderer,
@@ -166,7 +265,6 @@ impl App {
                 strands_per_bundle: self.args.strands_per_bundle,
                 verts_log2: self.args.verts_log2,
             },
-            lod: self.args.lod == "on",
             path,
             paused: false,
             dragging: None,
@@ -246,11 +344,15 @@ impl Running {
         let view = View {
             camera: self.camera.camera(),
             light_dir: Vec3::new(0.4, 1.0, 0.3),
-            lod: if self.lod {
-                LodSettings::default()
-            } else {
-                LodSettings::off()
-            },
+            lod: self.panel.lod,
+        };
+        let (primitives, ppp, freed) = self.panel_frame(scene_len)?;
+        let chain = self.swapchain.as_ref().expect("created above");
+        let semaphore = &self.acquire[(self.frame % self.acquire.len() as u64) as usize];
+        let ui = &mut self.panel.ui;
+        let mut overlay = |rec: &mut hairmesh::vk::CommandRecorder,
+                           target: &hairmesh::vk::Image| {
+            ui.draw(rec, target, ppp, &primitives)
         };
         let ticket = self.renderer.render_frame_to(
             &view,
@@ -262,17 +364,118 @@ impl Running {
                 image: &image,
                 wait: semaphore,
                 signal: chain.render_finished(image.index),
+                overlay: Some(&mut overlay),
             }),
         )?;
+        self.panel.pending_free.push((ticket, freed));
         let stale = chain.present(image.index)?;
         self.recreate |= stale || suboptimal;
         self.frame += 1;
         // The previous frame has (nearly always) completed: its report costs no stall.
         if let Some(t) = self.last_ticket.replace(ticket) {
             self.last_report = Some(self.renderer.wait(t)?);
+            let done: Vec<_> = self
+                .panel
+                .pending_free
+                .iter()
+                .filter(|(f, _)| f.0 <= t.0)
+                .flat_map(|(_, ids)| ids.clone())
+                .collect();
+            self.panel.pending_free.retain(|(f, _)| f.0 > t.0);
+            self.panel.ui.free_textures(&done)?;
         }
         self.update_title(scene_len);
         Ok(true)
+    }
+
+    /// Run the control panel for this frame: returns its meshes, pixels per point and the
+    /// textures egui freed; applies what the user changed.
+    fn panel_frame(
+        &mut self,
+        scene_len: usize,
+    ) -> Result<(Vec<egui::ClippedPrimitive>, f32, Vec<egui::TextureId>)> {
+        let input = self.panel.egui_state.take_egui_input(&self.window);
+        let egui_ctx = self.panel.egui_ctx.clone();
+        let mut c = Controls {
+            visible: self.panel.visible,
+            params: self.params,
+            lod: self.panel.lod,
+            path: self.path,
+            paused: self.paused,
+            present_mode: self.present_mode,
+        };
+        let stats = self.stats_text(scene_len);
+        let mesh_ok = self.renderer.has_mesh_path();
+        let output = egui_ctx.run_ui(input, |ui| c.show(ui.ctx(), scene_len, mesh_ok, &stats));
+        self.panel
+            .egui_state
+            .handle_platform_output(&self.window, output.platform_output);
+        self.panel.ui.set_textures(&output.textures_delta)?;
+        self.apply(c)?;
+        let ppp = output.pixels_per_point;
+        let primitives = egui_ctx.tessellate(output.shapes, ppp);
+        Ok((
+            primitives,
+            ppp,
+            output.textures_delta.free.iter().copied().collect(),
+        ))
+    }
+
+    fn apply(&mut self, c: Controls) -> Result<()> {
+        if c.visible != self.panel.visible {
+            for (k, id) in self.renderer.crowd().ids().into_iter().enumerate() {
+                self.renderer.set_visible(id, k < c.visible)?;
+            }
+            self.panel.visible = c.visible;
+        }
+        if c.params != self.params {
+            self.set_params(c.params)?;
+        }
+        if c.present_mode != self.present_mode {
+            self.present_mode = c.present_mode;
+            self.recreate = true;
+        }
+        self.panel.lod = c.lod;
+        self.path = c.path;
+        self.paused = c.paused;
+        Ok(())
+    }
+
+    fn stats_text(&self, scene_len: usize) -> String {
+        let Some(r) = &self.last_report else {
+            return "waiting for the first frame".into();
+        };
+        let passes: Vec<String> = r
+            .pass_ms
+            .iter()
+            .map(|(n, ms)| format!("{n} {ms:.1} ms"))
+            .collect();
+        let mut text = format!(
+            "{:.1} fps\nGPU: {}\nCPU record: {:.2} ms\nstrands {} / triangles {}\ncharacters {} of {scene_len}, textures {:.1} MiB",
+            self.fps,
+            passes.join(", "),
+            r.record_ms,
+            r.stats.strands_drawn,
+            r.stats.triangles_drawn,
+            self.panel.visible,
+            self.renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64,
+        );
+        if r.path == RenderPath::Compute {
+            text.push_str(&format!(
+                "\nvertex pool {} of {} slots{}",
+                r.stats.vertex_slots_written,
+                self.renderer.vertex_budget(),
+                if r.stats.strands_drawn < r.stats.strands_demanded {
+                    format!(
+                        ", OVERFLOW: {} of {} strands",
+                        r.stats.strands_drawn, r.stats.strands_demanded
+                    )
+                } else {
+                    String::new()
+                }
+            ));
+        }
+        text
     }
 
     fn update_title(&mut self, scene_len: usize) {
@@ -312,7 +515,7 @@ impl Running {
             r.stats.triangles_drawn,
             self.renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64,
             self.path,
-            if self.lod { "on" } else { "off" },
+            if self.panel.lod.enabled { "on" } else { "off" },
             self.swapchain.as_ref().map_or(self.present_mode, |s| s.present_mode),
             self.params.strands_per_bundle,
             self.params.verts_log2,
@@ -344,7 +547,7 @@ impl Running {
             KeyCode::KeyE => self.camera.centre.y += step,
             KeyCode::KeyQ => self.camera.centre.y -= step,
             KeyCode::Space => self.paused = !self.paused,
-            KeyCode::KeyL => self.lod = !self.lod,
+            KeyCode::KeyL => self.panel.lod.enabled = !self.panel.lod.enabled,
             KeyCode::KeyM => {
                 self.path = match self.path {
                     RenderPath::Mesh => RenderPath::Compute,
@@ -395,7 +598,19 @@ impl ApplicationHandler for App {
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         let scene_len = self.scene.character_count();
         let Some(r) = &mut self.running else { return };
+        let consumed = r
+            .panel
+            .egui_state
+            .on_window_event(&r.window, &event)
+            .consumed;
         let result = match event {
+            WindowEvent::KeyboardInput { .. }
+            | WindowEvent::MouseInput { .. }
+            | WindowEvent::MouseWheel { .. }
+                if consumed =>
+            {
+                Ok(())
+            }
             WindowEvent::CloseRequested => {
                 event_loop.exit();
                 Ok(())
