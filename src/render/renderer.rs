@@ -42,8 +42,11 @@ pub struct PresentTarget<'a> {
     pub signal: &'a Semaphore,
     /// Drawn over the frame before it is presented (the control panel): called with the
     /// colour target in colour-attachment use.
-    pub overlay: Option<&'a mut dyn FnMut(&mut CommandRecorder, &Image) -> GpuResult<()>>,
+    pub overlay: Option<&'a mut Overlay<'a>>,
 }
+
+/// Something drawn over a frame's colour target before it is presented.
+pub type Overlay<'a> = dyn FnMut(&mut CommandRecorder, &Image) -> GpuResult<()> + 'a;
 
 /// Prop meshes on the GPU and the instances placed for the next frames.
 #[derive(Default)]
