@@ -118,6 +118,17 @@ pub const MAX_SCALE: f32 = 1e4;
 /// Largest translation component of a character.
 pub const MAX_TRANSLATION: f32 = 1e6;
 
+/// Parse an image size `WIDTHxHEIGHT` with 1..=[`MAX_IMAGE_SIDE`] per side (tools' `--size`).
+pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || format!("--size '{s}': expected WIDTHxHEIGHT with 1..={MAX_IMAGE_SIDE} per side");
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
 impl SceneDesc {
     /// Load and validate a scene file; relative paths are resolved against its folder.
     pub fn load(path: &Path) -> Result<Self> {

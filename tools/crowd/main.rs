@@ -83,14 +83,7 @@ pub struct Args {
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32)> {
-    let max = hairmesh::render::scene::MAX_IMAGE_SIDE;
-    let bad = || anyhow::anyhow!("--size '{s}': expected WIDTHxHEIGHT with 1..={max} per side");
-    let (w, h) = s.split_once('x').ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
-    if w == 0 || h == 0 || w > max || h > max {
-        return Err(bad());
-    }
-    Ok((w, h))
+    hairmesh::render::scene::parse_size(s).map_err(anyhow::Error::msg)
 }
 
 /// The camera of frame `f`: orbiting the crowd's centre at eye height, far enough to see it.
