@@ -147,6 +147,8 @@ struct Running {
     /// Swapchain (re)creations and frames skipped for a zero-size window.
     recreations: u32,
     zero_skips: u32,
+    /// `--test-resize`: redraws left with a simulated zero-size window.
+    hold_zero: u32,
     window: Arc<Window>,
 }
 
@@ -157,6 +159,7 @@ struct App {
     error: Option<anyhow::Error>,
     presented: u64,
     simulated_zero: u32,
+    resize_requested: bool,
     summary: String,
 }
 
@@ -173,6 +176,7 @@ pub fn run(args: Args, scene: Scene) -> Result<()> {
         error: None,
         presented: 0,
         simulated_zero: 0,
+        resize_requested: false,
         summary: String::new(),
     };
     event_loop.run_app(&mut app)?;
@@ -275,30 +279,36 @@ impl App {
             fps: 0.0,
             recreations: 0,
             zero_skips: 0,
+            hold_zero: 0,
             window,
         });
         Ok(())
     }
 
-    /// Test script of `--test-resize`: a new size after 3 frames, a zero-size (minimised)
-    /// window for 3 frames after 6.
+    /// Test script of `--test-resize`, run once per redraw: a new size after 3 frames, a
+    /// zero-size (minimised) window for 3 redraws after 6 frames.
     fn scripted_resize(&mut self) {
         let Some(r) = &mut self.running else { return };
         if !self.args.test_resize {
             return;
         }
-        if self.presented == 3 && r.frame == 3 {
+        if self.presented >= 3 && !self.resize_requested {
+            self.resize_requested = true;
             let _ = r
                 .window
                 .request_inner_size(PhysicalSize::new(r.size.0 / 2 + 17, r.size.1 / 2 + 9));
         }
-        if self.presented == 6 && self.simulated_zero < 3 {
-            self.simulated_zero += 1;
+        // A zero-size window for the next 3 redraws (Resized events are held meanwhile).
+        if self.presented == 6 && self.simulated_zero == 0 {
+            self.simulated_zero = 1;
+            r.hold_zero = 3;
             r.size_changed(0, 0);
-        } else if self.simulated_zero == 3 {
-            self.simulated_zero += 1;
-            let s = r.window.inner_size();
-            r.size_changed(s.width, s.height);
+        } else if r.hold_zero > 0 {
+            r.hold_zero -= 1;
+            if r.hold_zero == 0 {
+                let s = r.window.inner_size();
+                r.size_changed(s.width, s.height);
+            }
         }
     }
 }
@@ -603,6 +613,7 @@ impl ApplicationHandler for App {
             .egui_state
             .on_window_event(&r.window, &event)
             .consumed;
+        let redraw = matches!(event, WindowEvent::RedrawRequested);
         let result = match event {
             WindowEvent::KeyboardInput { .. }
             | WindowEvent::MouseInput { .. }
@@ -616,7 +627,9 @@ impl ApplicationHandler for App {
                 Ok(())
             }
             WindowEvent::Resized(size) => {
-                r.size_changed(size.width, size.height);
+                if r.hold_zero == 0 {
+                    r.size_changed(size.width, size.height);
+                }
                 Ok(())
             }
             WindowEvent::KeyboardInput { event, .. } => match (event.state, event.physical_key) {
@@ -670,7 +683,9 @@ impl ApplicationHandler for App {
             self.error = Some(e);
             event_loop.exit();
         }
-        self.scripted_resize();
+        if redraw {
+            self.scripted_resize();
+        }
     }
 
     fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
