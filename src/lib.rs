@@ -14,6 +14,7 @@ pub mod model;
 pub mod reference;
 pub mod render;
 pub mod rng;
+pub mod shade;
 pub mod vk;
 
 pub use bake::{BakeOptions, BakedHairMesh, BundleDesc, MeshInfo, bake};

@@ -66,7 +66,8 @@ struct HairStyle {
     float frizz_power;
     uint density_by_area;
     float color[3];
-    uint _pad[2];
+    float roughness;
+    float cuticle_tilt_degrees;
 };
 
 struct BundleDesc {

@@ -4,7 +4,7 @@
 //! ```text
 //! offset  size  field
 //! 0       8     magic "HAIRMESH"
-//! 8       4     format version (u32, currently 1)
+//! 8       4     format version (u32, currently 2; version 1 had no roughness / cuticle tilt)
 //! 12      4     CRC-32 (IEEE) of the payload
 //! 16      8     payload length in bytes (u64)
 //! 24      ...   payload:
@@ -31,7 +31,7 @@ use crate::model::style::HairStyle;
 /// File magic.
 pub const MAGIC: &[u8; 8] = b"HAIRMESH";
 /// Current format version.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 const HEADER: usize = 24;
 
 /// Serialise a bake to bytes.
@@ -109,7 +109,7 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<BakedHairMesh> {
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
     if version != VERSION {
         return Err(bad(format!(
-            "unsupported format version {version} (this build reads {VERSION})"
+            "unsupported format version {version} (this build reads {VERSION}; re-bake the hair mesh)"
         )));
     }
     let crc = u32::from_le_bytes(bytes[12..16].try_into().unwrap());

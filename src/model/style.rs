@@ -70,9 +70,12 @@ pub struct HairStyle {
     /// Base colour, linear RGB.
     #[serde(deserialize_with = "crate::model::exact_array::exact")]
     pub color: [f32; 3],
-    /// Padding to a 16-byte multiple (std430 arrays of this struct).
-    #[serde(skip)]
-    pub _pad: [u32; 2],
+    /// Longitudinal roughness of the Marschner lobes: width `beta` of the R lobe in radians
+    /// (TT gets `beta / 2`, TRT `2 beta`).
+    pub roughness: f32,
+    /// Cuticle tilt `alpha` in degrees: the R lobe shifts by `-alpha`, TT by `alpha / 2`, TRT by
+    /// `3 alpha / 2` (Marschner et al. 2003).
+    pub cuticle_tilt_degrees: f32,
 }
 
 impl Default for HairStyle {
@@ -98,7 +101,8 @@ impl Default for HairStyle {
             frizz_power: 1.0,
             density_by_area: 1,
             color: [0.35, 0.2, 0.1],
-            _pad: [0; 2],
+            roughness: 0.25,
+            cuticle_tilt_degrees: 3.0,
         }
     }
 }
@@ -172,6 +176,8 @@ impl HairStyle {
             ("color[0]", self.color[0]),
             ("color[1]", self.color[1]),
             ("color[2]", self.color[2]),
+            ("roughness", self.roughness),
+            ("cuticle_tilt_degrees", self.cuticle_tilt_degrees),
         ];
         for (field, v) in floats {
             if !v.is_finite() {
@@ -180,7 +186,7 @@ impl HairStyle {
                     format!("style field {field} is not finite"),
                 ));
             }
-            if v < 0.0 && field != "wave_angle" {
+            if v < 0.0 && field != "wave_angle" && field != "cuticle_tilt_degrees" {
                 return Err(HairError::invalid(
                     name,
                     format!("style field {field} must be >= 0, got {v}"),
@@ -198,6 +204,14 @@ impl HairStyle {
         check(self.length_variation < 1.0, "length_variation must be < 1")?;
         check(self.clump_strength <= 1.0, "clump_strength must be <= 1")?;
         check(self.density_by_area <= 1, "density_by_area must be 0 or 1")?;
+        check(
+            (0.1..=1.0).contains(&self.roughness),
+            "roughness must be in [0.1, 1] radians",
+        )?;
+        check(
+            self.cuticle_tilt_degrees.abs() <= 20.0,
+            "cuticle_tilt_degrees must be in [-20, 20]",
+        )?;
         Ok(())
     }
 }

@@ -159,7 +159,8 @@ gpu_struct!(HairStyle as "HairStyle" {
     curl_radius: "float", curl_frequency: "float", curl_phase_jitter: "float",
     wave_amplitude: "float", wave_frequency: "float", wave_angle: "float",
     wave_phase_jitter: "float", frizz_amplitude: "float", frizz_frequency: "float",
-    frizz_power: "float", density_by_area: "uint", color: "float"[3], _pad: "uint"[2],
+    frizz_power: "float", density_by_area: "uint", color: "float"[3], roughness: "float",
+    cuticle_tilt_degrees: "float",
 });
 
 gpu_struct!(BundleDesc as "BundleDesc" {

@@ -1,0 +1,191 @@
+//! Hair shading: the CPU twins of `glsl/hair_shading.glsl` (same formulas, same constants),
+//! used to test the models (energy) and to document them.
+//!
+//! - **Kajiya-Kay** (Kajiya and Kay 1989): diffuse `sin(T, L)`, specular
+//!   `(sin(T,L) sin(T,V) - cos(T,L) cos(T,V))^p` (light and eye directions pointing away from
+//!   the fibre), which peaks on the mirror cone.
+//! - **Marschner** (Marschner et al. 2003; seed 000 eq. 1): `S = sum_p M_p(theta_h) N_p(phi) /
+//!   cos^2(theta_d)` over the lobes R, TT, TRT, with Gaussian longitudinal terms shifted by the
+//!   cuticle tilt and widened by the roughness, and the azimuthal terms of Karis 2016 (closed-form
+//!   fits of the R, TT, TRT azimuthal scattering with Fresnel and absorption from the base
+//!   colour).
+
+use glam::Vec3;
+
+/// Which model shades the strands.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+pub enum ShadingModel {
+    /// The simple look the project started with (diffuse + weak highlight, darker roots).
+    #[default]
+    Placeholder = 0,
+    /// Kajiya-Kay diffuse + specular.
+    KajiyaKay = 1,
+    /// Marschner R / TT / TRT lobes.
+    Marschner = 2,
+}
+
+impl std::str::FromStr for ShadingModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "placeholder" => Ok(ShadingModel::Placeholder),
+            "kajiya-kay" => Ok(ShadingModel::KajiyaKay),
+            "marschner" => Ok(ShadingModel::Marschner),
+            _ => Err(format!(
+                "unknown shading model '{s}' (placeholder, kajiya-kay, marschner)"
+            )),
+        }
+    }
+}
+
+/// Refractive index of hair keratin.
+pub const HAIR_ETA: f32 = 1.55;
+/// Kajiya-Kay specular exponent.
+pub const KAJIYA_KAY_EXPONENT: f32 = 80.0;
+
+/// Kajiya-Kay: `(diffuse, specular)` factors for unit tangent `t`, light `l`, eye `v`.
+pub fn kajiya_kay(t: Vec3, l: Vec3, v: Vec3) -> (f32, f32) {
+    let tl = t.dot(l).clamp(-1.0, 1.0);
+    let tv = t.dot(v).clamp(-1.0, 1.0);
+    let sin_tl = (1.0 - tl * tl).max(0.0).sqrt();
+    let sin_tv = (1.0 - tv * tv).max(0.0).sqrt();
+    // With both directions pointing away from the fibre, the mirror cone has T.V = -T.L.
+    let spec = (sin_tl * sin_tv - tl * tv)
+        .max(0.0)
+        .powf(KAJIYA_KAY_EXPONENT);
+    (sin_tl, spec)
+}
+
+/// Schlick's Fresnel reflectance for relative index `eta` at `cos_theta`.
+pub fn fresnel(eta: f32, cos_theta: f32) -> f32 {
+    let f0 = ((1.0 - eta) / (1.0 + eta)).powi(2);
+    f0 + (1.0 - f0) * (1.0 - cos_theta.clamp(0.0, 1.0)).powi(5)
+}
+
+/// Normalised Gaussian of width `beta` at `x`.
+fn gaussian(beta: f32, x: f32) -> f32 {
+    (-x * x / (2.0 * beta * beta)).exp() / ((2.0 * std::f32::consts::PI).sqrt() * beta)
+}
+
+/// Marschner parameters of one style.
+#[derive(Clone, Copy, Debug)]
+pub struct MarschnerParams {
+    /// Base colour (linear RGB): the colour after one pass through the fibre.
+    pub color: Vec3,
+    /// Longitudinal width `beta` of the R lobe, radians.
+    pub roughness: f32,
+    /// Cuticle tilt `alpha`, radians.
+    pub tilt: f32,
+}
+
+/// The hair scattering function `S(omega_i, omega_o)` per colour channel, for unit tangent
+/// `t`, direction to the light `l` and to the eye `v`. Outgoing radiance from a directional
+/// light of irradiance `E` (perpendicular to the light) is `S * E * cos(theta_i)`.
+pub fn marschner(t: Vec3, l: Vec3, v: Vec3, p: &MarschnerParams) -> Vec3 {
+    let sin_i = t.dot(l).clamp(-1.0, 1.0);
+    let sin_o = t.dot(v).clamp(-1.0, 1.0);
+    let (theta_i, theta_o) = (sin_i.asin(), sin_o.asin());
+    let theta_h = 0.5 * (theta_i + theta_o);
+    let cos_d = (0.5 * (theta_o - theta_i)).cos().max(1e-3);
+    let lp = l - t * sin_i;
+    let vp = v - t * sin_o;
+    let cos_phi =
+        (lp.dot(vp) / (lp.length_squared() * vp.length_squared() + 1e-8).sqrt()).clamp(-1.0, 1.0);
+    let cos_half_phi = (0.5 + 0.5 * cos_phi).sqrt();
+    // Longitudinal: shifts -a, a/2, 3a/2 and widths b, b/2, 2b (Marschner 2003), normalised
+    // over theta_o (d theta_o = 2 d theta_h).
+    let (a, b) = (p.tilt, p.roughness);
+    let m_r = 0.5 * gaussian(b, theta_h + a);
+    let m_tt = 0.5 * gaussian(0.5 * b, theta_h - 0.5 * a);
+    let m_trt = 0.5 * gaussian(2.0 * b, theta_h - 1.5 * a);
+    // Azimuthal (Karis 2016).
+    let n_r = 0.25 * cos_half_phi * fresnel(HAIR_ETA, (0.5 + 0.5 * l.dot(v)).max(0.0).sqrt());
+    let eta_p = 1.19 / cos_d + 0.36 * cos_d;
+    let inv_eta = 1.0 / eta_p;
+    let h_tt = (1.0 + inv_eta * (0.6 - 0.8 * cos_phi)) * cos_half_phi;
+    let path_tt = (1.0 - h_tt * h_tt * inv_eta * inv_eta).max(0.0).sqrt() / (2.0 * cos_d);
+    let f_tt = fresnel(HAIR_ETA, cos_d * (1.0 - h_tt * h_tt).max(0.0).sqrt());
+    let absorb = |path: f32| p.color.max(Vec3::splat(1e-4)).powf(path);
+    let n_tt = absorb(path_tt) * ((1.0 - f_tt) * (1.0 - f_tt) * (-3.65 * cos_phi - 3.98).exp());
+    let f_trt = fresnel(HAIR_ETA, cos_d * 0.5);
+    let n_trt = absorb(0.8 / cos_d)
+        * ((1.0 - f_trt) * (1.0 - f_trt) * f_trt * (17.0 * cos_phi - 16.78).exp());
+    (Vec3::splat(m_r * n_r) + n_tt * m_tt + n_trt * m_trt) * (ENERGY_SCALE / (cos_d * cos_d))
+}
+
+/// The azimuthal fits with the `1 / cos^2(theta_d)` factor return up to 9.6% more energy than
+/// arrives for narrow lobes at grazing incidence (white furnace, roughness 0.1, 60 degrees:
+/// 1.096); this scale keeps every tested case at or below 1 (tests below).
+pub const ENERGY_SCALE: f32 = 0.9;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `integral over the sphere of S(omega_i, omega_o) cos(theta_o) d omega_o` for white hair
+    /// (no absorption) and incidence `theta_i`, by midpoint quadrature in (theta_o, phi).
+    fn furnace(theta_i: f32, p: &MarschnerParams) -> f32 {
+        let t = Vec3::Y;
+        let l = Vec3::new(theta_i.cos(), theta_i.sin(), 0.0);
+        let (nt, np) = (400, 400);
+        let mut sum = 0.0f64;
+        for a in 0..nt {
+            let theta_o =
+                -std::f32::consts::FRAC_PI_2 + std::f32::consts::PI * (a as f32 + 0.5) / nt as f32;
+            for b in 0..np {
+                let phi =
+                    -std::f32::consts::PI + std::f32::consts::TAU * (b as f32 + 0.5) / np as f32;
+                let v = Vec3::new(
+                    theta_o.cos() * phi.cos(),
+                    theta_o.sin(),
+                    theta_o.cos() * phi.sin(),
+                );
+                let s = marschner(t, l, v, p).x;
+                // d omega = cos(theta_o) d theta_o d phi; times the cos(theta_o) projection.
+                sum += (s * theta_o.cos() * theta_o.cos()) as f64;
+            }
+        }
+        (sum * (std::f64::consts::PI / nt as f64) * (std::f64::consts::TAU / np as f64)) as f32
+    }
+
+    #[test]
+    fn marschner_lobes_conserve_energy_white_furnace() {
+        for roughness in [0.1, 0.25, 0.5, 1.0] {
+            let p = MarschnerParams {
+                color: Vec3::ONE,
+                roughness,
+                tilt: 3f32.to_radians(),
+            };
+            for deg in [0.0f32, 20.0, 40.0, 60.0, 80.0] {
+                let e = furnace(deg.to_radians(), &p);
+                println!("roughness {roughness}, theta_i {deg}: {e:.4}");
+                assert!(e <= 1.0, "roughness {roughness}, theta_i {deg}: {e}");
+                assert!(
+                    e > 0.4,
+                    "roughness {roughness}, theta_i {deg}: {e} (too dark)"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn dark_hair_absorbs_and_kajiya_kay_peaks_at_the_mirror_cone() {
+        let t = Vec3::Y;
+        let l = Vec3::new(0.8, 0.6, 0.0).normalize();
+        let v = Vec3::new(-0.8, -0.6, 0.0).normalize();
+        let white = MarschnerParams {
+            color: Vec3::ONE,
+            roughness: 0.25,
+            tilt: 0.0,
+        };
+        let dark = MarschnerParams {
+            color: Vec3::splat(0.05),
+            ..white
+        };
+        assert!(marschner(t, l, v, &dark).x < marschner(t, l, v, &white).x);
+        let (_, on_cone) = kajiya_kay(t, l, Vec3::new(-0.8, -0.6, 0.0).normalize());
+        let (_, off_cone) = kajiya_kay(t, l, Vec3::new(-0.6, 0.8, 0.0));
+        assert!(on_cone > 0.9 && off_cone < 0.1, "{on_cone} {off_cone}");
+    }
+}
