@@ -9,6 +9,7 @@ layout(location = 0) out vec3 out_tangent;
 layout(location = 1) out float out_s;
 layout(location = 2) out vec3 out_pos;
 layout(location = 3) flat out vec3 out_color;
+layout(location = 4) flat out uint out_character;
 
 void main() {
     uint idx = uint(gl_VertexIndex);
@@ -39,4 +40,5 @@ void main() {
     out_s = v.tangent_s.w;
     out_pos = world;
     out_color = style_color();
+    out_character = bundles[lo].character;
 }

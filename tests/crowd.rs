@@ -51,6 +51,7 @@ fn crowd_view(count: usize) -> View {
         camera: Camera::look_at(centre + Vec3::new(0.3, 1.2, -1.1) * side, centre, 40.0),
         light_dir: light(),
         lod: LodSettings::default(),
+        shading: hairmesh::shade::ShadingModel::Placeholder,
     }
 }
 

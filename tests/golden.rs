@@ -12,6 +12,7 @@
 mod common;
 
 use common::*;
+use hairmesh::shade::ShadingModel;
 
 const MEAN_MAX: f32 = 0.02;
 const P99_MAX: f32 = 0.25;
@@ -23,12 +24,27 @@ fn render_golden(
     e: u32,
     edit: impl Fn(&mut hairmesh::HairStyle),
 ) -> RenderOutput {
+    render_golden_shaded(mesh, n, e, ShadingModel::Placeholder, edit)
+}
+
+/// [`render_golden`] with a shading model.
+fn render_golden_shaded(
+    mesh: &str,
+    n: u32,
+    e: u32,
+    shading: ShadingModel,
+    edit: impl Fn(&mut hairmesh::HairStyle),
+) -> RenderOutput {
     let ctx = context();
     let (baked, mut style) = sample(mesh);
     edit(&mut style);
     let mut r = renderer(&ctx, 256);
     upload(&mut r, &baked, &style, n, e);
-    let out = render(&mut r, &framing(&baked), &compute_full());
+    let settings = RenderSettings {
+        shading,
+        ..compute_full()
+    };
+    let out = render(&mut r, &framing(&baked), &settings);
     assert_no_validation_errors(&ctx);
     out
 }
@@ -57,7 +73,11 @@ fn flip_against(name: &str, out: &RenderOutput) -> (nv_flip::FlipImageFloat, f32
 }
 
 fn check(name: &str, mesh: &str, n: u32, e: u32) {
-    let out = render_golden(mesh, n, e, |_| {});
+    check_shaded(name, mesh, n, e, ShadingModel::Placeholder);
+}
+
+fn check_shaded(name: &str, mesh: &str, n: u32, e: u32, shading: ShadingModel) {
+    let out = render_golden_shaded(mesh, n, e, shading, |_| {});
     let reference = root().join("tests/golden").join(format!("{name}.png"));
     if std::env::var("HAIRMESH_BLESS").is_ok_and(|v| v == "1") {
         save_png(&reference, out.width, out.height, &out.rgba);
@@ -99,6 +119,57 @@ fn thresholds_catch_a_changed_style_value() {
         });
         let (_, mean, p99) = flip_against(name, &out);
         println!("{name} with clump_strength + 0.3: FLIP mean {mean:.5}, p99 {p99:.5}");
+        assert!(
+            mean > MEAN_MAX || p99 > P99_MAX,
+            "{name}: a changed style passes the golden thresholds (mean {mean}, p99 {p99})"
+        );
+    }
+}
+
+#[test]
+fn golden_head_long_kajiya_kay() {
+    check_shaded(
+        "head_long_kajiya_kay",
+        "head_long.obj",
+        32,
+        5,
+        ShadingModel::KajiyaKay,
+    );
+}
+
+#[test]
+fn golden_head_long_marschner() {
+    check_shaded(
+        "head_long_marschner",
+        "head_long.obj",
+        32,
+        5,
+        ShadingModel::Marschner,
+    );
+}
+
+/// The shading goldens fail on a wrong shading input too: another roughness and tilt for
+/// Marschner, another colour for Kajiya-Kay.
+#[test]
+fn shading_thresholds_catch_a_changed_style_value() {
+    for (name, shading, edit) in [
+        (
+            "head_long_marschner",
+            ShadingModel::Marschner,
+            (|s: &mut hairmesh::HairStyle| {
+                s.roughness = 0.6;
+                s.cuticle_tilt_degrees = -8.0;
+            }) as fn(&mut hairmesh::HairStyle),
+        ),
+        (
+            "head_long_kajiya_kay",
+            ShadingModel::KajiyaKay,
+            |s: &mut hairmesh::HairStyle| s.color = [0.25, 0.2, 0.1],
+        ),
+    ] {
+        let out = render_golden_shaded("head_long.obj", 32, 5, shading, edit);
+        let (_, mean, p99) = flip_against(name, &out);
+        println!("{name} with a changed style: FLIP mean {mean:.5}, p99 {p99:.5}");
         assert!(
             mean > MEAN_MAX || p99 > P99_MAX,
             "{name}: a changed style passes the golden thresholds (mean {mean}, p99 {p99})"

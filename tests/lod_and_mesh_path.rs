@@ -20,6 +20,7 @@ fn settings(path: RenderPath, lod: bool) -> RenderSettings {
         } else {
             LodSettings::off()
         },
+        shading: hairmesh::shade::ShadingModel::Placeholder,
     }
 }
 

@@ -403,6 +403,7 @@ fn bench_view(camera: Camera, lod_on: bool) -> View {
         } else {
             LodSettings::off()
         },
+        shading: hairmesh::shade::ShadingModel::Placeholder,
     }
 }
 

@@ -68,6 +68,9 @@ struct Args {
     /// Geomorph window lambda of eq. 10-12, in (0, 1].
     #[arg(long, default_value_t = 0.5)]
     lod_lambda: f32,
+    /// Strand shading: placeholder, kajiya-kay or marschner.
+    #[arg(long, default_value = "marschner")]
+    shading: hairmesh::shade::ShadingModel,
     /// Size of the compute path's vertex pool in MiB (frames that need more keep whole strands
     /// up to it and report the overflow).
     #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u64).range(1..=4096))]
@@ -293,6 +296,7 @@ fn run(args: Args) -> Result<()> {
         camera,
         light_dir: inputs.light,
         lod,
+        shading: args.shading,
     };
     let out = renderer.render_one(
         &view,

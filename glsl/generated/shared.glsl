@@ -87,6 +87,7 @@ struct FrameBlock {
     vec4 lod;
     vec4 lod_ortho;
     uvec4 counts;
+    uvec4 shading;
 };
 
 struct CharacterRecord {

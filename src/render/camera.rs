@@ -175,6 +175,8 @@ pub struct View {
     pub light_dir: Vec3,
     /// LoD settings.
     pub lod: LodSettings,
+    /// Shading model of the strands.
+    pub shading: crate::shade::ShadingModel,
 }
 
 impl View {
@@ -228,6 +230,7 @@ impl View {
             ],
             lod_ortho: [0.0; 4],
             counts: [bundles, characters, self.lod.enabled as u32, vertex_budget],
+            shading: [self.shading as u32, 0, 0, 0],
         }
     }
 }
@@ -248,6 +251,6 @@ mod tests {
         assert!(inside(Vec3::ZERO));
         assert!(!inside(Vec3::new(0.0, 0.0, 10.0)), "behind the camera");
         assert!(!inside(Vec3::new(100.0, 0.0, 0.0)), "far to the side");
-        assert_eq!(size_of::<FrameBlock>(), 256);
+        assert_eq!(size_of::<FrameBlock>(), 272);
     }
 }

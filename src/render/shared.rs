@@ -189,11 +189,13 @@ pub struct FrameBlock {
     /// x bundles of all characters, y character slots, z LoD on, w vertex pool budget
     /// (compute path, in `HairVertex` slots).
     pub counts: [u32; 4],
+    /// x shading model (`shade::ShadingModel`); yzw reserved.
+    pub shading: [u32; 4],
 }
 
 gpu_struct!(FrameBlock as "FrameBlock" {
     view_proj: "mat4", camera_pos: "vec4", light_dir: "vec4", viewport: "vec4",
-    planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4",
+    planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4", shading: "uvec4",
 });
 
 /// One character: where its bundles and textures are, how it is placed and styled.

@@ -25,6 +25,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../glsl/strand_build.glsl"),
     ),
     ("strip.glsl", include_str!("../../glsl/strip.glsl")),
+    (
+        "hair_shading.glsl",
+        include_str!("../../glsl/hair_shading.glsl"),
+    ),
     ("strands.task", include_str!("../../glsl/strands.task")),
     ("strands.mesh", include_str!("../../glsl/strands.mesh")),
     ("cull.comp", include_str!("../../glsl/cull.comp")),

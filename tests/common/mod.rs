@@ -19,6 +19,7 @@ use hairmesh::{BakedHairMesh, HairStyle};
 pub struct RenderSettings {
     pub path: Option<RenderPath>,
     pub lod: LodSettings,
+    pub shading: hairmesh::shade::ShadingModel,
 }
 
 /// What a test render produced.
@@ -44,6 +45,7 @@ pub fn render(r: &mut Renderer, cam: &Camera, settings: &RenderSettings) -> Rend
         camera: *cam,
         light_dir: light(),
         lod: settings.lod,
+        shading: settings.shading,
     };
     let report = r
         .render_one(
@@ -107,6 +109,7 @@ pub fn compute_full() -> RenderSettings {
     RenderSettings {
         path: Some(RenderPath::Compute),
         lod: LodSettings::off(),
+        shading: hairmesh::shade::ShadingModel::Placeholder,
     }
 }
 

@@ -68,6 +68,9 @@ pub struct Args {
     /// Vertices per strand are 2^e + 1 (e in 0..=6).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=6))]
     verts_log2: u32,
+    /// Strand shading: placeholder, kajiya-kay or marschner.
+    #[arg(long, default_value = "marschner")]
+    shading: hairmesh::shade::ShadingModel,
     /// Level of detail.
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     lod: String,
@@ -199,6 +202,7 @@ fn run(args: Args) -> Result<()> {
             camera: orbit_camera(args.count, f),
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod,
+            shading: args.shading,
         };
         let t = Instant::now();
         let report = renderer.render_one(

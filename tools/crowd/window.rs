@@ -4,7 +4,8 @@
 //! A control panel (egui) sets the character count, strands per bundle, vertex level, LoD and its
 //! alphas and lambda, the path, pause and the present mode, and shows the frame's statistics.
 //! Mouse: left-drag orbits (outside the panel), wheel zooms. Keys: W/A/S/D/Q/E move the orbit
-//! centre, Space pauses the automatic orbit, L toggles LoD, M switches mesh / compute path,
+//! centre, Space pauses the automatic orbit, L toggles LoD, K cycles the shading model, M
+//! switches mesh / compute path,
 //! V cycles the present mode, [ and ] halve / double strands per bundle, - and = lower / raise
 //! the vertex level, Escape closes. The title bar repeats the main figures.
 
@@ -18,6 +19,7 @@ use hairmesh::render::{
     Camera, FrameOptions, FrameReport, FrameTicket, LodSettings, PresentTarget, RenderPath,
     Renderer, StrandParams, View,
 };
+use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{
     Acquired, Context, ContextDesc, PresentMode, Semaphore, Swapchain, UiRenderer, WindowHandles,
 };
@@ -34,6 +36,7 @@ use super::{Args, Scene, parse_size};
 /// What the control panel edits.
 struct Controls {
     visible: usize,
+    shading: ShadingModel,
     params: StrandParams,
     lod: LodSettings,
     path: RenderPath,
@@ -72,6 +75,12 @@ impl Controls {
                     self.lod.enabled,
                     egui::Slider::new(&mut self.lod.lambda, 0.05..=1.0).text("lambda"),
                 );
+                ui.horizontal(|ui| {
+                    ui.label("shading");
+                    ui.radio_value(&mut self.shading, ShadingModel::Placeholder, "placeholder");
+                    ui.radio_value(&mut self.shading, ShadingModel::KajiyaKay, "Kajiya-Kay");
+                    ui.radio_value(&mut self.shading, ShadingModel::Marschner, "Marschner");
+                });
                 ui.horizontal(|ui| {
                     ui.label("path");
                     ui.add_enabled_ui(mesh_ok, |ui| {
@@ -137,6 +146,7 @@ struct Running {
     camera: OrbitCamera,
     params: StrandParams,
     path: RenderPath,
+    shading: ShadingModel,
     paused: bool,
     dragging: Option<(f64, f64)>,
     cursor: (f64, f64),
@@ -270,6 +280,7 @@ impl App {
                 verts_log2: self.args.verts_log2,
             },
             path,
+            shading: self.args.shading,
             paused: false,
             dragging: None,
             cursor: (0.0, 0.0),
@@ -355,6 +366,7 @@ impl Running {
             camera: self.camera.camera(),
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod: self.panel.lod,
+            shading: self.shading,
         };
         let (primitives, ppp, freed) = self.panel_frame(scene_len)?;
         let chain = self.swapchain.as_ref().expect("created above");
@@ -408,6 +420,7 @@ impl Running {
         let egui_ctx = self.panel.egui_ctx.clone();
         let mut c = Controls {
             visible: self.panel.visible,
+            shading: self.shading,
             params: self.params,
             lod: self.panel.lod,
             path: self.path,
@@ -446,6 +459,7 @@ impl Running {
             self.recreate = true;
         }
         self.panel.lod = c.lod;
+        self.shading = c.shading;
         self.path = c.path;
         self.paused = c.paused;
         Ok(())
@@ -558,6 +572,13 @@ impl Running {
             KeyCode::KeyQ => self.camera.centre.y -= step,
             KeyCode::Space => self.paused = !self.paused,
             KeyCode::KeyL => self.panel.lod.enabled = !self.panel.lod.enabled,
+            KeyCode::KeyK => {
+                self.shading = match self.shading {
+                    ShadingModel::Placeholder => ShadingModel::KajiyaKay,
+                    ShadingModel::KajiyaKay => ShadingModel::Marschner,
+                    ShadingModel::Marschner => ShadingModel::Placeholder,
+                }
+            }
             KeyCode::KeyM => {
                 self.path = match self.path {
                     RenderPath::Mesh => RenderPath::Compute,
