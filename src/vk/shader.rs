@@ -42,6 +42,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("scalp.frag", include_str!("../../glsl/scalp.frag")),
     ("props.vert", include_str!("../../glsl/props.vert")),
     ("props.frag", include_str!("../../glsl/props.frag")),
+    (
+        "shading_probe.comp",
+        include_str!("../../glsl/shading_probe.comp"),
+    ),
 ];
 
 fn source(name: &str) -> Option<&'static str> {

@@ -1,0 +1,25 @@
+#version 460
+// Test probe (tests/shading_twin.rs): evaluates the GPU shading models at given directions so
+// they can be compared with their CPU twins in src/shade/mod.rs. Per sample, inputs are five
+// vec4 (tangent, to light, to eye, colour + roughness, tilt) and outputs two vec4 (Marschner
+// rgb; Kajiya-Kay diffuse, specular).
+#extension GL_GOOGLE_include_directive : require
+#include "hair_shading.glsl"
+layout(local_size_x = 64) in;
+layout(set = 0, binding = 0, std430) readonly buffer Inputs { vec4 inputs[]; };
+layout(set = 0, binding = 1, std430) writeonly buffer Outputs { vec4 outputs[]; };
+layout(push_constant) uniform Push { uvec4 params; } push;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= push.params.x) {
+        return;
+    }
+    vec3 t = inputs[5u * i].xyz;
+    vec3 l = inputs[5u * i + 1u].xyz;
+    vec3 v = inputs[5u * i + 2u].xyz;
+    vec4 cr = inputs[5u * i + 3u];
+    float tilt = inputs[5u * i + 4u].x;
+    outputs[2u * i] = vec4(marschner(t, l, v, cr.rgb, cr.a, tilt), 0.0);
+    outputs[2u * i + 1u] = vec4(kajiya_kay(t, l, v), 0.0, 0.0);
+}
