@@ -16,8 +16,8 @@ use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::bake::{BakedHairMesh, MeshInfo};
 use crate::model::style::HairStyle;
 use crate::vk::{
-    BindingDesc, Buffer, BufferDesc, Context, DescriptorKind, DescriptorSet, DescriptorSetLayout,
-    GpuError, GpuResult, Image, ImageDesc, Sampler,
+    BindingDesc, Buffer, Context, DescriptorKind, DescriptorSet, DescriptorSetLayout, GpuError,
+    GpuResult, Image, ImageDesc, Sampler,
 };
 
 /// The formats of the five textures, in Table 1 order (as [`TextureBinding::ALL`]).
@@ -389,24 +389,12 @@ impl Crowd {
         self.bundle_count = table.len() as u32;
         self.dirty = false;
         if !table.is_empty() {
-            let bytes: &[u8] = bytemuck::cast_slice(&table);
-            let buffer = Buffer::new(
+            let buffer = Buffer::device_local_with_data(
                 &self.ctx,
-                &BufferDesc::new(
-                    "bundle table",
-                    bytes.len() as u64,
-                    vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                ),
+                "bundle table",
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                bytemuck::cast_slice(&table),
             )?;
-            let staging = Buffer::with_data(
-                &self.ctx,
-                "staging",
-                vk::BufferUsageFlags::TRANSFER_SRC,
-                bytes,
-            )?;
-            self.ctx.submit_and_wait(|rec| {
-                rec.copy_buffer(&staging, 0, &buffer, 0, bytes.len() as u64);
-            })?;
             self.bundle_table = Some(buffer);
         }
         Ok(old)

@@ -238,25 +238,12 @@ impl Renderer {
         let vertices = if all.is_empty() {
             None
         } else {
-            let bytes: &[u8] = bytemuck::cast_slice(&all);
-            let buffer = Buffer::new(
+            Some(Buffer::device_local_with_data(
                 &self.ctx,
-                &BufferDesc::new(
-                    "prop vertices",
-                    bytes.len() as u64,
-                    vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                ),
-            )?;
-            let staging = Buffer::with_data(
-                &self.ctx,
-                "staging",
-                vk::BufferUsageFlags::TRANSFER_SRC,
-                bytes,
-            )?;
-            self.ctx.submit_and_wait(|rec| {
-                rec.copy_buffer(&staging, 0, &buffer, 0, bytes.len() as u64);
-            })?;
-            Some(buffer)
+                "prop vertices",
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                bytemuck::cast_slice(&all),
+            )?)
         };
         if let Some(old) = std::mem::replace(&mut self.props.vertices, vertices) {
             self.retire(Retired::Resource(Box::new(old)));

@@ -113,6 +113,29 @@ impl Buffer {
         Ok(b)
     }
 
+    /// Create a device-local buffer holding `data` (uploaded through a staging buffer; blocks
+    /// until the copy completed). `usage` gets `TRANSFER_DST` added.
+    pub fn device_local_with_data(
+        ctx: &Arc<Context>,
+        name: &str,
+        usage: vk::BufferUsageFlags,
+        data: &[u8],
+    ) -> GpuResult<Self> {
+        let buffer = Buffer::new(
+            ctx,
+            &BufferDesc::new(
+                name,
+                data.len() as u64,
+                usage | vk::BufferUsageFlags::TRANSFER_DST,
+            ),
+        )?;
+        let staging = Buffer::with_data(ctx, "staging", vk::BufferUsageFlags::TRANSFER_SRC, data)?;
+        ctx.submit_and_wait(|rec| {
+            rec.copy_buffer(&staging, 0, &buffer, 0, data.len() as u64);
+        })?;
+        Ok(buffer)
+    }
+
     fn mapped(&mut self) -> GpuResult<&mut [u8]> {
         self.allocation
             .as_mut()

@@ -13,7 +13,8 @@ use super::shared::GenerateArgs;
 use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets};
 use crate::vk::{
     Access, Attachment, Buffer, CommandRecorder, Context, DescriptorSet, GpuResult,
-    MeshPrimitivesQuery, PipelineLayout, Profiler, shader::ShaderOptions,
+    MeshPrimitivesQuery, PipelineLayout, Profiler,
+    shader::{ShaderOptions, compile},
 };
 use compute_generate::ComputeGenerate;
 use props::{PropDraw, PropPass};
@@ -43,6 +44,23 @@ pub fn shader_options(task_bundles: u32) -> ShaderOptions {
     ShaderOptions::default()
         .include("shared.glsl", super::shared::glsl_header())
         .define("TASK_BUNDLES", task_bundles)
+}
+
+/// A vertex + fragment pipeline drawing into `color` and `depth` (opaque, depth-tested).
+pub fn vertex_pipeline(
+    ctx: &Arc<Context>,
+    layout: &Arc<PipelineLayout>,
+    name: &str,
+    shaders: (&str, &str),
+    color: ash::vk::Format,
+    depth: ash::vk::Format,
+) -> GpuResult<crate::vk::Pipeline> {
+    let opts = shader_options(1);
+    let (v, f) = (compile(shaders.0, &opts)?, compile(shaders.1, &opts)?);
+    let desc = crate::vk::GraphicsDesc::new(name, color, depth)
+        .stage(ash::vk::ShaderStageFlags::VERTEX, &v)
+        .stage(ash::vk::ShaderStageFlags::FRAGMENT, &f);
+    crate::vk::Pipeline::graphics(ctx, layout, &desc)
 }
 
 /// `(x, y)` workgroup counts for `groups` workgroups with at most `DISPATCH_ROW` per row.

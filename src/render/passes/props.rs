@@ -5,9 +5,8 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{PassSets, shader_options};
-use crate::vk::shader::compile;
-use crate::vk::{CommandRecorder, Context, GpuResult, GraphicsDesc, Pipeline, PipelineLayout};
+use super::{PassSets, vertex_pipeline};
+use crate::vk::{CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One instanced draw: a mesh's vertex range and a run of instances.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -35,13 +34,15 @@ impl PropPass {
         color: vk::Format,
         depth: vk::Format,
     ) -> GpuResult<Self> {
-        let opts = shader_options(1);
-        let (v, f) = (compile("props.vert", &opts)?, compile("props.frag", &opts)?);
-        let desc = GraphicsDesc::new("props", color, depth)
-            .stage(vk::ShaderStageFlags::VERTEX, &v)
-            .stage(vk::ShaderStageFlags::FRAGMENT, &f);
         Ok(PropPass {
-            pipeline: Pipeline::graphics(ctx, layout, &desc)?,
+            pipeline: vertex_pipeline(
+                ctx,
+                layout,
+                "props",
+                ("props.vert", "props.frag"),
+                color,
+                depth,
+            )?,
         })
     }
 

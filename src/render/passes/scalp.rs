@@ -6,9 +6,8 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{PassSets, shader_options};
-use crate::vk::shader::compile;
-use crate::vk::{CommandRecorder, Context, GpuResult, GraphicsDesc, Pipeline, PipelineLayout};
+use super::{PassSets, vertex_pipeline};
+use crate::vk::{CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// The scalp pipeline.
 pub struct ScalpPass {
@@ -23,13 +22,15 @@ impl ScalpPass {
         color: vk::Format,
         depth: vk::Format,
     ) -> GpuResult<Self> {
-        let opts = shader_options(1);
-        let (v, f) = (compile("scalp.vert", &opts)?, compile("scalp.frag", &opts)?);
-        let desc = GraphicsDesc::new("scalp", color, depth)
-            .stage(vk::ShaderStageFlags::VERTEX, &v)
-            .stage(vk::ShaderStageFlags::FRAGMENT, &f);
         Ok(ScalpPass {
-            pipeline: Pipeline::graphics(ctx, layout, &desc)?,
+            pipeline: vertex_pipeline(
+                ctx,
+                layout,
+                "scalp",
+                ("scalp.vert", "scalp.frag"),
+                color,
+                depth,
+            )?,
         })
     }
 
