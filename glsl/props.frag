@@ -1,12 +1,32 @@
 #version 460
+// Props (bodies, ground): simple physically based shading, a Lambert diffuse lobe plus a GGX
+// specular lobe (Walter et al. 2007) with Schlick Fresnel (F0 = 0.04, dielectric skin and
+// ground) and Smith-Schlick visibility, under the directional light, plus an ambient term.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 
 layout(location = 0) in vec3 in_normal;
 layout(location = 1) flat in vec3 in_color;
+layout(location = 2) in vec3 in_pos;
 layout(location = 0) out vec4 out_color;
 
+#define PROP_ROUGHNESS 0.55
+#define LIGHT_IRRADIANCE 2.5
+#define AMBIENT 0.3
+
 void main() {
-    float d = max(dot(normalize(in_normal), normalize(frame.light_dir.xyz)), 0.0);
-    out_color = vec4(in_color * (0.35 + 0.65 * d), 1.0);
+    vec3 n = normalize(in_normal);
+    vec3 l = normalize(frame.light_dir.xyz);
+    vec3 v = normalize(frame.camera_pos.xyz - in_pos);
+    vec3 h = normalize(l + v);
+    float nl = max(dot(n, l), 0.0);
+    float nv = max(dot(n, v), 1e-4);
+    float nh = max(dot(n, h), 0.0);
+    float a = PROP_ROUGHNESS * PROP_ROUGHNESS;
+    float d = a * a / (3.14159265 * pow(nh * nh * (a * a - 1.0) + 1.0, 2.0));
+    float k = a * 0.5;
+    float vis = 0.25 / ((nl * (1.0 - k) + k) * (nv * (1.0 - k) + k));
+    float f = 0.04 + 0.96 * pow(1.0 - max(dot(h, v), 0.0), 5.0);
+    vec3 brdf = in_color / 3.14159265 + vec3(d * vis * f);
+    out_color = vec4(brdf * (LIGHT_IRRADIANCE * nl) + in_color * AMBIENT, 1.0);
 }

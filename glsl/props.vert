@@ -9,6 +9,7 @@ layout(set = SET_FRAME, binding = BINDING_PROP_INSTANCES, std430) readonly buffe
 
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) flat out vec3 out_color;
+layout(location = 2) out vec3 out_pos;
 
 void main() {
     PropVertex v = prop_vertices[gl_VertexIndex];
@@ -16,5 +17,6 @@ void main() {
     vec4 world = inst.model * vec4(v.position.xyz, 1.0);
     out_normal = normalize(mat3(inst.model) * v.normal.xyz);
     out_color = inst.color.rgb;
+    out_pos = world.xyz;
     gl_Position = frame.view_proj * world;
 }
