@@ -68,6 +68,9 @@ struct Args {
     /// Geomorph window lambda of eq. 10-12, in (0, 1].
     #[arg(long, default_value_t = 0.5)]
     lod_lambda: f32,
+    /// Samples per pixel (MSAA): 1, 2, 4, 8 where the device supports it (lavapipe: 1 or 4).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    msaa: u32,
     /// Strand shading: placeholder, kajiya-kay or marschner.
     #[arg(long, default_value = "marschner")]
     shading: hairmesh::shade::ShadingModel,
@@ -287,7 +290,8 @@ fn run(args: Args) -> Result<()> {
         &RendererDesc::default()
             .size(width, height)
             .path(path)
-            .vertex_pool_bytes(args.vertex_pool_mib << 20),
+            .vertex_pool_bytes(args.vertex_pool_mib << 20)
+            .msaa(args.msaa),
     )?;
     for c in &inputs.characters {
         renderer.add_character(&c.baked, &c.style, c.params, c.model)?;

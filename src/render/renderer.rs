@@ -135,7 +135,21 @@ impl Renderer {
         set_layouts[SET_FRAME as usize] = frame_layout.clone();
         set_layouts[SET_TEXTURES as usize] = crowd.texture_layout().clone();
         let layout = PipelineLayout::new(ctx, &set_layouts)?;
-        let passes = FramePasses::new(ctx, &layout, desc.task_bundles)?;
+        let supported = ctx.info.attachment_sample_counts;
+        if !desc.msaa.is_power_of_two() || supported & desc.msaa == 0 {
+            let counts: Vec<String> = (0..7)
+                .map(|b| 1u32 << b)
+                .filter(|c| supported & c != 0)
+                .map(|c| c.to_string())
+                .collect();
+            return Err(GpuError::Unsupported(format!(
+                "{}: {}x MSAA is not supported for colour and depth (supported: {})",
+                ctx.info.name,
+                desc.msaa,
+                counts.join(", ")
+            )));
+        }
+        let passes = FramePasses::new(ctx, &layout, desc.task_bundles, desc.msaa)?;
         if desc.path == Some(RenderPath::Mesh) && !passes.has_mesh_path() {
             return Err(GpuError::Unsupported(format!(
                 "{}: no usable VK_EXT_mesh_shader for the mesh path",
@@ -156,7 +170,7 @@ impl Renderer {
             props: Props::default(),
             next: 0,
             frame_number: 0,
-            targets: RenderTargets::new(ctx, desc.width, desc.height)?,
+            targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
             work,
             completed: VecDeque::new(),
             background: [0.6, 0.65, 0.7],
@@ -288,7 +302,7 @@ impl Renderer {
         }
         let old = std::mem::replace(
             &mut self.targets,
-            RenderTargets::new(&self.ctx, width, height)?,
+            RenderTargets::new(&self.ctx, width, height, self.desc.msaa)?,
         );
         self.retire(Retired::Resource(Box::new(old)));
         Ok(())
@@ -519,7 +533,7 @@ impl Renderer {
         )?;
         let mut present = present;
         if let Some(overlay) = present.as_mut().and_then(|p| p.overlay.as_mut()) {
-            overlay(&mut rec, &self.targets.color)?;
+            overlay(&mut rec, self.targets.output())?;
         }
         rec.barrier(
             &[Access::ComputeReadWrite, Access::TaskReadWrite],
@@ -530,17 +544,18 @@ impl Renderer {
         if opts.read_image
             && let Some(readback) = &slot.image_readback
         {
-            let color = &self.targets.color;
-            rec.image_barrier(color, Access::ColorAttachment, Access::TransferRead);
-            rec.copy_image_to_buffer(color, readback);
-            self.targets.color_access = Access::TransferRead;
+            let output = self.targets.output();
+            rec.image_barrier(output, Access::ColorAttachment, Access::TransferRead);
+            rec.copy_image_to_buffer(output, readback);
+            self.targets.set_output_access(Access::TransferRead);
         }
         if let Some(p) = present {
-            let color = &self.targets.color;
-            if self.targets.color_access != Access::TransferRead {
-                rec.image_barrier(color, Access::ColorAttachment, Access::TransferRead);
-                self.targets.color_access = Access::TransferRead;
+            let output = self.targets.output();
+            if self.targets.output_access != Access::TransferRead {
+                rec.image_barrier(output, Access::ColorAttachment, Access::TransferRead);
             }
+            self.targets.set_output_access(Access::TransferRead);
+            let color = self.targets.output();
             rec.swapchain_barrier(p.image, Access::Nothing, Access::TransferWrite);
             rec.blit_to_swapchain(color, p.image);
             rec.swapchain_barrier(p.image, Access::TransferWrite, Access::Present);

@@ -25,6 +25,8 @@ pub struct RendererDesc {
     pub width: u32,
     /// Initial target size.
     pub height: u32,
+    /// Samples per pixel (MSAA): 1, or a count the device supports for colour and depth.
+    pub msaa: u32,
 }
 
 impl Default for RendererDesc {
@@ -36,6 +38,7 @@ impl Default for RendererDesc {
             max_characters: 1024,
             width: 1280,
             height: 720,
+            msaa: 1,
         }
     }
 }
@@ -51,6 +54,12 @@ impl RendererDesc {
     /// Set the default path.
     pub fn path(mut self, path: Option<RenderPath>) -> Self {
         self.path = path;
+        self
+    }
+
+    /// Set the MSAA sample count.
+    pub fn msaa(mut self, samples: u32) -> Self {
+        self.msaa = samples;
         self
     }
 

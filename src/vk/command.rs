@@ -102,6 +102,9 @@ pub struct Attachment<'a> {
     pub image: &'a Image,
     /// Clear to this value, or keep the contents when `None`.
     pub clear: Option<[f32; 4]>,
+    /// Multisampled colour: average the samples into this single-sample image (in
+    /// [`Access::ColorAttachment`]) at the end of rendering.
+    pub resolve: Option<&'a Image>,
 }
 
 /// Records commands into a command buffer; every method is a safe wrapper of one Vulkan call.
@@ -224,6 +227,12 @@ impl CommandRecorder<'_> {
                 .image_view(a.image.view())
                 .image_layout(layout)
                 .store_op(vk::AttachmentStoreOp::STORE);
+            if let Some(r) = a.resolve {
+                info = info
+                    .resolve_mode(vk::ResolveModeFlags::AVERAGE)
+                    .resolve_image_view(r.view())
+                    .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+            }
             info = match a.clear {
                 Some(c) => info.load_op(vk::AttachmentLoadOp::CLEAR).clear_value(
                     if layout == vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL {

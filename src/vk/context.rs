@@ -78,6 +78,8 @@ pub struct DeviceInfo {
     pub max_bindless_sampled_images: u32,
     /// `maxComputeWorkGroupCount[0]`.
     pub max_compute_groups_x: u32,
+    /// Sample counts usable for both colour and depth attachments (bit `n` set: `2^n`).
+    pub attachment_sample_counts: u32,
 }
 
 /// GPU memory the allocator holds.

@@ -23,6 +23,8 @@ pub struct ImageDesc {
     pub usage: vk::ImageUsageFlags,
     /// A 3D image.
     pub dim_3d: bool,
+    /// Samples per pixel (1, or a count the device supports for attachments).
+    pub samples: u32,
 }
 
 impl ImageDesc {
@@ -34,6 +36,7 @@ impl ImageDesc {
             format,
             usage: vk::ImageUsageFlags::empty(),
             dim_3d: false,
+            samples: 1,
         }
     }
 
@@ -45,12 +48,19 @@ impl ImageDesc {
             format,
             usage: vk::ImageUsageFlags::empty(),
             dim_3d: true,
+            samples: 1,
         }
     }
 
     /// Add usage flags.
     pub fn usage(mut self, usage: vk::ImageUsageFlags) -> Self {
         self.usage |= usage;
+        self
+    }
+
+    /// Samples per pixel (multisampled attachments).
+    pub fn samples(mut self, samples: u32) -> Self {
+        self.samples = samples;
         self
     }
 }
@@ -103,7 +113,7 @@ impl Image {
             })
             .mip_levels(1)
             .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(super::sample_flags(desc.samples))
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(desc.usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);

@@ -52,6 +52,17 @@ pub enum GpuError {
     Shader(String),
 }
 
+/// `vk::SampleCountFlags` for a sample count (1, 2, 4, 8, 16...; others give 1).
+pub(crate) fn sample_flags(samples: u32) -> ash::vk::SampleCountFlags {
+    match samples {
+        2 => ash::vk::SampleCountFlags::TYPE_2,
+        4 => ash::vk::SampleCountFlags::TYPE_4,
+        8 => ash::vk::SampleCountFlags::TYPE_8,
+        16 => ash::vk::SampleCountFlags::TYPE_16,
+        _ => ash::vk::SampleCountFlags::TYPE_1,
+    }
+}
+
 /// Result alias of the GPU layer.
 pub type GpuResult<T> = std::result::Result<T, GpuError>;
 

@@ -96,6 +96,8 @@ pub struct GraphicsDesc<'a> {
     pub blend: BlendMode,
     /// Culling.
     pub cull: CullMode,
+    /// Samples per pixel of the attachments.
+    pub samples: u32,
 }
 
 impl<'a> GraphicsDesc<'a> {
@@ -109,6 +111,7 @@ impl<'a> GraphicsDesc<'a> {
             depth: DepthMode::TestWrite,
             blend: BlendMode::Opaque,
             cull: CullMode::None,
+            samples: 1,
         }
     }
 
@@ -133,6 +136,12 @@ impl<'a> GraphicsDesc<'a> {
     /// Set the cull mode.
     pub fn cull(mut self, cull: CullMode) -> Self {
         self.cull = cull;
+        self
+    }
+
+    /// Set the sample count (MSAA).
+    pub fn samples(mut self, samples: u32) -> Self {
+        self.samples = samples;
         self
     }
 }
@@ -279,7 +288,7 @@ impl Pipeline {
             .scissor_count(1);
         let raster = raster_state(desc.cull);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+            .rasterization_samples(super::sample_flags(desc.samples));
         let depth = depth_state(desc.depth);
         let blend_attachment = blend_attachment(desc.blend);
         let blend_attachments = [blend_attachment];

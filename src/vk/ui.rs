@@ -98,6 +98,7 @@ impl UiRenderer {
         rec.begin_rendering_color(Attachment {
             image: target,
             clear: None,
+            resolve: None,
         });
         let r = self.renderer.as_mut().expect("alive until drop");
         let result = r.cmd_draw(

@@ -68,6 +68,9 @@ pub struct Args {
     /// Vertices per strand are 2^e + 1 (e in 0..=6).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=6))]
     verts_log2: u32,
+    /// Samples per pixel (MSAA): 1, 2, 4, 8 where the device supports it (lavapipe: 1 or 4).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    msaa: u32,
     /// Strand shading: placeholder, kajiya-kay or marschner.
     #[arg(long, default_value = "marschner")]
     shading: hairmesh::shade::ShadingModel,
@@ -140,8 +143,13 @@ impl Scene {
             "mesh" => RenderPath::Mesh,
             _ => RenderPath::Compute,
         });
-        let mut renderer =
-            Renderer::new(ctx, &RendererDesc::default().size(width, height).path(path))?;
+        let mut renderer = Renderer::new(
+            ctx,
+            &RendererDesc::default()
+                .size(width, height)
+                .path(path)
+                .msaa(args.msaa),
+        )?;
         let params = StrandParams {
             strands_per_bundle: args.strands_per_bundle,
             verts_log2: args.verts_log2,

@@ -46,18 +46,36 @@ pub fn shader_options(task_bundles: u32) -> ShaderOptions {
         .define("TASK_BUNDLES", task_bundles)
 }
 
-/// A vertex + fragment pipeline drawing into `color` and `depth` (opaque, depth-tested).
+/// Formats and sample count of the targets the graphics passes draw into.
+#[derive(Clone, Copy, Debug)]
+pub struct TargetFormats {
+    /// Colour format.
+    pub color: ash::vk::Format,
+    /// Depth format.
+    pub depth: ash::vk::Format,
+    /// Samples per pixel.
+    pub samples: u32,
+}
+
+impl TargetFormats {
+    /// An opaque, depth-tested graphics pipeline description for these targets.
+    pub fn graphics_desc<'a>(&self, name: &'a str) -> crate::vk::GraphicsDesc<'a> {
+        crate::vk::GraphicsDesc::new(name, self.color, self.depth).samples(self.samples)
+    }
+}
+
+/// A vertex + fragment pipeline drawing into `targets` (opaque, depth-tested).
 pub fn vertex_pipeline(
     ctx: &Arc<Context>,
     layout: &Arc<PipelineLayout>,
     name: &str,
     shaders: (&str, &str),
-    color: ash::vk::Format,
-    depth: ash::vk::Format,
+    targets: TargetFormats,
 ) -> GpuResult<crate::vk::Pipeline> {
     let opts = shader_options(1);
     let (v, f) = (compile(shaders.0, &opts)?, compile(shaders.1, &opts)?);
-    let desc = crate::vk::GraphicsDesc::new(name, color, depth)
+    let desc = targets
+        .graphics_desc(name)
         .stage(ash::vk::ShaderStageFlags::VERTEX, &v)
         .stage(ash::vk::ShaderStageFlags::FRAGMENT, &f);
     crate::vk::Pipeline::graphics(ctx, layout, &desc)
@@ -102,12 +120,18 @@ impl FramePasses {
         ctx: &Arc<Context>,
         layout: &Arc<PipelineLayout>,
         task_bundles: u32,
+        samples: u32,
     ) -> GpuResult<Self> {
+        let targets = TargetFormats {
+            color: COLOR_FORMAT,
+            depth: DEPTH_FORMAT,
+            samples,
+        };
         Ok(FramePasses {
             generate: ComputeGenerate::new(ctx, layout)?,
-            props: PropPass::new(ctx, layout, COLOR_FORMAT, DEPTH_FORMAT)?,
-            scalp: ScalpPass::new(ctx, layout, COLOR_FORMAT, DEPTH_FORMAT)?,
-            strands: StrandDraw::new(ctx, layout, COLOR_FORMAT, DEPTH_FORMAT, task_bundles)?,
+            props: PropPass::new(ctx, layout, targets)?,
+            scalp: ScalpPass::new(ctx, layout, targets)?,
+            strands: StrandDraw::new(ctx, layout, targets, task_bundles)?,
         })
     }
 
@@ -151,16 +175,22 @@ impl FramePasses {
         };
         rec.image_barrier(&targets.color, color_from, Access::ColorAttachment);
         rec.image_barrier(&targets.depth, depth_from, Access::DepthAttachment);
+        if let Some(r) = &targets.resolved {
+            // The resolve overwrites every pixel: earlier contents are not needed.
+            rec.image_barrier(r, Access::Nothing, Access::ColorAttachment);
+        }
         let mesh = inp.path == RenderPath::Mesh;
         profiler.begin(rec, if mesh { "mesh draw" } else { "draw" });
         rec.begin_rendering(
             Attachment {
                 image: &targets.color,
                 clear: inp.clear,
+                resolve: targets.resolved.as_ref(),
             },
             Attachment {
                 image: &targets.depth,
                 clear: inp.clear.map(|_| [1.0; 4]),
+                resolve: None,
             },
         );
         let mut result = Ok(());
@@ -184,6 +214,7 @@ impl FramePasses {
         profiler.end(rec);
         targets.color_access = Access::ColorAttachment;
         targets.depth_access = Access::DepthAttachment;
+        targets.set_output_access(Access::ColorAttachment);
         result
     }
 }

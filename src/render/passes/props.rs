@@ -3,9 +3,7 @@
 
 use std::sync::Arc;
 
-use ash::vk;
-
-use super::{PassSets, vertex_pipeline};
+use super::{PassSets, TargetFormats, vertex_pipeline};
 use crate::vk::{CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One instanced draw: a mesh's vertex range and a run of instances.
@@ -31,18 +29,10 @@ impl PropPass {
     pub fn new(
         ctx: &Arc<Context>,
         layout: &Arc<PipelineLayout>,
-        color: vk::Format,
-        depth: vk::Format,
+        targets: TargetFormats,
     ) -> GpuResult<Self> {
         Ok(PropPass {
-            pipeline: vertex_pipeline(
-                ctx,
-                layout,
-                "props",
-                ("props.vert", "props.frag"),
-                color,
-                depth,
-            )?,
+            pipeline: vertex_pipeline(ctx, layout, "props", ("props.vert", "props.frag"), targets)?,
         })
     }
 

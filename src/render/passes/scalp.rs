@@ -4,9 +4,7 @@
 
 use std::sync::Arc;
 
-use ash::vk;
-
-use super::{PassSets, vertex_pipeline};
+use super::{PassSets, TargetFormats, vertex_pipeline};
 use crate::vk::{CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// The scalp pipeline.
@@ -19,18 +17,10 @@ impl ScalpPass {
     pub fn new(
         ctx: &Arc<Context>,
         layout: &Arc<PipelineLayout>,
-        color: vk::Format,
-        depth: vk::Format,
+        targets: TargetFormats,
     ) -> GpuResult<Self> {
         Ok(ScalpPass {
-            pipeline: vertex_pipeline(
-                ctx,
-                layout,
-                "scalp",
-                ("scalp.vert", "scalp.frag"),
-                color,
-                depth,
-            )?,
+            pipeline: vertex_pipeline(ctx, layout, "scalp", ("scalp.vert", "scalp.frag"), targets)?,
         })
     }
 

@@ -8,14 +8,12 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{PassSets, dispatch_2d, shader_options};
+use super::{PassSets, TargetFormats, dispatch_2d, shader_options};
 use crate::render::shared::{
     DISPATCH_ROW, GenerateArgs, MAX_SEGMENTS, STRAND_GROUP_SIZE, TASK_PAYLOAD_BUNDLES, TaskPayload,
 };
 use crate::vk::shader::compile;
-use crate::vk::{
-    Buffer, CommandRecorder, Context, GpuError, GpuResult, GraphicsDesc, Pipeline, PipelineLayout,
-};
+use crate::vk::{Buffer, CommandRecorder, Context, GpuError, GpuResult, Pipeline, PipelineLayout};
 
 /// Whether the device's mesh shader limits fit `strands.task` / `strands.mesh`.
 pub fn mesh_path_supported(ctx: &Context) -> bool {
@@ -48,8 +46,7 @@ impl StrandDraw {
     pub fn new(
         ctx: &Arc<Context>,
         layout: &Arc<PipelineLayout>,
-        color: vk::Format,
-        depth: vk::Format,
+        targets: TargetFormats,
         task_bundles: u32,
     ) -> GpuResult<Self> {
         if !(1..=TASK_PAYLOAD_BUNDLES).contains(&task_bundles) {
@@ -65,7 +62,8 @@ impl StrandDraw {
         let pulled = Pipeline::graphics(
             ctx,
             layout,
-            &GraphicsDesc::new("pulled strands", color, depth)
+            &targets
+                .graphics_desc("pulled strands")
                 .stage(vk::ShaderStageFlags::VERTEX, &v)
                 .stage(vk::ShaderStageFlags::FRAGMENT, &f),
         )?;
@@ -77,7 +75,8 @@ impl StrandDraw {
             Some(Pipeline::graphics(
                 ctx,
                 layout,
-                &GraphicsDesc::new("mesh strands", color, depth)
+                &targets
+                    .graphics_desc("mesh strands")
                     .stage(vk::ShaderStageFlags::TASK_EXT, &t)
                     .stage(vk::ShaderStageFlags::MESH_EXT, &m)
                     .stage(vk::ShaderStageFlags::FRAGMENT, &f),
