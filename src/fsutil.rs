@@ -193,6 +193,17 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// Encode RGBA8 pixels (`width x height`, top row first) as PNG bytes.
+pub fn encode_png(name: &str, width: u32, height: u32, rgba: Vec<u8>) -> Result<Vec<u8>> {
+    let img = image::RgbaImage::from_raw(width, height, rgba).ok_or_else(|| {
+        HairError::invalid(name, format!("pixel data does not match {width}x{height}"))
+    })?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| HairError::invalid(name, format!("PNG encoding: {e}")))?;
+    Ok(png)
+}
+
 /// `println!` that returns an error instead of panicking when stdout cannot be written
 /// (closed pipe, full disk): `outln!(...)?`.
 #[macro_export]

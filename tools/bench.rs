@@ -424,9 +424,7 @@ fn median_passes<'a>(first: &'a FrameReport, reports: &[FrameReport]) -> Vec<(&'
 
 /// Write RGBA pixels as a PNG by the output policy.
 fn write_png(out: &OutputPath, rgba: Vec<u8>, width: u32, height: u32) -> Result<()> {
-    let img = image::RgbaImage::from_raw(width, height, rgba).context("size")?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    let png = hairmesh::fsutil::encode_png(&out.path().display().to_string(), width, height, rgba)?;
     out.write(&png)?;
     outln!("wrote {}", out.path().display())?;
     Ok(())

@@ -318,9 +318,8 @@ fn run(args: Args) -> Result<()> {
         );
     }
     let rgba = out.rgba.clone().context("no image read back")?;
-    let img = image::RgbaImage::from_raw(width, height, rgba).context("image size mismatch")?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    let png =
+        hairmesh::fsutil::encode_png(&args.output.display().to_string(), width, height, rgba)?;
     print_report(&ctx, &args, inputs.characters.len(), &out, wall)?;
     output.write(&png)?;
     outln!("wrote {}", args.output.display())?;

@@ -70,6 +70,17 @@ fn max_draw_vertices(
     strands * (1u64 << params.verts_log2) * 6
 }
 
+/// A character transform must be finite.
+fn check_model(model: &Mat4) -> GpuResult<()> {
+    if model.is_finite() {
+        Ok(())
+    } else {
+        Err(GpuError::Unsupported(
+            "character transform is not finite".into(),
+        ))
+    }
+}
+
 /// A character handle (slot + generation, so a stale handle is refused).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CharacterId {
@@ -187,11 +198,7 @@ impl Crowd {
         model: Mat4,
     ) -> GpuResult<CharacterId> {
         params.validate()?;
-        if !model.is_finite() {
-            return Err(GpuError::Unsupported(
-                "character transform is not finite".into(),
-            ));
-        }
+        check_model(&model)?;
         let slot = match self.free.pop() {
             Some(s) => s,
             None if (self.slots.len() as u32) < self.capacity => {
@@ -289,11 +296,7 @@ impl Crowd {
 
     /// Move a character.
     pub fn set_model(&mut self, id: CharacterId, model: Mat4) -> GpuResult<()> {
-        if !model.is_finite() {
-            return Err(GpuError::Unsupported(
-                "character transform is not finite".into(),
-            ));
-        }
+        check_model(&model)?;
         self.get_mut(id)?.model = model;
         Ok(())
     }

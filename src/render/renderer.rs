@@ -82,7 +82,6 @@ pub struct Renderer {
     ctx: Arc<Context>,
     desc: RendererDesc,
     crowd: Crowd,
-    frame_layout: Arc<DescriptorSetLayout>,
     passes: FramePasses,
     frames: Vec<FrameSlot>,
     props: Props,
@@ -164,7 +163,6 @@ impl Renderer {
             ctx: ctx.clone(),
             desc: desc.clone(),
             crowd,
-            frame_layout,
             passes,
             frames,
             props: Props::default(),
@@ -632,11 +630,6 @@ impl Renderer {
             rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
         })?;
         Ok(bytemuck::pod_collect_to_vec(&readback.read()?))
-    }
-
-    /// The descriptor set layout of set 0 (for passes added later).
-    pub fn frame_layout(&self) -> &Arc<DescriptorSetLayout> {
-        &self.frame_layout
     }
 }
 

@@ -15,6 +15,22 @@ use super::pipeline::Pipeline;
 use super::swapchain::SwapchainImage;
 use super::{Context, GpuError, GpuResult, VkContext};
 
+/// A buffer <-> image copy of all of `image`, texels tightly packed.
+fn whole_image_copy(image: &Image) -> vk::BufferImageCopy {
+    let [width, height, depth] = image.desc.extent;
+    vk::BufferImageCopy::default()
+        .image_subresource(
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(aspect(image.desc.format))
+                .layer_count(1),
+        )
+        .image_extent(vk::Extent3D {
+            width,
+            height,
+            depth,
+        })
+}
+
 /// A primary command buffer with its own pool, re-recorded every time it is used.
 pub struct CommandBuffer {
     ctx: Arc<Context>,
@@ -453,18 +469,7 @@ impl CommandRecorder<'_> {
 
     /// Copy tightly packed texels from `src` into all of `dst` (in [`Access::TransferWrite`]).
     pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
-        let [w, h, d] = dst.desc.extent;
-        let region = [vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(aspect(dst.desc.format))
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: w,
-                height: h,
-                depth: d,
-            })];
+        let region = [whole_image_copy(dst)];
         // SAFETY: the image is in TRANSFER_DST_OPTIMAL; the buffer size is checked by the caller.
         unsafe {
             self.ctx.device.cmd_copy_buffer_to_image(
@@ -479,18 +484,7 @@ impl CommandRecorder<'_> {
 
     /// Copy all of 2D image `src` (in [`Access::TransferRead`]) into `dst`, tightly packed.
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
-        let [w, h, _] = src.desc.extent;
-        let region = [vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(aspect(src.desc.format))
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: w,
-                height: h,
-                depth: 1,
-            })];
+        let region = [whole_image_copy(src)];
         // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer size is checked by the caller.
         unsafe {
             self.ctx.device.cmd_copy_image_to_buffer(

@@ -76,8 +76,6 @@ pub struct DeviceInfo {
     /// Most sampled images one bindless set may hold (the smaller of the per-stage and
     /// per-set update-after-bind limits).
     pub max_bindless_sampled_images: u32,
-    /// `maxComputeWorkGroupCount[0]`.
-    pub max_compute_groups_x: u32,
     /// Sample counts usable for both colour and depth attachments (bit `n` set: `2^n`).
     pub attachment_sample_counts: u32,
 }

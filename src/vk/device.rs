@@ -249,7 +249,6 @@ pub(super) fn query_info(
             .max_per_stage_descriptor_update_after_bind_sampled_images
             .min(indexing.max_descriptor_set_update_after_bind_sampled_images)
             .min(indexing.max_update_after_bind_descriptors_in_all_pools),
-        max_compute_groups_x: limits.max_compute_work_group_count[0],
         attachment_sample_counts: (limits.framebuffer_color_sample_counts
             & limits.framebuffer_depth_sample_counts)
             .as_raw(),

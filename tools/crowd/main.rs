@@ -254,10 +254,9 @@ fn run(args: Args) -> Result<()> {
             report.record_ms
         )?;
         let rgba = report.rgba.context("no image read back")?;
-        let img = image::RgbaImage::from_raw(width, height, rgba).context("image size")?;
-        let mut png = Vec::new();
-        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-        OutputPath::check(&args.out.join(format!("frame_{f:05}.png")), &[])?.write(&png)?;
+        let path = args.out.join(format!("frame_{f:05}.png"));
+        let png = hairmesh::fsutil::encode_png(&path.display().to_string(), width, height, rgba)?;
+        OutputPath::check(&path, &[])?.write(&png)?;
     }
     csv_out.write(csv.as_bytes())?;
     outln!("wrote {} frames and {}", args.frames, csv_path.display())?;
