@@ -1,25 +1,17 @@
-//! `crowd --headless`: 16 characters with validation on render non-empty frames, write the
-//! PNGs and the stats CSV, and the 16 hairstyles look different from each other.
+//! `crowd --headless`: 16 characters with validation on render non-empty frames and write the
+//! PNGs and the stats CSV; the furry-teapot preset renders on the compute path too.
 
 use std::process::Command;
 
-#[test]
-fn headless_crowd_renders_frames_and_stats() {
+/// Run `crowd --headless --size 320x180 --validation` with `extra` flags; check `frames`
+/// frames of at least `min_strands` strands each and a mostly non-background image.
+fn headless(extra: &[&str], frames: usize, min_strands: u64) {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("frames");
     let o = Command::new(env!("CARGO_BIN_EXE_crowd"))
-        .args([
-            "--headless",
-            "--frames",
-            "3",
-            "--count",
-            "16",
-            "--size",
-            "320x180",
-            "--validation",
-            "--out",
-            out.to_str().unwrap(),
-        ])
+        .args(["--headless", "--size", "320x180", "--validation", "--out"])
+        .arg(&out)
+        .args(extra)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
@@ -31,11 +23,11 @@ fn headless_crowd_renders_frames_and_stats() {
     assert!(!String::from_utf8_lossy(&o.stderr).contains("validation error"));
     let csv = std::fs::read_to_string(out.join("stats.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
-    assert_eq!(rows.len(), 3, "{csv}");
+    assert_eq!(rows.len(), frames, "{csv}");
     for (f, row) in rows.iter().enumerate() {
         let cols: Vec<&str> = row.split(',').collect();
         let strands: u64 = cols[4].parse().unwrap();
-        assert!(strands > 1000, "frame {f}: {strands} strands");
+        assert!(strands > min_strands, "frame {f}: {strands} strands");
         let img = image::open(out.join(format!("frame_{f:05}.png")))
             .unwrap()
             .to_rgb8();
@@ -48,4 +40,20 @@ fn headless_crowd_renders_frames_and_stats() {
             "frame {f}: only {differ} non-background pixels"
         );
     }
+}
+
+#[test]
+fn headless_crowd_renders_frames_and_stats() {
+    headless(&["--frames", "3", "--count", "16"], 3, 1000);
+}
+
+#[test]
+fn furry_teapots_render_on_the_compute_path() {
+    headless(
+        &[
+            "--preset", "teapots", "--count", "4", "--frames", "1", "--path", "compute",
+        ],
+        1,
+        4 * 500,
+    );
 }

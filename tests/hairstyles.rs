@@ -6,7 +6,11 @@ use hairmesh::characters::preset::{Preset, build};
 use hairmesh::{BakeOptions, bake};
 
 fn bakes(count: usize, seed: u32) -> Vec<Vec<u8>> {
-    build(Preset::Mixed, count, seed)
+    preset_bakes(Preset::Mixed, count, seed)
+}
+
+fn preset_bakes(preset: Preset, count: usize, seed: u32) -> Vec<Vec<u8>> {
+    build(preset, count, seed)
         .unwrap()
         .iter()
         .map(|c| {
@@ -29,11 +33,16 @@ fn same_seed_gives_byte_identical_bakes() {
     assert_eq!(a, b);
     let c = bakes(16, 43);
     assert_ne!(a, c, "another seed gives other hair");
+    assert_eq!(
+        preset_bakes(Preset::Teapots, 3, 42),
+        preset_bakes(Preset::Teapots, 3, 42)
+    );
 }
 
 #[test]
 fn every_character_has_its_own_hair() {
-    let all = bakes(16, 7);
+    let mut all = bakes(16, 7);
+    all.extend(preset_bakes(Preset::Teapots, 6, 7));
     for i in 0..all.len() {
         for j in i + 1..all.len() {
             let (a, b) = (&all[i], &all[j]);

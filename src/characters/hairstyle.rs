@@ -184,6 +184,33 @@ pub fn generate(family: StyleFamily, seed: u32, head: &HeadShape) -> Result<Hair
     })
 }
 
+/// Fur grown on a teapot of `height` metres from `seed` (the paper's furry-teapot scene):
+/// every patch but the bottom grows short fur along its normals, bending a little downward.
+pub fn teapot_fur(seed: u32, height: f32) -> Result<Hairstyle> {
+    let family = StyleFamily::Fur;
+    let mut rng = Pcg32::new(seed as u64 ^ 0x7ea9_07u64 << 40);
+    let g = growth(family);
+    let step = range(&mut rng, g.step.0, g.step.1) * 1.25;
+    let gravity = range(&mut rng, 0.0, 0.5);
+    let mut style = style_for(family, seed, &mut rng);
+    // Teapot bundles are large: strong clumping would show the patch grid as tufts.
+    style.clump_strength = range(&mut rng, 0.0, 0.08);
+    let surface = super::teapot::fur_scalp(height, 5);
+    let desc = ExtrudeDesc::new(g.layers, step).gravity(gravity, Vec3::NEG_Y);
+    let mesh = extrude(
+        format!("teapot #{seed}"),
+        &surface.positions,
+        &surface.uv,
+        &surface.faces,
+        &desc,
+    )?;
+    Ok(Hairstyle {
+        family,
+        mesh,
+        style,
+    })
+}
+
 /// A ponytail: layers 1-3 gather the scalp toward a tie at the back of the head, the rest
 /// hang from the tie as one narrow bundle of bundles.
 fn ponytail(
@@ -234,5 +261,8 @@ mod tests {
             assert!(h.mesh.faces.len() >= 10, "{family:?}");
             h.style.validate("test").unwrap();
         }
+        let fur = teapot_fur(3, 0.27).unwrap();
+        assert!(fur.mesh.faces.len() > 500);
+        fur.style.validate("test").unwrap();
     }
 }

@@ -5,3 +5,4 @@
 pub mod hairstyle;
 pub mod head;
 pub mod preset;
+pub mod teapot;

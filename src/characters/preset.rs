@@ -4,9 +4,10 @@
 
 use glam::{Mat4, Quat, Vec3};
 
-use super::hairstyle::{Hairstyle, StyleFamily, generate};
+use super::hairstyle::{Hairstyle, StyleFamily, generate, teapot_fur};
 use super::head::{HeadShape, body_mesh, ground_mesh};
 use crate::error::{HairError, Result};
+use crate::render::StrandParams;
 use crate::render::shared::{PropInstance, PropVertex};
 use crate::rng::Pcg32;
 
@@ -20,6 +21,18 @@ pub enum Preset {
     People,
     /// People and furry balls.
     Mixed,
+    /// Furry Utah teapots (the paper's 200-teapot scene).
+    Teapots,
+}
+
+impl Preset {
+    /// Height the cameras look at: heads for people, the middle of a teapot.
+    pub fn focus_height(self) -> f32 {
+        match self {
+            Preset::People | Preset::Mixed => 1.2,
+            Preset::Teapots => 0.12,
+        }
+    }
 }
 
 impl std::str::FromStr for Preset {
@@ -28,7 +41,8 @@ impl std::str::FromStr for Preset {
         match s {
             "people" => Ok(Preset::People),
             "mixed" => Ok(Preset::Mixed),
-            _ => Err(format!("unknown preset '{s}' (people, mixed)")),
+            "teapots" => Ok(Preset::Teapots),
+            _ => Err(format!("unknown preset '{s}' (people, mixed, teapots)")),
         }
     }
 }
@@ -40,6 +54,8 @@ pub enum Body {
     Person,
     /// A ball the fur grows on.
     Ball,
+    /// A Utah teapot the fur grows on.
+    Teapot,
 }
 
 /// One character of a crowd.
@@ -54,6 +70,23 @@ pub struct CrowdCharacter {
     pub skin: [f32; 3],
 }
 
+/// Most vertex level fur uses: 2^3 = 8 segments are plenty for strands a few centimetres long.
+pub const FUR_MAX_VERTS_LOG2: u32 = 3;
+
+impl CrowdCharacter {
+    /// The strand settings this character uses when the crowd asks for `crowd`: fur (balls,
+    /// teapots) caps the vertex level at [`FUR_MAX_VERTS_LOG2`].
+    pub fn strand_params(&self, crowd: StrandParams) -> StrandParams {
+        match self.body {
+            Body::Person => crowd,
+            Body::Ball | Body::Teapot => StrandParams {
+                verts_log2: crowd.verts_log2.min(FUR_MAX_VERTS_LOG2),
+                ..crowd
+            },
+        }
+    }
+}
+
 /// The head every person has.
 pub fn person_head() -> HeadShape {
     HeadShape::default()
@@ -66,6 +99,9 @@ pub fn ball_head() -> HeadShape {
         radii: Vec3::splat(0.16),
     }
 }
+
+/// Height of a teapot in metres (small enough that neighbours never touch at [`SPACING`]).
+pub const TEAPOT_HEIGHT: f32 = 0.27;
 
 /// Grid spacing in metres.
 pub const SPACING: f32 = 0.9;
@@ -91,13 +127,17 @@ pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharact
     for i in 0..count {
         let ball = preset == Preset::Mixed && i % 4 == 3;
         let character_seed = seed.wrapping_mul(0x9E37_79B9).wrapping_add(i as u32);
-        let (family, head, body) = if ball {
-            (StyleFamily::Fur, ball_head(), Body::Ball)
+        let (hair, body) = if preset == Preset::Teapots {
+            (teapot_fur(character_seed, TEAPOT_HEIGHT)?, Body::Teapot)
+        } else if ball {
+            (
+                generate(StyleFamily::Fur, character_seed, &ball_head())?,
+                Body::Ball,
+            )
         } else {
             let f = StyleFamily::PEOPLE[(i + (seed as usize)) % StyleFamily::PEOPLE.len()];
-            (f, person_head(), Body::Person)
+            (generate(f, character_seed, &person_head())?, Body::Person)
         };
-        let hair = generate(family, character_seed, &head)?;
         let x = (i % side) as f32 - (side as f32 - 1.0) * 0.5;
         let z = (i / side) as f32;
         let jitter = Vec3::new(rng.next_f32() - 0.5, 0.0, rng.next_f32() - 0.5) * 0.3;
@@ -106,7 +146,7 @@ pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharact
             Quat::from_rotation_y(yaw),
             Vec3::new(x, 0.0, z) * SPACING + jitter,
         );
-        let skin = if ball {
+        let skin = if body != Body::Person {
             hair.style.color.map(|c| c * 0.8)
         } else {
             SKIN[rng.next_u32() as usize % SKIN.len()]
@@ -121,13 +161,14 @@ pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharact
     Ok(out)
 }
 
-/// Prop meshes of crowds: 0 the ground, 1 a person's body, 2 a ball.
+/// Prop meshes of crowds: 0 the ground, 1 a person's body, 2 a ball, 3 a teapot.
 pub fn prop_meshes() -> Vec<Vec<PropVertex>> {
     let ball = ball_head();
     vec![
         ground_mesh(60.0),
         body_mesh(&person_head()),
         super::head::sphere_mesh(ball.centre, ball.radii * 0.985),
+        super::teapot::teapot_mesh(TEAPOT_HEIGHT),
     ]
 }
 
@@ -144,6 +185,7 @@ pub fn prop_instances(characters: &[CrowdCharacter]) -> Vec<(usize, PropInstance
         let mesh = match c.body {
             Body::Person => 1,
             Body::Ball => 2,
+            Body::Teapot => 3,
         };
         out.push((
             mesh,

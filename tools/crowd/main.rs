@@ -53,7 +53,7 @@ pub struct Args {
     /// Output folder for frame PNGs and stats.csv (headless).
     #[arg(long, default_value = "crowd_frames")]
     out: PathBuf,
-    /// Scene preset: people or mixed (people and furry balls).
+    /// Scene preset: people, mixed (people and furry balls) or teapots (furry Utah teapots).
     #[arg(long, default_value = "people")]
     preset: Preset,
     /// Number of characters.
@@ -93,12 +93,16 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
 }
 
 /// The camera of frame `f`: orbiting the crowd's centre at eye height, far enough to see it.
-pub fn orbit_camera(count: u32, f: u32) -> Camera {
+pub fn orbit_camera(preset: Preset, count: u32, f: u32) -> Camera {
     let side = (count as f32).sqrt().ceil();
-    let centre = Vec3::new(0.0, 1.2, (side - 1.0) * 0.5 * SPACING);
-    let radius = (side * SPACING * 0.75).max(1.6);
+    let centre = Vec3::new(0.0, preset.focus_height(), (side - 1.0) * 0.5 * SPACING);
+    // People are seen from a little above head height; teapots from further out and above.
+    let (radius, rise) = match preset {
+        Preset::Teapots => ((side * SPACING * 1.05).max(1.2), 0.5 + 0.12 * side),
+        _ => ((side * SPACING * 0.75).max(1.6), 0.6 + 0.1 * side),
+    };
     let angle = std::f32::consts::PI + f as f32 * 0.05;
-    let eye = centre + Vec3::new(angle.sin() * radius, 0.6 + 0.1 * side, angle.cos() * radius);
+    let eye = centre + Vec3::new(angle.sin() * radius, rise, angle.cos() * radius);
     Camera::look_at(eye, centre, 45.0)
 }
 
@@ -155,7 +159,7 @@ impl Scene {
             verts_log2: args.verts_log2,
         };
         for (c, b) in self.characters.iter().zip(&self.baked) {
-            renderer.add_character(b, &c.hair.style, params, c.model)?;
+            renderer.add_character(b, &c.hair.style, c.strand_params(params), c.model)?;
         }
         renderer.set_prop_meshes(&preset::prop_meshes())?;
         renderer.set_prop_instances(&preset::prop_instances(&self.characters))?;
@@ -165,6 +169,14 @@ impl Scene {
     /// Number of characters.
     pub fn character_count(&self) -> usize {
         self.characters.len()
+    }
+
+    /// The strand settings of character `i` when the crowd asks for `crowd` (fur caps the
+    /// vertex level).
+    pub fn strand_params(&self, i: usize, crowd: StrandParams) -> StrandParams {
+        self.characters
+            .get(i)
+            .map_or(crowd, |c| c.strand_params(crowd))
     }
 }
 
@@ -207,7 +219,7 @@ fn run(args: Args) -> Result<()> {
     };
     for f in 0..args.frames {
         let view = View {
-            camera: orbit_camera(args.count, f),
+            camera: orbit_camera(args.preset, args.count, f),
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod,
             shading: args.shading,

@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use glam::Vec3;
+use hairmesh::characters::preset;
 use hairmesh::outln;
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, FrameTicket, LodSettings, PresentTarget, RenderPath,
@@ -145,6 +146,8 @@ struct Running {
     present_mode: PresentMode,
     camera: OrbitCamera,
     params: StrandParams,
+    /// Highest vertex level of each character (fur caps it), in the order they were added.
+    verts_caps: Vec<u32>,
     path: RenderPath,
     shading: ShadingModel,
     paused: bool,
@@ -270,7 +273,11 @@ impl App {
             recreate: true,
             present_mode: present_mode(&self.args.present_mode),
             camera: OrbitCamera {
-                centre: Vec3::new(0.0, 1.2, (side - 1.0) * 0.5 * 0.9),
+                centre: Vec3::new(
+                    0.0,
+                    self.args.preset.focus_height(),
+                    (side - 1.0) * 0.5 * preset::SPACING,
+                ),
                 yaw: std::f32::consts::PI,
                 pitch: 0.35,
                 distance: (side * 0.9 * 0.8).max(1.8),
@@ -279,6 +286,15 @@ impl App {
                 strands_per_bundle: self.args.strands_per_bundle,
                 verts_log2: self.args.verts_log2,
             },
+            verts_caps: (0..self.scene.character_count())
+                .map(|i| {
+                    let most = StrandParams {
+                        strands_per_bundle: 1,
+                        verts_log2: 6,
+                    };
+                    self.scene.strand_params(i, most).verts_log2
+                })
+                .collect(),
             path,
             shading: self.args.shading,
             paused: false,
@@ -551,9 +567,15 @@ impl Running {
             return Ok(());
         }
         self.params = params;
+        // Characters were added in order into slots 0.. and never removed: ids() is in that
+        // order.
         let ids: Vec<_> = self.renderer.crowd().ids();
-        for id in ids {
-            self.renderer.set_params(id, params)?;
+        for (id, cap) in ids.into_iter().zip(&self.verts_caps) {
+            let own = StrandParams {
+                verts_log2: params.verts_log2.min(*cap),
+                ..params
+            };
+            self.renderer.set_params(id, own)?;
         }
         Ok(())
     }
