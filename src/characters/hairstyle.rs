@@ -188,7 +188,7 @@ pub fn generate(family: StyleFamily, seed: u32, head: &HeadShape) -> Result<Hair
 /// every patch but the bottom grows short fur along its normals, bending a little downward.
 pub fn teapot_fur(seed: u32, height: f32) -> Result<Hairstyle> {
     let family = StyleFamily::Fur;
-    let mut rng = Pcg32::new(seed as u64 ^ 0x7ea9_07u64 << 40);
+    let mut rng = Pcg32::new(seed as u64 ^ (0x007e_a907_u64 << 40));
     let g = growth(family);
     let step = range(&mut rng, g.step.0, g.step.1) * 1.25;
     let gravity = range(&mut rng, 0.0, 0.5);
