@@ -42,6 +42,7 @@ struct Controls {
     lod: LodSettings,
     path: RenderPath,
     paused: bool,
+    fly: bool,
     present_mode: PresentMode,
 }
 
@@ -95,29 +96,69 @@ impl Controls {
                     ui.radio_value(&mut self.present_mode, PresentMode::Mailbox, "mailbox");
                     ui.radio_value(&mut self.present_mode, PresentMode::Immediate, "immediate");
                 });
-                ui.checkbox(&mut self.paused, "pause orbit");
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut self.paused, "pause orbit");
+                    ui.checkbox(&mut self.fly, "fly camera");
+                });
                 ui.separator();
                 ui.label(stats);
             });
     }
 }
 
-/// Orbit camera around a centre; the centre moves with the fly keys.
+/// The window's camera: an eye `distance` from `centre` in the direction given by `yaw` and
+/// `pitch`. Orbit mode turns the eye around the centre and moves the centre on the ground
+/// plane; fly mode turns the view around the eye and moves along the view direction.
 struct OrbitCamera {
     centre: Vec3,
     yaw: f32,
     pitch: f32,
     distance: f32,
+    fly: bool,
 }
 
 impl OrbitCamera {
-    fn camera(&self) -> Camera {
-        let dir = Vec3::new(
+    /// Unit vector from the centre to the eye.
+    fn to_eye(&self) -> Vec3 {
+        Vec3::new(
             self.pitch.cos() * self.yaw.sin(),
             self.pitch.sin(),
             self.pitch.cos() * self.yaw.cos(),
-        );
-        Camera::look_at(self.centre + dir * self.distance, self.centre, 45.0)
+        )
+    }
+
+    fn eye(&self) -> Vec3 {
+        self.centre + self.to_eye() * self.distance
+    }
+
+    fn camera(&self) -> Camera {
+        Camera::look_at(self.eye(), self.centre, 45.0)
+    }
+
+    /// A mouse drag of `(dx, dy)` pixels.
+    fn drag(&mut self, dx: f32, dy: f32) {
+        if self.fly {
+            // Turn the view around the eye: the eye stays, the centre moves.
+            let eye = self.eye();
+            self.yaw -= dx * 0.003;
+            self.pitch = (self.pitch - dy * 0.003).clamp(-1.4, 1.4);
+            self.centre = eye - self.to_eye() * self.distance;
+        } else {
+            self.yaw -= dx * 0.005;
+            self.pitch = (self.pitch + dy * 0.005).clamp(-0.2, 1.4);
+        }
+    }
+
+    /// One step of a movement key: `forward`, `right` and `up` in -1..=1.
+    fn step(&mut self, forward: f32, right: f32, up: f32) {
+        let step = self.distance * 0.05;
+        let ahead = if self.fly {
+            -self.to_eye()
+        } else {
+            Vec3::new(-self.yaw.sin(), 0.0, -self.yaw.cos())
+        };
+        let side = ahead.cross(Vec3::Y).normalize_or(Vec3::X);
+        self.centre += (ahead * forward + side * right + Vec3::Y * up) * step;
     }
 }
 
@@ -281,6 +322,7 @@ impl App {
                 yaw: std::f32::consts::PI,
                 pitch: 0.35,
                 distance: (side * 0.9 * 0.8).max(1.8),
+                fly: false,
             },
             params: StrandParams {
                 strands_per_bundle: self.args.strands_per_bundle,
@@ -441,6 +483,7 @@ impl Running {
             lod: self.panel.lod,
             path: self.path,
             paused: self.paused,
+            fly: self.camera.fly,
             present_mode: self.present_mode,
         };
         let stats = self.stats_text(scene_len);
@@ -477,7 +520,8 @@ impl Running {
         self.panel.lod = c.lod;
         self.shading = c.shading;
         self.path = c.path;
-        self.paused = c.paused;
+        self.paused = c.paused || (c.fly && !self.camera.fly);
+        self.camera.fly = c.fly;
         Ok(())
     }
 
@@ -581,17 +625,18 @@ impl Running {
     }
 
     fn key(&mut self, code: KeyCode, event_loop: &ActiveEventLoop) -> Result<()> {
-        let step = self.camera.distance * 0.05;
-        let forward = Vec3::new(-self.camera.yaw.sin(), 0.0, -self.camera.yaw.cos());
-        let right = forward.cross(Vec3::Y);
         match code {
             KeyCode::Escape => event_loop.exit(),
-            KeyCode::KeyW => self.camera.centre += forward * step,
-            KeyCode::KeyS => self.camera.centre -= forward * step,
-            KeyCode::KeyD => self.camera.centre += right * step,
-            KeyCode::KeyA => self.camera.centre -= right * step,
-            KeyCode::KeyE => self.camera.centre.y += step,
-            KeyCode::KeyQ => self.camera.centre.y -= step,
+            KeyCode::KeyW => self.camera.step(1.0, 0.0, 0.0),
+            KeyCode::KeyS => self.camera.step(-1.0, 0.0, 0.0),
+            KeyCode::KeyD => self.camera.step(0.0, 1.0, 0.0),
+            KeyCode::KeyA => self.camera.step(0.0, -1.0, 0.0),
+            KeyCode::KeyE => self.camera.step(0.0, 0.0, 1.0),
+            KeyCode::KeyQ => self.camera.step(0.0, 0.0, -1.0),
+            KeyCode::KeyF => {
+                self.camera.fly = !self.camera.fly;
+                self.paused |= self.camera.fly;
+            }
             KeyCode::Space => self.paused = !self.paused,
             KeyCode::KeyL => self.panel.lod.enabled = !self.panel.lod.enabled,
             KeyCode::KeyK => {
@@ -689,9 +734,8 @@ impl ApplicationHandler for App {
             }
             WindowEvent::CursorMoved { position, .. } => {
                 if let Some((x, y)) = r.dragging {
-                    r.camera.yaw -= ((position.x - x) * 0.005) as f32;
-                    r.camera.pitch =
-                        (r.camera.pitch + ((position.y - y) * 0.005) as f32).clamp(-0.2, 1.4);
+                    r.camera
+                        .drag((position.x - x) as f32, (position.y - y) as f32);
                     r.dragging = Some((position.x, position.y));
                 }
                 r.cursor = (position.x, position.y);
