@@ -4,6 +4,7 @@
 // ground) and Smith-Schlick visibility, under the directional light, plus an ambient term.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
+#include "shadow_lookup.glsl"
 
 layout(location = 0) in vec3 in_normal;
 layout(location = 1) flat in vec3 in_color;
@@ -28,5 +29,7 @@ void main() {
     float vis = 0.25 / ((nl * (1.0 - k) + k) * (nv * (1.0 - k) + k));
     float f = 0.04 + 0.96 * pow(1.0 - max(dot(h, v), 0.0), 5.0);
     vec3 brdf = in_color / 3.14159265 + vec3(d * vis * f);
-    out_color = vec4(brdf * (LIGHT_IRRADIANCE * nl) + in_color * AMBIENT, 1.0);
+    // Lookups start a little toward the light, against self-shadowing of the surface.
+    float lit = nl > 0.0 ? light_transmittance(in_pos, 2.0 * frame.shadow_params.w) : 0.0;
+    out_color = vec4(brdf * (LIGHT_IRRADIANCE * nl * lit) + in_color * AMBIENT, 1.0);
 }

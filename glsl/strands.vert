@@ -10,6 +10,7 @@ layout(location = 1) out float out_s;
 layout(location = 2) out vec3 out_pos;
 layout(location = 3) flat out vec3 out_color;
 layout(location = 4) flat out uint out_character;
+layout(location = 5) out float out_coverage;
 
 void main() {
     uint idx = uint(gl_VertexIndex);
@@ -41,4 +42,5 @@ void main() {
     out_pos = world;
     out_color = style_color();
     out_character = bundles[lo].character;
+    out_coverage = strip_coverage(v.pos_width.xyz, v.pos_width.w);
 }

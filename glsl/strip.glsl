@@ -1,15 +1,29 @@
-// Camera-facing strip expansion shared by strands.vert (compute path) and strands.mesh.
-// Strands thinner than one pixel are widened to one pixel so they do not break into dots.
+// Camera-facing strip expansion shared by strands.vert (compute path) and strands.mesh, for
+// perspective views (the camera) and orthographic ones (the light: frame.light_dir.w == 0,
+// facing frame.light_dir). A strand thinner than one pixel is widened to one pixel so it does
+// not break into dots; strip_coverage says which fraction of that pixel-wide strip the strand
+// really covers (coverage to alpha, seed 002), for passes that accumulate opacity.
 #ifndef STRIP_GLSL
 #define STRIP_GLSL
 
+// World size of one pixel at `pos`.
+float pixel_size(vec3 pos) {
+    if (frame.light_dir.w > 0.0) {
+        return 2.0 * length(frame.camera_pos.xyz - pos) / (frame.camera_pos.w * frame.light_dir.w);
+    }
+    return frame.lod_ortho.x / frame.camera_pos.w;
+}
+
 vec3 strip_offset(vec3 pos, vec3 tangent, float width, float side) {
-    vec3 to_eye = frame.camera_pos.xyz - pos;
-    float dist = length(to_eye);
-    vec3 across = cross(tangent, to_eye / max(dist, 1e-6));
+    vec3 to_eye = frame.light_dir.w > 0.0 ? normalize(frame.camera_pos.xyz - pos) : frame.light_dir.xyz;
+    vec3 across = cross(tangent, to_eye);
     across = length(across) > 1e-6 ? normalize(across) : normalize(cross(tangent, vec3(0.0, 0.0, 1.0)) + 1e-6);
-    float pixel = frame.light_dir.w > 0.0 ? 2.0 * dist / (frame.camera_pos.w * frame.light_dir.w) : 0.0;
-    return pos + across * (side * 0.5 * max(width, pixel));
+    return pos + across * (side * 0.5 * max(width, pixel_size(pos)));
+}
+
+// Fraction of the drawn strip the strand covers: 1 when wider than a pixel.
+float strip_coverage(vec3 pos, float width) {
+    return clamp(width / max(pixel_size(pos), 1e-12), 0.0, 1.0);
 }
 
 #endif

@@ -52,6 +52,7 @@ fn crowd_view(count: usize) -> View {
         light_dir: light(),
         lod: LodSettings::default(),
         shading: hairmesh::shade::ShadingModel::Placeholder,
+        shadows: hairmesh::render::ShadowMode::Off,
     }
 }
 

@@ -21,6 +21,7 @@ fn settings(path: RenderPath, lod: bool) -> RenderSettings {
             LodSettings::off()
         },
         shading: hairmesh::shade::ShadingModel::Placeholder,
+        shadows: hairmesh::render::ShadowMode::Off,
     }
 }
 

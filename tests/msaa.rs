@@ -18,6 +18,7 @@ fn frame(ctx: &std::sync::Arc<hairmesh::vk::Context>, msaa: u32, path: RenderPat
         light_dir: light(),
         lod: LodSettings::off(),
         shading: ShadingModel::Marschner,
+        shadows: hairmesh::render::ShadowMode::Off,
     };
     let opts = FrameOptions {
         path: Some(path),

@@ -404,6 +404,7 @@ fn bench_view(camera: Camera, lod_on: bool) -> View {
             LodSettings::off()
         },
         shading: hairmesh::shade::ShadingModel::Placeholder,
+        shadows: hairmesh::render::ShadowMode::Off,
     }
 }
 

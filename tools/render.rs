@@ -68,12 +68,18 @@ struct Args {
     /// Geomorph window lambda of eq. 10-12, in (0, 1].
     #[arg(long, default_value_t = 0.5)]
     lod_lambda: f32,
-    /// Samples per pixel (MSAA): 1, 2, 4, 8 where the device supports it (lavapipe: 1 or 4).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
-    msaa: u32,
-    /// Strand shading: placeholder, kajiya-kay or marschner.
-    #[arg(long, default_value = "marschner")]
-    shading: hairmesh::shade::ShadingModel,
+    /// Samples per pixel (MSAA): 1, 2, 4, 8 where the device supports it (lavapipe: 1 or 4);
+    /// default: the scene's `[look] msaa`, else 1.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    msaa: Option<u32>,
+    /// Shadows: off, deep-opacity (deep opacity maps) or approximate (approximate deep
+    /// shadow maps); default: the scene's `[look] shadows`, else off.
+    #[arg(long)]
+    shadows: Option<hairmesh::render::ShadowMode>,
+    /// Strand shading: placeholder, kajiya-kay or marschner; default: the scene's
+    /// `[look] shading`, else marschner.
+    #[arg(long)]
+    shading: Option<hairmesh::shade::ShadingModel>,
     /// Size of the compute path's vertex pool in MiB (frames that need more keep whole strands
     /// up to it and report the overflow).
     #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u64).range(1..=4096))]
@@ -127,6 +133,7 @@ struct Inputs {
     scene_camera: Option<Camera>,
     light: Vec3,
     size: (u32, u32),
+    look: hairmesh::render::scene::LookDesc,
 }
 
 fn load_inputs(args: &Args) -> Result<Inputs> {
@@ -136,6 +143,7 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
         scene_camera: None,
         light: Vec3::new(0.4, 1.0, 0.6),
         size: parse_size(&args.size)?,
+        look: Default::default(),
     };
     if let Some(scene_path) = &args.scene {
         let scene = SceneDesc::load(scene_path)?;
@@ -153,6 +161,7 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
         if let Some(l) = &scene.light {
             inputs.light = Vec3::from(l.direction);
         }
+        inputs.look = scene.look.clone();
         for c in &scene.characters {
             inputs.files.push(c.mesh.clone());
             inputs.files.extend(c.style.clone());
@@ -291,7 +300,7 @@ fn run(args: Args) -> Result<()> {
             .size(width, height)
             .path(path)
             .vertex_pool_bytes(args.vertex_pool_mib << 20)
-            .msaa(args.msaa),
+            .msaa(args.msaa.or(inputs.look.msaa).unwrap_or(1)),
     )?;
     for c in &inputs.characters {
         renderer.add_character(&c.baked, &c.style, c.params, c.model)?;
@@ -300,7 +309,14 @@ fn run(args: Args) -> Result<()> {
         camera,
         light_dir: inputs.light,
         lod,
-        shading: args.shading,
+        shading: args
+            .shading
+            .or(inputs.look.shading_model())
+            .unwrap_or(hairmesh::shade::ShadingModel::Marschner),
+        shadows: args
+            .shadows
+            .or(inputs.look.shadow_mode())
+            .unwrap_or_default(),
     };
     let out = renderer.render_one(
         &view,

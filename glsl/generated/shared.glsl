@@ -28,6 +28,9 @@
 #define BINDING_VERTICES 8
 #define BINDING_PROP_VERTICES 9
 #define BINDING_PROP_INSTANCES 10
+#define BINDING_SHADOW_HAIR_DEPTH 11
+#define BINDING_SHADOW_PROP_DEPTH 12
+#define BINDING_SHADOW_LAYERS 13
 #define BINDING_TEX_POSITION 0
 #define BINDING_TEX_UV 1
 #define BINDING_TEX_W 2
@@ -88,6 +91,9 @@ struct FrameBlock {
     vec4 lod_ortho;
     uvec4 counts;
     uvec4 shading;
+    mat4 light_view_proj;
+    uvec4 shadow;
+    vec4 shadow_params;
 };
 
 struct CharacterRecord {

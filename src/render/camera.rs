@@ -177,6 +177,8 @@ pub struct View {
     pub lod: LodSettings,
     /// Shading model of the strands.
     pub shading: crate::shade::ShadingModel,
+    /// Shadows from the light (hair on hair, hair and bodies on each other).
+    pub shadows: super::shadow::ShadowMode,
 }
 
 impl View {
@@ -231,6 +233,10 @@ impl View {
             lod_ortho: [0.0; 4],
             counts: [bundles, characters, self.lod.enabled as u32, vertex_budget],
             shading: [self.shading as u32, 0, 0, 0],
+            // Filled in by the renderer once the light view is fitted.
+            light_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
+            shadow: [0; 4],
+            shadow_params: [0.0; 4],
         }
     }
 }
@@ -251,6 +257,6 @@ mod tests {
         assert!(inside(Vec3::ZERO));
         assert!(!inside(Vec3::new(0.0, 0.0, 10.0)), "behind the camera");
         assert!(!inside(Vec3::new(100.0, 0.0, 0.0)), "far to the side");
-        assert_eq!(size_of::<FrameBlock>(), 272);
+        assert_eq!(size_of::<FrameBlock>(), 368);
     }
 }

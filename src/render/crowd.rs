@@ -326,6 +326,34 @@ impl Crowd {
             .sum()
     }
 
+    /// World-space bounds of every visible character's hair: the box of its hair mesh texture,
+    /// transformed, grown by the styling offsets (as `bundle_lod.glsl` grows bundle bounds).
+    pub fn hair_bounds(&self) -> Vec<(glam::Vec3, glam::Vec3)> {
+        use glam::Vec3;
+        self.slots
+            .iter()
+            .flatten()
+            .filter(|c| c.visible)
+            .map(|c| {
+                let lo = Vec3::from_slice(&c.info.pos_origin[..3]);
+                let ext = Vec3::from_slice(&c.info.pos_extent[..3]);
+                let (mut wlo, mut whi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+                for k in 0..8 {
+                    let corner = lo
+                        + ext * Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, (k >> 2) as f32);
+                    let p = c.model.transform_point3(corner);
+                    wlo = wlo.min(p);
+                    whi = whi.max(p);
+                }
+                let st = &c.style;
+                let scale = c.model.x_axis.truncate().length();
+                let margin = scale
+                    * (st.curl_radius + st.wave_amplitude + st.frizz_amplitude + st.strand_width);
+                (wlo - margin, whi + margin)
+            })
+            .collect()
+    }
+
     /// Handles of every live character.
     pub fn ids(&self) -> Vec<CharacterId> {
         self.slots

@@ -69,6 +69,8 @@ pub(crate) struct FrameSlot {
     pub cmd: CommandBuffer,
     pub fence: Fence,
     pub frame_ubo: Buffer,
+    /// The light's frame block (shadow passes).
+    pub light_ubo: Buffer,
     pub records: Buffer,
     pub prop_instances: Buffer,
     pub stats_readback: Buffer,
@@ -76,6 +78,8 @@ pub(crate) struct FrameSlot {
     pub profiler: Profiler,
     pub mesh_query: Option<MeshPrimitivesQuery>,
     pub set: DescriptorSet,
+    /// Set 0 of the shadow passes: as `set`, with `light_ubo` as the frame block.
+    pub light_set: DescriptorSet,
     pub retired: Vec<Retired>,
     pub pending: Option<Pending>,
 }
@@ -85,15 +89,8 @@ impl FrameSlot {
         Ok(FrameSlot {
             cmd: CommandBuffer::new(ctx, "frame")?,
             fence: Fence::new(ctx, true)?,
-            frame_ubo: Buffer::new(
-                ctx,
-                &BufferDesc::new(
-                    "frame block",
-                    size_of::<FrameBlock>() as u64,
-                    vk::BufferUsageFlags::UNIFORM_BUFFER,
-                )
-                .host_visible(),
-            )?,
+            frame_ubo: frame_block_buffer(ctx, "frame block")?,
+            light_ubo: frame_block_buffer(ctx, "light frame block")?,
             records: records_buffer(ctx, 1)?,
             prop_instances: prop_instance_buffer(ctx, 1)?,
             stats_readback: Buffer::new(
@@ -109,10 +106,24 @@ impl FrameSlot {
             profiler: Profiler::new(ctx)?,
             mesh_query: MeshPrimitivesQuery::new(ctx)?,
             set: DescriptorSet::new(ctx, "frame set", layout)?,
+            light_set: DescriptorSet::new(ctx, "light frame set", layout)?,
             retired: Vec::new(),
             pending: None,
         })
     }
+}
+
+/// A host-visible uniform buffer for one `FrameBlock`.
+fn frame_block_buffer(ctx: &Arc<Context>, name: &str) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            name,
+            size_of::<FrameBlock>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )
+        .host_visible(),
+    )
 }
 
 /// A host-visible buffer for `n` prop instances.

@@ -19,16 +19,17 @@ use super::frame::{
 use super::passes::props::PropDraw;
 use super::passes::{FrameInputs, FramePasses, PassSets};
 pub use super::settings::{FrameOptions, FrameTicket, RenderPath, RendererDesc};
+use super::shadow::{LightView, ShadowMode};
 use super::shared::{FrameBinding, GenerateArgs, HairVertex, SET_FRAME, SET_TEXTURES};
 use super::shared::{PropInstance, PropVertex};
-use super::targets::RenderTargets;
+use super::targets::{RenderTargets, ShadowMaps};
 use super::workspace::FrameBuffers;
 use super::workspace::Workspace;
 use crate::bake::BakedHairMesh;
 use crate::model::style::HairStyle;
 use crate::vk::{
-    Access, BindingDesc, Buffer, BufferDesc, CommandRecorder, Context, DescriptorKind,
-    DescriptorSetLayout, GpuError, GpuResult, Image, PipelineLayout, Semaphore, SwapchainImage,
+    Access, BindingDesc, Buffer, BufferDesc, CommandRecorder, Context, DescriptorSetLayout,
+    GpuError, GpuResult, Image, PipelineLayout, Semaphore, SwapchainImage,
 };
 
 /// Where a windowed frame goes: a swapchain image, the semaphore its acquisition signals and
@@ -88,10 +89,20 @@ pub struct Renderer {
     next: usize,
     frame_number: u64,
     targets: RenderTargets,
+    shadow: ShadowMaps,
     work: Workspace,
     completed: VecDeque<FrameReport>,
     /// Background colour (linear RGB).
     pub background: [f32; 3],
+}
+
+/// What one frame draws (beyond the options the caller gave).
+struct FrameWork<'a> {
+    path: RenderPath,
+    bundles: u32,
+    props: &'a [PropDraw],
+    /// Shadow mode, when shadows are on and there is hair to shadow.
+    shadows: Option<ShadowMode>,
 }
 
 fn check_size(width: u32, height: u32) -> GpuResult<()> {
@@ -117,17 +128,16 @@ impl Renderer {
                 ctx.info.name
             )));
         }
+        if !(16..=8192).contains(&desc.shadow_resolution) {
+            return Err(GpuError::Unsupported(format!(
+                "shadow map resolution {} outside 16..=8192",
+                desc.shadow_resolution
+            )));
+        }
         let crowd = Crowd::new(ctx, desc.max_characters)?;
         let bindings: Vec<BindingDesc> = FrameBinding::ALL
             .iter()
-            .map(|(b, _)| {
-                let kind = if *b == FrameBinding::Frame {
-                    DescriptorKind::UniformBuffer
-                } else {
-                    DescriptorKind::StorageBuffer
-                };
-                BindingDesc::single(*b as u32, kind)
-            })
+            .map(|(b, _)| BindingDesc::single(*b as u32, b.kind()))
             .collect();
         let frame_layout = DescriptorSetLayout::new(ctx, &bindings)?;
         let mut set_layouts = vec![frame_layout.clone(); 2];
@@ -169,6 +179,7 @@ impl Renderer {
             next: 0,
             frame_number: 0,
             targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
+            shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
             work,
             completed: VecDeque::new(),
             background: [0.6, 0.65, 0.7],
@@ -379,16 +390,45 @@ impl Renderer {
             slot.prop_instances = prop_instance_buffer(&self.ctx, instances.next_power_of_two())?;
         }
         let slot = &self.frames[i];
-        self.work.write_set(
-            &slot.set,
-            FrameBuffers {
-                frame_ubo: &slot.frame_ubo,
-                records: &slot.records,
-                prop_instances: &slot.prop_instances,
-                bundle_table: self.crowd.bundle_table(),
-                prop_vertices: self.props.vertices.as_ref(),
-            },
-        )
+        for (set, ubo) in [
+            (&slot.set, &slot.frame_ubo),
+            (&slot.light_set, &slot.light_ubo),
+        ] {
+            self.work.write_set(
+                set,
+                FrameBuffers {
+                    frame_ubo: ubo,
+                    records: &slot.records,
+                    prop_instances: &slot.prop_instances,
+                    bundle_table: self.crowd.bundle_table(),
+                    prop_vertices: self.props.vertices.as_ref(),
+                    shadow: &self.shadow,
+                },
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The light's view for `view`: fitted around the visible characters whose hair is in the
+    /// camera's frustum. `None` when shadows are off or no hair is in view.
+    fn light_view(&self, view: &View, block: &super::shared::FrameBlock) -> Option<LightView> {
+        if view.shadows == ShadowMode::Off {
+            return None;
+        }
+        let inside = |(lo, hi): &(glam::Vec3, glam::Vec3)| {
+            block.planes.iter().all(|pl| {
+                let n = glam::Vec3::from_slice(&pl[..3]);
+                let corner = glam::Vec3::select(n.cmpge(glam::Vec3::ZERO), *hi, *lo);
+                n.dot(corner) + pl[3] >= 0.0
+            })
+        };
+        let bounds: Vec<_> = self
+            .crowd
+            .hair_bounds()
+            .into_iter()
+            .filter(inside)
+            .collect();
+        LightView::fit(&bounds, view.light_dir, self.shadow.resolution())
     }
 
     /// Record and submit one frame of every visible character seen from `view`. Waits only
@@ -433,18 +473,27 @@ impl Renderer {
         self.prepare_workspace(i, path)?;
         let (width, height) = self.targets.size();
         let bundles = self.crowd.bundle_count();
-        let block = view.frame_block(
+        let mut block = view.frame_block(
             width,
             height,
             bundles,
             self.crowd.slot_count(),
             self.vertex_budget(),
         );
+        let light = self.light_view(view, &block);
+        if let Some(l) = &light {
+            (block.light_view_proj, block.shadow, block.shadow_params) =
+                l.shadow_fields(view.shadows);
+        }
+        let light_block = light.map(|l| l.frame_block(&block, &view.lod));
         let records = self.crowd.records();
         let (prop_instances, prop_draws) = self.props.frame_lists();
         {
             let slot = &mut self.frames[i];
             slot.frame_ubo.write(0, bytemuck::bytes_of(&block))?;
+            if let Some(lb) = &light_block {
+                slot.light_ubo.write(0, bytemuck::bytes_of(lb))?;
+            }
             slot.records.write(0, bytemuck::cast_slice(&records))?;
             slot.prop_instances
                 .write(0, bytemuck::cast_slice(&prop_instances))?;
@@ -467,7 +516,14 @@ impl Renderer {
             }
         }
         let start = Instant::now();
-        self.record(i, path, bundles, opts, &prop_draws, present.as_mut())?;
+        let shadows = light_block.map(|_| view.shadows);
+        let work = FrameWork {
+            path,
+            bundles,
+            props: &prop_draws,
+            shadows,
+        };
+        self.record(i, work, opts, present.as_mut())?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
         let slot = &mut self.frames[i];
         slot.fence.reset()?;
@@ -498,12 +554,16 @@ impl Renderer {
     fn record(
         &mut self,
         i: usize,
-        path: RenderPath,
-        bundles: u32,
+        work: FrameWork,
         opts: &FrameOptions,
-        props: &[PropDraw],
         present: Option<&mut PresentTarget>,
     ) -> GpuResult<()> {
+        let FrameWork {
+            path,
+            bundles,
+            props,
+            shadows,
+        } = work;
         let slot = &mut self.frames[i];
         let bg = self.background;
         let mut rec = slot.cmd.begin()?;
@@ -522,6 +582,14 @@ impl Renderer {
             targets: &mut self.targets,
             clear: opts.clear.then_some([bg[0], bg[1], bg[2], 1.0]),
             props,
+            shadow: super::passes::ShadowInputs {
+                mode: shadows,
+                light_sets: PassSets {
+                    frame: &slot.light_set,
+                    textures: self.crowd.texture_set(),
+                },
+                maps: &mut self.shadow,
+            },
         };
         self.passes.record(
             &mut rec,

@@ -8,6 +8,10 @@
 //! fov_y_degrees = 40.0
 //! [light]
 //! direction = [0.3, 1.0, 0.5]      # toward the light
+//! [look]                           # optional; `render` flags override it
+//! shading = "marschner"            # placeholder, kajiya-kay, marschner
+//! shadows = "deep-opacity"         # off, deep-opacity, approximate
+//! msaa = 4                         # samples per pixel
 //! [[character]]
 //! mesh = "hairmeshes/head_long.obj" # .obj (baked on load) or .hmb; relative to this file
 //! style = "hairmeshes/head_long.toml" # optional: default is the style beside the mesh / baked in
@@ -58,6 +62,30 @@ pub struct LightDesc {
     pub direction: [f32; 3],
 }
 
+/// How a scene looks: shading model, shadows, anti-aliasing (each optional).
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LookDesc {
+    /// Strand shading model name (`shade::ShadingModel`).
+    pub shading: Option<String>,
+    /// Shadow mode name (`render::ShadowMode`).
+    pub shadows: Option<String>,
+    /// Samples per pixel.
+    pub msaa: Option<u32>,
+}
+
+impl LookDesc {
+    /// The shading model, if given (validated by [`SceneDesc::validate`]).
+    pub fn shading_model(&self) -> Option<crate::shade::ShadingModel> {
+        self.shading.as_deref().and_then(|s| s.parse().ok())
+    }
+
+    /// The shadow mode, if given (validated by [`SceneDesc::validate`]).
+    pub fn shadow_mode(&self) -> Option<crate::render::ShadowMode> {
+        self.shadows.as_deref().and_then(|s| s.parse().ok())
+    }
+}
+
 /// One character.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -104,6 +132,9 @@ pub struct SceneDesc {
     pub camera: Option<CameraDesc>,
     /// Light (default: from above-front).
     pub light: Option<LightDesc>,
+    /// Shading, shadows, MSAA.
+    #[serde(default)]
+    pub look: LookDesc,
     /// Characters.
     #[serde(rename = "character")]
     pub characters: Vec<CharacterDesc>,
@@ -180,6 +211,19 @@ impl SceneDesc {
         if let Some(l) = &self.light {
             validate_light(Vec3::from(l.direction)).map_err(|e| format!("[light]: {e}"))?;
         }
+        if let Some(s) = &self.look.shading {
+            s.parse::<crate::shade::ShadingModel>()
+                .map_err(|e| format!("[look]: {e}"))?;
+        }
+        if let Some(s) = &self.look.shadows {
+            s.parse::<crate::render::ShadowMode>()
+                .map_err(|e| format!("[look]: {e}"))?;
+        }
+        if let Some(m) = self.look.msaa
+            && !(m.is_power_of_two() && m <= 64)
+        {
+            return Err(format!("[look]: msaa {m} is not 1, 2, 4, 8, 16, 32 or 64"));
+        }
         if self.characters.is_empty() {
             return Err("scene has no [[character]]".into());
         }
@@ -245,4 +289,42 @@ pub fn load_mesh(mesh: &Path, style: Option<&Path>) -> Result<(BakedHairMesh, Ha
         None => baked.style,
     };
     Ok((baked, style))
+}
+
+#[cfg(test)]
+mod look_tests {
+    use super::*;
+
+    const CHARACTER: &str = "[[character]]\nmesh = \"a.obj\"\n";
+
+    #[test]
+    fn look_block_is_optional_and_checked() {
+        let base = Path::new(".");
+        let plain = SceneDesc::parse("s.toml", CHARACTER, base).unwrap();
+        assert!(plain.look.shading_model().is_none() && plain.look.shadow_mode().is_none());
+        let text = format!(
+            "[look]\nshading = \"kajiya-kay\"\nshadows = \"approximate\"\nmsaa = 4\n{CHARACTER}"
+        );
+        let s = SceneDesc::parse("s.toml", &text, base).unwrap();
+        assert_eq!(
+            s.look.shading_model(),
+            Some(crate::shade::ShadingModel::KajiyaKay)
+        );
+        assert_eq!(
+            s.look.shadow_mode(),
+            Some(crate::render::ShadowMode::Approximate)
+        );
+        assert_eq!(s.look.msaa, Some(4));
+        for (bad, what) in [
+            ("shadows = \"soft\"", "unknown shadow mode"),
+            ("shading = \"phong\"", "unknown shading model"),
+            ("msaa = 3", "msaa 3"),
+        ] {
+            let text = format!("[look]\n{bad}\n{CHARACTER}");
+            let e = SceneDesc::parse("s.toml", &text, base)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("s.toml") && e.contains(what), "{e}");
+        }
+    }
 }

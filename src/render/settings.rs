@@ -27,6 +27,8 @@ pub struct RendererDesc {
     pub height: u32,
     /// Samples per pixel (MSAA): 1, or a count the device supports for colour and depth.
     pub msaa: u32,
+    /// Side of the square shadow maps in texels (16..=8192).
+    pub shadow_resolution: u32,
 }
 
 impl Default for RendererDesc {
@@ -39,6 +41,7 @@ impl Default for RendererDesc {
             width: 1280,
             height: 720,
             msaa: 1,
+            shadow_resolution: super::shadow::DEFAULT_SHADOW_RESOLUTION,
         }
     }
 }
@@ -60,6 +63,12 @@ impl RendererDesc {
     /// Set the MSAA sample count.
     pub fn msaa(mut self, samples: u32) -> Self {
         self.msaa = samples;
+        self
+    }
+
+    /// Set the shadow map resolution.
+    pub fn shadow_resolution(mut self, texels: u32) -> Self {
+        self.shadow_resolution = texels;
         self
     }
 

@@ -60,11 +60,17 @@ pub enum FrameBinding {
     PropVertices = 9,
     /// `PropInstance[]`: this frame's placed props.
     PropInstances = 10,
+    /// Shadow map: depth of the hair nearest the light (sampled, `shadow_lookup.glsl`).
+    ShadowHairDepth = 11,
+    /// Shadow map: depth of the opaque props nearest the light.
+    ShadowPropDepth = 12,
+    /// Deep opacity map: hair opacity in 4 layers behind the hair depth (RGBA).
+    ShadowLayers = 13,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 11] = [
+    pub const ALL: [(FrameBinding, &'static str); 14] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -76,7 +82,22 @@ impl FrameBinding {
         (FrameBinding::Vertices, "BINDING_VERTICES"),
         (FrameBinding::PropVertices, "BINDING_PROP_VERTICES"),
         (FrameBinding::PropInstances, "BINDING_PROP_INSTANCES"),
+        (FrameBinding::ShadowHairDepth, "BINDING_SHADOW_HAIR_DEPTH"),
+        (FrameBinding::ShadowPropDepth, "BINDING_SHADOW_PROP_DEPTH"),
+        (FrameBinding::ShadowLayers, "BINDING_SHADOW_LAYERS"),
     ];
+
+    /// What the binding holds.
+    pub fn kind(self) -> crate::vk::DescriptorKind {
+        use crate::vk::DescriptorKind;
+        match self {
+            FrameBinding::Frame => DescriptorKind::UniformBuffer,
+            FrameBinding::ShadowHairDepth
+            | FrameBinding::ShadowPropDepth
+            | FrameBinding::ShadowLayers => DescriptorKind::SampledImage,
+            _ => DescriptorKind::StorageBuffer,
+        }
+    }
 }
 
 /// Bindings of set 1 ([`SET_TEXTURES`]): the five textures of paper 003 Table 1, each a
@@ -191,11 +212,20 @@ pub struct FrameBlock {
     pub counts: [u32; 4],
     /// x shading model (`shade::ShadingModel`); yzw reserved.
     pub shading: [u32; 4],
+    /// World to the light's clip space (the shadow maps; camera views only).
+    pub light_view_proj: [[f32; 4]; 4],
+    /// x shadow mode (`render::ShadowMode`: 0 off, 1 deep opacity, 2 approximate deep), y
+    /// shadow map resolution; zw reserved.
+    pub shadow: [u32; 4],
+    /// x deep-opacity layer thickness (world units), y light depth range (far - near, world),
+    /// z opacity of one strand, w depth bias (world units).
+    pub shadow_params: [f32; 4],
 }
 
 gpu_struct!(FrameBlock as "FrameBlock" {
     view_proj: "mat4", camera_pos: "vec4", light_dir: "vec4", viewport: "vec4",
     planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4", shading: "uvec4",
+    light_view_proj: "mat4", shadow: "uvec4", shadow_params: "vec4",
 });
 
 /// One character: where its bundles and textures are, how it is placed and styled.

@@ -82,3 +82,56 @@ impl RenderTargets {
         }
     }
 }
+
+/// Format of the deep opacity layers (one layer per channel, summed with additive blending).
+pub const SHADOW_LAYERS_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+/// The light's maps (square, shared by the frames in flight; each frame's barriers order its
+/// use after the previous frame's reads): hair depth, prop depth and deep opacity layers.
+pub struct ShadowMaps {
+    /// Depth of the hair nearest the light.
+    pub hair_depth: Image,
+    /// Depth of the props nearest the light.
+    pub prop_depth: Image,
+    /// Hair opacity per layer behind `hair_depth` (deep opacity mode).
+    pub layers: Image,
+    /// Last use of each map (`hair_depth`, `prop_depth`, `layers`).
+    pub access: [Access; 3],
+    /// Nearest, clamped: lookups read texel by texel.
+    pub sampler: crate::vk::Sampler,
+}
+
+impl ShadowMaps {
+    /// Maps of `resolution` x `resolution` texels.
+    pub fn new(ctx: &Arc<Context>, resolution: u32) -> GpuResult<Self> {
+        let depth_usage =
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let depth = |name| {
+            Image::new(
+                ctx,
+                &ImageDesc::new_2d(name, DEPTH_FORMAT, resolution, resolution).usage(depth_usage),
+            )
+        };
+        Ok(ShadowMaps {
+            hair_depth: depth("shadow hair depth")?,
+            prop_depth: depth("shadow prop depth")?,
+            layers: Image::new(
+                ctx,
+                &ImageDesc::new_2d(
+                    "shadow opacity layers",
+                    SHADOW_LAYERS_FORMAT,
+                    resolution,
+                    resolution,
+                )
+                .usage(vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED),
+            )?,
+            access: [Access::Nothing; 3],
+            sampler: crate::vk::Sampler::nearest_clamp(ctx)?,
+        })
+    }
+
+    /// Side in texels.
+    pub fn resolution(&self) -> u32 {
+        self.hair_depth.desc.extent[0]
+    }
+}

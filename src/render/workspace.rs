@@ -32,6 +32,8 @@ pub struct FrameBuffers<'a> {
     pub bundle_table: Option<&'a Buffer>,
     /// The prop meshes, once set.
     pub prop_vertices: Option<&'a Buffer>,
+    /// The light's maps.
+    pub shadow: &'a super::targets::ShadowMaps,
 }
 
 /// The working buffers.
@@ -140,6 +142,18 @@ impl Workspace {
                 FrameBinding::Vertices => pool,
                 FrameBinding::PropVertices => prop_vertices,
                 FrameBinding::PropInstances => frame.prop_instances,
+                FrameBinding::ShadowHairDepth
+                | FrameBinding::ShadowPropDepth
+                | FrameBinding::ShadowLayers => {
+                    let maps = frame.shadow;
+                    let image = match b {
+                        FrameBinding::ShadowHairDepth => &maps.hair_depth,
+                        FrameBinding::ShadowPropDepth => &maps.prop_depth,
+                        _ => &maps.layers,
+                    };
+                    set.write_image(b as u32, 0, image, &maps.sampler)?;
+                    continue;
+                }
             };
             set.write_buffer(b as u32, buffer)?;
         }

@@ -302,6 +302,64 @@ impl CommandRecorder<'_> {
         self.rendering = true;
     }
 
+    /// Begin dynamic rendering into `depth` only (shadow maps), viewport and scissor covering
+    /// it.
+    pub fn begin_rendering_depth(&mut self, depth: Attachment) {
+        let [w, h, _] = depth.image.desc.extent;
+        let mut att = vk::RenderingAttachmentInfo::default()
+            .image_view(depth.image.view())
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .store_op(vk::AttachmentStoreOp::STORE);
+        att = match depth.clear {
+            Some(c) => att
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: c[0],
+                        stencil: 0,
+                    },
+                }),
+            None => att.load_op(vk::AttachmentLoadOp::LOAD),
+        };
+        let area = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D {
+                width: w,
+                height: h,
+            },
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .depth_attachment(&att);
+        // SAFETY: the image is in DEPTH_ATTACHMENT_OPTIMAL (the caller's barriers).
+        unsafe {
+            self.ctx.device.cmd_begin_rendering(self.raw, &info);
+            self.set_viewport_scissor(area);
+        }
+        self.rendering = true;
+    }
+
+    /// Viewport and scissor covering `area`.
+    ///
+    /// # Safety
+    /// Inside a command buffer being recorded.
+    unsafe fn set_viewport_scissor(&mut self, area: vk::Rect2D) {
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: area.extent.width as f32,
+            height: area.extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: the caller is recording this command buffer.
+        unsafe {
+            self.ctx.device.cmd_set_viewport(self.raw, 0, &[viewport]);
+            self.ctx.device.cmd_set_scissor(self.raw, 0, &[area]);
+        }
+    }
+
     /// Begin dynamic rendering into `color` only (overlays such as the control panel).
     pub fn begin_rendering_color(&mut self, color: Attachment) {
         let [w, h, _] = color.image.desc.extent;
@@ -330,7 +388,10 @@ impl CommandRecorder<'_> {
             .layer_count(1)
             .color_attachments(&atts);
         // SAFETY: the image is in COLOR_ATTACHMENT_OPTIMAL (the caller's barriers).
-        unsafe { self.ctx.device.cmd_begin_rendering(self.raw, &info) };
+        unsafe {
+            self.ctx.device.cmd_begin_rendering(self.raw, &info);
+            self.set_viewport_scissor(area);
+        }
         self.rendering = true;
     }
 

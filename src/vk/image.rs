@@ -251,9 +251,18 @@ impl Sampler {
 impl Sampler {
     /// Linear min/mag filtering, clamp to edge, no mips.
     pub fn linear_clamp(ctx: &Arc<Context>) -> GpuResult<Self> {
+        Self::clamped(ctx, vk::Filter::LINEAR)
+    }
+
+    /// Nearest filtering, clamp to edge, no mips (shadow maps, read texel by texel).
+    pub fn nearest_clamp(ctx: &Arc<Context>) -> GpuResult<Self> {
+        Self::clamped(ctx, vk::Filter::NEAREST)
+    }
+
+    fn clamped(ctx: &Arc<Context>, filter: vk::Filter) -> GpuResult<Self> {
         let info = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::LINEAR)
-            .min_filter(vk::Filter::LINEAR)
+            .mag_filter(filter)
+            .min_filter(filter)
             .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
             .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)

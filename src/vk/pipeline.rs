@@ -290,15 +290,16 @@ impl Pipeline {
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
             .rasterization_samples(super::sample_flags(desc.samples));
         let depth = depth_state(desc.depth);
-        let blend_attachment = blend_attachment(desc.blend);
-        let blend_attachments = [blend_attachment];
-        let blend =
-            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        // No colour format: a depth-only pipeline (shadow maps).
+        let has_color = desc.color_format != vk::Format::UNDEFINED;
+        let blend_attachments = [blend_attachment(desc.blend)];
+        let blend = vk::PipelineColorBlendStateCreateInfo::default()
+            .attachments(&blend_attachments[..has_color as usize]);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let color_formats = [desc.color_format];
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
-            .color_attachment_formats(&color_formats)
+            .color_attachment_formats(&color_formats[..has_color as usize])
             .depth_attachment_format(desc.depth_format);
         let mesh = desc
             .stages

@@ -26,6 +26,11 @@ pub const SOURCES: &[(&str, &str)] = &[
     ),
     ("strip.glsl", include_str!("../../glsl/strip.glsl")),
     (
+        "shadow_lookup.glsl",
+        include_str!("../../glsl/shadow_lookup.glsl"),
+    ),
+    ("shadow.frag", include_str!("../../glsl/shadow.frag")),
+    (
         "hair_shading.glsl",
         include_str!("../../glsl/hair_shading.glsl"),
     ),

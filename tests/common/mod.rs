@@ -20,6 +20,7 @@ pub struct RenderSettings {
     pub path: Option<RenderPath>,
     pub lod: LodSettings,
     pub shading: hairmesh::shade::ShadingModel,
+    pub shadows: hairmesh::render::ShadowMode,
 }
 
 /// What a test render produced.
@@ -46,6 +47,7 @@ pub fn render(r: &mut Renderer, cam: &Camera, settings: &RenderSettings) -> Rend
         light_dir: light(),
         lod: settings.lod,
         shading: settings.shading,
+        shadows: settings.shadows,
     };
     let report = r
         .render_one(
@@ -110,6 +112,7 @@ pub fn compute_full() -> RenderSettings {
         path: Some(RenderPath::Compute),
         lod: LodSettings::off(),
         shading: hairmesh::shade::ShadingModel::Placeholder,
+        shadows: hairmesh::render::ShadowMode::Off,
     }
 }
 

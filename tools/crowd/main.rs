@@ -74,6 +74,10 @@ pub struct Args {
     /// Strand shading: placeholder, kajiya-kay or marschner.
     #[arg(long, default_value = "marschner")]
     shading: hairmesh::shade::ShadingModel,
+    /// Shadows: off, deep-opacity (deep opacity maps) or approximate (approximate deep
+    /// shadow maps).
+    #[arg(long, default_value = "deep-opacity")]
+    shadows: hairmesh::render::ShadowMode,
     /// Level of detail.
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     lod: String,
@@ -223,6 +227,7 @@ fn run(args: Args) -> Result<()> {
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod,
             shading: args.shading,
+            shadows: args.shadows,
         };
         let t = Instant::now();
         let report = renderer.render_one(

@@ -18,7 +18,7 @@ use hairmesh::characters::preset;
 use hairmesh::outln;
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, FrameTicket, LodSettings, PresentTarget, RenderPath,
-    Renderer, StrandParams, View,
+    Renderer, ShadowMode, StrandParams, View,
 };
 use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{
@@ -38,6 +38,7 @@ use super::{Args, Scene, parse_size};
 struct Controls {
     visible: usize,
     shading: ShadingModel,
+    shadows: ShadowMode,
     params: StrandParams,
     lod: LodSettings,
     path: RenderPath,
@@ -82,6 +83,12 @@ impl Controls {
                     ui.radio_value(&mut self.shading, ShadingModel::Placeholder, "placeholder");
                     ui.radio_value(&mut self.shading, ShadingModel::KajiyaKay, "Kajiya-Kay");
                     ui.radio_value(&mut self.shading, ShadingModel::Marschner, "Marschner");
+                });
+                ui.horizontal(|ui| {
+                    ui.label("shadows");
+                    for m in ShadowMode::ALL {
+                        ui.radio_value(&mut self.shadows, m, m.name());
+                    }
                 });
                 ui.horizontal(|ui| {
                     ui.label("path");
@@ -191,6 +198,7 @@ struct Running {
     verts_caps: Vec<u32>,
     path: RenderPath,
     shading: ShadingModel,
+    shadows: ShadowMode,
     paused: bool,
     dragging: Option<(f64, f64)>,
     cursor: (f64, f64),
@@ -339,6 +347,7 @@ impl App {
                 .collect(),
             path,
             shading: self.args.shading,
+            shadows: self.args.shadows,
             paused: false,
             dragging: None,
             cursor: (0.0, 0.0),
@@ -425,6 +434,7 @@ impl Running {
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod: self.panel.lod,
             shading: self.shading,
+            shadows: self.shadows,
         };
         let (primitives, ppp, freed) = self.panel_frame(scene_len)?;
         let chain = self.swapchain.as_ref().expect("created above");
@@ -479,6 +489,7 @@ impl Running {
         let mut c = Controls {
             visible: self.panel.visible,
             shading: self.shading,
+            shadows: self.shadows,
             params: self.params,
             lod: self.panel.lod,
             path: self.path,
@@ -519,6 +530,7 @@ impl Running {
         }
         self.panel.lod = c.lod;
         self.shading = c.shading;
+        self.shadows = c.shadows;
         self.path = c.path;
         self.paused = c.paused || (c.fly && !self.camera.fly);
         self.camera.fly = c.fly;
@@ -645,6 +657,10 @@ impl Running {
                     ShadingModel::KajiyaKay => ShadingModel::Marschner,
                     ShadingModel::Marschner => ShadingModel::Placeholder,
                 }
+            }
+            KeyCode::KeyH => {
+                let k = ShadowMode::ALL.iter().position(|m| *m == self.shadows);
+                self.shadows = ShadowMode::ALL[(k.unwrap_or(0) + 1) % ShadowMode::ALL.len()];
             }
             KeyCode::KeyM => {
                 self.path = match self.path {

@@ -70,8 +70,14 @@ impl ComputeGenerate {
         })
     }
 
-    /// Record generation of every visible strand of the `bundles` bundles into the vertex
-    /// pool. `args` must have been cleared before (statistics accumulate).
+    /// Profiler scope names of the camera's generation.
+    pub const CAMERA_SCOPES: [&'static str; 3] = ["cull", "scan", "generate"];
+    /// Profiler scope names of the light's generation.
+    pub const LIGHT_SCOPES: [&'static str; 3] = ["shadow cull", "shadow scan", "shadow generate"];
+
+    /// Record generation of every visible strand of the `bundles` bundles, seen from the view
+    /// of `sets`' frame block, into the vertex pool. `args` must have been cleared before
+    /// (statistics accumulate). `scopes` name the cull, scan and generate timings.
     pub fn record(
         &self,
         rec: &mut CommandRecorder,
@@ -79,9 +85,11 @@ impl ComputeGenerate {
         sets: PassSets,
         bundles: u32,
         args: &Buffer,
+        scopes: [&'static str; 3],
     ) {
         let rw = [Access::ComputeReadWrite];
-        // Earlier frames' draws read the pool and the offsets: finish them first.
+        // Earlier draws (this frame's light passes, earlier frames) read the pool and the
+        // offsets: finish them first.
         rec.barrier(
             &[
                 Access::VertexRead,
@@ -90,14 +98,14 @@ impl ComputeGenerate {
             ],
             &rw,
         );
-        profiler.begin(rec, "cull");
+        profiler.begin(rec, scopes[0]);
         rec.bind(&self.cull, &sets.both());
         let (x, y) = dispatch_2d(bundles.div_ceil(CULL_GROUP_SIZE));
         rec.dispatch(x, y, 1);
         profiler.end(rec);
         rec.barrier(&rw, &rw);
 
-        profiler.begin(rec, "scan");
+        profiler.begin(rec, scopes[1]);
         let (levels, _) = scan_plan(bundles);
         for (i, l) in levels.iter().enumerate() {
             rec.bind(&self.scan, &sets.both());
@@ -123,7 +131,7 @@ impl ComputeGenerate {
         profiler.end(rec);
         rec.barrier(&rw, &[Access::ComputeReadWrite, Access::IndirectRead]);
 
-        profiler.begin(rec, "generate");
+        profiler.begin(rec, scopes[2]);
         rec.bind(&self.generate, &sets.both());
         rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);
         profiler.end(rec);

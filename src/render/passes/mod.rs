@@ -4,6 +4,7 @@
 pub mod compute_generate;
 pub mod props;
 pub mod scalp;
+pub mod shadow;
 pub mod strands;
 
 use std::sync::Arc;
@@ -19,6 +20,7 @@ use crate::vk::{
 use compute_generate::ComputeGenerate;
 use props::{PropDraw, PropPass};
 use scalp::ScalpPass;
+use shadow::{ShadowDraw, ShadowPass};
 use strands::StrandDraw;
 
 /// The two descriptor sets every pass binds: set 0 (frame and crowd tables) and set 1 (the
@@ -64,20 +66,53 @@ impl TargetFormats {
     }
 }
 
-/// A vertex + fragment pipeline drawing into `targets` (opaque, depth-tested).
+/// What a graphics pipeline draws into.
+#[derive(Clone, Copy, Debug)]
+pub enum DrawTarget {
+    /// The camera view's colour and depth.
+    Camera(TargetFormats),
+    /// One of the light's depth maps: depth only, no fragment shader.
+    ShadowDepth,
+    /// The deep opacity layers: colour only, additive, no depth.
+    ShadowOpacity,
+}
+
+impl DrawTarget {
+    /// The pipeline description (formats, depth, blending) for this target.
+    pub fn graphics_desc<'a>(&self, name: &'a str) -> crate::vk::GraphicsDesc<'a> {
+        use crate::vk::{BlendMode, DepthMode, GraphicsDesc};
+        use ash::vk::Format;
+        match self {
+            DrawTarget::Camera(t) => t.graphics_desc(name),
+            DrawTarget::ShadowDepth => GraphicsDesc::new(name, Format::UNDEFINED, DEPTH_FORMAT),
+            DrawTarget::ShadowOpacity => GraphicsDesc::new(
+                name,
+                super::targets::SHADOW_LAYERS_FORMAT,
+                Format::UNDEFINED,
+            )
+            .depth(DepthMode::Off)
+            .blend(BlendMode::Additive),
+        }
+    }
+}
+
+/// A vertex (+ fragment, where given) pipeline drawing into `target`.
 pub fn vertex_pipeline(
     ctx: &Arc<Context>,
     layout: &Arc<PipelineLayout>,
     name: &str,
-    shaders: (&str, &str),
-    targets: TargetFormats,
+    shaders: (&str, Option<&str>),
+    target: DrawTarget,
 ) -> GpuResult<crate::vk::Pipeline> {
     let opts = shader_options(1);
-    let (v, f) = (compile(shaders.0, &opts)?, compile(shaders.1, &opts)?);
-    let desc = targets
+    let v = compile(shaders.0, &opts)?;
+    let f = shaders.1.map(|f| compile(f, &opts)).transpose()?;
+    let mut desc = target
         .graphics_desc(name)
-        .stage(ash::vk::ShaderStageFlags::VERTEX, &v)
-        .stage(ash::vk::ShaderStageFlags::FRAGMENT, &f);
+        .stage(ash::vk::ShaderStageFlags::VERTEX, &v);
+    if let Some(f) = &f {
+        desc = desc.stage(ash::vk::ShaderStageFlags::FRAGMENT, f);
+    }
     crate::vk::Pipeline::graphics(ctx, layout, &desc)
 }
 
@@ -103,15 +138,47 @@ pub struct FrameInputs<'a> {
     pub clear: Option<[f32; 4]>,
     /// Props to draw (bodies, ground).
     pub props: &'a [PropDraw],
+    /// The light's passes.
+    pub shadow: ShadowInputs<'a>,
 }
 
-/// The passes of a frame, in order: statistics reset, generation (compute path), the opaque
-/// pass (props, scalps, strands; the mesh path generates inside it).
+/// What the light's passes need.
+pub struct ShadowInputs<'a> {
+    /// Shadow mode of this frame; `None` when off (or nothing to shadow).
+    pub mode: Option<super::shadow::ShadowMode>,
+    /// Set 0 with the light's frame block, and the texture set.
+    pub light_sets: PassSets<'a>,
+    /// The maps.
+    pub maps: &'a mut super::targets::ShadowMaps,
+}
+
+/// The passes of a frame, in order: statistics reset; with shadows, the light's generation
+/// (compute path) and passes, then a second reset; generation (compute path); the opaque pass
+/// (props, scalps, strands; the mesh path generates inside it).
 pub struct FramePasses {
     generate: ComputeGenerate,
+    shadow: ShadowPass,
     props: PropPass,
     scalp: ScalpPass,
     strands: StrandDraw,
+}
+
+/// Zero `args` (indirect arguments and statistics) after earlier generation used it.
+fn clear_args(rec: &mut CommandRecorder, args: &Buffer) {
+    rec.barrier(
+        &[
+            Access::ComputeReadWrite,
+            Access::TaskReadWrite,
+            Access::IndirectRead,
+            Access::TransferRead,
+        ],
+        &[Access::TransferWrite],
+    );
+    rec.fill_buffer(args, 0, size_of::<GenerateArgs>() as u64, 0);
+    rec.barrier(
+        &[Access::TransferWrite],
+        &[Access::ComputeReadWrite, Access::TaskReadWrite],
+    );
 }
 
 impl FramePasses {
@@ -127,11 +194,13 @@ impl FramePasses {
             depth: DEPTH_FORMAT,
             samples,
         };
+        let camera = DrawTarget::Camera(targets);
         Ok(FramePasses {
             generate: ComputeGenerate::new(ctx, layout)?,
-            props: PropPass::new(ctx, layout, targets)?,
+            shadow: ShadowPass::new(ctx, layout, task_bundles)?,
+            props: PropPass::new(ctx, layout, camera)?,
             scalp: ScalpPass::new(ctx, layout, targets)?,
-            strands: StrandDraw::new(ctx, layout, targets, task_bundles)?,
+            strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
         })
     }
 
@@ -150,23 +219,35 @@ impl FramePasses {
         inp: FrameInputs,
     ) -> GpuResult<()> {
         // Statistics accumulate from zero every frame.
-        rec.barrier(
-            &[
-                Access::ComputeReadWrite,
-                Access::TaskReadWrite,
-                Access::IndirectRead,
-                Access::TransferRead,
-            ],
-            &[Access::TransferWrite],
-        );
-        rec.fill_buffer(inp.args, 0, size_of::<GenerateArgs>() as u64, 0);
-        rec.barrier(
-            &[Access::TransferWrite],
-            &[Access::ComputeReadWrite, Access::TaskReadWrite],
-        );
-        if inp.bundles > 0 && inp.path == RenderPath::Compute {
+        clear_args(rec, inp.args);
+        let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
+        let shadow = inp.shadow;
+        match shadow.mode {
+            Some(mode) => {
+                if compute {
+                    let scopes = ComputeGenerate::LIGHT_SCOPES;
+                    let sets = shadow.light_sets;
+                    self.generate
+                        .record(rec, profiler, sets, inp.bundles, inp.args, scopes);
+                }
+                let draw = ShadowDraw {
+                    mode,
+                    sets: shadow.light_sets,
+                    bundles: inp.bundles,
+                    path: inp.path,
+                    args: inp.args,
+                    props: inp.props,
+                };
+                self.shadow.record(rec, profiler, shadow.maps, draw)?;
+                // The camera's statistics start from zero again.
+                clear_args(rec, inp.args);
+            }
+            None => ShadowPass::keep_readable(rec, shadow.maps),
+        }
+        if compute {
+            let scopes = ComputeGenerate::CAMERA_SCOPES;
             self.generate
-                .record(rec, profiler, inp.sets, inp.bundles, inp.args);
+                .record(rec, profiler, inp.sets, inp.bundles, inp.args, scopes);
         }
         let targets = inp.targets;
         let (color_from, depth_from) = match inp.clear {

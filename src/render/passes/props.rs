@@ -1,9 +1,10 @@
 //! Props: static triangle meshes placed by instance records (character bodies, the ground).
-//! Reads: frame block, prop vertices, prop instances. Writes: colour and depth.
+//! Reads: frame block, prop vertices, prop instances. Writes: colour and depth (camera) or the
+//! light's prop depth map.
 
 use std::sync::Arc;
 
-use super::{PassSets, TargetFormats, vertex_pipeline};
+use super::{DrawTarget, PassSets, vertex_pipeline};
 use crate::vk::{CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One instanced draw: a mesh's vertex range and a run of instances.
@@ -25,14 +26,15 @@ pub struct PropPass {
 }
 
 impl PropPass {
-    /// Compile the pipeline for the given target formats.
+    /// Compile the pipeline for `target` (shaded for the camera, depth only for the light).
     pub fn new(
         ctx: &Arc<Context>,
         layout: &Arc<PipelineLayout>,
-        targets: TargetFormats,
+        target: DrawTarget,
     ) -> GpuResult<Self> {
+        let frag = matches!(target, DrawTarget::Camera(_)).then_some("props.frag");
         Ok(PropPass {
-            pipeline: vertex_pipeline(ctx, layout, "props", ("props.vert", "props.frag"), targets)?,
+            pipeline: vertex_pipeline(ctx, layout, "props", ("props.vert", frag), target)?,
         })
     }
 

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use super::{PassSets, TargetFormats, vertex_pipeline};
+use super::{DrawTarget, PassSets, TargetFormats, vertex_pipeline};
 use crate::vk::{CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// The scalp pipeline.
@@ -20,7 +20,13 @@ impl ScalpPass {
         targets: TargetFormats,
     ) -> GpuResult<Self> {
         Ok(ScalpPass {
-            pipeline: vertex_pipeline(ctx, layout, "scalp", ("scalp.vert", "scalp.frag"), targets)?,
+            pipeline: vertex_pipeline(
+                ctx,
+                layout,
+                "scalp",
+                ("scalp.vert", Some("scalp.frag")),
+                DrawTarget::Camera(targets),
+            )?,
         })
     }
 

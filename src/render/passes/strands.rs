@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{PassSets, TargetFormats, dispatch_2d, shader_options};
+use super::{DrawTarget, PassSets, dispatch_2d, shader_options};
 use crate::render::shared::{
     DISPATCH_ROW, GenerateArgs, MAX_SEGMENTS, STRAND_GROUP_SIZE, TASK_PAYLOAD_BUNDLES, TaskPayload,
 };
@@ -42,11 +42,12 @@ pub struct StrandDraw {
 
 impl StrandDraw {
     /// Compile the pulled-strand pipeline and, where the device supports it, the mesh path
-    /// with `task_bundles` (1..=32) bundles per task workgroup.
+    /// with `task_bundles` (1..=32) bundles per task workgroup, drawing into `target`: shaded
+    /// strips for the camera, depth for the light, or opacity into the deep opacity layers.
     pub fn new(
         ctx: &Arc<Context>,
         layout: &Arc<PipelineLayout>,
-        targets: TargetFormats,
+        target: DrawTarget,
         task_bundles: u32,
     ) -> GpuResult<Self> {
         if !(1..=TASK_PAYLOAD_BUNDLES).contains(&task_bundles) {
@@ -55,17 +56,25 @@ impl StrandDraw {
             )));
         }
         let opts = shader_options(task_bundles);
-        let (v, f) = (
-            compile("strands.vert", &opts)?,
-            compile("strands.frag", &opts)?,
-        );
+        let frag = match target {
+            DrawTarget::Camera(_) => Some("strands.frag"),
+            DrawTarget::ShadowDepth => None,
+            DrawTarget::ShadowOpacity => Some("shadow.frag"),
+        };
+        let v = compile("strands.vert", &opts)?;
+        let f = frag.map(|f| compile(f, &opts)).transpose()?;
+        let with_fragment =
+            |desc: crate::vk::GraphicsDesc<'static>| -> crate::vk::GraphicsDesc<'_> {
+                match &f {
+                    Some(f) => desc.stage(vk::ShaderStageFlags::FRAGMENT, f),
+                    None => desc,
+                }
+            };
         let pulled = Pipeline::graphics(
             ctx,
             layout,
-            &targets
-                .graphics_desc("pulled strands")
-                .stage(vk::ShaderStageFlags::VERTEX, &v)
-                .stage(vk::ShaderStageFlags::FRAGMENT, &f),
+            &with_fragment(target.graphics_desc("pulled strands"))
+                .stage(vk::ShaderStageFlags::VERTEX, &v),
         )?;
         let mesh = if mesh_path_supported(ctx) {
             let (t, m) = (
@@ -75,11 +84,9 @@ impl StrandDraw {
             Some(Pipeline::graphics(
                 ctx,
                 layout,
-                &targets
-                    .graphics_desc("mesh strands")
+                &with_fragment(target.graphics_desc("mesh strands"))
                     .stage(vk::ShaderStageFlags::TASK_EXT, &t)
-                    .stage(vk::ShaderStageFlags::MESH_EXT, &m)
-                    .stage(vk::ShaderStageFlags::FRAGMENT, &f),
+                    .stage(vk::ShaderStageFlags::MESH_EXT, &m),
             )?)
         } else {
             None
