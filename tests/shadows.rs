@@ -89,3 +89,58 @@ fn shadows_darken_the_hair_and_both_paths_agree() {
         assert!(paths < base + 0.01, "{mode:?}: paths differ by {paths}");
     }
 }
+
+/// On the compute path the light's strands are generated into the same vertex pool before the
+/// camera's: after a frame with shadows the pool holds exactly what a frame without shadows
+/// writes (the camera's LoD differs from the light's, so leftovers would show).
+#[test]
+fn light_generation_does_not_leak_into_the_camera_pool() {
+    let ctx = context();
+    let (baked, style) = sample("head_long.obj");
+    let mut r = Renderer::new(
+        &ctx,
+        &RendererDesc::default()
+            .size(128, 128)
+            .shadow_resolution(256)
+            .path(Some(RenderPath::Compute)),
+    )
+    .unwrap();
+    upload(&mut r, &baked, &style, 16, 4);
+    let mut view = View {
+        camera: framing(&baked),
+        light_dir: glam::Vec3::new(-1.0, 0.5, 0.2),
+        lod: LodSettings::default(),
+        shading: ShadingModel::Marschner,
+        shadows: ShadowMode::Off,
+    };
+    // Far enough that LoD drops strands in the camera's view.
+    view.camera.eye = view.camera.target + (view.camera.eye - view.camera.target) * 3.0;
+    let opts = FrameOptions::default();
+    let mut pools = Vec::new();
+    for shadows in [
+        ShadowMode::Off,
+        ShadowMode::DeepOpacity,
+        ShadowMode::Approximate,
+    ] {
+        view.shadows = shadows;
+        let report = r.render_one(&view, &opts).unwrap();
+        let n = report.stats.vertex_slots_written;
+        let pool: Vec<[f32; 8]> = r
+            .read_vertices(n)
+            .unwrap()
+            .iter()
+            .map(|v| {
+                let mut a = [0.0; 8];
+                a[..4].copy_from_slice(&v.pos_width);
+                a[4..].copy_from_slice(&v.tangent_s);
+                a
+            })
+            .collect();
+        println!("{shadows:?}: {n} vertex slots");
+        pools.push(pool);
+    }
+    assert_no_validation_errors(&ctx);
+    assert!(!pools[0].is_empty());
+    assert_eq!(pools[0], pools[1], "deep opacity frame left other vertices");
+    assert_eq!(pools[0], pools[2], "approximate frame left other vertices");
+}

@@ -37,6 +37,9 @@ struct Args {
     /// Camera as `eye_x,eye_y,eye_z:target_x,target_y,target_z` (default: frame the mesh).
     #[arg(long)]
     camera: Option<String>,
+    /// Direction toward the light as `x,y,z` (default: the scene's, else 0.4,1,0.6).
+    #[arg(long)]
+    light: Option<String>,
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 40.0)]
     fov: f32,
@@ -92,11 +95,11 @@ struct Args {
     output: PathBuf,
 }
 
-fn parse_vec3(s: &str) -> Result<Vec3> {
+fn parse_vec3(flag: &str, s: &str) -> Result<Vec3> {
     let v: Option<Vec<f32>> = s.split(',').map(|x| x.trim().parse::<f32>().ok()).collect();
     match v.as_deref() {
         Some(&[x, y, z]) if [x, y, z].iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
-        _ => bail!("--camera: bad vector '{s}': expected three finite numbers x,y,z"),
+        _ => bail!("{flag}: bad vector '{s}': expected three finite numbers x,y,z"),
     }
 }
 
@@ -205,8 +208,12 @@ fn pick_camera(args: &Args, inputs: &Inputs) -> Result<Camera> {
         let (eye, target) = c
             .split_once(':')
             .with_context(|| format!("--camera '{c}': expected eye:target"))?;
-        return Camera::checked(parse_vec3(eye)?, parse_vec3(target)?, args.fov)
-            .map_err(|e| anyhow::anyhow!("--camera: {e}"));
+        return Camera::checked(
+            parse_vec3("--camera", eye)?,
+            parse_vec3("--camera", target)?,
+            args.fov,
+        )
+        .map_err(|e| anyhow::anyhow!("--camera: {e}"));
     }
     if let Some(c) = inputs.scene_camera {
         return Ok(c);
@@ -307,7 +314,15 @@ fn run(args: Args) -> Result<()> {
     }
     let view = View {
         camera,
-        light_dir: inputs.light,
+        light_dir: match &args.light {
+            Some(l) => {
+                let d = parse_vec3("--light", l)?;
+                hairmesh::render::camera::validate_light(d)
+                    .map_err(|e| anyhow::anyhow!("--light: {e}"))?;
+                d
+            }
+            None => inputs.light,
+        },
         lod,
         shading: args
             .shading
