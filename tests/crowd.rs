@@ -56,15 +56,6 @@ fn crowd_view(count: usize) -> View {
     }
 }
 
-fn mean_abs_diff(a: &[u8], b: &[u8]) -> f64 {
-    let s: u64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (*x as i32 - *y as i32).unsigned_abs() as u64)
-        .sum();
-    s as f64 / a.len() as f64 / 255.0
-}
-
 #[test]
 fn three_hundred_characters_in_one_frame_match_one_at_a_time() {
     let ctx = context();

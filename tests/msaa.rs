@@ -40,12 +40,7 @@ fn four_samples_resolve_and_smooth_edges() {
                 .collect::<HashSet<_>>()
                 .len()
         };
-        let diff: u64 = one
-            .iter()
-            .zip(&four)
-            .map(|(a, b)| (*a as i32 - *b as i32).unsigned_abs() as u64)
-            .sum();
-        let mean = diff as f64 / one.len() as f64 / 255.0;
+        let mean = mean_abs_diff(&one, &four);
         println!(
             "{path:?}: {} colours at 1x, {} at 4x, mean abs diff {mean:.4}",
             colours(&one),

@@ -42,15 +42,6 @@ fn frame(
     rgba
 }
 
-fn mean_abs_diff(a: &[u8], b: &[u8]) -> f64 {
-    let d: u64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (*x as i32 - *y as i32).unsigned_abs() as u64)
-        .sum();
-    d as f64 / a.len() as f64 / 255.0
-}
-
 /// Mean brightness of the pixels of `img` that are not background in `mask_of`.
 fn brightness(img: &[u8], mask_of: &[u8]) -> f64 {
     let bg = &mask_of[..4];

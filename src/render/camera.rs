@@ -156,6 +156,26 @@ impl LodSettings {
     }
 }
 
+/// The 8 corners of the box `lo..hi`.
+pub fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
+    std::array::from_fn(|k| {
+        Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
+/// Whether the box `lo..hi` is not entirely outside one of `planes` (CPU twin of `box_visible`
+/// in `bundle_lod.glsl`: the corner furthest along each plane's normal is tested).
+pub fn box_in_frustum(planes: &[[f32; 4]; 6], lo: Vec3, hi: Vec3) -> bool {
+    planes.iter().all(|pl| {
+        let n = Vec3::from_slice(&pl[..3]);
+        n.dot(Vec3::select(n.cmpge(Vec3::ZERO), hi, lo)) + pl[3] >= 0.0
+    })
+}
+
 /// Frustum planes of a Vulkan view-projection matrix (Gribb-Hartmann), normalised.
 pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
     let row = |i: usize| Vec4::new(m.x_axis[i], m.y_axis[i], m.z_axis[i], m.w_axis[i]);
@@ -257,6 +277,28 @@ mod tests {
         assert!(inside(Vec3::ZERO));
         assert!(!inside(Vec3::new(0.0, 0.0, 10.0)), "behind the camera");
         assert!(!inside(Vec3::new(100.0, 0.0, 0.0)), "far to the side");
+        let unit = Vec3::splat(0.5);
+        assert!(box_in_frustum(&planes, -unit, unit));
+        assert!(box_in_frustum(
+            &planes,
+            Vec3::new(-50.0, -0.5, -0.5),
+            Vec3::new(50.0, 0.5, 0.5)
+        ));
+        assert!(!box_in_frustum(
+            &planes,
+            Vec3::new(99.0, -0.5, -0.5),
+            Vec3::new(101.0, 0.5, 0.5)
+        ));
+        assert!(!box_in_frustum(
+            &planes,
+            Vec3::new(-0.5, -0.5, 9.0),
+            Vec3::new(0.5, 0.5, 11.0)
+        ));
+        let c = box_corners(Vec3::ZERO, Vec3::ONE);
+        assert_eq!(
+            (c[0], c[7], c[5]),
+            (Vec3::ZERO, Vec3::ONE, Vec3::new(1.0, 0.0, 1.0))
+        );
         assert_eq!(size_of::<FrameBlock>(), 368);
     }
 }

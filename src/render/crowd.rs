@@ -95,6 +95,12 @@ impl CharacterId {
     }
 }
 
+/// Uniform scale of a character transform: the length of its x axis (widths and styling
+/// margins scale by it; characters are expected to be scaled uniformly).
+fn model_scale(model: &Mat4) -> f32 {
+    model.x_axis.truncate().length()
+}
+
 /// The five textures of one character.
 pub struct CharacterTextures {
     _images: Vec<Image>,
@@ -336,18 +342,15 @@ impl Crowd {
             .filter(|c| c.visible)
             .map(|c| {
                 let lo = Vec3::from_slice(&c.info.pos_origin[..3]);
-                let ext = Vec3::from_slice(&c.info.pos_extent[..3]);
+                let hi = lo + Vec3::from_slice(&c.info.pos_extent[..3]);
                 let (mut wlo, mut whi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-                for k in 0..8 {
-                    let corner = lo
-                        + ext * Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, (k >> 2) as f32);
+                for corner in super::camera::box_corners(lo, hi) {
                     let p = c.model.transform_point3(corner);
                     wlo = wlo.min(p);
                     whi = whi.max(p);
                 }
                 let st = &c.style;
-                let scale = c.model.x_axis.truncate().length();
-                let margin = scale
+                let margin = model_scale(&c.model)
                     * (st.curl_radius + st.wave_amplitude + st.frizz_amplitude + st.strand_width);
                 (wlo - margin, whi + margin)
             })
@@ -447,7 +450,7 @@ impl Crowd {
                     strands_per_bundle: c.params.strands_per_bundle,
                     verts_log2: c.params.verts_log2,
                     flags: if c.visible { CHARACTER_VISIBLE } else { 0 },
-                    model_scale: c.model.x_axis.truncate().length(),
+                    model_scale: model_scale(&c.model),
                     _pad: 0,
                 },
                 None => bytemuck::Zeroable::zeroed(),

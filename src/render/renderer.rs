@@ -415,18 +415,11 @@ impl Renderer {
         if view.shadows == ShadowMode::Off {
             return None;
         }
-        let inside = |(lo, hi): &(glam::Vec3, glam::Vec3)| {
-            block.planes.iter().all(|pl| {
-                let n = glam::Vec3::from_slice(&pl[..3]);
-                let corner = glam::Vec3::select(n.cmpge(glam::Vec3::ZERO), *hi, *lo);
-                n.dot(corner) + pl[3] >= 0.0
-            })
-        };
         let bounds: Vec<_> = self
             .crowd
             .hair_bounds()
             .into_iter()
-            .filter(inside)
+            .filter(|(lo, hi)| super::camera::box_in_frustum(&block.planes, *lo, *hi))
             .collect();
         LightView::fit(&bounds, view.light_dir, self.shadow.resolution())
     }

@@ -15,7 +15,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::camera::{LodSettings, frustum_planes};
+use super::camera::{LodSettings, box_corners, frustum_planes};
 use super::shared::FrameBlock;
 
 /// Deep opacity layers (the 4 channels of one RGBA16F map).
@@ -108,12 +108,7 @@ impl LightView {
         let mut diag_sum = 0.0;
         for (blo, bhi) in bounds {
             diag_sum += (*bhi - *blo).length();
-            for k in 0..8 {
-                let c = Vec3::new(
-                    if k & 1 == 0 { blo.x } else { bhi.x },
-                    if k & 2 == 0 { blo.y } else { bhi.y },
-                    if k & 4 == 0 { blo.z } else { bhi.z },
-                );
+            for c in box_corners(*blo, *bhi) {
                 let l = Vec3::new(c.dot(side), c.dot(up), c.dot(forward));
                 lo = lo.min(l);
                 hi = hi.max(l);

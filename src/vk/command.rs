@@ -123,6 +123,48 @@ pub struct Attachment<'a> {
     pub resolve: Option<&'a Image>,
 }
 
+/// A rendering attachment for `a` in `layout`: stored, cleared to `a.clear` (depth from its
+/// first component) or loaded, resolved into `a.resolve` where given.
+fn attachment_info<'a>(a: &Attachment, layout: vk::ImageLayout) -> vk::RenderingAttachmentInfo<'a> {
+    let mut info = vk::RenderingAttachmentInfo::default()
+        .image_view(a.image.view())
+        .image_layout(layout)
+        .store_op(vk::AttachmentStoreOp::STORE);
+    if let Some(r) = a.resolve {
+        info = info
+            .resolve_mode(vk::ResolveModeFlags::AVERAGE)
+            .resolve_image_view(r.view())
+            .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+    }
+    match a.clear {
+        Some(c) => {
+            let value = if layout == vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL {
+                vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: c[0],
+                        stencil: 0,
+                    },
+                }
+            } else {
+                vk::ClearValue {
+                    color: vk::ClearColorValue { float32: c },
+                }
+            };
+            info.load_op(vk::AttachmentLoadOp::CLEAR).clear_value(value)
+        }
+        None => info.load_op(vk::AttachmentLoadOp::LOAD),
+    }
+}
+
+/// The whole of `image` as a render area.
+fn full_area(image: &Image) -> vk::Rect2D {
+    let [width, height, _] = image.desc.extent;
+    vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent: vk::Extent2D { width, height },
+    }
+}
+
 /// Records commands into a command buffer; every method is a safe wrapper of one Vulkan call.
 pub struct CommandRecorder<'a> {
     ctx: &'a Context,
@@ -237,114 +279,49 @@ impl CommandRecorder<'_> {
     /// Begin dynamic rendering into `color` and `depth` over their full extent, with viewport
     /// and scissor covering it.
     pub fn begin_rendering(&mut self, color: Attachment, depth: Attachment) {
-        let [w, h, _] = color.image.desc.extent;
-        let att = |a: &Attachment, layout| {
-            let mut info = vk::RenderingAttachmentInfo::default()
-                .image_view(a.image.view())
-                .image_layout(layout)
-                .store_op(vk::AttachmentStoreOp::STORE);
-            if let Some(r) = a.resolve {
-                info = info
-                    .resolve_mode(vk::ResolveModeFlags::AVERAGE)
-                    .resolve_image_view(r.view())
-                    .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
-            }
-            info = match a.clear {
-                Some(c) => info.load_op(vk::AttachmentLoadOp::CLEAR).clear_value(
-                    if layout == vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL {
-                        vk::ClearValue {
-                            depth_stencil: vk::ClearDepthStencilValue {
-                                depth: c[0],
-                                stencil: 0,
-                            },
-                        }
-                    } else {
-                        vk::ClearValue {
-                            color: vk::ClearColorValue { float32: c },
-                        }
-                    },
-                ),
-                None => info.load_op(vk::AttachmentLoadOp::LOAD),
-            };
-            info
-        };
-        let color_att = [att(&color, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)];
-        let depth_att = att(&depth, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
-        let area = vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent: vk::Extent2D {
-                width: w,
-                height: h,
-            },
-        };
+        let color_att = [attachment_info(
+            &color,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+        )];
+        let depth_att = attachment_info(&depth, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+        let area = full_area(color.image);
         let info = vk::RenderingInfo::default()
             .render_area(area)
             .layer_count(1)
             .color_attachments(&color_att)
             .depth_attachment(&depth_att);
-        // SAFETY: attachments are in the layouts named above (the caller's barriers).
-        unsafe {
-            self.ctx.device.cmd_begin_rendering(self.raw, &info);
-            self.ctx.device.cmd_set_viewport(
-                self.raw,
-                0,
-                &[vk::Viewport {
-                    x: 0.0,
-                    y: 0.0,
-                    width: w as f32,
-                    height: h as f32,
-                    min_depth: 0.0,
-                    max_depth: 1.0,
-                }],
-            );
-            self.ctx.device.cmd_set_scissor(self.raw, 0, &[area]);
-        }
-        self.rendering = true;
+        self.begin(&info, area);
     }
 
     /// Begin dynamic rendering into `depth` only (shadow maps), viewport and scissor covering
     /// it.
     pub fn begin_rendering_depth(&mut self, depth: Attachment) {
-        let [w, h, _] = depth.image.desc.extent;
-        let mut att = vk::RenderingAttachmentInfo::default()
-            .image_view(depth.image.view())
-            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-            .store_op(vk::AttachmentStoreOp::STORE);
-        att = match depth.clear {
-            Some(c) => att
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: c[0],
-                        stencil: 0,
-                    },
-                }),
-            None => att.load_op(vk::AttachmentLoadOp::LOAD),
-        };
-        let area = vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent: vk::Extent2D {
-                width: w,
-                height: h,
-            },
-        };
+        let att = attachment_info(&depth, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+        let area = full_area(depth.image);
         let info = vk::RenderingInfo::default()
             .render_area(area)
             .layer_count(1)
             .depth_attachment(&att);
-        // SAFETY: the image is in DEPTH_ATTACHMENT_OPTIMAL (the caller's barriers).
-        unsafe {
-            self.ctx.device.cmd_begin_rendering(self.raw, &info);
-            self.set_viewport_scissor(area);
-        }
-        self.rendering = true;
+        self.begin(&info, area);
     }
 
-    /// Viewport and scissor covering `area`.
-    ///
-    /// # Safety
-    /// Inside a command buffer being recorded.
-    unsafe fn set_viewport_scissor(&mut self, area: vk::Rect2D) {
+    /// Begin dynamic rendering into `color` only (overlays such as the control panel, the deep
+    /// opacity layers), viewport and scissor covering it.
+    pub fn begin_rendering_color(&mut self, color: Attachment) {
+        let atts = [attachment_info(
+            &color,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+        )];
+        let area = full_area(color.image);
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&atts);
+        self.begin(&info, area);
+    }
+
+    /// Begin rendering as `info` says, with viewport and scissor covering `area`.
+    fn begin(&mut self, info: &vk::RenderingInfo, area: vk::Rect2D) {
         let viewport = vk::Viewport {
             x: 0.0,
             y: 0.0,
@@ -353,44 +330,12 @@ impl CommandRecorder<'_> {
             min_depth: 0.0,
             max_depth: 1.0,
         };
-        // SAFETY: the caller is recording this command buffer.
+        // SAFETY: the attachments are in the layouts `info` names (the callers' barriers) and
+        // this command buffer is recording.
         unsafe {
+            self.ctx.device.cmd_begin_rendering(self.raw, info);
             self.ctx.device.cmd_set_viewport(self.raw, 0, &[viewport]);
             self.ctx.device.cmd_set_scissor(self.raw, 0, &[area]);
-        }
-    }
-
-    /// Begin dynamic rendering into `color` only (overlays such as the control panel).
-    pub fn begin_rendering_color(&mut self, color: Attachment) {
-        let [w, h, _] = color.image.desc.extent;
-        let mut att = vk::RenderingAttachmentInfo::default()
-            .image_view(color.image.view())
-            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-            .store_op(vk::AttachmentStoreOp::STORE);
-        att = match color.clear {
-            Some(c) => att
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .clear_value(vk::ClearValue {
-                    color: vk::ClearColorValue { float32: c },
-                }),
-            None => att.load_op(vk::AttachmentLoadOp::LOAD),
-        };
-        let atts = [att];
-        let area = vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent: vk::Extent2D {
-                width: w,
-                height: h,
-            },
-        };
-        let info = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .color_attachments(&atts);
-        // SAFETY: the image is in COLOR_ATTACHMENT_OPTIMAL (the caller's barriers).
-        unsafe {
-            self.ctx.device.cmd_begin_rendering(self.raw, &info);
-            self.set_viewport_scissor(area);
         }
         self.rendering = true;
     }

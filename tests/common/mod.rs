@@ -102,6 +102,17 @@ pub fn framing(baked: &BakedHairMesh) -> Camera {
     Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0)
 }
 
+/// Mean absolute difference of two equally sized 8-bit images, in [0, 1].
+pub fn mean_abs_diff(a: &[u8], b: &[u8]) -> f64 {
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    let s: u64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (*x as i32 - *y as i32).unsigned_abs() as u64)
+        .sum();
+    s as f64 / a.len() as f64 / 255.0
+}
+
 pub fn light() -> Vec3 {
     Vec3::new(0.4, 1.0, 0.6)
 }
