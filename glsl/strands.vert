@@ -11,6 +11,7 @@ layout(location = 2) out vec3 out_pos;
 layout(location = 3) flat out vec3 out_color;
 layout(location = 4) flat out uint out_character;
 layout(location = 5) out float out_coverage;
+layout(location = 6) flat out float out_thickness;
 
 void main() {
     uint idx = uint(gl_VertexIndex);
@@ -43,4 +44,5 @@ void main() {
     out_color = style_color();
     out_character = bundles[lo].character;
     out_coverage = strip_coverage(v.pos_width.xyz, v.pos_width.w);
+    out_thickness = uintBitsToFloat(bundle_lods[lo].w);
 }

@@ -53,6 +53,8 @@ fn crowd_view(count: usize) -> View {
         lod: LodSettings::default(),
         shading: hairmesh::shade::ShadingModel::Placeholder,
         shadows: hairmesh::render::ShadowMode::Off,
+        transparency: hairmesh::render::Transparency::Opaque,
+        lod_appearance: true,
     }
 }
 

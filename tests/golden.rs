@@ -56,6 +56,8 @@ fn render_golden_look(
     let settings = RenderSettings {
         shading,
         shadows,
+        transparency: hairmesh::render::Transparency::Opaque,
+        lod_appearance: true,
         ..compute_full()
     };
     let out = render(&mut r, &framing(&baked), &settings);

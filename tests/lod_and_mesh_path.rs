@@ -22,6 +22,8 @@ fn settings(path: RenderPath, lod: bool) -> RenderSettings {
         },
         shading: hairmesh::shade::ShadingModel::Placeholder,
         shadows: hairmesh::render::ShadowMode::Off,
+        transparency: hairmesh::render::Transparency::Opaque,
+        lod_appearance: true,
     }
 }
 

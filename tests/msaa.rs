@@ -19,6 +19,8 @@ fn frame(ctx: &std::sync::Arc<hairmesh::vk::Context>, msaa: u32, path: RenderPat
         lod: LodSettings::off(),
         shading: ShadingModel::Marschner,
         shadows: hairmesh::render::ShadowMode::Off,
+        transparency: hairmesh::render::Transparency::Opaque,
+        lod_appearance: true,
     };
     let opts = FrameOptions {
         path: Some(path),

@@ -31,6 +31,8 @@ fn frame(
         lod: LodSettings::off(),
         shading: ShadingModel::KajiyaKay,
         shadows,
+        transparency: hairmesh::render::Transparency::Opaque,
+        lod_appearance: true,
     };
     let opts = FrameOptions {
         path: Some(path),
@@ -103,6 +105,8 @@ fn light_generation_does_not_leak_into_the_camera_pool() {
         lod: LodSettings::default(),
         shading: ShadingModel::Marschner,
         shadows: ShadowMode::Off,
+        transparency: hairmesh::render::Transparency::Opaque,
+        lod_appearance: true,
     };
     // Far enough that LoD drops strands in the camera's view.
     view.camera.eye = view.camera.target + (view.camera.eye - view.camera.target) * 3.0;

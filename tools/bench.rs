@@ -405,6 +405,8 @@ fn bench_view(camera: Camera, lod_on: bool) -> View {
         },
         shading: hairmesh::shade::ShadingModel::Placeholder,
         shadows: hairmesh::render::ShadowMode::Off,
+        transparency: hairmesh::render::Transparency::Opaque,
+        lod_appearance: true,
     }
 }
 

@@ -83,6 +83,15 @@ struct Args {
     /// `[look] shading`, else marschner.
     #[arg(long)]
     shading: Option<hairmesh::shade::ShadingModel>,
+    /// Strand compositing: opaque, oit or oit:K (K-buffer OIT with K fragments per pixel,
+    /// default 8), peel or peel:N (depth peeling of N layers, default 32: the slow
+    /// reference); default: the scene's `[look] transparency`, else opaque.
+    #[arg(long)]
+    transparency: Option<hairmesh::render::Transparency>,
+    /// Seed 000's thick-strand appearance term under LoD (true/false); default: the scene's
+    /// `[look] lod_appearance`, else true.
+    #[arg(long)]
+    lod_appearance: Option<bool>,
     /// Size of the compute path's vertex pool in MiB (frames that need more keep whole strands
     /// up to it and report the overflow).
     #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u64).range(1..=4096))]
@@ -332,6 +341,14 @@ fn run(args: Args) -> Result<()> {
             .shadows
             .or(inputs.look.shadow_mode())
             .unwrap_or_default(),
+        transparency: args
+            .transparency
+            .or(inputs.look.transparency_mode())
+            .unwrap_or_default(),
+        lod_appearance: args
+            .lod_appearance
+            .or(inputs.look.lod_appearance)
+            .unwrap_or(true),
     };
     let out = renderer.render_one(
         &view,

@@ -199,6 +199,11 @@ pub struct View {
     pub shading: crate::shade::ShadingModel,
     /// Shadows from the light (hair on hair, hair and bodies on each other).
     pub shadows: super::shadow::ShadowMode,
+    /// How strands are composited: opaque, k-buffer OIT or depth peeling.
+    pub transparency: super::transparency::Transparency,
+    /// Seed 000's aggregated appearance for LoD-thickened strands (opacity and multiple
+    /// scattering scaled by the strands a thick strand stands for).
+    pub lod_appearance: bool,
 }
 
 impl View {
@@ -252,11 +257,12 @@ impl View {
             ],
             lod_ortho: [0.0; 4],
             counts: [bundles, characters, self.lod.enabled as u32, vertex_budget],
-            shading: [self.shading as u32, 0, 0, 0],
+            shading: [self.shading as u32, self.lod_appearance as u32, 0, 0],
             // Filled in by the renderer once the light view is fitted.
             light_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
             shadow: [0; 4],
             shadow_params: [0.0; 4],
+            transparency: self.transparency.frame_fields(),
         }
     }
 }
@@ -299,6 +305,6 @@ mod tests {
             (c[0], c[7], c[5]),
             (Vec3::ZERO, Vec3::ONE, Vec3::new(1.0, 0.0, 1.0))
         );
-        assert_eq!(size_of::<FrameBlock>(), 368);
+        assert_eq!(size_of::<FrameBlock>(), 384);
     }
 }

@@ -13,6 +13,7 @@ pub mod settings;
 pub mod shadow;
 pub mod shared;
 pub mod targets;
+pub mod transparency;
 pub mod workspace;
 
 pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
@@ -21,3 +22,4 @@ pub use frame::{FRAMES_IN_FLIGHT, FrameReport};
 pub use renderer::{FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc};
 pub use shadow::ShadowMode;
 pub use shared::FrameStats;
+pub use transparency::Transparency;

@@ -23,6 +23,7 @@ use super::shadow::{LightView, ShadowMode};
 use super::shared::{FrameBinding, GenerateArgs, HairVertex, SET_FRAME, SET_TEXTURES};
 use super::shared::{PropInstance, PropVertex};
 use super::targets::{RenderTargets, ShadowMaps};
+use super::transparency::TransparencyBuffers;
 use super::workspace::FrameBuffers;
 use super::workspace::Workspace;
 use crate::bake::BakedHairMesh;
@@ -90,6 +91,8 @@ pub struct Renderer {
     frame_number: u64,
     targets: RenderTargets,
     shadow: ShadowMaps,
+    /// Per-pixel buffers of the transparent modes.
+    transparency: TransparencyBuffers,
     work: Workspace,
     completed: VecDeque<FrameReport>,
     /// Background colour (linear RGB).
@@ -103,6 +106,8 @@ struct FrameWork<'a> {
     props: &'a [PropDraw],
     /// Shadow mode, when shadows are on and there is hair to shadow.
     shadows: Option<ShadowMode>,
+    /// How strands are composited.
+    transparency: super::Transparency,
 }
 
 fn check_size(width: u32, height: u32) -> GpuResult<()> {
@@ -180,6 +185,7 @@ impl Renderer {
             frame_number: 0,
             targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
             shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
+            transparency: TransparencyBuffers::new(ctx)?,
             work,
             completed: VecDeque::new(),
             background: [0.6, 0.65, 0.7],
@@ -403,6 +409,7 @@ impl Renderer {
                     bundle_table: self.crowd.bundle_table(),
                     prop_vertices: self.props.vertices.as_ref(),
                     shadow: &self.shadow,
+                    transparency: &self.transparency,
                 },
             )?;
         }
@@ -463,6 +470,11 @@ impl Renderer {
         }
         let i = self.next;
         self.retire_slot(i)?;
+        self.passes.prepare_transparency(view.transparency)?;
+        let (width, height) = self.targets.size();
+        for old in self.transparency.ensure(view.transparency, width, height)? {
+            self.frames[i].retired.push(Retired::Resource(old));
+        }
         self.prepare_workspace(i, path)?;
         let (width, height) = self.targets.size();
         let bundles = self.crowd.bundle_count();
@@ -515,6 +527,7 @@ impl Renderer {
             bundles,
             props: &prop_draws,
             shadows,
+            transparency: view.transparency,
         };
         self.record(i, work, opts, present.as_mut())?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -556,6 +569,7 @@ impl Renderer {
             bundles,
             props,
             shadows,
+            transparency,
         } = work;
         let slot = &mut self.frames[i];
         let bg = self.background;
@@ -583,6 +597,8 @@ impl Renderer {
                 },
                 maps: &mut self.shadow,
             },
+            transparency,
+            transparency_buffers: &mut self.transparency,
         };
         self.passes.record(
             &mut rec,

@@ -12,6 +12,8 @@
 //! shading = "marschner"            # placeholder, kajiya-kay, marschner
 //! shadows = "deep-opacity"         # off, deep-opacity, approximate
 //! msaa = 4                         # samples per pixel
+//! transparency = "oit:8"           # opaque, oit[:K] (K-buffer), peel[:N] (depth peeling)
+//! lod_appearance = true            # seed 000's thick-strand term under LoD (default on)
 //! [[character]]
 //! mesh = "hairmeshes/head_long.obj" # .obj (baked on load) or .hmb; relative to this file
 //! style = "hairmeshes/head_long.toml" # optional: default is the style beside the mesh / baked in
@@ -62,7 +64,7 @@ pub struct LightDesc {
     pub direction: [f32; 3],
 }
 
-/// How a scene looks: shading model, shadows, anti-aliasing (each optional).
+/// How a scene looks: shading model, shadows, anti-aliasing, transparency (each optional).
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LookDesc {
@@ -72,6 +74,10 @@ pub struct LookDesc {
     pub shadows: Option<String>,
     /// Samples per pixel.
     pub msaa: Option<u32>,
+    /// Transparency (`render::Transparency`): `opaque`, `oit[:K]`, `peel[:N]`.
+    pub transparency: Option<String>,
+    /// Thick-strand appearance term under LoD.
+    pub lod_appearance: Option<bool>,
 }
 
 impl LookDesc {
@@ -83,6 +89,11 @@ impl LookDesc {
     /// The shadow mode, if given (validated by [`SceneDesc::validate`]).
     pub fn shadow_mode(&self) -> Option<crate::render::ShadowMode> {
         self.shadows.as_deref().and_then(|s| s.parse().ok())
+    }
+
+    /// The transparency mode, if given (validated by [`SceneDesc::validate`]).
+    pub fn transparency_mode(&self) -> Option<crate::render::Transparency> {
+        self.transparency.as_deref().and_then(|s| s.parse().ok())
     }
 }
 
@@ -219,6 +230,10 @@ impl SceneDesc {
             s.parse::<crate::render::ShadowMode>()
                 .map_err(|e| format!("[look]: {e}"))?;
         }
+        if let Some(s) = &self.look.transparency {
+            s.parse::<crate::render::Transparency>()
+                .map_err(|e| format!("[look]: {e}"))?;
+        }
         if let Some(m) = self.look.msaa
             && !(m.is_power_of_two() && m <= 64)
         {
@@ -303,7 +318,7 @@ mod look_tests {
         let plain = SceneDesc::parse("s.toml", CHARACTER, base).unwrap();
         assert!(plain.look.shading_model().is_none() && plain.look.shadow_mode().is_none());
         let text = format!(
-            "[look]\nshading = \"kajiya-kay\"\nshadows = \"approximate\"\nmsaa = 4\n{CHARACTER}"
+            "[look]\nshading = \"kajiya-kay\"\nshadows = \"approximate\"\nmsaa = 4\ntransparency = \"oit:3\"\nlod_appearance = false\n{CHARACTER}"
         );
         let s = SceneDesc::parse("s.toml", &text, base).unwrap();
         assert_eq!(
@@ -315,10 +330,17 @@ mod look_tests {
             Some(crate::render::ShadowMode::Approximate)
         );
         assert_eq!(s.look.msaa, Some(4));
+        assert_eq!(
+            s.look.transparency_mode(),
+            Some(crate::render::Transparency::KBuffer { budget: 3 })
+        );
+        assert_eq!(s.look.lod_appearance, Some(false));
         for (bad, what) in [
             ("shadows = \"soft\"", "unknown shadow mode"),
             ("shading = \"phong\"", "unknown shading model"),
             ("msaa = 3", "msaa 3"),
+            ("transparency = \"oit:99\"", "OIT budget 99"),
+            ("transparency = \"glass\"", "unknown transparency"),
         ] {
             let text = format!("[look]\n{bad}\n{CHARACTER}");
             let e = SceneDesc::parse("s.toml", &text, base)

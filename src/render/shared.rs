@@ -66,11 +66,22 @@ pub enum FrameBinding {
     ShadowPropDepth = 12,
     /// Deep opacity map: hair opacity in 4 layers behind the hair depth (RGBA).
     ShadowLayers = 13,
+    /// K-buffer OIT: `K` nodes per pixel (`uint64`: depth bits << 32 | packed colour), kept
+    /// sorted nearest first by `oit.frag` (`oit.glsl`).
+    OitNodes = 14,
+    /// K-buffer OIT: per pixel, the fixed-point sums of the fragments evicted past the budget
+    /// (premultiplied rgb, optical depth).
+    OitTail = 15,
+    /// Depth peeling: per pixel, the previous layer's depth, then (second half) the opaque
+    /// depth.
+    PeelDepth = 16,
+    /// Depth peeling: per pixel, premultiplied colour and opacity composited front to back.
+    PeelAccum = 17,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 14] = [
+    pub const ALL: [(FrameBinding, &'static str); 18] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -85,6 +96,10 @@ impl FrameBinding {
         (FrameBinding::ShadowHairDepth, "BINDING_SHADOW_HAIR_DEPTH"),
         (FrameBinding::ShadowPropDepth, "BINDING_SHADOW_PROP_DEPTH"),
         (FrameBinding::ShadowLayers, "BINDING_SHADOW_LAYERS"),
+        (FrameBinding::OitNodes, "BINDING_OIT_NODES"),
+        (FrameBinding::OitTail, "BINDING_OIT_TAIL"),
+        (FrameBinding::PeelDepth, "BINDING_PEEL_DEPTH"),
+        (FrameBinding::PeelAccum, "BINDING_PEEL_ACCUM"),
     ];
 
     /// What the binding holds.
@@ -210,7 +225,8 @@ pub struct FrameBlock {
     /// x bundles of all characters, y character slots, z LoD on, w vertex pool budget
     /// (compute path, in `HairVertex` slots).
     pub counts: [u32; 4],
-    /// x shading model (`shade::ShadingModel`); yzw reserved.
+    /// x shading model (`shade::ShadingModel`), y thick-strand appearance term on (seed 000,
+    /// `lod_appearance.glsl`); zw reserved.
     pub shading: [u32; 4],
     /// World to the light's clip space (the shadow maps; camera views only).
     pub light_view_proj: [[f32; 4]; 4],
@@ -220,12 +236,15 @@ pub struct FrameBlock {
     /// x deep-opacity layer thickness (world units), y light depth range (far - near, world),
     /// z opacity of one strand, w depth bias (world units).
     pub shadow_params: [f32; 4],
+    /// x transparency mode (`render::Transparency`: 0 opaque, 1 k-buffer OIT, 2 depth
+    /// peeling), y k-buffer nodes per pixel; zw reserved.
+    pub transparency: [u32; 4],
 }
 
 gpu_struct!(FrameBlock as "FrameBlock" {
     view_proj: "mat4", camera_pos: "vec4", light_dir: "vec4", viewport: "vec4",
     planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4", shading: "uvec4",
-    light_view_proj: "mat4", shadow: "uvec4", shadow_params: "vec4",
+    light_view_proj: "mat4", shadow: "uvec4", shadow_params: "vec4", transparency: "uvec4",
 });
 
 /// One character: where its bundles and textures are, how it is placed and styled.
@@ -526,6 +545,10 @@ pub fn glsl_header() -> String {
             "u"
         };
         let _ = writeln!(out, "#define {name} {v}{suffix}");
+    }
+    let float_consts = [("STRAND_OPACITY", super::transparency::STRAND_OPACITY)];
+    for (name, v) in float_consts {
+        let _ = writeln!(out, "#define {name} {v:?}");
     }
     for (b, name) in FrameBinding::ALL {
         let _ = writeln!(out, "#define {name} {}", b as u32);

@@ -47,7 +47,11 @@ impl RenderTargets {
             depth: Image::new(
                 ctx,
                 &ImageDesc::new_2d("depth", DEPTH_FORMAT, width, height)
-                    .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)
+                    // Copied out by depth peeling (the opaque depth).
+                    .usage(
+                        vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                            | vk::ImageUsageFlags::TRANSFER_SRC,
+                    )
                     .samples(samples),
             )?,
             resolved: if samples > 1 {

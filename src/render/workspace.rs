@@ -34,6 +34,8 @@ pub struct FrameBuffers<'a> {
     pub prop_vertices: Option<&'a Buffer>,
     /// The light's maps.
     pub shadow: &'a super::targets::ShadowMaps,
+    /// The transparent modes' per-pixel buffers.
+    pub transparency: &'a super::transparency::TransparencyBuffers,
 }
 
 /// The working buffers.
@@ -142,6 +144,10 @@ impl Workspace {
                 FrameBinding::Vertices => pool,
                 FrameBinding::PropVertices => prop_vertices,
                 FrameBinding::PropInstances => frame.prop_instances,
+                FrameBinding::OitNodes => &frame.transparency.nodes,
+                FrameBinding::OitTail => &frame.transparency.tail,
+                FrameBinding::PeelDepth => &frame.transparency.peel_depth,
+                FrameBinding::PeelAccum => &frame.transparency.peel_accum,
                 FrameBinding::ShadowHairDepth
                 | FrameBinding::ShadowPropDepth
                 | FrameBinding::ShadowLayers => {

@@ -21,6 +21,8 @@ pub enum Access {
     MeshRead,
     /// Storage/uniform read in fragment shaders.
     FragmentRead,
+    /// Storage read/write (and atomics) in fragment shaders.
+    FragmentReadWrite,
     /// Sampled by any shader stage (image in `SHADER_READ_ONLY_OPTIMAL`).
     SampledRead,
     /// Written as a colour attachment.
@@ -84,6 +86,12 @@ impl Access {
                 A::SHADER_STORAGE_READ | A::UNIFORM_READ,
                 L::UNDEFINED,
                 false,
+            ),
+            Access::FragmentReadWrite => (
+                S::FRAGMENT_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                L::GENERAL,
+                true,
             ),
             Access::SampledRead => (
                 S::ALL_COMMANDS,

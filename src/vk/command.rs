@@ -490,7 +490,13 @@ impl CommandRecorder<'_> {
 
     /// Copy all of 2D image `src` (in [`Access::TransferRead`]) into `dst`, tightly packed.
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
-        let region = [whole_image_copy(src)];
+        self.copy_image_to_buffer_at(src, dst, 0);
+    }
+
+    /// Copy all of 2D image `src` (in [`Access::TransferRead`]) into `dst` from byte `offset`,
+    /// tightly packed (depth images: their depth values).
+    pub fn copy_image_to_buffer_at(&mut self, src: &Image, dst: &Buffer, offset: u64) {
+        let region = [whole_image_copy(src).buffer_offset(offset)];
         // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer size is checked by the caller.
         unsafe {
             self.ctx.device.cmd_copy_image_to_buffer(

@@ -78,6 +78,8 @@ pub struct DeviceInfo {
     pub max_bindless_sampled_images: u32,
     /// Sample counts usable for both colour and depth attachments (bit `n` set: `2^n`).
     pub attachment_sample_counts: u32,
+    /// Whether 64-bit integers and 64-bit storage-buffer atomics are enabled (k-buffer OIT).
+    pub int64_atomics: bool,
 }
 
 /// GPU memory the allocator holds.

@@ -89,6 +89,8 @@ pub(super) struct DeviceFeatures {
     host_query_reset: bool,
     pipeline_statistics: bool,
     fragment_stores: bool,
+    /// `shaderInt64` and `shaderBufferInt64Atomics` (the k-buffer's 64-bit `atomicMin`).
+    int64_atomics: bool,
 }
 
 /// Query features; fails with the name of the first missing required feature.
@@ -152,6 +154,7 @@ pub(super) fn query_features(
         host_query_reset: f12.host_query_reset != 0,
         pipeline_statistics: base.pipeline_statistics_query != 0,
         fragment_stores: base.fragment_stores_and_atomics != 0,
+        int64_atomics: base.shader_int64 != 0 && f12.shader_buffer_int64_atomics != 0,
     })
 }
 
@@ -184,14 +187,16 @@ pub(super) fn create_logical(
         .descriptor_binding_partially_bound(true)
         .descriptor_binding_sampled_image_update_after_bind(true)
         .descriptor_binding_update_unused_while_pending(true)
-        .shader_sampled_image_array_non_uniform_indexing(true);
+        .shader_sampled_image_array_non_uniform_indexing(true)
+        .shader_buffer_int64_atomics(f.int64_atomics);
     let mut enable_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default()
         .mesh_shader(true)
         .task_shader(true)
         .mesh_shader_queries(f.mesh_queries);
     let enable_base = vk::PhysicalDeviceFeatures::default()
         .pipeline_statistics_query(f.pipeline_statistics)
-        .fragment_stores_and_atomics(f.fragment_stores);
+        .fragment_stores_and_atomics(f.fragment_stores)
+        .shader_int64(f.int64_atomics);
     let mut device_info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queue_info)
         .enabled_extension_names(&ext_names)
@@ -252,5 +257,6 @@ pub(super) fn query_info(
         attachment_sample_counts: (limits.framebuffer_color_sample_counts
             & limits.framebuffer_depth_sample_counts)
             .as_raw(),
+        int64_atomics: f.int64_atomics,
     }
 }

@@ -58,6 +58,8 @@ pub enum DepthMode {
     TestWrite,
     /// Test `LESS_OR_EQUAL`, no write (transparent geometry over opaque depth).
     TestOnly,
+    /// Test `EQUAL`, no write (the fragments of a depth-peeled layer).
+    Equal,
 }
 
 /// Colour blending of a graphics pipeline.
@@ -69,6 +71,9 @@ pub enum BlendMode {
     PremultipliedOver,
     /// Additive.
     Additive,
+    /// `dst.rgb = src.rgb + dst.rgb * src.a`, `dst.a` kept: premultiplied colour over, with
+    /// the source carrying its transmittance in alpha (the transparency resolve).
+    Transmittance,
 }
 
 /// Face culling of a graphics pipeline.
@@ -98,6 +103,9 @@ pub struct GraphicsDesc<'a> {
     pub cull: CullMode,
     /// Samples per pixel of the attachments.
     pub samples: u32,
+    /// The fragment's alpha is coverage: with MSAA it picks the samples the fragment covers
+    /// (alpha to coverage); colour alpha is not written either way.
+    pub alpha_to_coverage: bool,
 }
 
 impl<'a> GraphicsDesc<'a> {
@@ -112,6 +120,7 @@ impl<'a> GraphicsDesc<'a> {
             blend: BlendMode::Opaque,
             cull: CullMode::None,
             samples: 1,
+            alpha_to_coverage: false,
         }
     }
 
@@ -144,6 +153,12 @@ impl<'a> GraphicsDesc<'a> {
         self.samples = samples;
         self
     }
+
+    /// Turn the fragment's alpha into a sample mask (only with more than one sample).
+    pub fn alpha_to_coverage(mut self, on: bool) -> Self {
+        self.alpha_to_coverage = on;
+        self
+    }
 }
 
 fn raster_state(cull: CullMode) -> vk::PipelineRasterizationStateCreateInfo<'static> {
@@ -168,25 +183,38 @@ fn depth_state(mode: DepthMode) -> vk::PipelineDepthStencilStateCreateInfo<'stat
         DepthMode::TestOnly => d
             .depth_test_enable(true)
             .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL),
+        DepthMode::Equal => d
+            .depth_test_enable(true)
+            .depth_compare_op(vk::CompareOp::EQUAL),
     }
 }
 
-fn blend_attachment(mode: BlendMode) -> vk::PipelineColorBlendAttachmentState {
-    let b = vk::PipelineColorBlendAttachmentState::default()
-        .color_write_mask(vk::ColorComponentFlags::RGBA);
+fn blend_attachment(mode: BlendMode, write_alpha: bool) -> vk::PipelineColorBlendAttachmentState {
+    let mask = if write_alpha {
+        vk::ColorComponentFlags::RGBA
+    } else {
+        vk::ColorComponentFlags::R | vk::ColorComponentFlags::G | vk::ColorComponentFlags::B
+    };
+    let b = vk::PipelineColorBlendAttachmentState::default().color_write_mask(mask);
     let (src, dst) = match mode {
         BlendMode::Opaque => return b,
         BlendMode::PremultipliedOver => {
             (vk::BlendFactor::ONE, vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
         }
         BlendMode::Additive => (vk::BlendFactor::ONE, vk::BlendFactor::ONE),
+        BlendMode::Transmittance => (vk::BlendFactor::ONE, vk::BlendFactor::SRC_ALPHA),
+    };
+    // The transmittance blend keeps the target's alpha (the image stays opaque).
+    let (src_a, dst_a) = match mode {
+        BlendMode::Transmittance => (vk::BlendFactor::ZERO, vk::BlendFactor::ONE),
+        _ => (src, dst),
     };
     b.blend_enable(true)
         .src_color_blend_factor(src)
         .dst_color_blend_factor(dst)
         .color_blend_op(vk::BlendOp::ADD)
-        .src_alpha_blend_factor(src)
-        .dst_alpha_blend_factor(dst)
+        .src_alpha_blend_factor(src_a)
+        .dst_alpha_blend_factor(dst_a)
         .alpha_blend_op(vk::BlendOp::ADD)
 }
 
@@ -287,12 +315,15 @@ impl Pipeline {
             .viewport_count(1)
             .scissor_count(1);
         let raster = raster_state(desc.cull);
+        let alpha_to_coverage = desc.alpha_to_coverage && desc.samples > 1;
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(super::sample_flags(desc.samples));
+            .rasterization_samples(super::sample_flags(desc.samples))
+            .alpha_to_coverage_enable(alpha_to_coverage);
         let depth = depth_state(desc.depth);
         // No colour format: a depth-only pipeline (shadow maps).
         let has_color = desc.color_format != vk::Format::UNDEFINED;
-        let blend_attachments = [blend_attachment(desc.blend)];
+        // Alpha carries coverage, not opacity: the target keeps its alpha.
+        let blend_attachments = [blend_attachment(desc.blend, !desc.alpha_to_coverage)];
         let blend = vk::PipelineColorBlendStateCreateInfo::default()
             .attachments(&blend_attachments[..has_color as usize]);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];

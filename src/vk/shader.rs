@@ -51,6 +51,33 @@ pub const SOURCES: &[(&str, &str)] = &[
         "shading_probe.comp",
         include_str!("../../glsl/shading_probe.comp"),
     ),
+    (
+        "strand_fragment.glsl",
+        include_str!("../../glsl/strand_fragment.glsl"),
+    ),
+    (
+        "lod_appearance.glsl",
+        include_str!("../../glsl/lod_appearance.glsl"),
+    ),
+    ("oit.glsl", include_str!("../../glsl/oit.glsl")),
+    ("oit.frag", include_str!("../../glsl/oit.frag")),
+    ("peel.glsl", include_str!("../../glsl/peel.glsl")),
+    (
+        "peel_depth.frag",
+        include_str!("../../glsl/peel_depth.frag"),
+    ),
+    (
+        "peel_color.frag",
+        include_str!("../../glsl/peel_color.frag"),
+    ),
+    (
+        "fullscreen.vert",
+        include_str!("../../glsl/fullscreen.vert"),
+    ),
+    (
+        "oit_resolve.frag",
+        include_str!("../../glsl/oit_resolve.frag"),
+    ),
 ];
 
 fn source(name: &str) -> Option<&'static str> {

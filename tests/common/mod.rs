@@ -21,6 +21,8 @@ pub struct RenderSettings {
     pub lod: LodSettings,
     pub shading: hairmesh::shade::ShadingModel,
     pub shadows: hairmesh::render::ShadowMode,
+    pub transparency: hairmesh::render::Transparency,
+    pub lod_appearance: bool,
 }
 
 /// What a test render produced.
@@ -48,6 +50,8 @@ pub fn render(r: &mut Renderer, cam: &Camera, settings: &RenderSettings) -> Rend
         lod: settings.lod,
         shading: settings.shading,
         shadows: settings.shadows,
+        transparency: settings.transparency,
+        lod_appearance: settings.lod_appearance,
     };
     let report = r
         .render_one(
@@ -124,6 +128,8 @@ pub fn compute_full() -> RenderSettings {
         lod: LodSettings::off(),
         shading: hairmesh::shade::ShadingModel::Placeholder,
         shadows: hairmesh::render::ShadowMode::Off,
+        transparency: hairmesh::render::Transparency::Opaque,
+        lod_appearance: true,
     }
 }
 

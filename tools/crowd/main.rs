@@ -78,6 +78,13 @@ pub struct Args {
     /// shadow maps).
     #[arg(long, default_value = "deep-opacity")]
     shadows: hairmesh::render::ShadowMode,
+    /// Strand compositing: opaque, oit or oit:K (K-buffer OIT, K fragments per pixel, default
+    /// 8) or peel or peel:N (depth peeling, N layers: the slow reference).
+    #[arg(long, default_value = "opaque")]
+    transparency: hairmesh::render::Transparency,
+    /// Seed 000's thick-strand appearance term under LoD.
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    lod_appearance: bool,
     /// Level of detail.
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     lod: String,
@@ -228,6 +235,8 @@ fn run(args: Args) -> Result<()> {
             lod,
             shading: args.shading,
             shadows: args.shadows,
+            transparency: args.transparency,
+            lod_appearance: args.lod_appearance,
         };
         let t = Instant::now();
         let report = renderer.render_one(

@@ -16,9 +16,10 @@ use anyhow::{Context as _, Result};
 use glam::Vec3;
 use hairmesh::characters::preset;
 use hairmesh::outln;
+use hairmesh::render::transparency::{DEFAULT_OIT_BUDGET, DEFAULT_PEEL_LAYERS, MAX_OIT_BUDGET};
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, FrameTicket, LodSettings, PresentTarget, RenderPath,
-    Renderer, ShadowMode, StrandParams, View,
+    Renderer, ShadowMode, StrandParams, Transparency, View,
 };
 use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{
@@ -39,6 +40,8 @@ struct Controls {
     visible: usize,
     shading: ShadingModel,
     shadows: ShadowMode,
+    transparency: Transparency,
+    lod_appearance: bool,
     params: StrandParams,
     lod: LodSettings,
     path: RenderPath,
@@ -90,6 +93,39 @@ impl Controls {
                         ui.radio_value(&mut self.shadows, m, m.name());
                     }
                 });
+                ui.horizontal(|ui| {
+                    ui.label("transparency");
+                    let oit = Transparency::KBuffer {
+                        budget: DEFAULT_OIT_BUDGET,
+                    };
+                    let peel = Transparency::DepthPeeling {
+                        layers: DEFAULT_PEEL_LAYERS,
+                    };
+                    let t = &mut self.transparency;
+                    ui.radio_value(t, Transparency::Opaque, "opaque");
+                    if ui
+                        .radio(matches!(t, Transparency::KBuffer { .. }), "OIT")
+                        .clicked()
+                    {
+                        *t = oit;
+                    }
+                    if ui
+                        .radio(matches!(t, Transparency::DepthPeeling { .. }), "peel")
+                        .clicked()
+                    {
+                        *t = peel;
+                    }
+                    match t {
+                        Transparency::KBuffer { budget } => {
+                            ui.add(egui::Slider::new(budget, 1..=MAX_OIT_BUDGET).text("K"));
+                        }
+                        Transparency::DepthPeeling { layers } => {
+                            ui.add(egui::Slider::new(layers, 1..=64).text("layers"));
+                        }
+                        Transparency::Opaque => {}
+                    }
+                });
+                ui.checkbox(&mut self.lod_appearance, "thick-strand appearance (LoD)");
                 ui.horizontal(|ui| {
                     ui.label("path");
                     ui.add_enabled_ui(mesh_ok, |ui| {
@@ -199,6 +235,8 @@ struct Running {
     path: RenderPath,
     shading: ShadingModel,
     shadows: ShadowMode,
+    transparency: Transparency,
+    lod_appearance: bool,
     paused: bool,
     dragging: Option<(f64, f64)>,
     cursor: (f64, f64),
@@ -348,6 +386,8 @@ impl App {
             path,
             shading: self.args.shading,
             shadows: self.args.shadows,
+            transparency: self.args.transparency,
+            lod_appearance: self.args.lod_appearance,
             paused: false,
             dragging: None,
             cursor: (0.0, 0.0),
@@ -435,6 +475,8 @@ impl Running {
             lod: self.panel.lod,
             shading: self.shading,
             shadows: self.shadows,
+            transparency: self.transparency,
+            lod_appearance: self.lod_appearance,
         };
         let (primitives, ppp, freed) = self.panel_frame(scene_len)?;
         let chain = self.swapchain.as_ref().expect("created above");
@@ -490,6 +532,8 @@ impl Running {
             visible: self.panel.visible,
             shading: self.shading,
             shadows: self.shadows,
+            transparency: self.transparency,
+            lod_appearance: self.lod_appearance,
             params: self.params,
             lod: self.panel.lod,
             path: self.path,
@@ -531,6 +575,8 @@ impl Running {
         self.panel.lod = c.lod;
         self.shading = c.shading;
         self.shadows = c.shadows;
+        self.transparency = c.transparency;
+        self.lod_appearance = c.lod_appearance;
         self.path = c.path;
         self.paused = c.paused || (c.fly && !self.camera.fly);
         self.camera.fly = c.fly;
@@ -656,6 +702,14 @@ impl Running {
                     ShadingModel::Placeholder => ShadingModel::KajiyaKay,
                     ShadingModel::KajiyaKay => ShadingModel::Marschner,
                     ShadingModel::Marschner => ShadingModel::Placeholder,
+                }
+            }
+            KeyCode::KeyT => {
+                self.transparency = match self.transparency {
+                    Transparency::Opaque => Transparency::KBuffer {
+                        budget: DEFAULT_OIT_BUDGET,
+                    },
+                    _ => Transparency::Opaque,
                 }
             }
             KeyCode::KeyH => {

@@ -6,6 +6,7 @@ pub mod props;
 pub mod scalp;
 pub mod shadow;
 pub mod strands;
+pub mod transparency;
 
 use std::sync::Arc;
 
@@ -22,6 +23,7 @@ use props::{PropDraw, PropPass};
 use scalp::ScalpPass;
 use shadow::{ShadowDraw, ShadowPass};
 use strands::StrandDraw;
+use transparency::{TransparencyPass, TransparentDraw};
 
 /// The two descriptor sets every pass binds: set 0 (frame and crowd tables) and set 1 (the
 /// bindless textures).
@@ -75,6 +77,14 @@ pub enum DrawTarget {
     ShadowDepth,
     /// The deep opacity layers: colour only, additive, no depth.
     ShadowOpacity,
+    /// K-buffer insert: the camera's depth (tested, not written), no colour; fragments go to
+    /// the per-pixel node buffers.
+    OitInsert(TargetFormats),
+    /// Depth peeling, first pass of a layer: depth only.
+    PeelDepth,
+    /// Depth peeling, second pass of a layer: depth test `EQUAL`; fragments go to the
+    /// accumulation buffer.
+    PeelColor,
 }
 
 impl DrawTarget {
@@ -92,6 +102,25 @@ impl DrawTarget {
             )
             .depth(DepthMode::Off)
             .blend(BlendMode::Additive),
+            DrawTarget::OitInsert(t) => GraphicsDesc::new(name, Format::UNDEFINED, t.depth)
+                .samples(t.samples)
+                .depth(DepthMode::TestOnly),
+            DrawTarget::PeelDepth => GraphicsDesc::new(name, Format::UNDEFINED, DEPTH_FORMAT),
+            DrawTarget::PeelColor => {
+                GraphicsDesc::new(name, Format::UNDEFINED, DEPTH_FORMAT).depth(DepthMode::Equal)
+            }
+        }
+    }
+
+    /// The fragment shader strands drawn into this target use (`None`: depth only).
+    pub fn strand_fragment_shader(&self) -> Option<&'static str> {
+        match self {
+            DrawTarget::Camera(_) => Some("strands.frag"),
+            DrawTarget::ShadowDepth => None,
+            DrawTarget::ShadowOpacity => Some("shadow.frag"),
+            DrawTarget::OitInsert(_) => Some("oit.frag"),
+            DrawTarget::PeelDepth => Some("peel_depth.frag"),
+            DrawTarget::PeelColor => Some("peel_color.frag"),
         }
     }
 }
@@ -140,6 +169,10 @@ pub struct FrameInputs<'a> {
     pub props: &'a [PropDraw],
     /// The light's passes.
     pub shadow: ShadowInputs<'a>,
+    /// How the strands are composited.
+    pub transparency: super::Transparency,
+    /// The transparent modes' per-pixel buffers (sized for this frame's mode).
+    pub transparency_buffers: &'a mut super::transparency::TransparencyBuffers,
 }
 
 /// What the light's passes need.
@@ -154,17 +187,19 @@ pub struct ShadowInputs<'a> {
 
 /// The passes of a frame, in order: statistics reset; with shadows, the light's generation
 /// (compute path) and passes, then a second reset; generation (compute path); the opaque pass
-/// (props, scalps, strands; the mesh path generates inside it).
+/// (props, scalps, and opaque strands; the mesh path generates inside it); with transparency,
+/// the transparent strand passes and their resolve.
 pub struct FramePasses {
     generate: ComputeGenerate,
     shadow: ShadowPass,
     props: PropPass,
     scalp: ScalpPass,
     strands: StrandDraw,
+    transparency: TransparencyPass,
 }
 
 /// Zero `args` (indirect arguments and statistics) after earlier generation used it.
-fn clear_args(rec: &mut CommandRecorder, args: &Buffer) {
+pub(crate) fn clear_args(rec: &mut CommandRecorder, args: &Buffer) {
     rec.barrier(
         &[
             Access::ComputeReadWrite,
@@ -201,7 +236,13 @@ impl FramePasses {
             props: PropPass::new(ctx, layout, camera)?,
             scalp: ScalpPass::new(ctx, layout, targets)?,
             strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
+            transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
         })
+    }
+
+    /// Check and compile what `mode` needs, before a frame uses it.
+    pub fn prepare_transparency(&mut self, mode: super::Transparency) -> GpuResult<()> {
+        self.transparency.prepare(mode)
     }
 
     /// Whether the mesh path is available.
@@ -261,12 +302,14 @@ impl FramePasses {
             rec.image_barrier(r, Access::Nothing, Access::ColorAttachment);
         }
         let mesh = inp.path == RenderPath::Mesh;
+        let transparent = inp.bundles > 0 && inp.transparency != super::Transparency::Opaque;
         profiler.begin(rec, if mesh { "mesh draw" } else { "draw" });
         rec.begin_rendering(
             Attachment {
                 image: &targets.color,
                 clear: inp.clear,
-                resolve: targets.resolved.as_ref(),
+                // With transparency the resolve pass ends the frame's colour.
+                resolve: targets.resolved.as_ref().filter(|_| !transparent),
             },
             Attachment {
                 image: &targets.depth,
@@ -276,15 +319,17 @@ impl FramePasses {
         );
         let mut result = Ok(());
         self.props.record(rec, inp.sets, inp.props);
+        let mut query = mesh_query;
         if inp.bundles > 0 {
             self.scalp.record(rec, inp.sets, inp.bundles);
-            if mesh {
-                let mut query = mesh_query;
+            if transparent {
+                // Drawn by the transparent passes below.
+            } else if mesh {
                 if let Some(q) = query.as_deref_mut() {
                     q.begin(rec);
                 }
                 result = self.strands.record_mesh(rec, inp.sets, inp.bundles);
-                if let Some(q) = query {
+                if let Some(q) = query.as_deref_mut() {
                     q.end(rec);
                 }
             } else {
@@ -295,7 +340,21 @@ impl FramePasses {
         profiler.end(rec);
         targets.color_access = Access::ColorAttachment;
         targets.depth_access = Access::DepthAttachment;
+        result?;
+        if transparent {
+            let draw = TransparentDraw {
+                mode: inp.transparency,
+                sets: inp.sets,
+                bundles: inp.bundles,
+                path: inp.path,
+                args: inp.args,
+                targets: &mut *targets,
+                buffers: inp.transparency_buffers,
+                mesh_query: query,
+            };
+            self.transparency.record(rec, profiler, draw)?;
+        }
         targets.set_output_access(Access::ColorAttachment);
-        result
+        Ok(())
     }
 }

@@ -1,0 +1,39 @@
+// K-buffer order-independent transparency (src/render/transparency.rs): per pixel, K 64-bit
+// nodes (depth bits << 32 | colour packed by pack_fragment) kept sorted nearest first, and a
+// tail of fixed-point sums for the fragments pushed past the K-th node. Used by oit.frag
+// (insert) and oit_resolve.frag.
+#ifndef OIT_GLSL
+#define OIT_GLSL
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+
+layout(set = SET_FRAME, binding = BINDING_OIT_NODES, std430) buffer OitNodes { uint64_t oit_nodes[]; };
+// x, y, z: sum of colour x optical depth; w: sum of optical depth; all times OIT_FIXED.
+layout(set = SET_FRAME, binding = BINDING_OIT_TAIL, std430) buffer OitTail { uvec4 oit_tail[]; };
+
+#define OIT_EMPTY 0xFFFFFFFFFFFFFFFFul
+// Fixed-point scale of the tail sums: integer adds make the tail independent of the order
+// fragments arrive in. One fragment adds at most 5.6 OIT_FIXED per lane (optical depth is
+// capped by the 8-bit alpha), so a lane holds about 740 000 evicted fragments per pixel.
+#define OIT_FIXED 1024.0
+
+uint oit_pixel() {
+    return uint(gl_FragCoord.y) * uint(frame.viewport.x) + uint(gl_FragCoord.x);
+}
+
+// Colour in [0, 1] with a square-root curve (more codes for dark hair), alpha linear.
+uint pack_fragment(vec3 c, float a) {
+    return packUnorm4x8(vec4(sqrt(clamp(c, 0.0, 1.0)), a));
+}
+
+vec4 unpack_fragment(uint p) {
+    vec4 v = unpackUnorm4x8(p);
+    return vec4(v.rgb * v.rgb, v.a);
+}
+
+// Optical depth of one fragment's alpha (capped below 1 by the 8-bit alpha).
+float optical_depth(float a) {
+    return -log(max(1.0 - a, 1.0 / 256.0));
+}
+
+#endif

@@ -1,0 +1,270 @@
+//! How strands are composited, chosen per frame ([`Transparency`]), and the per-pixel buffers
+//! the transparent modes use ([`TransparencyBuffers`]).
+//!
+//! - **Opaque**: strands write depth; with MSAA their pixel coverage becomes a sample mask
+//!   (alpha to coverage), so strands thinner than a pixel keep their width.
+//! - **K-buffer OIT** (seed 002 sec. 4, after Bavoil et al.'s k-buffer): every strand fragment
+//!   (opacity `STRAND_OPACITY` x pixel coverage, seed 002's coverage to alpha) is inserted into
+//!   a per-pixel array of `K` nodes kept sorted by depth with 64-bit `atomicMin`; the node
+//!   pushed past the end (always the farthest so far) is merged into a per-pixel tail (sums of
+//!   premultiplied colour and optical depth, fixed point so the result does not depend on the
+//!   order fragments arrive in). The resolve composites the `K` nearest in order, then the tail
+//!   as one layer behind them. Memory is bounded: `K x 8 + 16` bytes per pixel.
+//! - **Depth peeling** (seed 004's reference): `layers` passes, each finding the nearest
+//!   fragment behind the previous layer and compositing it under the layers before; exact up
+//!   to the layer count, and slow (two geometry passes per layer). Single-sample only.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use crate::vk::{Access, Buffer, BufferDesc, Context, GpuResult, Image, ImageDesc};
+
+/// Largest k-buffer budget (nodes per pixel).
+pub const MAX_OIT_BUDGET: u32 = 16;
+/// Default k-buffer budget.
+pub const DEFAULT_OIT_BUDGET: u32 = 8;
+/// Largest number of peeled layers.
+pub const MAX_PEEL_LAYERS: u32 = 256;
+/// Default number of peeled layers.
+pub const DEFAULT_PEEL_LAYERS: u32 = 32;
+/// Opacity of one full-detail strand over the part of a pixel it covers.
+pub const STRAND_OPACITY: f32 = 0.7;
+
+/// How the strands of a frame are composited.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Transparency {
+    /// Opaque strands (depth-tested; alpha to coverage with MSAA).
+    #[default]
+    Opaque,
+    /// Order-independent transparency with `budget` sorted nodes per pixel and a merged tail.
+    KBuffer {
+        /// Nodes per pixel (1..=[`MAX_OIT_BUDGET`]).
+        budget: u32,
+    },
+    /// Depth peeling of `layers` layers (the slow reference).
+    DepthPeeling {
+        /// Layers peeled (1..=[`MAX_PEEL_LAYERS`]).
+        layers: u32,
+    },
+}
+
+impl Transparency {
+    /// Mode number in `FrameBlock::transparency.x`.
+    pub fn mode(self) -> u32 {
+        match self {
+            Transparency::Opaque => 0,
+            Transparency::KBuffer { .. } => 1,
+            Transparency::DepthPeeling { .. } => 2,
+        }
+    }
+
+    /// `FrameBlock::transparency`.
+    pub fn frame_fields(self) -> [u32; 4] {
+        let budget = match self {
+            Transparency::KBuffer { budget } => budget,
+            _ => 0,
+        };
+        [self.mode(), budget, 0, 0]
+    }
+
+    /// Check the budget or layer count.
+    pub fn validate(self) -> Result<(), String> {
+        match self {
+            Transparency::Opaque => Ok(()),
+            Transparency::KBuffer { budget } if (1..=MAX_OIT_BUDGET).contains(&budget) => Ok(()),
+            Transparency::KBuffer { budget } => Err(format!(
+                "OIT budget {budget} must be 1..={MAX_OIT_BUDGET} fragments per pixel"
+            )),
+            Transparency::DepthPeeling { layers } if (1..=MAX_PEEL_LAYERS).contains(&layers) => {
+                Ok(())
+            }
+            Transparency::DepthPeeling { layers } => Err(format!(
+                "depth peeling layers {layers} must be 1..={MAX_PEEL_LAYERS}"
+            )),
+        }
+    }
+
+    /// Bytes of the per-pixel buffers for `pixels` pixels: (nodes, tail, peel depth, peel
+    /// accumulation).
+    pub fn buffer_bytes(self, pixels: u64) -> [u64; 4] {
+        match self {
+            Transparency::Opaque => [0; 4],
+            Transparency::KBuffer { budget } => [pixels * budget as u64 * 8, pixels * 16, 0, 0],
+            Transparency::DepthPeeling { .. } => [0, 0, pixels * 8, pixels * 16],
+        }
+    }
+}
+
+impl std::fmt::Display for Transparency {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Transparency::Opaque => write!(f, "opaque"),
+            Transparency::KBuffer { budget } => write!(f, "oit:{budget}"),
+            Transparency::DepthPeeling { layers } => write!(f, "peel:{layers}"),
+        }
+    }
+}
+
+impl std::str::FromStr for Transparency {
+    type Err = String;
+    /// `opaque`, `oit` or `oit:K` (K nodes per pixel), `peel` or `peel:N` (N layers).
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (name, count) = match s.split_once(':') {
+            Some((n, c)) => (
+                n,
+                Some(
+                    c.parse::<u32>()
+                        .map_err(|_| format!("transparency '{s}': '{c}' is not a whole number"))?,
+                ),
+            ),
+            None => (s, None),
+        };
+        let t = match name {
+            "opaque" if count.is_none() => Transparency::Opaque,
+            "oit" => Transparency::KBuffer {
+                budget: count.unwrap_or(DEFAULT_OIT_BUDGET),
+            },
+            "peel" => Transparency::DepthPeeling {
+                layers: count.unwrap_or(DEFAULT_PEEL_LAYERS),
+            },
+            _ => {
+                return Err(format!(
+                    "unknown transparency '{s}' (opaque, oit, oit:K, peel, peel:N)"
+                ));
+            }
+        };
+        t.validate()?;
+        Ok(t)
+    }
+}
+
+/// The per-pixel buffers of the transparent modes, sized for the current target and mode
+/// (grown when a frame needs more, never shrunk; a placeholder where a mode is not used).
+pub struct TransparencyBuffers {
+    ctx: Arc<Context>,
+    /// K-buffer nodes.
+    pub nodes: Buffer,
+    /// K-buffer tail sums.
+    pub tail: Buffer,
+    /// Depth peeling: previous layer and opaque depth.
+    pub peel_depth: Buffer,
+    /// Depth peeling: accumulated colour.
+    pub peel_accum: Buffer,
+    /// Depth peeling: the depth attachment of the layers (single sample, target size).
+    pub peel_image: Option<Image>,
+    /// Last use of `peel_image`.
+    pub peel_access: Access,
+}
+
+fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            name,
+            bytes.max(16),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+        ),
+    )
+}
+
+impl TransparencyBuffers {
+    /// Placeholders only.
+    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
+        Ok(TransparencyBuffers {
+            ctx: ctx.clone(),
+            nodes: storage(ctx, "oit nodes", 16)?,
+            tail: storage(ctx, "oit tail", 16)?,
+            peel_depth: storage(ctx, "peel depth", 16)?,
+            peel_accum: storage(ctx, "peel accumulation", 16)?,
+            peel_image: None,
+            peel_access: Access::Nothing,
+        })
+    }
+
+    /// Make every buffer at least as large as `mode` needs for `width x height` targets, and
+    /// the peel depth image that size; returns the replaced resources (frames in flight may
+    /// still use them).
+    pub fn ensure(
+        &mut self,
+        mode: Transparency,
+        width: u32,
+        height: u32,
+    ) -> GpuResult<Vec<Box<dyn std::any::Any>>> {
+        let need = mode.buffer_bytes(width as u64 * height as u64);
+        let limit = self.ctx.info.max_storage_buffer_range;
+        if let Some(too_big) = need.iter().find(|&&b| b > limit) {
+            return Err(crate::vk::GpuError::Unsupported(format!(
+                "transparency {mode} needs a {too_big}-byte buffer at this size, more than the device's maxStorageBufferRange ({limit}); lower the budget or the size"
+            )));
+        }
+        let mut replaced: Vec<Box<dyn std::any::Any>> = Vec::new();
+        let peel = matches!(mode, Transparency::DepthPeeling { .. });
+        let stale = self
+            .peel_image
+            .as_ref()
+            .is_some_and(|i| i.desc.extent[..2] != [width, height]);
+        if peel && (self.peel_image.is_none() || stale) {
+            let image = Image::new(
+                &self.ctx,
+                &ImageDesc::new_2d("peel depth", super::targets::DEPTH_FORMAT, width, height)
+                    .usage(
+                        vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                            | vk::ImageUsageFlags::TRANSFER_SRC,
+                    ),
+            )?;
+            if let Some(old) = self.peel_image.replace(image) {
+                replaced.push(Box::new(old));
+            }
+            self.peel_access = Access::Nothing;
+        }
+        let slots = [
+            (&mut self.nodes, "oit nodes", need[0]),
+            (&mut self.tail, "oit tail", need[1]),
+            (&mut self.peel_depth, "peel depth", need[2]),
+            (&mut self.peel_accum, "peel accumulation", need[3]),
+        ];
+        for (buffer, name, bytes) in slots {
+            if bytes > buffer.size {
+                replaced.push(Box::new(std::mem::replace(
+                    buffer,
+                    storage(&self.ctx, name, bytes)?,
+                )));
+            }
+        }
+        Ok(replaced)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_rejects() {
+        assert_eq!("opaque".parse(), Ok(Transparency::Opaque));
+        assert_eq!(
+            "oit".parse(),
+            Ok(Transparency::KBuffer {
+                budget: DEFAULT_OIT_BUDGET
+            })
+        );
+        assert_eq!("oit:2".parse(), Ok(Transparency::KBuffer { budget: 2 }));
+        assert_eq!(
+            "peel:12".parse(),
+            Ok(Transparency::DepthPeeling { layers: 12 })
+        );
+        for bad in [
+            "oit:0", "oit:17", "peel:0", "peel:x", "opaque:3", "blend", "",
+        ] {
+            assert!(bad.parse::<Transparency>().is_err(), "{bad}");
+        }
+        for t in ["opaque", "oit:3", "peel:7"] {
+            assert_eq!(t.parse::<Transparency>().unwrap().to_string(), t);
+        }
+        assert_eq!(
+            Transparency::KBuffer { budget: 4 }.buffer_bytes(10),
+            [320, 160, 0, 0]
+        );
+    }
+}
