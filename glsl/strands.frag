@@ -1,7 +1,8 @@
 #version 460
-// Opaque strands (Transparency::Opaque). With MSAA, alpha is the strand's pixel coverage and
-// the pipeline turns it into a sample mask (alpha to coverage; colour alpha is not written),
-// so strands thinner than a pixel keep their width.
+// Opaque strands (Transparency::Opaque): strips at least one pixel wide, written with depth;
+// MSAA smooths their edges. Coverage to alpha (thin strands keep their true width) needs
+// blending in depth order: the transparent modes (oit.frag, peel_color.frag) use it. (A
+// dithered sample mask from coverage was tried here: at 4 samples the hair turns to noise.)
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 #include "strand_fragment.glsl"
@@ -9,5 +10,5 @@
 layout(location = 0) out vec4 out_color;
 
 void main() {
-    out_color = vec4(shade_strand(), clamp(in_coverage, 0.0, 1.0));
+    out_color = vec4(shade_strand(), 1.0);
 }

@@ -12,7 +12,7 @@
 mod common;
 
 use common::*;
-use hairmesh::render::ShadowMode;
+use hairmesh::render::{ShadowMode, Transparency};
 use hairmesh::shade::ShadingModel;
 
 const MEAN_MAX: f32 = 0.02;
@@ -36,16 +36,44 @@ fn render_golden_shaded(
     shading: ShadingModel,
     edit: impl Fn(&mut hairmesh::HairStyle),
 ) -> RenderOutput {
-    render_golden_look(mesh, n, e, shading, ShadowMode::Off, edit)
+    render_golden_look(mesh, n, e, Look::shaded(shading), edit)
 }
 
-/// [`render_golden`] with a shading model and shadows.
+/// Shading, shadows and transparency of a golden scene.
+#[derive(Clone, Copy, Debug)]
+struct Look {
+    shading: ShadingModel,
+    shadows: ShadowMode,
+    transparency: Transparency,
+}
+
+impl Look {
+    fn shaded(shading: ShadingModel) -> Self {
+        Look {
+            shading,
+            shadows: ShadowMode::Off,
+            transparency: Transparency::Opaque,
+        }
+    }
+
+    fn shadows(self, shadows: ShadowMode) -> Self {
+        Look { shadows, ..self }
+    }
+
+    fn transparency(self, transparency: Transparency) -> Self {
+        Look {
+            transparency,
+            ..self
+        }
+    }
+}
+
+/// [`render_golden`] with a look.
 fn render_golden_look(
     mesh: &str,
     n: u32,
     e: u32,
-    shading: ShadingModel,
-    shadows: ShadowMode,
+    look: Look,
     edit: impl Fn(&mut hairmesh::HairStyle),
 ) -> RenderOutput {
     let ctx = context();
@@ -54,9 +82,9 @@ fn render_golden_look(
     let mut r = renderer(&ctx, 256);
     upload(&mut r, &baked, &style, n, e);
     let settings = RenderSettings {
-        shading,
-        shadows,
-        transparency: hairmesh::render::Transparency::Opaque,
+        shading: look.shading,
+        shadows: look.shadows,
+        transparency: look.transparency,
         lod_appearance: true,
         ..compute_full()
     };
@@ -93,11 +121,11 @@ fn check(name: &str, mesh: &str, n: u32, e: u32) {
 }
 
 fn check_shaded(name: &str, mesh: &str, n: u32, e: u32, shading: ShadingModel) {
-    check_look(name, mesh, n, e, shading, ShadowMode::Off);
+    check_look(name, mesh, n, e, Look::shaded(shading));
 }
 
-fn check_look(name: &str, mesh: &str, n: u32, e: u32, shading: ShadingModel, shadows: ShadowMode) {
-    let out = render_golden_look(mesh, n, e, shading, shadows, |_| {});
+fn check_look(name: &str, mesh: &str, n: u32, e: u32, look: Look) {
+    let out = render_golden_look(mesh, n, e, look, |_| {});
     let reference = root().join("tests/golden").join(format!("{name}.png"));
     if std::env::var("HAIRMESH_BLESS").is_ok_and(|v| v == "1") {
         save_png(&reference, out.width, out.height, &out.rgba);
@@ -175,8 +203,7 @@ fn golden_head_long_deep_opacity_shadows() {
         "head_long.obj",
         32,
         5,
-        ShadingModel::KajiyaKay,
-        ShadowMode::DeepOpacity,
+        Look::shaded(ShadingModel::KajiyaKay).shadows(ShadowMode::DeepOpacity),
     );
 }
 
@@ -187,8 +214,7 @@ fn golden_head_long_approximate_shadows() {
         "head_long.obj",
         32,
         5,
-        ShadingModel::KajiyaKay,
-        ShadowMode::Approximate,
+        Look::shaded(ShadingModel::KajiyaKay).shadows(ShadowMode::Approximate),
     );
 }
 
@@ -204,8 +230,7 @@ fn shadow_thresholds_catch_a_wrong_shadow_mode() {
             "head_long.obj",
             32,
             5,
-            ShadingModel::KajiyaKay,
-            wrong,
+            Look::shaded(ShadingModel::KajiyaKay).shadows(wrong),
             |_| {},
         );
         let (_, mean, p99) = flip_against(name, &out);
@@ -264,4 +289,48 @@ fn golden_small_patch() {
 #[test]
 fn golden_triangle_tuft() {
     check("triangle_tuft", "triangle_tuft.obj", 64, 4);
+}
+
+/// The full look: Marschner, deep opacity shadows and k-buffer OIT (8 fragments per pixel).
+fn full_look() -> Look {
+    Look::shaded(ShadingModel::Marschner)
+        .shadows(ShadowMode::DeepOpacity)
+        .transparency(Transparency::KBuffer { budget: 8 })
+}
+
+#[test]
+fn golden_head_long_oit() {
+    check_look(
+        "head_long_oit",
+        "head_long.obj",
+        32,
+        5,
+        Look::shaded(ShadingModel::KajiyaKay).transparency(Transparency::KBuffer { budget: 8 }),
+    );
+}
+
+#[test]
+fn golden_head_long_full_look() {
+    check_look("head_long_full_look", "head_long.obj", 32, 5, full_look());
+}
+
+/// The transparency goldens fail on a wrong render: the same scenes drawn opaque.
+#[test]
+fn transparency_thresholds_catch_opaque_strands() {
+    for (name, look) in [
+        (
+            "head_long_oit",
+            Look::shaded(ShadingModel::KajiyaKay).transparency(Transparency::KBuffer { budget: 8 }),
+        ),
+        ("head_long_full_look", full_look()),
+    ] {
+        let wrong = look.transparency(Transparency::Opaque);
+        let out = render_golden_look("head_long.obj", 32, 5, wrong, |_| {});
+        let (_, mean, p99) = flip_against(name, &out);
+        println!("{name} rendered opaque: FLIP mean {mean:.5}, p99 {p99:.5}");
+        assert!(
+            mean > MEAN_MAX || p99 > P99_MAX,
+            "{name}: opaque strands pass the golden thresholds (mean {mean}, p99 {p99})"
+        );
+    }
 }

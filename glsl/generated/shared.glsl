@@ -17,6 +17,7 @@
 #define CHARACTER_VISIBLE 1u
 #define SET_FRAME 0
 #define SET_TEXTURES 1
+#define STRAND_OPACITY 0.7
 #define BINDING_FRAME 0
 #define BINDING_CHARACTERS 1
 #define BINDING_BUNDLES 2
@@ -31,6 +32,10 @@
 #define BINDING_SHADOW_HAIR_DEPTH 11
 #define BINDING_SHADOW_PROP_DEPTH 12
 #define BINDING_SHADOW_LAYERS 13
+#define BINDING_OIT_NODES 14
+#define BINDING_OIT_TAIL 15
+#define BINDING_PEEL_DEPTH 16
+#define BINDING_PEEL_ACCUM 17
 #define BINDING_TEX_POSITION 0
 #define BINDING_TEX_UV 1
 #define BINDING_TEX_W 2
@@ -94,6 +99,7 @@ struct FrameBlock {
     mat4 light_view_proj;
     uvec4 shadow;
     vec4 shadow_params;
+    uvec4 transparency;
 };
 
 struct CharacterRecord {

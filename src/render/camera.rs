@@ -262,7 +262,8 @@ impl View {
             light_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
             shadow: [0; 4],
             shadow_params: [0.0; 4],
-            transparency: self.transparency.frame_fields(),
+            // Samples filled in by the renderer.
+            transparency: self.transparency.frame_fields(1),
         }
     }
 }

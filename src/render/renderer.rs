@@ -485,6 +485,7 @@ impl Renderer {
             self.crowd.slot_count(),
             self.vertex_budget(),
         );
+        block.transparency = view.transparency.frame_fields(self.desc.msaa);
         let light = self.light_view(view, &block);
         if let Some(l) = &light {
             (block.light_view_proj, block.shadow, block.shadow_params) =

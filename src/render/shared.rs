@@ -237,7 +237,7 @@ pub struct FrameBlock {
     /// z opacity of one strand, w depth bias (world units).
     pub shadow_params: [f32; 4],
     /// x transparency mode (`render::Transparency`: 0 opaque, 1 k-buffer OIT, 2 depth
-    /// peeling), y k-buffer nodes per pixel; zw reserved.
+    /// peeling), y k-buffer nodes per pixel, z samples per pixel of the targets; w reserved.
     pub transparency: [u32; 4],
 }
 

@@ -1,8 +1,8 @@
 //! How strands are composited, chosen per frame ([`Transparency`]), and the per-pixel buffers
 //! the transparent modes use ([`TransparencyBuffers`]).
 //!
-//! - **Opaque**: strands write depth; with MSAA their pixel coverage becomes a sample mask
-//!   (alpha to coverage), so strands thinner than a pixel keep their width.
+//! - **Opaque**: strands write depth, as strips at least one pixel wide (MSAA smooths
+//!   their edges).
 //! - **K-buffer OIT** (seed 002 sec. 4, after Bavoil et al.'s k-buffer): every strand fragment
 //!   (opacity `STRAND_OPACITY` x pixel coverage, seed 002's coverage to alpha) is inserted into
 //!   a per-pixel array of `K` nodes kept sorted by depth with 64-bit `atomicMin`; the node
@@ -34,7 +34,7 @@ pub const STRAND_OPACITY: f32 = 0.7;
 /// How the strands of a frame are composited.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Transparency {
-    /// Opaque strands (depth-tested; alpha to coverage with MSAA).
+    /// Opaque strands (depth-tested, at least one pixel wide).
     #[default]
     Opaque,
     /// Order-independent transparency with `budget` sorted nodes per pixel and a merged tail.
@@ -59,13 +59,13 @@ impl Transparency {
         }
     }
 
-    /// `FrameBlock::transparency`.
-    pub fn frame_fields(self) -> [u32; 4] {
+    /// `FrameBlock::transparency` for targets of `samples` samples per pixel.
+    pub fn frame_fields(self, samples: u32) -> [u32; 4] {
         let budget = match self {
             Transparency::KBuffer { budget } => budget,
             _ => 0,
         };
-        [self.mode(), budget, 0, 0]
+        [self.mode(), budget, samples, 0]
     }
 
     /// Check the budget or layer count.

@@ -103,9 +103,6 @@ pub struct GraphicsDesc<'a> {
     pub cull: CullMode,
     /// Samples per pixel of the attachments.
     pub samples: u32,
-    /// The fragment's alpha is coverage: with MSAA it picks the samples the fragment covers
-    /// (alpha to coverage); colour alpha is not written either way.
-    pub alpha_to_coverage: bool,
 }
 
 impl<'a> GraphicsDesc<'a> {
@@ -120,7 +117,6 @@ impl<'a> GraphicsDesc<'a> {
             blend: BlendMode::Opaque,
             cull: CullMode::None,
             samples: 1,
-            alpha_to_coverage: false,
         }
     }
 
@@ -153,12 +149,6 @@ impl<'a> GraphicsDesc<'a> {
         self.samples = samples;
         self
     }
-
-    /// Turn the fragment's alpha into a sample mask (only with more than one sample).
-    pub fn alpha_to_coverage(mut self, on: bool) -> Self {
-        self.alpha_to_coverage = on;
-        self
-    }
 }
 
 fn raster_state(cull: CullMode) -> vk::PipelineRasterizationStateCreateInfo<'static> {
@@ -189,13 +179,9 @@ fn depth_state(mode: DepthMode) -> vk::PipelineDepthStencilStateCreateInfo<'stat
     }
 }
 
-fn blend_attachment(mode: BlendMode, write_alpha: bool) -> vk::PipelineColorBlendAttachmentState {
-    let mask = if write_alpha {
-        vk::ColorComponentFlags::RGBA
-    } else {
-        vk::ColorComponentFlags::R | vk::ColorComponentFlags::G | vk::ColorComponentFlags::B
-    };
-    let b = vk::PipelineColorBlendAttachmentState::default().color_write_mask(mask);
+fn blend_attachment(mode: BlendMode) -> vk::PipelineColorBlendAttachmentState {
+    let b = vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA);
     let (src, dst) = match mode {
         BlendMode::Opaque => return b,
         BlendMode::PremultipliedOver => {
@@ -315,15 +301,12 @@ impl Pipeline {
             .viewport_count(1)
             .scissor_count(1);
         let raster = raster_state(desc.cull);
-        let alpha_to_coverage = desc.alpha_to_coverage && desc.samples > 1;
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(super::sample_flags(desc.samples))
-            .alpha_to_coverage_enable(alpha_to_coverage);
+            .rasterization_samples(super::sample_flags(desc.samples));
         let depth = depth_state(desc.depth);
         // No colour format: a depth-only pipeline (shadow maps).
         let has_color = desc.color_format != vk::Format::UNDEFINED;
-        // Alpha carries coverage, not opacity: the target keeps its alpha.
-        let blend_attachments = [blend_attachment(desc.blend, !desc.alpha_to_coverage)];
+        let blend_attachments = [blend_attachment(desc.blend)];
         let blend = vk::PipelineColorBlendStateCreateInfo::default()
             .attachments(&blend_attachments[..has_color as usize]);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];

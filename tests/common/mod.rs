@@ -117,6 +117,35 @@ pub fn mean_abs_diff(a: &[u8], b: &[u8]) -> f64 {
     s as f64 / a.len() as f64 / 255.0
 }
 
+/// FLIP (nv-flip) of RGBA image `test` against `reference`, both `w x h`: the error image,
+/// its mean and 99th percentile.
+pub fn flip_rgba(
+    w: u32,
+    h: u32,
+    reference: &[u8],
+    test: &[u8],
+) -> (nv_flip::FlipImageFloat, f32, f32) {
+    let rgb = |img: &[u8]| -> Vec<u8> { img.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, &rgb(reference));
+    let t = nv_flip::FlipImageRgb8::with_data(w, h, &rgb(test));
+    let err = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    let mut pool = nv_flip::FlipPool::from_image(&err);
+    let (mean, p99) = (pool.mean(), pool.get_percentile(0.99, true));
+    (err, mean, p99)
+}
+
+/// Write `rgba` and the magma FLIP `err` image as `tests/output/<name>-actual.png` and
+/// `<name>-diff.png`.
+pub fn save_failure(name: &str, w: u32, h: u32, rgba: &[u8], err: &nv_flip::FlipImageFloat) {
+    let dir = output_dir();
+    save_png(&dir.join(format!("{name}-actual.png")), w, h, rgba);
+    let diff = err.apply_color_lut(&nv_flip::magma_lut());
+    image::RgbImage::from_raw(w, h, diff.to_vec())
+        .unwrap()
+        .save(dir.join(format!("{name}-diff.png")))
+        .unwrap();
+}
+
 pub fn light() -> Vec3 {
     Vec3::new(0.4, 1.0, 0.6)
 }

@@ -57,13 +57,10 @@ impl StrandDraw {
         }
         let opts = shader_options(task_bundles);
         let frag = target.strand_fragment_shader();
-        // Opaque strands with MSAA: coverage becomes a sample mask.
-        let coverage_mask = matches!(target, DrawTarget::Camera(_));
         let v = compile("strands.vert", &opts)?;
         let f = frag.map(|f| compile(f, &opts)).transpose()?;
         let with_fragment =
             |desc: crate::vk::GraphicsDesc<'static>| -> crate::vk::GraphicsDesc<'_> {
-                let desc = desc.alpha_to_coverage(coverage_mask);
                 match &f {
                     Some(f) => desc.stage(vk::ShaderStageFlags::FRAGMENT, f),
                     None => desc,
