@@ -6,11 +6,13 @@
 // further back. Lookups: shadow_lookup.glsl.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
+#include "lod_appearance.glsl"
 
 // Only the hair depth: the layers are this pass's attachment.
 layout(set = SET_FRAME, binding = BINDING_SHADOW_HAIR_DEPTH) uniform sampler2D shadow_hair_depth;
 
 layout(location = 5) in float in_coverage;
+layout(location = 6) flat in float in_thickness;
 layout(location = 0) out vec4 out_layers;
 
 void main() {
@@ -18,6 +20,6 @@ void main() {
     float dz = max(gl_FragCoord.z - d0, 0.0) * frame.shadow_params.y;
     int layer = min(int(dz / frame.shadow_params.x), 3);
     vec4 add = vec4(0.0);
-    add[layer] = frame.shadow_params.z * in_coverage;
+    add[layer] = cluster_opacity(frame.shadow_params.z * in_coverage, in_thickness);
     out_layers = add;
 }

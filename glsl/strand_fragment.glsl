@@ -33,30 +33,28 @@ vec3 shade_strand() {
     // Direct light reaching this fragment through the hair and bodies in front of it.
     float lit = light_transmittance(in_pos, 0.0);
     float root_shadow = mix(0.55, 1.0, smoothstep(0.0, 0.3, in_s));
-    // Seed 000: a thick strand scatters like the cluster it stands for.
-    ClusterScattering cl = cluster_scattering(in_thickness, base);
     vec3 c;
     if (frame.shading.x == 1u) {
         vec2 kk = kajiya_kay(t, l, e);
-        c = (base * (AMBIENT * cl.multiple + kk.x * lit * cl.single) + vec3(0.3) * (kk.y * lit * cl.single)) * root_shadow;
+        c = (base * (AMBIENT + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
     } else if (frame.shading.x == 2u) {
         HairStyle s = characters[in_character].style;
         vec3 sc = marschner(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees));
         float cos_i = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));
-        c = (sc * (LIGHT_IRRADIANCE * cos_i * lit * cl.single) + base * (AMBIENT * cl.multiple)) * root_shadow;
+        c = (sc * (LIGHT_IRRADIANCE * cos_i * lit) + base * AMBIENT) * root_shadow;
     } else {
         float tl = dot(t, l);
         float diffuse = sqrt(max(1.0 - tl * tl, 0.0));
         vec3 h = normalize(l + e);
         float th = dot(t, h);
         float spec = pow(sqrt(max(1.0 - th * th, 0.0)), 80.0);
-        c = base * (0.25 * cl.multiple + 0.75 * diffuse * lit * cl.single) * root_shadow + vec3(0.25) * (spec * lit * cl.single) * root_shadow;
+        c = base * (0.25 + 0.75 * diffuse * lit) * root_shadow + vec3(0.25) * (spec * lit) * root_shadow;
     }
     return c;
 }
 
 // Opacity of this fragment over its pixel: one strand's opacity times the fraction of the
-// pixel it covers (coverage to alpha, seed 002), aggregated under LoD.
+// pixel it covers (coverage to alpha, seed 002), aggregated under LoD (lod_appearance.glsl).
 float strand_alpha() {
     return cluster_opacity(STRAND_OPACITY * clamp(in_coverage, 0.0, 1.0), in_thickness);
 }

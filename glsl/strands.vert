@@ -36,13 +36,15 @@ void main() {
     uint end = (corner == 2u || corner == 3u || corner == 5u) ? 1u : 0u;
     float side = (corner == 1u || corner == 4u || corner == 5u) ? 1.0 : -1.0;
     HairVertex v = hair_vertices[bundle_offsets[lo].y + strand * (segments + 1u) + seg + end];
-    vec3 world = strip_offset(v.pos_width.xyz, v.tangent_s.xyz, v.pos_width.w, side);
+    float thickness = uintBitsToFloat(bundle_lods[lo].w);
+    float drawn = drawn_width(v.pos_width.xyz, v.pos_width.w, thickness, model_scale * bundles[lo].rest_size);
+    vec3 world = strip_offset(v.pos_width.xyz, v.tangent_s.xyz, drawn, side);
     gl_Position = frame.view_proj * vec4(world, 1.0);
     out_tangent = v.tangent_s.xyz;
     out_s = v.tangent_s.w;
     out_pos = world;
     out_color = style_color();
     out_character = bundles[lo].character;
-    out_coverage = strip_coverage(v.pos_width.xyz, v.pos_width.w);
-    out_thickness = uintBitsToFloat(bundle_lods[lo].w);
+    out_coverage = strip_coverage(v.pos_width.w, drawn);
+    out_thickness = thickness;
 }

@@ -1,10 +1,11 @@
 // Camera-facing strip expansion shared by strands.vert (compute path) and strands.mesh, for
 // perspective views (the camera) and orthographic ones (the light: frame.light_dir.w == 0,
-// facing frame.light_dir). A strand thinner than one pixel is widened to one pixel so it does
-// not break into dots; strip_coverage says which fraction of that pixel-wide strip the strand
-// really covers (coverage to alpha, seed 002), for passes that accumulate opacity.
+// facing frame.light_dir). A strand thinner than one pixel is drawn one pixel wide so it does
+// not break into dots; strip_coverage says which fraction of the drawn strip the strand really
+// covers (coverage to alpha, seed 002), for passes that accumulate opacity.
 #ifndef STRIP_GLSL
 #define STRIP_GLSL
+#include "lod_appearance.glsl"
 
 // World size of one pixel at `pos`.
 float pixel_size(vec3 pos) {
@@ -14,16 +15,23 @@ float pixel_size(vec3 pos) {
     return frame.lod_ortho.x / frame.camera_pos.w;
 }
 
-vec3 strip_offset(vec3 pos, vec3 tangent, float width, float side) {
+// Width the strip is drawn with: the strand's (LoD-thickened) width, at least one pixel; with
+// the thick-strand term, at least the pixels of the `thickness` strands it stands for, capped
+// by the bundle's size `cap` (lod_appearance.glsl).
+float drawn_width(vec3 pos, float width, float thickness, float cap) {
+    return max(width, cluster_min_width(pixel_size(pos), thickness, cap));
+}
+
+vec3 strip_offset(vec3 pos, vec3 tangent, float drawn, float side) {
     vec3 to_eye = frame.light_dir.w > 0.0 ? normalize(frame.camera_pos.xyz - pos) : frame.light_dir.xyz;
     vec3 across = cross(tangent, to_eye);
     across = length(across) > 1e-6 ? normalize(across) : normalize(cross(tangent, vec3(0.0, 0.0, 1.0)) + 1e-6);
-    return pos + across * (side * 0.5 * max(width, pixel_size(pos)));
+    return pos + across * (side * 0.5 * drawn);
 }
 
 // Fraction of the drawn strip the strand covers: 1 when wider than a pixel.
-float strip_coverage(vec3 pos, float width) {
-    return clamp(width / max(pixel_size(pos), 1e-12), 0.0, 1.0);
+float strip_coverage(float width, float drawn) {
+    return clamp(width / max(drawn, 1e-12), 0.0, 1.0);
 }
 
 #endif

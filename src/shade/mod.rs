@@ -12,6 +12,8 @@
 
 use glam::Vec3;
 
+pub mod lod_appearance;
+
 /// Which model shades the strands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[repr(u32)]
