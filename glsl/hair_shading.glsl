@@ -3,6 +3,16 @@
 // eq. 1) with the azimuthal fits of Karis 2016. All directions point away from the fibre.
 #ifndef HAIR_SHADING_GLSL
 #define HAIR_SHADING_GLSL
+#include "shared.glsl"
+
+// The colour-independent TT / TRT azimuthal factors, tabulated at start-up (src/shade/lut.rs;
+// seed 001's precomputation idea). Includers other than the hair passes (the test probe) name
+// its set and binding first.
+#ifndef SHADING_LUT_SET
+#define SHADING_LUT_SET SET_FRAME
+#define SHADING_LUT_BINDING BINDING_SHADING_LUT
+#endif
+layout(set = SHADING_LUT_SET, binding = SHADING_LUT_BINDING) uniform sampler2D marschner_lut;
 
 #define HAIR_ETA 1.55
 #define KAJIYA_KAY_EXPONENT 80.0
@@ -45,15 +55,13 @@ vec3 marschner(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt) 
     float m_tt = 0.5 * hair_gaussian(0.5 * b, theta_h - 0.5 * a);
     float m_trt = 0.5 * hair_gaussian(2.0 * b, theta_h - 1.5 * a);
     float n_r = 0.25 * cos_half_phi * hair_fresnel(HAIR_ETA, sqrt(max(0.5 + 0.5 * dot(l, v), 0.0)));
-    float eta_p = 1.19 / cos_d + 0.36 * cos_d;
-    float inv_eta = 1.0 / eta_p;
-    float h_tt = (1.0 + inv_eta * (0.6 - 0.8 * cos_phi)) * cos_half_phi;
-    float path_tt = sqrt(max(1.0 - h_tt * h_tt * inv_eta * inv_eta, 0.0)) / (2.0 * cos_d);
-    float f_tt = hair_fresnel(HAIR_ETA, cos_d * sqrt(max(1.0 - h_tt * h_tt, 0.0)));
+    // Texel centres sit at cos(phi) = -1 + 2 i / (PHI - 1), cos(theta_d) = j / (D - 1).
+    vec2 size = vec2(MARSCHNER_LUT_PHI, MARSCHNER_LUT_D);
+    vec2 uv = (vec2(0.5 + 0.5 * cos_phi, cos_d) * (size - 1.0) + 0.5) / size;
+    vec3 az = textureLod(marschner_lut, uv, 0.0).rgb;
     vec3 base = max(color, vec3(1e-4));
-    vec3 n_tt = pow(base, vec3(path_tt)) * ((1.0 - f_tt) * (1.0 - f_tt) * exp(-3.65 * cos_phi - 3.98));
-    float f_trt = hair_fresnel(HAIR_ETA, cos_d * 0.5);
-    vec3 n_trt = pow(base, vec3(0.8 / cos_d)) * ((1.0 - f_trt) * (1.0 - f_trt) * f_trt * exp(17.0 * cos_phi - 16.78));
+    vec3 n_tt = pow(base, vec3(az.r / (2.0 * cos_d))) * az.g;
+    vec3 n_trt = pow(base, vec3(0.8 / cos_d)) * (az.b / MARSCHNER_LUT_TRT_SCALE);
     return (vec3(m_r * n_r) + n_tt * m_tt + n_trt * m_trt) * (MARSCHNER_ENERGY_SCALE / (cos_d * cos_d));
 }
 

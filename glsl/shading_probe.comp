@@ -2,8 +2,10 @@
 // Test probe (tests/shading_twin.rs): evaluates the GPU shading models at given directions so
 // they can be compared with their CPU twins in src/shade/mod.rs. Per sample, inputs are five
 // vec4 (tangent, to light, to eye, colour + roughness, tilt) and outputs two vec4 (Marschner
-// rgb; Kajiya-Kay diffuse, specular).
+// rgb; Kajiya-Kay diffuse, specular). Binding 2: the Marschner lookup texture.
 #extension GL_GOOGLE_include_directive : require
+#define SHADING_LUT_SET 0
+#define SHADING_LUT_BINDING 2
 #include "hair_shading.glsl"
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0, std430) readonly buffer Inputs { vec4 inputs[]; };

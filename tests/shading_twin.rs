@@ -6,12 +6,14 @@ mod common;
 
 use ash::vk::BufferUsageFlags;
 use glam::Vec3;
+use hairmesh::render::passes::shader_options;
+use hairmesh::render::shared::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI};
 use hairmesh::rng::Pcg32;
 use hairmesh::shade::{MarschnerParams, kajiya_kay, marschner};
-use hairmesh::vk::shader::{ShaderOptions, compile};
+use hairmesh::vk::shader::compile;
 use hairmesh::vk::{
     Access, BindingDesc, Buffer, BufferDesc, DescriptorKind, DescriptorSet, DescriptorSetLayout,
-    Pipeline, PipelineLayout,
+    Image, ImageDesc, Pipeline, PipelineLayout, Sampler,
 };
 
 fn unit(rng: &mut Pcg32) -> Vec3 {
@@ -69,14 +71,29 @@ fn gpu_shading_equals_the_cpu_twin() {
         &[
             BindingDesc::single(0, DescriptorKind::StorageBuffer),
             BindingDesc::single(1, DescriptorKind::StorageBuffer),
+            BindingDesc::single(2, DescriptorKind::SampledImage),
         ],
     )
     .unwrap();
+    // The lookup texture the renderer builds (src/shade/lut.rs).
+    let lut = Image::with_data(
+        &ctx,
+        &ImageDesc::new_2d(
+            "marschner lut",
+            ash::vk::Format::R16G16B16A16_UNORM,
+            MARSCHNER_LUT_PHI,
+            MARSCHNER_LUT_D,
+        ),
+        bytemuck::cast_slice(&hairmesh::shade::lut::marschner_lut()),
+    )
+    .unwrap();
+    let sampler = Sampler::linear_clamp(&ctx).unwrap();
     let set = DescriptorSet::new(&ctx, "probe", &layout).unwrap();
     set.write_buffer(0, &input).unwrap();
     set.write_buffer(1, &output).unwrap();
+    set.write_image(2, 0, &lut, &sampler).unwrap();
     let pipeline_layout = PipelineLayout::new(&ctx, &[layout]).unwrap();
-    let spirv = compile("shading_probe.comp", &ShaderOptions::default()).unwrap();
+    let spirv = compile("shading_probe.comp", &shader_options(1)).unwrap();
     let pipeline = Pipeline::compute(&ctx, "shading probe", &pipeline_layout, &spirv).unwrap();
     ctx.submit_and_wait(|rec| {
         rec.bind(&pipeline, &[&set]);

@@ -28,6 +28,13 @@ pub const SCAN_BLOCK: u32 = 1024;
 pub const DISPATCH_ROW: u32 = 65535;
 /// `CharacterRecord::flags`: the character is drawn this frame.
 pub const CHARACTER_VISIBLE: u32 = 1;
+/// Marschner lookup texture (`shade::lut`): texels over `cos(phi)`.
+pub const MARSCHNER_LUT_PHI: u32 = 256;
+/// Marschner lookup texture: texels over `cos(theta_d)`.
+pub const MARSCHNER_LUT_D: u32 = 64;
+/// Marschner lookup texture: scale of the TRT attenuation channel (its largest value is
+/// 0.185).
+pub const MARSCHNER_LUT_TRT_SCALE: f32 = 5.0;
 
 /// Descriptor set 0: per-frame data and the crowd's tables.
 pub const SET_FRAME: u32 = 0;
@@ -77,11 +84,13 @@ pub enum FrameBinding {
     PeelDepth = 16,
     /// Depth peeling: per pixel, premultiplied colour and opacity composited front to back.
     PeelAccum = 17,
+    /// The Marschner lookup texture (`shade::lut`, sampled bilinearly).
+    ShadingLut = 18,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 18] = [
+    pub const ALL: [(FrameBinding, &'static str); 19] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -100,6 +109,7 @@ impl FrameBinding {
         (FrameBinding::OitTail, "BINDING_OIT_TAIL"),
         (FrameBinding::PeelDepth, "BINDING_PEEL_DEPTH"),
         (FrameBinding::PeelAccum, "BINDING_PEEL_ACCUM"),
+        (FrameBinding::ShadingLut, "BINDING_SHADING_LUT"),
     ];
 
     /// What the binding holds.
@@ -109,7 +119,8 @@ impl FrameBinding {
             FrameBinding::Frame => DescriptorKind::UniformBuffer,
             FrameBinding::ShadowHairDepth
             | FrameBinding::ShadowPropDepth
-            | FrameBinding::ShadowLayers => DescriptorKind::SampledImage,
+            | FrameBinding::ShadowLayers
+            | FrameBinding::ShadingLut => DescriptorKind::SampledImage,
             _ => DescriptorKind::StorageBuffer,
         }
     }
@@ -517,7 +528,7 @@ pub fn glsl_header() -> String {
          // Shaders are compiled with this text; this copy is for reading.\n\
          #ifndef SHARED_GLSL\n#define SHARED_GLSL\n"
     );
-    let consts: [(&str, u32); 14] = [
+    let consts: [(&str, u32); 16] = [
         ("STRAND_GROUP_SIZE", STRAND_GROUP_SIZE),
         ("MAX_VERTS_LOG2", MAX_VERTS_LOG2),
         ("MAX_SEGMENTS", MAX_SEGMENTS),
@@ -530,6 +541,8 @@ pub fn glsl_header() -> String {
         ("SCAN_BLOCK", SCAN_BLOCK),
         ("DISPATCH_ROW", DISPATCH_ROW),
         ("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
+        ("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
+        ("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
         ("SET_FRAME", SET_FRAME),
         ("SET_TEXTURES", SET_TEXTURES),
     ];
@@ -546,7 +559,10 @@ pub fn glsl_header() -> String {
         };
         let _ = writeln!(out, "#define {name} {v}{suffix}");
     }
-    let float_consts = [("STRAND_OPACITY", super::transparency::STRAND_OPACITY)];
+    let float_consts = [
+        ("STRAND_OPACITY", super::transparency::STRAND_OPACITY),
+        ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
+    ];
     for (name, v) in float_consts {
         let _ = writeln!(out, "#define {name} {v:?}");
     }

@@ -1,5 +1,6 @@
 //! GPU working buffers shared by the frames: root samples, per-bundle LoD decisions and prefix
-//! sums, scan scratch, indirect arguments + statistics, and the compute path's vertex pool.
+//! sums, scan scratch, indirect arguments + statistics, the compute path's vertex pool, and the
+//! Marschner lookup texture.
 //! Sized by the crowd's bundle count (grown by half again when too small, never shrunk); the
 //! pool is allocated when the compute path is first used.
 
@@ -9,9 +10,9 @@ use ash::vk;
 use glam::Vec2;
 
 use super::passes::compute_generate::scan_plan;
-use super::shared::{FrameBinding, GenerateArgs};
+use super::shared::{FrameBinding, GenerateArgs, MARSCHNER_LUT_D, MARSCHNER_LUT_PHI};
 use crate::bake::blue_noise::{quad_samples, triangle_samples};
-use crate::vk::{Buffer, BufferDesc, Context, DescriptorSet, GpuResult};
+use crate::vk::{Buffer, BufferDesc, Context, DescriptorSet, GpuResult, Image, ImageDesc, Sampler};
 
 fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
     Buffer::new(
@@ -51,6 +52,9 @@ pub struct Workspace {
     pub pool: Option<Buffer>,
     placeholder: Buffer,
     bundles: u32,
+    /// The Marschner lookup texture (`shade::lut`), built at start-up.
+    shading_lut: Image,
+    lut_sampler: Sampler,
 }
 
 /// Buffers replaced by a resize, to retire with the current frame.
@@ -89,6 +93,17 @@ impl Workspace {
             pool: None,
             placeholder: storage(ctx, "vertex pool (unused)", 16)?,
             bundles: 0,
+            shading_lut: Image::with_data(
+                ctx,
+                &ImageDesc::new_2d(
+                    "marschner lut",
+                    vk::Format::R16G16B16A16_UNORM,
+                    MARSCHNER_LUT_PHI,
+                    MARSCHNER_LUT_D,
+                ),
+                bytemuck::cast_slice(&crate::shade::lut::marschner_lut()),
+            )?,
+            lut_sampler: Sampler::linear_clamp(ctx)?,
         })
     }
 
@@ -158,6 +173,10 @@ impl Workspace {
                         _ => &maps.layers,
                     };
                     set.write_image(b as u32, 0, image, &maps.sampler)?;
+                    continue;
+                }
+                FrameBinding::ShadingLut => {
+                    set.write_image(b as u32, 0, &self.shading_lut, &self.lut_sampler)?;
                     continue;
                 }
             };

@@ -13,6 +13,7 @@
 use glam::Vec3;
 
 pub mod lod_appearance;
+pub mod lut;
 
 /// Which model shades the strands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -103,17 +104,41 @@ pub fn marschner(t: Vec3, l: Vec3, v: Vec3, p: &MarschnerParams) -> Vec3 {
     let m_trt = 0.5 * gaussian(2.0 * b, theta_h - 1.5 * a);
     // Azimuthal (Karis 2016).
     let n_r = 0.25 * cos_half_phi * fresnel(HAIR_ETA, (0.5 + 0.5 * l.dot(v)).max(0.0).sqrt());
+    let az = azimuthal_factors(cos_phi, cos_d);
+    let absorb = |path: f32| p.color.max(Vec3::splat(1e-4)).powf(path);
+    let n_tt = absorb(az.tt_path / (2.0 * cos_d)) * az.tt;
+    let n_trt = absorb(0.8 / cos_d) * az.trt;
+    (Vec3::splat(m_r * n_r) + n_tt * m_tt + n_trt * m_trt) * (ENERGY_SCALE / (cos_d * cos_d))
+}
+
+/// The colour-independent parts of the TT and TRT azimuthal terms (Karis 2016) at
+/// `cos(phi)` and `cos(theta_d)`: what the GPU reads from the Marschner lookup texture
+/// ([`lut`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AzimuthalFactors {
+    /// TT path length through the fibre times `2 cos(theta_d)`, in [0, 1].
+    pub tt_path: f32,
+    /// TT attenuation: `(1 - F)^2 exp(-3.65 cos(phi) - 3.98)`.
+    pub tt: f32,
+    /// TRT attenuation: `(1 - F)^2 F exp(17 cos(phi) - 16.78)`.
+    pub trt: f32,
+}
+
+/// [`AzimuthalFactors`] at `cos_phi` in [-1, 1] and `cos_d` in (0, 1].
+pub fn azimuthal_factors(cos_phi: f32, cos_d: f32) -> AzimuthalFactors {
+    let cos_d = cos_d.max(1e-3);
+    let cos_half_phi = (0.5 + 0.5 * cos_phi).max(0.0).sqrt();
     let eta_p = 1.19 / cos_d + 0.36 * cos_d;
     let inv_eta = 1.0 / eta_p;
     let h_tt = (1.0 + inv_eta * (0.6 - 0.8 * cos_phi)) * cos_half_phi;
-    let path_tt = (1.0 - h_tt * h_tt * inv_eta * inv_eta).max(0.0).sqrt() / (2.0 * cos_d);
+    let tt_path = (1.0 - h_tt * h_tt * inv_eta * inv_eta).max(0.0).sqrt();
     let f_tt = fresnel(HAIR_ETA, cos_d * (1.0 - h_tt * h_tt).max(0.0).sqrt());
-    let absorb = |path: f32| p.color.max(Vec3::splat(1e-4)).powf(path);
-    let n_tt = absorb(path_tt) * ((1.0 - f_tt) * (1.0 - f_tt) * (-3.65 * cos_phi - 3.98).exp());
     let f_trt = fresnel(HAIR_ETA, cos_d * 0.5);
-    let n_trt = absorb(0.8 / cos_d)
-        * ((1.0 - f_trt) * (1.0 - f_trt) * f_trt * (17.0 * cos_phi - 16.78).exp());
-    (Vec3::splat(m_r * n_r) + n_tt * m_tt + n_trt * m_trt) * (ENERGY_SCALE / (cos_d * cos_d))
+    AzimuthalFactors {
+        tt_path,
+        tt: (1.0 - f_tt) * (1.0 - f_tt) * (-3.65 * cos_phi - 3.98).exp(),
+        trt: (1.0 - f_trt) * (1.0 - f_trt) * f_trt * (17.0 * cos_phi - 16.78).exp(),
+    }
 }
 
 /// The azimuthal fits with the `1 / cos^2(theta_d)` factor return up to 9.6% more energy than
