@@ -83,20 +83,19 @@ mod tests {
             let y = cos_d * (h - 1) as f32;
             let (i, j) = ((x as usize).min(w - 2), (y as usize).min(h - 2));
             let (fx, fy) = (x - i as f32, y - j as f32);
-            let mut v = [0.0f32; 4];
-            for c in 0..4 {
+            let v: [f32; 4] = std::array::from_fn(|c| {
                 let top = texel(i, j)[c] * (1.0 - fx) + texel(i + 1, j)[c] * fx;
                 let bottom = texel(i, j + 1)[c] * (1.0 - fx) + texel(i + 1, j + 1)[c] * fx;
-                v[c] = top * (1.0 - fy) + bottom * fy;
-            }
+                top * (1.0 - fy) + bottom * fy
+            });
             let f = super::super::azimuthal_factors(cos_phi, cos_d);
             let errs = [
                 (v[0] - f.tt_path).abs(),
                 (v[1] - f.tt).abs() / f.tt.max(1e-2),
                 (v[2] / MARSCHNER_LUT_TRT_SCALE - f.trt).abs() / f.trt.max(1e-3),
             ];
-            for k in 0..3 {
-                worst[k] = worst[k].max(errs[k]);
+            for (w, e) in worst.iter_mut().zip(errs) {
+                *w = w.max(e);
             }
         }
         println!(
