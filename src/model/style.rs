@@ -131,12 +131,58 @@ pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
     }
 }
 
+/// Largest melanin concentration accepted (black hair is about 8).
+pub const MAX_MELANIN: f32 = 50.0;
+
+/// `[eumelanin, pheomelanin]` from a TOML value: two finite numbers in `0..=MAX_MELANIN`.
+fn parse_melanin(v: &toml::Value) -> std::result::Result<[f32; 2], String> {
+    let items = v
+        .as_array()
+        .filter(|a| a.len() == 2)
+        .ok_or("expected [eumelanin, pheomelanin]")?;
+    let mut m = [0.0f32; 2];
+    for (slot, item) in m.iter_mut().zip(items) {
+        let x = item
+            .as_float()
+            .or_else(|| item.as_integer().map(|i| i as f64))
+            .ok_or("expected numbers")?;
+        if !(0.0..=MAX_MELANIN as f64).contains(&x) {
+            return Err(format!("{x} is outside 0..={MAX_MELANIN}"));
+        }
+        *slot = x as f32;
+    }
+    Ok(m)
+}
+
 impl HairStyle {
-    /// Parse a style from TOML text; `name` is used in errors.
+    /// Parse a style from TOML text; `name` is used in errors. Besides the fields, the text
+    /// may give `melanin = [eumelanin, pheomelanin]` (concentrations, 0..=50) instead of
+    /// `color`: the colour is then the fibre's transmittance per diameter for that melanin
+    /// ([`crate::shade::melanin_color`]).
     pub fn from_toml(name: &str, text: &str) -> Result<Self> {
-        let style: HairStyle = toml::from_str(text).map_err(|e| {
-            HairError::invalid(name, format!("bad style: {}", toml_error(text, &e)))
-        })?;
+        let bad = |e: &toml::de::Error| {
+            HairError::invalid(name, format!("bad style: {}", toml_error(text, e)))
+        };
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| bad(&e))?;
+        let style: HairStyle = match table.remove("melanin") {
+            // Parsed from the text itself, so errors keep their line.
+            None => toml::from_str(text).map_err(|e| bad(&e))?,
+            Some(melanin) => {
+                if table.contains_key("color") {
+                    return Err(HairError::invalid(
+                        name,
+                        "bad style: give color or melanin, not both",
+                    ));
+                }
+                let m = parse_melanin(&melanin)
+                    .map_err(|e| HairError::invalid(name, format!("bad style: melanin: {e}")))?;
+                let mut s: HairStyle = table.try_into().map_err(|e: toml::de::Error| {
+                    HairError::invalid(name, format!("bad style: {}", e.message().trim()))
+                })?;
+                s.color = crate::shade::melanin_color(m[0], m[1]).to_array();
+                s
+            }
+        };
         style.validate(name)?;
         Ok(style)
     }
@@ -246,5 +292,34 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("length_variation"), "{e}");
+    }
+
+    #[test]
+    fn melanin_gives_the_colour() {
+        let dark = HairStyle::from_toml("t", "melanin = [8.0, 0.0]").unwrap();
+        let blond = HairStyle::from_toml("t", "melanin = [0.3, 0.1]\nroughness = 0.3").unwrap();
+        let red = HairStyle::from_toml("t", "melanin = [0.3, 1.5]").unwrap();
+        assert_eq!(blond.roughness, 0.3);
+        assert!(dark.color.iter().all(|&c| c < 0.05), "{:?}", dark.color);
+        assert!(blond.color.iter().all(|&c| c > 0.55), "{:?}", blond.color);
+        // Red hair: red well above green, green above blue.
+        assert!(red.color[0] > 1.4 * red.color[1] && red.color[1] > red.color[2]);
+        assert_eq!(
+            blond.color,
+            crate::shade::melanin_color(0.3, 0.1).to_array()
+        );
+        for (bad, what) in [
+            ("melanin = [1.0]", "expected [eumelanin"),
+            ("melanin = [1.0, -1.0]", "outside"),
+            ("melanin = [\"a\", 1.0]", "expected numbers"),
+            ("melanin = [1.0, 0.0]\ncolor = [0.1, 0.1, 0.1]", "not both"),
+            ("melanin = [1.0, 0.0]\nstrand_widht = 0.1", "strand_widht"),
+        ] {
+            let e = HairStyle::from_toml("s.toml", bad).unwrap_err().to_string();
+            assert!(
+                e.starts_with("s.toml: bad style") && e.contains(what),
+                "{bad}: {e}"
+            );
+        }
     }
 }

@@ -42,6 +42,22 @@ impl std::str::FromStr for ShadingModel {
     }
 }
 
+/// Absorption per fibre diameter of eumelanin and pheomelanin at unit concentration, linear
+/// RGB (d'Eon et al. 2011, as used by Chiang et al. 2016).
+pub const EUMELANIN_SIGMA_A: [f32; 3] = [0.419, 0.697, 1.37];
+/// See [`EUMELANIN_SIGMA_A`].
+pub const PHEOMELANIN_SIGMA_A: [f32; 3] = [0.187, 0.4, 1.05];
+
+/// Hair colour (transmittance across one fibre diameter, the `color` the Marschner model
+/// absorbs with as `color^path`) from melanin concentrations: `exp(-sigma_a)` with
+/// `sigma_a = eumelanin * EUMELANIN_SIGMA_A + pheomelanin * PHEOMELANIN_SIGMA_A` (Chiang et al.
+/// 2016, sec. 4.2). About 0.3 is blond, 1.3 brown, 8 black; pheomelanin reddens.
+pub fn melanin_color(eumelanin: f32, pheomelanin: f32) -> Vec3 {
+    let sigma =
+        Vec3::from(EUMELANIN_SIGMA_A) * eumelanin + Vec3::from(PHEOMELANIN_SIGMA_A) * pheomelanin;
+    (-sigma).exp()
+}
+
 /// Refractive index of hair keratin.
 pub const HAIR_ETA: f32 = 1.55;
 /// Kajiya-Kay specular exponent.
