@@ -34,7 +34,16 @@ fn corner_xi(layout: &hairmesh::bake::layout::RootLayout, f: usize, v: u32) -> V
 fn texture_curves_match_catmull_rom_columns() {
     for charts in [true, false] {
         let m = mesh("head_long.obj");
-        let baked = bake(&m, &HairStyle::default(), BakeOptions { charts }, |_, _| {}).unwrap();
+        let baked = bake(
+            &m,
+            &HairStyle::default(),
+            BakeOptions {
+                charts,
+                ..Default::default()
+            },
+            |_, _| {},
+        )
+        .unwrap();
         let tex = HairTextures::new(&baked);
         let layout = layout_root_slice(&m, charts);
         // Quantisation: 1/65535 of the extent per axis, plus f32 filtering noise.
@@ -64,7 +73,16 @@ fn styling_is_continuous_across_bundle_borders() {
     style.wave_amplitude = 0.01;
     style.wave_frequency = 5.0;
     // Per-face 2x2 blocks: the two sides of an edge read different texels (copies).
-    let baked = bake(&m, &style, BakeOptions { charts: false }, |_, _| {}).unwrap();
+    let baked = bake(
+        &m,
+        &style,
+        BakeOptions {
+            charts: false,
+            ..Default::default()
+        },
+        |_, _| {},
+    )
+    .unwrap();
     let tex = HairTextures::new(&baked);
     let layout = layout_root_slice(&m, false);
     let mut checked = 0;

@@ -85,6 +85,7 @@ fn run(args: Args) -> Result<()> {
         &mesh,
         &style,
         BakeOptions {
+            motion_margin: 0.0,
             charts: !args.no_charts,
         },
         |done, total| {

@@ -17,15 +17,16 @@
 pub mod baked_file;
 pub mod blue_noise;
 pub mod curve;
+pub mod deform;
 pub mod layout;
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat2, Vec3};
+use glam::Vec3;
 
 use crate::bake::curve::column_control_points;
 use crate::bake::layout::{EMPTY_TEXEL, RootLayout, layout_root_slice};
 use crate::error::{HairError, Result};
-use crate::model::hair_mesh::{HairMesh, bounds, corner_triangle};
+use crate::model::hair_mesh::{HairMesh, bounds};
 use crate::model::style::HairStyle;
 
 /// Texture decode constants and sizes, shared with GLSL as `MeshInfo` (std430, 64 bytes).
@@ -171,11 +172,17 @@ impl BakedHairMesh {
 pub struct BakeOptions {
     /// Pack grid-like regions as shared-vertex charts (else one 2x2 block per face).
     pub charts: bool,
+    /// Grow the position decode box by this much on every side (object units), so that an
+    /// animated mesh ([`deform`]) stays inside it; 0 for static hair.
+    pub motion_margin: f32,
 }
 
 impl Default for BakeOptions {
     fn default() -> Self {
-        BakeOptions { charts: true }
+        BakeOptions {
+            charts: true,
+            motion_margin: 0.0,
+        }
     }
 }
 
@@ -186,43 +193,7 @@ pub const MAX_TEXTURE_SIDE: u32 = 2048;
 /// average of each corner triangle's linear map of the uv axes, normalised. Shared by every
 /// bundle meeting at the vertex, so styling has no seams between bundles.
 pub fn styling_directions(mesh: &HairMesh, layer: usize) -> (Vec<Vec3>, Vec<Vec3>) {
-    let n = mesh.vertices_per_layer();
-    let p = &mesh.layers[layer];
-    let mut su = vec![Vec3::ZERO; n];
-    let mut sv = vec![Vec3::ZERO; n];
-    let mut sa = vec![0.0f32; n];
-    for face in &mesh.faces {
-        let v = face.vertices();
-        for c in 0..v.len() {
-            let [i0, i1, i2] = corner_triangle(v, c);
-            let (uv0, uv1, uv2) = (mesh.uv[i0], mesh.uv[i1], mesh.uv[i2]);
-            // Eq. 2: T_i = [uv1 - uv0, uv2 - uv0] as columns.
-            let t = Mat2::from_cols(uv1 - uv0, uv2 - uv0);
-            let det = t.determinant();
-            if det.abs() < 1e-20 {
-                continue; // validated meshes have none; stay robust for deformed ones
-            }
-            let inv = t.inverse();
-            // Eq. 3: [u_i v_i] = [p1 - p0, p2 - p0] T_i^-1.
-            let (e1, e2) = (p[i1] - p[i0], p[i2] - p[i0]);
-            let ui = e1 * inv.x_axis.x + e2 * inv.x_axis.y;
-            let vi = e1 * inv.y_axis.x + e2 * inv.y_axis.y;
-            let area = 0.5 * det.abs();
-            su[i0] += ui * area;
-            sv[i0] += vi * area;
-            sa[i0] += area;
-        }
-    }
-    // Eq. 1: area-weighted mean, normalised (the division by sum A_i cancels in the normalisation).
-    let u = su
-        .iter()
-        .map(|x| x.try_normalize().unwrap_or(Vec3::X))
-        .collect();
-    let v = sv
-        .iter()
-        .map(|x| x.try_normalize().unwrap_or(Vec3::Y))
-        .collect();
-    (u, v)
+    deform::StylingBasis::new(mesh).directions(&mesh.layers[layer])
 }
 
 /// Quantise `x` in `[0, 1]` to UNORM16.
@@ -275,7 +246,14 @@ pub fn bake(
             progress(i, total_steps);
         }
     }
+    if !(options.motion_margin.is_finite() && options.motion_margin >= 0.0) {
+        return Err(HairError::invalid(
+            &mesh.name,
+            format!("motion margin {} must be >= 0", options.motion_margin),
+        ));
+    }
     let (lo, hi) = bounds(ctrl.iter().flatten().copied());
+    let (lo, hi) = (lo - options.motion_margin, hi + options.motion_margin);
     let extent = safe_extent(hi - lo);
     let (uv_lo, uv_hi) = bounds(mesh.uv.iter().map(|uv| uv.extend(0.0)));
     let uv_extent = safe_extent(uv_hi - uv_lo).truncate();
@@ -287,39 +265,27 @@ pub fn bake(
         .max(1e-12);
 
     let slice = layout.texels.len();
-    let mut position = vec![[0u16; 4]; slice * depth];
+    let position = deform::encode_columns(&layout.texels, &ctrl, lo, extent);
     let mut uv = vec![[0u16; 2]; slice];
     let mut w = vec![0u16; slice * layers];
-    let mut u_dir = vec![[0i16; 4]; slice * layers];
-    let mut v_dir = vec![[0i16; 4]; slice * layers];
-
     for (t, &vert) in layout.texels.iter().enumerate() {
         if vert == EMPTY_TEXEL {
             continue;
         }
         let vi = vert as usize;
-        for (z, p) in ctrl[vi].iter().enumerate() {
-            let q = (*p - lo) / extent;
-            position[z * slice + t] = [to_unorm16(q.x), to_unorm16(q.y), to_unorm16(q.z), 0];
-        }
         let q = (mesh.uv[vi] - uv_lo.truncate()) / uv_extent;
         uv[t] = [to_unorm16(q.x), to_unorm16(q.y)];
         for k in 0..layers {
             w[k * slice + t] = to_unorm16(mesh.w[k][vi] / w_scale);
         }
     }
+    let styling = deform::StylingBasis::new(mesh);
+    let mut dirs = Vec::with_capacity(layers);
     for k in 0..layers {
-        let (us, vs) = styling_directions(mesh, k);
-        for (t, &vert) in layout.texels.iter().enumerate() {
-            if vert == EMPTY_TEXEL {
-                continue;
-            }
-            let (a, b) = (us[vert as usize], vs[vert as usize]);
-            u_dir[k * slice + t] = [to_snorm16(a.x), to_snorm16(a.y), to_snorm16(a.z), 0];
-            v_dir[k * slice + t] = [to_snorm16(b.x), to_snorm16(b.y), to_snorm16(b.z), 0];
-        }
+        dirs.push(styling.directions(&mesh.layers[k]));
         progress(n + k + 1, total_steps);
     }
+    let [u_dir, v_dir] = deform::encode_directions(&layout.texels, &dirs);
 
     let sizes = mesh.bundle_sizes();
     let areas = mesh.bundle_areas();
