@@ -45,6 +45,15 @@
 #define BINDING_TEX_W 2
 #define BINDING_TEX_U 3
 #define BINDING_TEX_V 4
+#define DEFORM_PARAMS 0
+#define DEFORM_POSITIONS 1
+#define DEFORM_TEXEL_VERTEX 2
+#define DEFORM_STYLING_OFFSETS 3
+#define DEFORM_STYLING_TERMS 4
+#define DEFORM_POSITION_TEXELS 5
+#define DEFORM_U_TEXELS 6
+#define DEFORM_V_TEXELS 7
+#define EMPTY_TEXEL 4294967295u
 // Depth of the hair mesh texture: SLICES_PER_SEGMENT (L - 1) + 1 slices.
 #define POSITION_DEPTH(layers) (SLICES_PER_SEGMENT * ((layers) - 1u) + 1u)
 
@@ -168,6 +177,19 @@ struct TaskPayload {
     uint first_group[33];
     uint count;
     uint _pad[2];
+};
+
+struct DeformParams {
+    vec4 origin;
+    vec4 extent;
+    uvec4 counts;
+};
+
+struct StylingTerm {
+    uint i1;
+    uint i2;
+    vec2 u;
+    vec2 v;
 };
 
 #endif

@@ -101,10 +101,12 @@ fn model_scale(model: &Mat4) -> f32 {
     model.x_axis.truncate().length()
 }
 
-/// The five textures of one character.
+/// The GPU resources of one character: its five textures and, when its hair mesh moves, the
+/// update state.
 pub struct CharacterTextures {
-    _images: Vec<Image>,
+    images: Vec<Image>,
     bytes: u64,
+    deform: Option<super::deform::DeformState>,
 }
 
 struct Character {
@@ -258,6 +260,8 @@ impl Crowd {
             } else {
                 ImageDesc::new_3d(t.name, format, t.extent)
             };
+            // Transfer source: `Renderer::read_texture` reads them back.
+            let desc = desc.usage(vk::ImageUsageFlags::TRANSFER_SRC);
             let image = Image::with_data(&self.ctx, &desc, t.bytes)?;
             bytes += image.byte_size();
             images.push(image);
@@ -268,8 +272,9 @@ impl Crowd {
                 .write_image(binding as u32, slot, image, &self.sampler)?;
         }
         Ok(CharacterTextures {
-            _images: images,
+            images,
             bytes,
+            deform: None,
         })
     }
 
@@ -293,6 +298,86 @@ impl Crowd {
             textures: c.textures,
             slot: id.slot,
         })
+    }
+
+    /// Let character `id`'s hair mesh move: `basis` must come from the mesh and bake it was
+    /// added with (same root layout and layers); `layout` is the update pass's set layout.
+    pub fn make_deformable(
+        &mut self,
+        id: CharacterId,
+        basis: crate::bake::deform::DeformBasis,
+        layout: &Arc<DescriptorSetLayout>,
+    ) -> GpuResult<()> {
+        let ctx = self.ctx.clone();
+        let c = self.get_mut(id)?;
+        if basis.info != c.info {
+            return Err(GpuError::Unsupported(
+                "the deform basis belongs to another bake (decode box or layout differ)".into(),
+            ));
+        }
+        c.textures.deform = Some(super::deform::DeformState::new(&ctx, basis, layout)?);
+        Ok(())
+    }
+
+    /// Set the hair mesh pose of a deformable character for the next frame.
+    pub fn set_pose(&mut self, id: CharacterId, positions: &[glam::Vec3]) -> GpuResult<()> {
+        match &mut self.get_mut(id)?.textures.deform {
+            Some(d) => d.set_pose(positions),
+            None => Err(GpuError::Unsupported(format!(
+                "character {id:?} was not made deformable"
+            ))),
+        }
+    }
+
+    /// Write every pending pose into frame slot `frame`'s buffers; the character slots that
+    /// have an update this frame.
+    pub fn write_pending_poses(&mut self, frame: usize) -> GpuResult<Vec<usize>> {
+        let mut updated = Vec::new();
+        for (slot, c) in self.slots.iter_mut().enumerate() {
+            if let Some(d) = c.as_mut().and_then(|c| c.textures.deform.as_mut())
+                && d.write_pending(frame)?
+            {
+                updated.push(slot);
+            }
+        }
+        Ok(updated)
+    }
+
+    /// The update jobs of character slots `updated` for frame slot `frame`.
+    pub fn update_jobs(
+        &self,
+        frame: usize,
+        updated: &[usize],
+    ) -> Vec<super::passes::hair_mesh_update::UpdateJob<'_>> {
+        updated
+            .iter()
+            .filter_map(|&slot| self.slots.get(slot)?.as_ref())
+            .filter_map(|c| {
+                let d = c.textures.deform.as_ref()?;
+                let (set, groups) = d.dispatch(frame);
+                let img = |b: TextureBinding| &c.textures.images[b as usize];
+                Some(super::passes::hair_mesh_update::UpdateJob {
+                    set,
+                    groups,
+                    outputs: &d.outputs,
+                    images: [
+                        img(TextureBinding::Position),
+                        img(TextureBinding::U),
+                        img(TextureBinding::V),
+                    ],
+                })
+            })
+            .collect()
+    }
+
+    /// The image of character `id`'s texture `binding` (tests and tools read it back).
+    pub fn texture(&self, id: CharacterId, binding: TextureBinding) -> GpuResult<&Image> {
+        self.slots
+            .get(id.slot as usize)
+            .and_then(|c| c.as_ref())
+            .filter(|c| c.generation == id.generation)
+            .map(|c| &c.textures.images[binding as usize])
+            .ok_or_else(|| GpuError::Unsupported(format!("no character {id:?}")))
     }
 
     /// Make a retired slot available again.

@@ -5,6 +5,7 @@
 
 pub mod camera;
 pub mod crowd;
+pub mod deform;
 pub mod frame;
 pub mod passes;
 pub mod renderer;

@@ -108,6 +108,8 @@ struct FrameWork<'a> {
     shadows: Option<ShadowMode>,
     /// How strands are composited.
     transparency: super::Transparency,
+    /// Character slots whose hair mesh pose changed (rebuilt this frame).
+    pose_updates: Vec<usize>,
 }
 
 fn check_size(width: u32, height: u32) -> GpuResult<()> {
@@ -248,6 +250,55 @@ impl Renderer {
     /// Change a character's strand settings.
     pub fn set_params(&mut self, id: CharacterId, params: StrandParams) -> GpuResult<()> {
         self.crowd.set_params(id, params)
+    }
+
+    /// Let character `id`'s hair mesh move (`bake::deform`): `basis` from the mesh and bake it
+    /// was added with (bake with a `motion_margin` so the motion stays inside the decode box).
+    pub fn make_deformable(
+        &mut self,
+        id: CharacterId,
+        basis: crate::bake::deform::DeformBasis,
+    ) -> GpuResult<()> {
+        let layout = self.passes.deform_set_layout().clone();
+        self.crowd.make_deformable(id, basis, &layout)
+    }
+
+    /// Set a deformable character's hair mesh pose (`layers x vertices` object-space positions,
+    /// layer-major). The next frame rebuilds its hair mesh and u/v textures on the GPU before
+    /// anything reads them.
+    pub fn set_hair_mesh_pose(
+        &mut self,
+        id: CharacterId,
+        positions: &[glam::Vec3],
+    ) -> GpuResult<()> {
+        self.crowd.set_pose(id, positions)
+    }
+
+    /// Read back character `id`'s texture `binding` (tightly packed texels, as in the bake).
+    /// Waits for every frame in flight; for tests and tools.
+    pub fn read_texture(
+        &mut self,
+        id: CharacterId,
+        binding: super::shared::TextureBinding,
+    ) -> GpuResult<Vec<u8>> {
+        self.finish()?;
+        let image = self.crowd.texture(id, binding)?;
+        let mut readback = Buffer::new(
+            &self.ctx,
+            &BufferDesc::new(
+                "texture readback",
+                image.byte_size(),
+                vk::BufferUsageFlags::TRANSFER_DST,
+            )
+            .readback(),
+        )?;
+        self.ctx.submit_and_wait(|rec| {
+            rec.image_barrier(image, Access::SampledRead, Access::TransferRead);
+            rec.copy_image_to_buffer(image, &readback);
+            rec.image_barrier(image, Access::TransferRead, Access::SampledRead);
+            rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
+        })?;
+        readback.read()
     }
 
     /// Upload the prop meshes (triangle lists); instances refer to them by index. Replaces
@@ -476,7 +527,7 @@ impl Renderer {
             self.frames[i].retired.push(Retired::Resource(old));
         }
         self.prepare_workspace(i, path)?;
-        let (width, height) = self.targets.size();
+        let pose_updates = self.crowd.write_pending_poses(i)?;
         let bundles = self.crowd.bundle_count();
         let mut block = view.frame_block(
             width,
@@ -529,6 +580,7 @@ impl Renderer {
             props: &prop_draws,
             shadows,
             transparency: view.transparency,
+            pose_updates,
         };
         self.record(i, work, opts, present.as_mut())?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -571,6 +623,7 @@ impl Renderer {
             props,
             shadows,
             transparency,
+            pose_updates,
         } = work;
         let slot = &mut self.frames[i];
         let bg = self.background;
@@ -579,6 +632,9 @@ impl Renderer {
         if let Some(q) = &mut slot.mesh_query {
             q.reset(&mut rec);
         }
+        let jobs = self.crowd.update_jobs(i, &pose_updates);
+        self.passes
+            .record_updates(&mut rec, &mut slot.profiler, &jobs);
         let inputs = FrameInputs {
             sets: PassSets {
                 frame: &slot.set,

@@ -126,6 +126,55 @@ impl FrameBinding {
     }
 }
 
+/// Bindings of the hair mesh update pass's own set (`passes/hair_mesh_update.rs`,
+/// `glsl/hair_mesh_update.comp`): one set per animated character and frame slot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum DeformBinding {
+    /// `DeformParams`: decode box and counts.
+    Params = 0,
+    /// `vec4[]` layer vertex positions, layer-major (written by the CPU each frame).
+    Positions = 1,
+    /// `uint[]` root-slice texel -> vertex column (`EMPTY_TEXEL` where none).
+    TexelVertex = 2,
+    /// `uint[]` first styling term of each vertex (vertices + 1 entries).
+    StylingOffsets = 3,
+    /// `StylingTerm[]`.
+    StylingTerms = 4,
+    /// `uvec2[]` out: hair mesh texture texels (RGBA16 UNORM packed), copied into the texture.
+    PositionTexels = 5,
+    /// `uvec2[]` out: u-texture texels (RGBA16 SNORM packed).
+    UTexels = 6,
+    /// `uvec2[]` out: v-texture texels.
+    VTexels = 7,
+}
+
+impl DeformBinding {
+    /// Every binding, with its GLSL macro name.
+    pub const ALL: [(DeformBinding, &'static str); 8] = [
+        (DeformBinding::Params, "DEFORM_PARAMS"),
+        (DeformBinding::Positions, "DEFORM_POSITIONS"),
+        (DeformBinding::TexelVertex, "DEFORM_TEXEL_VERTEX"),
+        (DeformBinding::StylingOffsets, "DEFORM_STYLING_OFFSETS"),
+        (DeformBinding::StylingTerms, "DEFORM_STYLING_TERMS"),
+        (DeformBinding::PositionTexels, "DEFORM_POSITION_TEXELS"),
+        (DeformBinding::UTexels, "DEFORM_U_TEXELS"),
+        (DeformBinding::VTexels, "DEFORM_V_TEXELS"),
+    ];
+}
+
+/// Decode box and sizes of one animated character (`DeformBinding::Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DeformParams {
+    /// xyz: position of texel value 0 (`MeshInfo::pos_origin`).
+    pub origin: [f32; 4],
+    /// xyz: extent of the box.
+    pub extent: [f32; 4],
+    /// x root-slice texels, y layers, z vertices per layer, w unused.
+    pub counts: [u32; 4],
+}
+
 /// Bindings of set 1 ([`SET_TEXTURES`]): the five textures of paper 003 Table 1, each a
 /// bindless array indexed by the character's texture slot.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -462,6 +511,10 @@ pub struct StructInfo {
     /// Rust `size_of`.
     pub rust_size: usize,
 }
+gpu_struct!(DeformParams as "DeformParams" { origin: "vec4", extent: "vec4", counts: "uvec4" });
+gpu_struct!(crate::bake::deform::StylingTerm as "StylingTerm" {
+    i1: "uint", i2: "uint", u: "vec2", v: "vec2",
+});
 
 fn info<T: GpuStruct>() -> StructInfo {
     StructInfo {
@@ -486,6 +539,8 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<PropVertex>(),
         info::<PropInstance>(),
         info::<TaskPayload>(),
+        info::<DeformParams>(),
+        info::<crate::bake::deform::StylingTerm>(),
     ]
 }
 
@@ -572,6 +627,14 @@ pub fn glsl_header() -> String {
     for (b, name) in TextureBinding::ALL {
         let _ = writeln!(out, "#define {name} {}", b as u32);
     }
+    for (b, name) in DeformBinding::ALL {
+        let _ = writeln!(out, "#define {name} {}", b as u32);
+    }
+    let _ = writeln!(
+        out,
+        "#define EMPTY_TEXEL {}u",
+        crate::bake::layout::EMPTY_TEXEL
+    );
     let _ = writeln!(
         out,
         "// Depth of the hair mesh texture: SLICES_PER_SEGMENT (L - 1) + 1 slices.\n\

@@ -78,6 +78,11 @@ pub const SOURCES: &[(&str, &str)] = &[
         "oit_resolve.frag",
         include_str!("../../glsl/oit_resolve.frag"),
     ),
+    ("curve.glsl", include_str!("../../glsl/curve.glsl")),
+    (
+        "hair_mesh_update.comp",
+        include_str!("../../glsl/hair_mesh_update.comp"),
+    ),
 ];
 
 fn source(name: &str) -> Option<&'static str> {

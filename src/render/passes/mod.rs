@@ -2,6 +2,7 @@
 //! what it reads and writes.
 
 pub mod compute_generate;
+pub mod hair_mesh_update;
 pub mod props;
 pub mod scalp;
 pub mod shadow;
@@ -196,6 +197,7 @@ pub struct FramePasses {
     scalp: ScalpPass,
     strands: StrandDraw,
     transparency: TransparencyPass,
+    hair_mesh_update: hair_mesh_update::HairMeshUpdate,
 }
 
 /// Zero `args` (indirect arguments and statistics) after earlier generation used it.
@@ -237,7 +239,23 @@ impl FramePasses {
             scalp: ScalpPass::new(ctx, layout, targets)?,
             strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
+            hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
         })
+    }
+
+    /// Layout of the animated characters' update sets.
+    pub fn deform_set_layout(&self) -> &Arc<crate::vk::DescriptorSetLayout> {
+        self.hair_mesh_update.set_layout()
+    }
+
+    /// Record this frame's hair mesh texture rebuilds (before [`Self::record`]).
+    pub fn record_updates(
+        &self,
+        rec: &mut CommandRecorder,
+        profiler: &mut Profiler,
+        jobs: &[hair_mesh_update::UpdateJob],
+    ) {
+        self.hair_mesh_update.record(rec, profiler, jobs);
     }
 
     /// Check and compile what `mode` needs, before a frame uses it.

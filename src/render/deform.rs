@@ -1,0 +1,175 @@
+//! The GPU side of moving hair meshes (`bake::deform`): per animated character, the static
+//! basis (texel -> column map, styling terms, decode box) in buffers, one host-visible pose
+//! buffer per frame in flight, and the packed texels `glsl/hair_mesh_update.comp` writes before
+//! `passes::hair_mesh_update` copies them into the character's textures.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::Vec3;
+
+use super::frame::FRAMES_IN_FLIGHT;
+use super::shared::{DeformBinding, DeformParams};
+use crate::bake::deform::DeformBasis;
+use crate::vk::{
+    Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult,
+};
+
+/// Invocations of one `hair_mesh_update.comp` workgroup.
+pub const DEFORM_GROUP_SIZE: u32 = 64;
+
+/// One animated character's update state.
+pub struct DeformState {
+    basis: DeformBasis,
+    /// Per frame slot: the pose buffer and the set that reads it.
+    poses: Vec<(Buffer, DescriptorSet)>,
+    /// Packed output texels: hair mesh texture, u, v.
+    pub outputs: [Buffer; 3],
+    _static: [Buffer; 4],
+    /// A pose given since the last frame, waiting for a frame slot.
+    pending: Option<Vec<[f32; 4]>>,
+}
+
+fn storage(
+    ctx: &Arc<Context>,
+    name: &str,
+    bytes: u64,
+    extra: vk::BufferUsageFlags,
+) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            name,
+            bytes.max(16),
+            vk::BufferUsageFlags::STORAGE_BUFFER | extra,
+        ),
+    )
+}
+
+fn with_data(ctx: &Arc<Context>, name: &str, bytes: &[u8]) -> GpuResult<Buffer> {
+    let mut padded = bytes.to_vec();
+    padded.resize(bytes.len().max(16), 0);
+    Buffer::device_local_with_data(ctx, name, vk::BufferUsageFlags::STORAGE_BUFFER, &padded)
+}
+
+impl DeformState {
+    /// Buffers for `basis`; sets from `layout` (the update pass's).
+    pub fn new(
+        ctx: &Arc<Context>,
+        basis: DeformBasis,
+        layout: &Arc<DescriptorSetLayout>,
+    ) -> GpuResult<Self> {
+        let info = &basis.info;
+        let slice = info.slice_texels() as u64;
+        let layers = info.layers as u64;
+        let params = DeformParams {
+            origin: info.pos_origin,
+            extent: info.pos_extent,
+            counts: [slice as u32, info.layers, basis.vertices, 0],
+        };
+        let statics = [
+            with_data(ctx, "deform params", bytemuck::bytes_of(&params))?,
+            with_data(
+                ctx,
+                "texel vertex",
+                bytemuck::cast_slice(&basis.texel_vertex),
+            )?,
+            with_data(
+                ctx,
+                "styling offsets",
+                bytemuck::cast_slice(&basis.styling.offsets),
+            )?,
+            with_data(
+                ctx,
+                "styling terms",
+                bytemuck::cast_slice(&basis.styling.terms),
+            )?,
+        ];
+        let src = vk::BufferUsageFlags::TRANSFER_SRC;
+        let outputs = [
+            storage(
+                ctx,
+                "deformed positions",
+                slice * info.position_depth() as u64 * 8,
+                src,
+            )?,
+            storage(ctx, "deformed u", slice * layers * 8, src)?,
+            storage(ctx, "deformed v", slice * layers * 8, src)?,
+        ];
+        let pose_bytes = layers * basis.vertices as u64 * 16;
+        let mut poses = Vec::with_capacity(FRAMES_IN_FLIGHT);
+        for _ in 0..FRAMES_IN_FLIGHT {
+            let pose = Buffer::new(
+                ctx,
+                &BufferDesc::new(
+                    "hair mesh pose",
+                    pose_bytes,
+                    vk::BufferUsageFlags::STORAGE_BUFFER,
+                )
+                .host_visible(),
+            )?;
+            let set = DescriptorSet::new(ctx, "hair mesh update", layout)?;
+            for (b, _) in DeformBinding::ALL {
+                let buffer = match b {
+                    DeformBinding::Params => &statics[0],
+                    DeformBinding::Positions => &pose,
+                    DeformBinding::TexelVertex => &statics[1],
+                    DeformBinding::StylingOffsets => &statics[2],
+                    DeformBinding::StylingTerms => &statics[3],
+                    DeformBinding::PositionTexels => &outputs[0],
+                    DeformBinding::UTexels => &outputs[1],
+                    DeformBinding::VTexels => &outputs[2],
+                };
+                set.write_buffer(b as u32, buffer)?;
+            }
+            poses.push((pose, set));
+        }
+        Ok(DeformState {
+            basis,
+            poses,
+            outputs,
+            _static: statics,
+            pending: None,
+        })
+    }
+
+    /// The basis (decode box, layout, styling terms).
+    pub fn basis(&self) -> &DeformBasis {
+        &self.basis
+    }
+
+    /// Set the next frame's pose: `layers x vertices` object-space positions, layer-major.
+    /// Every value must be finite; points outside the decode box are clamped to it.
+    pub fn set_pose(&mut self, positions: &[Vec3]) -> GpuResult<()> {
+        let n = self.basis.vertices as usize * self.basis.info.layers as usize;
+        if positions.len() != n {
+            return Err(GpuError::Unsupported(format!(
+                "hair mesh pose: {} positions for {n} layer vertices",
+                positions.len()
+            )));
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(GpuError::Unsupported(format!(
+                "hair mesh pose: position {i} is not finite"
+            )));
+        }
+        self.pending = Some(positions.iter().map(|p| p.extend(0.0).to_array()).collect());
+        Ok(())
+    }
+
+    /// Write a pending pose into frame slot `slot`'s buffer (its earlier frame has completed);
+    /// whether there was one.
+    pub fn write_pending(&mut self, slot: usize) -> GpuResult<bool> {
+        let Some(pose) = self.pending.take() else {
+            return Ok(false);
+        };
+        self.poses[slot].0.write(0, bytemuck::cast_slice(&pose))?;
+        Ok(true)
+    }
+
+    /// The set frame slot `slot` dispatches with, and the workgroup count.
+    pub fn dispatch(&self, slot: usize) -> (&DescriptorSet, u32) {
+        let invocations = self.basis.info.slice_texels() as u32 * self.basis.info.layers;
+        (&self.poses[slot].1, invocations.div_ceil(DEFORM_GROUP_SIZE))
+    }
+}
