@@ -5,6 +5,7 @@
 //! [`reference`] (CPU oracle of strand generation and LoD) | [`render`] (GPU generation,
 //! shading, image) on the thin Vulkan layer [`vk`].
 
+pub mod animate;
 pub mod bake;
 pub mod characters;
 pub mod error;
