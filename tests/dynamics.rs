@@ -38,8 +38,9 @@ fn scalp_sphere(mesh: &HairMesh) -> (Vec3, f32) {
         for r in 0..4 {
             if r != c {
                 let f = ata[r][c] / ata[c][c];
-                for k in 0..4 {
-                    ata[r][k] -= f * ata[c][k];
+                let pivot_row = ata[c];
+                for (a, p) in ata[r].iter_mut().zip(pivot_row) {
+                    *a -= f * p;
                 }
                 atb[r] -= f * atb[c];
             }

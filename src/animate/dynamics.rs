@@ -46,10 +46,10 @@ impl Collider {
             Collider::Ellipsoid { centre, radii } => {
                 let q = (p - centre) / radii;
                 let l = q.length();
-                if l >= 1.0 || l < 1e-9 {
-                    p
-                } else {
+                if (1e-9..1.0).contains(&l) {
                     centre + q / l * radii
+                } else {
+                    p
                 }
             }
             Collider::Capsule { a, b, radius } => {
@@ -327,8 +327,8 @@ impl HairDynamics {
         let keep = (-s.damping * h).exp();
         let mut p = self.x.clone();
         // Scalp: rigid with the character.
-        for i in 0..n {
-            p[i] = m.transform_point3(self.rest[i]);
+        for (q, r) in p.iter_mut().zip(&self.rest).take(n) {
+            *q = m.transform_point3(*r);
         }
         // Predict, and pull toward the authored shape (XPBD, per unit mass).
         for k in 1..layers {
