@@ -1,11 +1,12 @@
 //! `crowd --headless`: 16 characters with validation on render non-empty frames and write the
-//! PNGs and the stats CSV; the furry-teapot preset renders on the compute path too.
+//! PNGs and the stats CSV; the furry-teapot preset renders on the compute path too; with the
+//! camera still, animated frames differ from one to the next (and do not without animation).
 
 use std::process::Command;
 
 /// Run `crowd --headless --size 320x180 --validation` with `extra` flags; check `frames`
 /// frames of at least `min_strands` strands each and a mostly non-background image.
-fn headless(extra: &[&str], frames: usize, min_strands: u64) {
+fn headless(extra: &[&str], frames: usize, min_strands: u64) -> (tempfile::TempDir, Vec<Vec<u8>>) {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("frames");
     let o = Command::new(env!("CARGO_BIN_EXE_crowd"))
@@ -22,11 +23,19 @@ fn headless(extra: &[&str], frames: usize, min_strands: u64) {
     );
     assert!(!String::from_utf8_lossy(&o.stderr).contains("validation error"));
     let csv = std::fs::read_to_string(out.join("stats.csv")).unwrap();
+    let column = csv
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|c| c == "strands_drawn")
+        .unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len(), frames, "{csv}");
+    let mut images = Vec::new();
     for (f, row) in rows.iter().enumerate() {
         let cols: Vec<&str> = row.split(',').collect();
-        let strands: u64 = cols[4].parse().unwrap();
+        let strands: u64 = cols[column].parse().unwrap();
         assert!(strands > min_strands, "frame {f}: {strands} strands");
         let img = image::open(out.join(format!("frame_{f:05}.png")))
             .unwrap()
@@ -39,7 +48,44 @@ fn headless(extra: &[&str], frames: usize, min_strands: u64) {
             differ > 320 * 180 / 4,
             "frame {f}: only {differ} non-background pixels"
         );
+        images.push(img.into_raw());
     }
+    (dir, images)
+}
+
+/// Hair and characters move: with the camera still, consecutive frames differ; with
+/// `--animate off` they are identical (so the difference is the animation).
+#[test]
+fn animated_frames_differ() {
+    let flags = [
+        "--frames", "8", "--count", "16", "--orbit", "off", "--wind", "20",
+    ];
+    let (_dir, moving) = headless(&flags, 8, 1000);
+    for f in 1..8 {
+        assert!(
+            moving[f] != moving[f - 1],
+            "frames {} and {f} are equal",
+            f - 1
+        );
+    }
+    let (_dir2, off) = headless(
+        &[
+            "--frames",
+            "3",
+            "--count",
+            "16",
+            "--orbit",
+            "off",
+            "--animate",
+            "off",
+        ],
+        3,
+        1000,
+    );
+    assert!(
+        off[1] == off[0] && off[2] == off[1],
+        "frames without animation differ"
+    );
 }
 
 #[test]

@@ -137,3 +137,21 @@ fn returns_to_rest_when_motion_stops() {
     assert!(moved > 0.05 * radius);
     assert!(settled < 0.01 * radius, "settled {settled}");
 }
+
+/// Distant characters step several frames at once (up to 8 frames at 60 Hz): still stable.
+#[test]
+fn stable_with_long_steps() {
+    let mesh = head_long();
+    let (mut d, _, _) = sim(&mesh, 40.0);
+    let mut motion = CharacterMotion::idle(Mat4::IDENTITY, 9);
+    motion.jerk = 0.5;
+    for f in 0..150 {
+        d.step(8.0 / 60.0, motion.model(f as f32 * 8.0 / 60.0));
+        assert!(d.positions().iter().all(|p| p.is_finite()), "frame {f}");
+        assert!(
+            d.max_edge_strain() < 0.1,
+            "frame {f}: {}",
+            d.max_edge_strain()
+        );
+    }
+}

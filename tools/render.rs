@@ -105,11 +105,7 @@ struct Args {
 }
 
 fn parse_vec3(flag: &str, s: &str) -> Result<Vec3> {
-    let v: Option<Vec<f32>> = s.split(',').map(|x| x.trim().parse::<f32>().ok()).collect();
-    match v.as_deref() {
-        Some(&[x, y, z]) if [x, y, z].iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
-        _ => bail!("{flag}: bad vector '{s}': expected three finite numbers x,y,z"),
-    }
+    hairmesh::render::scene::parse_vec3(s).map_err(|e| anyhow::anyhow!("{flag}: {e}"))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32)> {

@@ -203,9 +203,9 @@ impl DynamicsSettings {
     }
 }
 
-/// Longest frame step simulated at once; longer frames (a hitch) are slowed down rather than
-/// integrated with a step that could explode.
-pub const MAX_FRAME_STEP: f32 = 1.0 / 24.0;
+/// Longest step simulated at once (distant characters step several frames at a time); longer
+/// gaps (a hitch) are slowed down rather than integrated with a step that could explode.
+pub const MAX_FRAME_STEP: f32 = 0.125;
 
 /// One character's hair mesh in motion.
 pub struct HairDynamics {

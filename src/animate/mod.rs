@@ -3,8 +3,10 @@
 //! vertices above the scalp (position-based, small steps); the renderer rebuilds the textures
 //! of the new pose on the GPU (`bake::deform`, `passes::hair_mesh_update`).
 
+pub mod crowd;
 pub mod dynamics;
 pub mod motion;
 
+pub use crowd::{AnimationStats, CrowdAnimation};
 pub use dynamics::{Collider, DynamicsSettings, HairDynamics, Wind};
 pub use motion::CharacterMotion;

@@ -160,6 +160,17 @@ pub const MAX_SCALE: f32 = 1e4;
 /// Largest translation component of a character.
 pub const MAX_TRANSLATION: f32 = 1e6;
 
+/// Parse `x,y,z` (three finite numbers).
+pub fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
+    let v: Option<Vec<f32>> = s.split(',').map(|x| x.trim().parse::<f32>().ok()).collect();
+    match v.as_deref() {
+        Some(&[x, y, z]) if [x, y, z].iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!(
+            "bad vector '{s}': expected three finite numbers x,y,z"
+        )),
+    }
+}
+
 /// Parse an image size `WIDTHxHEIGHT` with 1..=[`MAX_IMAGE_SIDE`] per side (tools' `--size`).
 pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let bad = || format!("--size '{s}': expected WIDTHxHEIGHT with 1..={MAX_IMAGE_SIDE} per side");

@@ -17,6 +17,9 @@ use std::time::Instant;
 use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::Vec3;
+use hairmesh::animate::crowd::person_colliders;
+use hairmesh::animate::{CharacterMotion, Collider, CrowdAnimation, Wind};
+use hairmesh::bake::deform::DeformBasis;
 use hairmesh::characters::preset::{self, Preset, SPACING};
 use hairmesh::fsutil::OutputPath;
 use hairmesh::render::{
@@ -88,6 +91,19 @@ pub struct Args {
     /// Level of detail.
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     lod: String,
+    /// Characters walk, turn and sway, and their hair meshes are simulated (people and furry
+    /// balls; teapots move without hair dynamics).
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    animate: String,
+    /// Wind strength on the hair tips, m/s^2 (0..=100; gusty).
+    #[arg(long, default_value_t = 0.0)]
+    wind: f32,
+    /// Wind direction x,y,z.
+    #[arg(long, default_value = "1,0,0.3")]
+    wind_dir: String,
+    /// Headless: the camera orbits the crowd (off: it stays at frame 0's place).
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    orbit: String,
     /// Generation path (default: mesh where supported).
     #[arg(long, value_parser = ["mesh", "compute"])]
     path: Option<String>,
@@ -135,7 +151,7 @@ impl Scene {
             baked.push(hairmesh::bake(
                 &c.hair.mesh,
                 &c.hair.style,
-                BakeOptions::default(),
+                bake_options(c, args.animate == "on"),
                 |_, _| {},
             )?);
         }
@@ -177,6 +193,58 @@ impl Scene {
         Ok(renderer)
     }
 
+    /// The crowd's animation (nothing moves with `--animate off`): every character's motion,
+    /// and for people and furry balls their hair dynamics (their textures rebuilt on the GPU).
+    pub fn animation(&self, renderer: &mut Renderer, args: &Args) -> Result<CrowdAnimation> {
+        let mut anim = CrowdAnimation::new();
+        anim.wind = Wind {
+            direction: hairmesh::render::scene::parse_vec3(&args.wind_dir)
+                .map_err(|e| anyhow::anyhow!("--wind-dir: {e}"))?,
+            strength: args.wind,
+            gustiness: 0.6,
+        };
+        if !(0.0..=100.0).contains(&args.wind) {
+            bail!("--wind {}: must be 0..=100", args.wind);
+        }
+        if args.animate != "on" {
+            anim.moving = false;
+            anim.simulating = false;
+            return Ok(anim);
+        }
+        let ids = renderer.crowd().ids();
+        for (k, ((c, b), id)) in self.characters.iter().zip(&self.baked).zip(ids).enumerate() {
+            let motion = match c.body {
+                preset::Body::Person => CharacterMotion::idle(c.model, args.seed ^ k as u32),
+                // Fur sways gently in place.
+                _ => CharacterMotion {
+                    walk_radius: 0.0,
+                    ..CharacterMotion::idle(c.model, args.seed ^ k as u32)
+                },
+            };
+            let colliders = match c.body {
+                preset::Body::Person => Some(person_colliders(&preset::person_head())),
+                preset::Body::Ball => {
+                    let h = preset::ball_head();
+                    Some(vec![Collider::Ellipsoid {
+                        centre: h.centre,
+                        radii: h.radii * 0.97,
+                    }])
+                }
+                preset::Body::Teapot => None,
+            };
+            let hair = match colliders {
+                Some(colliders) => {
+                    let options = bake_options(c, true);
+                    renderer.make_deformable(id, DeformBasis::new(&c.hair.mesh, b, options)?)?;
+                    Some((&c.hair.mesh, colliders))
+                }
+                None => None,
+            };
+            anim.add(id, motion, hair);
+        }
+        Ok(anim)
+    }
+
     /// Number of characters.
     pub fn character_count(&self) -> usize {
         self.characters.len()
@@ -188,6 +256,29 @@ impl Scene {
         self.characters
             .get(i)
             .map_or(crowd, |c| c.strand_params(crowd))
+    }
+}
+
+/// Bake options of `c`: animated hair gets a decode box grown by its longest vertex column, so
+/// no pose can leave it.
+fn bake_options(c: &preset::CrowdCharacter, animated: bool) -> BakeOptions {
+    let mesh = &c.hair.mesh;
+    let n = mesh.vertices_per_layer();
+    let reach = (0..n)
+        .map(|i| {
+            mesh.layers
+                .windows(2)
+                .map(|w| w[0][i].distance(w[1][i]))
+                .sum::<f32>()
+        })
+        .fold(0.0f32, f32::max);
+    BakeOptions {
+        motion_margin: if animated && c.body != preset::Body::Teapot {
+            reach
+        } else {
+            0.0
+        },
+        ..Default::default()
     }
 }
 
@@ -208,12 +299,13 @@ fn run(args: Args) -> Result<()> {
             .device(args.device.clone()),
     )?);
     let mut renderer = scene.renderer(&ctx, &args, width, height)?;
+    let mut animation = scene.animation(&mut renderer, &args)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("--out {}: cannot create the folder", args.out.display()))?;
     let csv_path = args.out.join("stats.csv");
     let csv_out = OutputPath::check(&csv_path, &[])?;
     let mut csv = String::from(
-        "frame,gpu_ms,record_ms,wall_ms,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
+        "frame,gpu_ms,record_ms,wall_ms,simulate_ms,simulated,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
     );
     outln!(
         "device: {} ({}); {} characters ({:?}), generated and baked in {generate_s:.2} s, textures {:.1} MiB",
@@ -229,8 +321,15 @@ fn run(args: Args) -> Result<()> {
         LodSettings::off()
     };
     for f in 0..args.frames {
+        let camera = orbit_camera(
+            args.preset,
+            args.count,
+            if args.orbit == "on" { f } else { 0 },
+        );
+        // Headless frames are 1/30 s apart in animation time.
+        animation.advance(&mut renderer, 1.0 / 30.0, &camera, height)?;
         let view = View {
-            camera: orbit_camera(args.preset, args.count, f),
+            camera,
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod,
             shading: args.shading,
@@ -260,9 +359,11 @@ fn run(args: Args) -> Result<()> {
             .map(|(n, ms)| format!("{n}={ms:.2}"))
             .collect();
         csv.push_str(&format!(
-            "{f},{:.3},{:.3},{wall_ms:.1},{},{},{},{},{},{}\n",
+            "{f},{:.3},{:.3},{wall_ms:.1},{:.3},{},{},{},{},{},{},{}\n",
             report.gpu_ms(),
             report.record_ms,
+            animation.stats.simulate_ms,
+            animation.stats.simulated,
             s.strands_drawn,
             s.strands_demanded,
             s.triangles_drawn,
@@ -271,13 +372,15 @@ fn run(args: Args) -> Result<()> {
             passes.join(" ")
         ));
         outln!(
-            "frame {f}: {:?} path, {} strands, {} triangles, GPU {:.1} ms ({}), record {:.3} ms",
+            "frame {f}: {:?} path, {} strands, {} triangles, GPU {:.1} ms ({}), record {:.3} ms, hair simulation {:.1} ms ({} characters)",
             report.path,
             s.strands_drawn,
             s.triangles_drawn,
             report.gpu_ms(),
             passes.join(", "),
-            report.record_ms
+            report.record_ms,
+            animation.stats.simulate_ms,
+            animation.stats.simulated
         )?;
         let rgba = report.rgba.context("no image read back")?;
         let path = args.out.join(format!("frame_{f:05}.png"));

@@ -42,6 +42,9 @@ struct Controls {
     shadows: ShadowMode,
     transparency: Transparency,
     lod_appearance: bool,
+    moving: bool,
+    simulating: bool,
+    wind: hairmesh::animate::Wind,
     params: StrandParams,
     lod: LodSettings,
     path: RenderPath,
@@ -126,6 +129,24 @@ impl Controls {
                     }
                 });
                 ui.checkbox(&mut self.lod_appearance, "thick-strand appearance (LoD)");
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut self.moving, "motion");
+                    ui.checkbox(&mut self.simulating, "hair dynamics");
+                });
+                ui.add(egui::Slider::new(&mut self.wind.strength, 0.0..=60.0).text("wind m/s²"));
+                let mut angle = self
+                    .wind
+                    .direction
+                    .z
+                    .atan2(self.wind.direction.x)
+                    .to_degrees();
+                if ui
+                    .add(egui::Slider::new(&mut angle, -180.0..=180.0).text("wind direction °"))
+                    .changed()
+                {
+                    let a = angle.to_radians();
+                    self.wind.direction = Vec3::new(a.cos(), self.wind.direction.y, a.sin());
+                }
                 ui.horizontal(|ui| {
                     ui.label("path");
                     ui.add_enabled_ui(mesh_ok, |ui| {
@@ -237,6 +258,8 @@ struct Running {
     shadows: ShadowMode,
     transparency: Transparency,
     lod_appearance: bool,
+    animation: hairmesh::animate::CrowdAnimation,
+    last_draw: Instant,
     paused: bool,
     dragging: Option<(f64, f64)>,
     cursor: (f64, f64),
@@ -316,9 +339,10 @@ impl App {
                 .window(handles),
         )?);
         let size = window.inner_size();
-        let renderer =
+        let mut renderer =
             self.scene
                 .renderer(&ctx, &self.args, size.width.max(1), size.height.max(1))?;
+        let animation = self.scene.animation(&mut renderer, &self.args)?;
         let path = renderer.default_path();
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(
@@ -388,6 +412,8 @@ impl App {
             shadows: self.args.shadows,
             transparency: self.args.transparency,
             lod_appearance: self.args.lod_appearance,
+            animation,
+            last_draw: Instant::now(),
             paused: false,
             dragging: None,
             cursor: (0.0, 0.0),
@@ -469,8 +495,12 @@ impl Running {
                 return Ok(false);
             }
         };
+        let dt = self.last_draw.elapsed().as_secs_f32();
+        self.last_draw = Instant::now();
+        let camera = self.camera.camera();
+        self.animation.advance(&mut self.renderer, dt, &camera, h)?;
         let view = View {
-            camera: self.camera.camera(),
+            camera,
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod: self.panel.lod,
             shading: self.shading,
@@ -534,6 +564,9 @@ impl Running {
             shadows: self.shadows,
             transparency: self.transparency,
             lod_appearance: self.lod_appearance,
+            moving: self.animation.moving,
+            simulating: self.animation.simulating,
+            wind: self.animation.wind,
             params: self.params,
             lod: self.panel.lod,
             path: self.path,
@@ -577,6 +610,9 @@ impl Running {
         self.shadows = c.shadows;
         self.transparency = c.transparency;
         self.lod_appearance = c.lod_appearance;
+        self.animation.moving = c.moving;
+        self.animation.simulating = c.simulating;
+        self.animation.wind = c.wind;
         self.path = c.path;
         self.paused = c.paused || (c.fly && !self.camera.fly);
         self.camera.fly = c.fly;
@@ -602,6 +638,11 @@ impl Running {
             self.panel.visible,
             self.renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64,
         );
+        let a = &self.animation.stats;
+        text.push_str(&format!(
+            "\nhair dynamics: {:.1} ms CPU, {} characters, {} vertices",
+            a.simulate_ms, a.simulated, a.vertices
+        ));
         if r.path == RenderPath::Compute {
             text.push_str(&format!(
                 "\nvertex pool {} of {} slots{}",

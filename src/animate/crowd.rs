@@ -1,0 +1,208 @@
+//! A crowd in motion: every character follows its [`CharacterMotion`]; characters with a
+//! simulated hair mesh step their [`HairDynamics`] and hand the new pose to the renderer, which
+//! rebuilds their textures on the GPU. Characters small on screen simulate less often: by the
+//! height in pixels of their hair (the projected size eq. 7 of paper 003 uses), every frame
+//! above 96 px, every 2nd above 48, every 4th above 24, else every 8th frame, with the time
+//! they skipped (up to [`MAX_FRAME_STEP`](super::dynamics::MAX_FRAME_STEP)) in one step.
+
+use std::time::Instant;
+
+use glam::Vec3;
+
+use super::dynamics::{Collider, DynamicsSettings, HairDynamics, Wind};
+use super::motion::CharacterMotion;
+use crate::model::hair_mesh::HairMesh;
+use crate::render::{Camera, CharacterId, Renderer};
+use crate::vk::GpuResult;
+
+/// One character of an animated crowd.
+pub struct AnimatedCharacter {
+    id: CharacterId,
+    motion: CharacterMotion,
+    dynamics: Option<HairDynamics>,
+    /// Centre and radius of its hair at rest, character frame.
+    bounds: (Vec3, f32),
+    /// Seconds since its hair was last simulated.
+    pending_dt: f32,
+}
+
+/// What the last [`CrowdAnimation::advance`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AnimationStats {
+    /// CPU milliseconds simulating hair meshes.
+    pub simulate_ms: f64,
+    /// Characters whose hair was simulated (and textures rebuilt).
+    pub simulated: usize,
+    /// Hair mesh vertices simulated.
+    pub vertices: usize,
+}
+
+/// The crowd's motion and hair dynamics.
+pub struct CrowdAnimation {
+    characters: Vec<AnimatedCharacter>,
+    time: f32,
+    frame: u64,
+    /// Characters move (walk, turn, sway).
+    pub moving: bool,
+    /// Hair meshes are simulated (otherwise they stay at rest, moving rigidly).
+    pub simulating: bool,
+    /// Wind, shared by every character.
+    pub wind: Wind,
+    /// What the last frame did.
+    pub stats: AnimationStats,
+}
+
+/// Hair pixels above which a character simulates every frame (halving per step down).
+pub const FULL_RATE_PIXELS: f32 = 96.0;
+
+impl Default for CrowdAnimation {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl CrowdAnimation {
+    /// Nothing animated yet.
+    pub fn new() -> Self {
+        CrowdAnimation {
+            characters: Vec::new(),
+            time: 0.0,
+            frame: 0,
+            moving: true,
+            simulating: true,
+            wind: Wind::default(),
+            stats: AnimationStats::default(),
+        }
+    }
+
+    /// Animate character `id` with `motion`; with `hair` (its mesh and colliders in the
+    /// character's frame, and the character made deformable in the renderer) its hair mesh is
+    /// simulated too.
+    pub fn add(
+        &mut self,
+        id: CharacterId,
+        motion: CharacterMotion,
+        hair: Option<(&HairMesh, Vec<Collider>)>,
+    ) {
+        let (bounds, dynamics) = match hair {
+            Some((mesh, colliders)) => {
+                let (lo, hi) =
+                    crate::model::hair_mesh::bounds(mesh.layers.iter().flatten().copied());
+                let settings = DynamicsSettings {
+                    wind: self.wind,
+                    ..Default::default()
+                };
+                (
+                    ((lo + hi) * 0.5, (hi - lo).length() * 0.5),
+                    Some(HairDynamics::new(
+                        mesh,
+                        colliders,
+                        settings,
+                        motion.model(0.0),
+                    )),
+                )
+            }
+            None => ((Vec3::ZERO, 0.0), None),
+        };
+        self.characters.push(AnimatedCharacter {
+            id,
+            motion,
+            dynamics,
+            bounds,
+            pending_dt: 0.0,
+        });
+    }
+
+    /// Seconds of animation so far.
+    pub fn time(&self) -> f32 {
+        self.time
+    }
+
+    /// Advance by `dt` seconds: place every character, simulate the hair of those due this
+    /// frame (seen by `camera` in an image `height` pixels tall) and hand their poses to
+    /// `renderer`.
+    pub fn advance(
+        &mut self,
+        renderer: &mut Renderer,
+        dt: f32,
+        camera: &Camera,
+        height: u32,
+    ) -> GpuResult<()> {
+        let dt = if dt.is_finite() { dt.max(0.0) } else { 0.0 };
+        if self.moving {
+            self.time += dt;
+        }
+        self.frame += 1;
+        let start = Instant::now();
+        let mut stats = AnimationStats::default();
+        let focal = height as f32 / (2.0 * (camera.fov_y * 0.5).tan());
+        for c in &mut self.characters {
+            let model = c.motion.model(self.time);
+            renderer.set_model(c.id, model)?;
+            let Some(d) = c.dynamics.as_mut() else {
+                continue;
+            };
+            c.pending_dt += dt;
+            if !self.simulating {
+                continue;
+            }
+            let centre = model.transform_point3(c.bounds.0);
+            let scale = model.x_axis.truncate().length();
+            let pixels = 2.0 * c.bounds.1 * scale * focal / camera.eye.distance(centre).max(1e-3);
+            if self.frame % update_interval(pixels) != 0 {
+                continue;
+            }
+            d.settings.wind = self.wind;
+            d.step(c.pending_dt, model);
+            c.pending_dt = 0.0;
+            renderer.set_hair_mesh_pose(c.id, &d.pose())?;
+            stats.simulated += 1;
+            stats.vertices += d.vertex_count();
+        }
+        stats.simulate_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.stats = stats;
+        Ok(())
+    }
+}
+
+/// Frames between hair updates for a character whose hair is `pixels` tall on screen.
+pub fn update_interval(pixels: f32) -> u64 {
+    let mut interval = 1;
+    let mut threshold = FULL_RATE_PIXELS;
+    while pixels < threshold && interval < 8 {
+        interval *= 2;
+        threshold *= 0.5;
+    }
+    interval
+}
+
+/// Colliders of a person with `head` (the scalp lies on the head surface, so the head
+/// collider sits just inside it): the head and a capsule across the shoulders.
+pub fn person_colliders(head: &crate::characters::head::HeadShape) -> Vec<Collider> {
+    let r = head.radii;
+    let shoulders = head.centre - Vec3::new(0.0, 2.1 * r.y, 0.0);
+    vec![
+        Collider::Ellipsoid {
+            centre: head.centre,
+            radii: r * 0.97,
+        },
+        Collider::Capsule {
+            a: shoulders - Vec3::new(2.0 * r.x, 0.0, 0.0),
+            b: shoulders + Vec3::new(2.0 * r.x, 0.0, 0.0),
+            radius: 0.8 * r.x,
+        },
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn update_interval_halves_with_size() {
+        assert_eq!(update_interval(200.0), 1);
+        assert_eq!(update_interval(60.0), 2);
+        assert_eq!(update_interval(30.0), 4);
+        assert_eq!(update_interval(5.0), 8);
+    }
+}
