@@ -149,7 +149,7 @@ impl CrowdAnimation {
             let centre = model.transform_point3(c.bounds.0);
             let scale = model.x_axis.truncate().length();
             let pixels = 2.0 * c.bounds.1 * scale * focal / camera.eye.distance(centre).max(1e-3);
-            if self.frame % update_interval(pixels) != 0 {
+            if !self.frame.is_multiple_of(update_interval(pixels)) {
                 continue;
             }
             d.settings.wind = self.wind;
