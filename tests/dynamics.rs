@@ -13,52 +13,17 @@ fn head_long() -> HairMesh {
     load_hair_mesh_obj(&root.join("head_long.obj")).unwrap()
 }
 
-/// Least-squares sphere through the scalp (algebraic fit, normal equations).
-fn scalp_sphere(mesh: &HairMesh) -> (Vec3, f32) {
-    // |p|^2 = 2 c.p + (r^2 - |c|^2): unknowns (cx, cy, cz, d).
-    let mut ata = [[0.0f64; 4]; 4];
-    let mut atb = [0.0f64; 4];
-    for p in &mesh.layers[0] {
-        let row = [2.0 * p.x as f64, 2.0 * p.y as f64, 2.0 * p.z as f64, 1.0];
-        let rhs = p.length_squared() as f64;
-        for i in 0..4 {
-            for j in 0..4 {
-                ata[i][j] += row[i] * row[j];
-            }
-            atb[i] += row[i] * rhs;
-        }
-    }
-    // Gaussian elimination.
-    for c in 0..4 {
-        let pivot = (c..4)
-            .max_by(|&a, &b| ata[a][c].abs().total_cmp(&ata[b][c].abs()))
-            .unwrap();
-        ata.swap(c, pivot);
-        atb.swap(c, pivot);
-        for r in 0..4 {
-            if r != c {
-                let f = ata[r][c] / ata[c][c];
-                let pivot_row = ata[c];
-                for (a, p) in ata[r].iter_mut().zip(pivot_row) {
-                    *a -= f * p;
-                }
-                atb[r] -= f * atb[c];
-            }
-        }
-    }
-    let x: Vec<f64> = (0..4).map(|i| atb[i] / ata[i][i]).collect();
-    let c = Vec3::new(x[0] as f32, x[1] as f32, x[2] as f32);
-    let r = (x[3] + c.length_squared() as f64).sqrt() as f32;
-    (c, r)
-}
-
 fn sim(mesh: &HairMesh, wind: f32) -> (HairDynamics, f32, Vec3) {
-    let (centre, radius) = scalp_sphere(mesh);
-    // Slightly inside the scalp, so roots never start inside the collider.
-    let head = Collider::Ellipsoid {
-        centre,
-        radii: Vec3::splat(radius * 0.97),
+    // A sphere fitted to the scalp, slightly inside it.
+    let head = Collider::fit_scalp(mesh);
+    let Collider::Ellipsoid { centre, radii } = head else {
+        unreachable!()
     };
+    let radius = radii.x / 0.97;
+    assert!(
+        (radius - 0.1).abs() < 1e-3 && centre.length() < 1e-3,
+        "head_long's head sphere"
+    );
     let settings = DynamicsSettings {
         wind: Wind {
             direction: Vec3::new(1.0, 0.2, 0.4),

@@ -6,9 +6,16 @@
 //! `bench lod [--mesh M] [--size 1280x720] [--runs 5] [--picture out.png]`: one scene at near,
 //! mid and far distances; strand triangles and median GPU time with LoD on vs off, mesh vs
 //! compute path (timestamp queries); optionally a near/mid/far picture with LoD on.
+//!
+//! `bench animate [--mesh M] [--wind 30] [--frames 90] [--strip out.png]`: one hair mesh in
+//! wind, simulated and re-textured every frame: CPU ms of the dynamics, GPU ms of the texture
+//! rebuild and of the frame (medians); optionally a strip of frames side by side.
 
 use std::path::PathBuf;
 use std::time::Instant;
+
+#[path = "bench/animate.rs"]
+mod animate;
 
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
@@ -82,6 +89,34 @@ enum Cmd {
         /// Campaign seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+    },
+    /// One hair mesh in wind, simulated and re-textured every frame (30 Hz): CPU ms of the
+    /// dynamics, GPU ms of the texture rebuild and of the frame; optionally a strip of frames.
+    Animate {
+        /// Hair mesh OBJ (style: the .toml beside it).
+        #[arg(long, default_value = "hairmeshes/head_long.obj")]
+        mesh: PathBuf,
+        /// Frames (1/30 s apart).
+        #[arg(long, default_value_t = 90, value_parser = clap::value_parser!(u32).range(1..=100000))]
+        frames: u32,
+        /// Wind strength on the tips, m/s^2 (0..=100).
+        #[arg(long, default_value_t = 30.0)]
+        wind: f32,
+        /// Image size.
+        #[arg(long, default_value = "240x240")]
+        size: String,
+        /// Strands per bundle.
+        #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        strands_per_bundle: u32,
+        /// Write frames side by side here.
+        #[arg(long)]
+        strip: Option<PathBuf>,
+        /// Frames in the strip (evenly spaced).
+        #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=32))]
+        strip_frames: u32,
+        /// Choose the GPU by name substring.
+        #[arg(long)]
+        device: Option<String>,
     },
     /// A crowd of mixed sample meshes on a ground plane seen from human height: GPU ms per
     /// pass, CPU ms to record a frame, peak RSS and GPU memory, for N characters, LoD on/off,
@@ -446,6 +481,25 @@ fn main() {
 
 fn run(args: Args) -> Result<()> {
     match args.cmd {
+        Cmd::Animate {
+            mesh,
+            frames,
+            wind,
+            size,
+            strands_per_bundle,
+            strip,
+            strip_frames,
+            device,
+        } => animate::bench_animate(animate::AnimateArgs {
+            mesh,
+            frames,
+            wind,
+            size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
+            strands_per_bundle,
+            strip,
+            strip_frames,
+            device,
+        })?,
         Cmd::Fuzz { iterations, seed } => {
             outln!("| reader | inputs | accepted | rejected | panics | slowest ms | seconds |")?;
             outln!("|---|---|---|---|---|---|---|")?;

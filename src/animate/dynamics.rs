@@ -67,6 +67,52 @@ impl Collider {
         }
     }
 
+    /// A sphere fitted to the scalp (layer 0) of `mesh` by least squares, shrunk to 97% so the
+    /// roots start outside it: a head collider for meshes that come without one.
+    pub fn fit_scalp(mesh: &HairMesh) -> Collider {
+        // |p|^2 = 2 c.p + (r^2 - |c|^2): linear in (c, d); normal equations, then elimination.
+        let mut a = [[0.0f64; 5]; 4];
+        for p in &mesh.layers[0] {
+            let row = [2.0 * p.x as f64, 2.0 * p.y as f64, 2.0 * p.z as f64, 1.0];
+            for i in 0..4 {
+                for j in 0..4 {
+                    a[i][j] += row[i] * row[j];
+                }
+                a[i][4] += row[i] * p.length_squared() as f64;
+            }
+        }
+        for c in 0..4 {
+            let pivot = (c..4)
+                .max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))
+                .unwrap_or(c);
+            a.swap(c, pivot);
+            if a[c][c].abs() < 1e-30 {
+                // Degenerate scalp (flat): a sphere at its centre that catches nothing.
+                let (lo, hi) = crate::model::hair_mesh::bounds(mesh.layers[0].iter().copied());
+                return Collider::Ellipsoid {
+                    centre: (lo + hi) * 0.5,
+                    radii: Vec3::splat(1e-6),
+                };
+            }
+            let pivot_row = a[c];
+            for (r, row) in a.iter_mut().enumerate() {
+                if r != c {
+                    let f = row[c] / pivot_row[c];
+                    for (x, p) in row.iter_mut().zip(pivot_row) {
+                        *x -= f * p;
+                    }
+                }
+            }
+        }
+        let x: Vec<f64> = (0..4).map(|i| a[i][4] / a[i][i]).collect();
+        let centre = Vec3::new(x[0] as f32, x[1] as f32, x[2] as f32);
+        let r = (x[3] + centre.length_squared() as f64).max(0.0).sqrt() as f32;
+        Collider::Ellipsoid {
+            centre,
+            radii: Vec3::splat(r * 0.97),
+        }
+    }
+
     fn transformed(&self, m: &Mat4) -> Collider {
         let scale = m.x_axis.truncate().length();
         match *self {

@@ -417,8 +417,9 @@ impl Crowd {
             .sum()
     }
 
-    /// World-space bounds of every visible character's hair: the box of its hair mesh texture,
-    /// transformed, grown by the styling offsets (as `bundle_lod.glsl` grows bundle bounds).
+    /// World-space bounds of every visible character's hair: the box of its latest pose for
+    /// animated characters, else of its hair mesh texture, transformed, grown by the styling
+    /// offsets (as `bundle_lod.glsl` grows bundle bounds).
     pub fn hair_bounds(&self) -> Vec<(glam::Vec3, glam::Vec3)> {
         use glam::Vec3;
         self.slots
@@ -426,8 +427,16 @@ impl Crowd {
             .flatten()
             .filter(|c| c.visible)
             .map(|c| {
-                let lo = Vec3::from_slice(&c.info.pos_origin[..3]);
-                let hi = lo + Vec3::from_slice(&c.info.pos_extent[..3]);
+                let texture_box = || {
+                    let lo = Vec3::from_slice(&c.info.pos_origin[..3]);
+                    (lo, lo + Vec3::from_slice(&c.info.pos_extent[..3]))
+                };
+                let (lo, hi) = c
+                    .textures
+                    .deform
+                    .as_ref()
+                    .and_then(|d| d.pose_bounds())
+                    .unwrap_or_else(texture_box);
                 let (mut wlo, mut whi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
                 for corner in super::camera::box_corners(lo, hi) {
                     let p = c.model.transform_point3(corner);

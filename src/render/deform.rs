@@ -28,6 +28,8 @@ pub struct DeformState {
     _static: [Buffer; 4],
     /// A pose given since the last frame, waiting for a frame slot.
     pending: Option<Vec<[f32; 4]>>,
+    /// Bounds of the latest pose (character frame), for fitting the light's view.
+    pose_bounds: Option<(Vec3, Vec3)>,
 }
 
 fn storage(
@@ -130,6 +132,7 @@ impl DeformState {
             outputs,
             _static: statics,
             pending: None,
+            pose_bounds: None,
         })
     }
 
@@ -154,7 +157,13 @@ impl DeformState {
             )));
         }
         self.pending = Some(positions.iter().map(|p| p.extend(0.0).to_array()).collect());
+        self.pose_bounds = Some(crate::model::hair_mesh::bounds(positions.iter().copied()));
         Ok(())
+    }
+
+    /// Bounds of the latest pose in the character's frame (`None` before the first pose).
+    pub fn pose_bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.pose_bounds
     }
 
     /// Write a pending pose into frame slot `slot`'s buffer (its earlier frame has completed);
