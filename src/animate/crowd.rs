@@ -4,6 +4,7 @@
 //! height in pixels of their hair (the projected size eq. 7 of paper 003 uses), every frame
 //! above 96 px, every 2nd above 48, every 4th above 24, else every 8th frame, with the time
 //! they skipped (up to [`MAX_FRAME_STEP`](super::dynamics::MAX_FRAME_STEP)) in one step.
+//! Characters due in a frame are simulated in parallel on all cores.
 
 use std::time::Instant;
 
@@ -136,12 +137,14 @@ impl CrowdAnimation {
         let start = Instant::now();
         let mut stats = AnimationStats::default();
         let focal = height as f32 / (2.0 * (camera.fov_y * 0.5).tan());
+        // Place everyone; pick the characters whose hair is due this frame.
+        let mut due: Vec<(&mut AnimatedCharacter, glam::Mat4)> = Vec::new();
         for c in &mut self.characters {
             let model = c.motion.model(self.time);
             renderer.set_model(c.id, model)?;
-            let Some(d) = c.dynamics.as_mut() else {
+            if c.dynamics.is_none() {
                 continue;
-            };
+            }
             c.pending_dt += dt;
             if !self.simulating {
                 continue;
@@ -149,15 +152,33 @@ impl CrowdAnimation {
             let centre = model.transform_point3(c.bounds.0);
             let scale = model.x_axis.truncate().length();
             let pixels = 2.0 * c.bounds.1 * scale * focal / camera.eye.distance(centre).max(1e-3);
-            if !self.frame.is_multiple_of(update_interval(pixels)) {
-                continue;
+            if self.frame.is_multiple_of(update_interval(pixels)) {
+                due.push((c, model));
             }
-            d.settings.wind = self.wind;
-            d.step(c.pending_dt, model);
-            c.pending_dt = 0.0;
-            renderer.set_hair_mesh_pose(c.id, &d.pose())?;
-            stats.simulated += 1;
-            stats.vertices += d.vertex_count();
+        }
+        // Characters are independent: simulate them on all cores.
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let chunk = due.len().div_ceil(threads).max(1);
+        let wind = self.wind;
+        std::thread::scope(|scope| {
+            for part in due.chunks_mut(chunk) {
+                scope.spawn(move || {
+                    for (c, model) in part.iter_mut() {
+                        if let Some(d) = c.dynamics.as_mut() {
+                            d.settings.wind = wind;
+                            d.step(c.pending_dt, *model);
+                            c.pending_dt = 0.0;
+                        }
+                    }
+                });
+            }
+        });
+        for (c, _) in &due {
+            if let Some(d) = &c.dynamics {
+                renderer.set_hair_mesh_pose(c.id, &d.pose())?;
+                stats.simulated += 1;
+                stats.vertices += d.vertex_count();
+            }
         }
         stats.simulate_ms = start.elapsed().as_secs_f64() * 1e3;
         self.stats = stats;
