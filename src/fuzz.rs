@@ -27,11 +27,19 @@ pub enum Reader {
     Scene,
     /// `baked_file::from_bytes`.
     Hmb,
+    /// `HairFile::parse` (`.hair` strand files).
+    Hair,
 }
 
 impl Reader {
     /// Every reader.
-    pub const ALL: [Reader; 4] = [Reader::Obj, Reader::Style, Reader::Scene, Reader::Hmb];
+    pub const ALL: [Reader; 5] = [
+        Reader::Obj,
+        Reader::Style,
+        Reader::Scene,
+        Reader::Hmb,
+        Reader::Hair,
+    ];
 }
 
 /// What a campaign found.
@@ -231,6 +239,67 @@ fn mutate_hmb(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
     out
 }
 
+/// A `.hair` seed: a few strands with every optional array, and the same without them.
+fn hair_seeds() -> [Vec<u8>; 2] {
+    use crate::model::hair_file::HairFile;
+    let full = HairFile {
+        segments: Some(vec![3, 1, 2]),
+        default_segments: 2,
+        points: (0..9).map(|i| [i as f32, 0.5 * i as f32, 0.1]).collect(),
+        thickness: Some(vec![0.01; 9]),
+        default_thickness: 0.01,
+        transparency: Some(vec![0.2; 9]),
+        default_transparency: 0.0,
+        colors: Some(vec![[0.3, 0.2, 0.1]; 9]),
+        default_color: [0.3, 0.2, 0.1],
+        info: "fuzz seed".into(),
+        hair_count: 3,
+    };
+    let plain = HairFile {
+        segments: None,
+        points: full.points[..6].to_vec(),
+        thickness: None,
+        transparency: None,
+        colors: None,
+        hair_count: 2,
+        ..full.clone()
+    };
+    [full.to_bytes(), plain.to_bytes()]
+}
+
+/// Mutations of a `.hair` file: header words set to extremes, default floats to NaN/inf, bit
+/// flips, truncation and extension.
+fn mutate_hair(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
+    let mut out = seed.to_vec();
+    const EXTREMES: [u32; 8] = [0, 1, 2, 0x1f, 0x20, 0x7fff_ffff, 0xffff_ffff, 65535];
+    for _ in 0..1 + below(rng, 3) {
+        match below(rng, 5) {
+            0 | 1 => {
+                let at = 4 + 4 * below(rng, 4);
+                let v = *pick(rng, &EXTREMES);
+                out[at..at + 4].copy_from_slice(&v.to_le_bytes());
+            }
+            2 => {
+                let at = 20 + 4 * below(rng, 5);
+                let v = *pick(rng, &[f32::NAN, f32::INFINITY, -1e38, 0.0]);
+                out[at..at + 4].copy_from_slice(&v.to_le_bytes());
+            }
+            3 => {
+                let i = below(rng, out.len());
+                out[i] ^= 1 << below(rng, 8);
+            }
+            _ => {
+                let n = out.len();
+                out.truncate(below(rng, n + 1));
+                if out.len() < 40 {
+                    return out;
+                }
+            }
+        }
+    }
+    out
+}
+
 fn hmb_seed() -> Vec<u8> {
     let mesh = crate::model::obj_io::parse_hair_mesh_obj("seed", OBJ_SEEDS[0].as_bytes())
         .expect("sample OBJ parses");
@@ -267,6 +336,7 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
             crate::render::scene::SceneDesc::parse("fuzz.toml", t, Path::new(".")).is_ok()
         }),
         Reader::Hmb => crate::bake::baked_file::from_bytes("fuzz.hmb", input).is_ok(),
+        Reader::Hair => crate::model::hair_file::HairFile::parse("fuzz.hair", input).is_ok(),
     }));
     result.map_err(|p| {
         p.downcast_ref::<&str>()
@@ -280,6 +350,7 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
 pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
     let mut rng = Pcg32::new(seed ^ (reader as u64) << 32);
     let hmb = (reader == Reader::Hmb).then(hmb_seed);
+    let hair = hair_seeds();
     let mut report = FuzzReport::default();
     for i in 0..iterations {
         let input = match reader {
@@ -293,6 +364,10 @@ pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
             }
             Reader::Scene => mutate_text(&mut rng, SCENE_SEED),
             Reader::Hmb => mutate_hmb(&mut rng, hmb.as_deref().unwrap_or_default()),
+            Reader::Hair => {
+                let seed = pick(&mut rng, &hair).clone();
+                mutate_hair(&mut rng, &seed)
+            }
         };
         let start = Instant::now();
         let outcome = run_one(reader, &input);

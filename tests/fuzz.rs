@@ -87,3 +87,8 @@ fn fuzz_scene_reader() {
 fn fuzz_hmb_reader() {
     check(Reader::Hmb);
 }
+
+#[test]
+fn fuzz_hair_reader() {
+    check(Reader::Hair);
+}

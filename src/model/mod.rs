@@ -1,7 +1,9 @@
 //! The hair mesh model and its files: [`HairMesh`](hair_mesh::HairMesh) (scalp + layers), the
-//! OBJ layer convention ([`obj_io`]) and the styling parameters ([`style`]).
+//! OBJ layer convention ([`obj_io`]), the styling parameters ([`style`]) and Yuksel's `.hair`
+//! strand files ([`hair_file`]).
 
 pub mod exact_array;
+pub mod hair_file;
 pub mod hair_mesh;
 pub mod obj_io;
 pub mod style;
