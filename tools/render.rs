@@ -55,9 +55,11 @@ struct Args {
     /// Choose the GPU by name substring (default: discrete, else integrated, else lavapipe).
     #[arg(long)]
     device: Option<String>,
-    /// Generation path: mesh (task + mesh shaders) or compute (compute + vertex pulling);
-    /// default: mesh where the device supports it.
-    #[arg(long, value_parser = ["mesh", "compute"])]
+    /// Generation path: mesh (task + mesh shaders), compute (compute + vertex pulling), or
+    /// static (a compute frame generates the strands, then a second frame draws them again
+    /// with no generation: the raster limit; the report is the second frame's); default: mesh
+    /// where the device supports it.
+    #[arg(long, value_parser = ["mesh", "compute", "static"])]
     path: Option<String>,
     /// Level of detail (paper sec. 3.6).
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
@@ -284,12 +286,10 @@ fn print_report(
 
 fn run(args: Args) -> Result<()> {
     let lod = lod_settings(&args)?;
-    let path = args.path.as_deref().map(|p| {
-        if p == "mesh" {
-            RenderPath::Mesh
-        } else {
-            RenderPath::Compute
-        }
+    let path = args.path.as_deref().map(|p| match p {
+        "mesh" => RenderPath::Mesh,
+        // The renderer's default path is compute here; the static frame is asked for below.
+        _ => RenderPath::Compute,
     });
     // Load and validate every input, and the output path, before touching the GPU.
     let inputs = load_inputs(&args)?;
@@ -346,13 +346,27 @@ fn run(args: Args) -> Result<()> {
             .or(inputs.look.lod_appearance)
             .unwrap_or(true),
     };
-    let out = renderer.render_one(
+    let mut out = renderer.render_one(
         &view,
         &FrameOptions {
             read_image: true,
             ..Default::default()
         },
     )?;
+    if args.path.as_deref() == Some("static") {
+        outln!(
+            "generated (compute path): GPU {:.3} ms; drawing the same strands again:",
+            out.gpu_ms()
+        )?;
+        out = renderer.render_one(
+            &view,
+            &FrameOptions {
+                path: Some(RenderPath::Static),
+                read_image: true,
+                ..Default::default()
+            },
+        )?;
+    }
     let wall = start.elapsed().as_secs_f64();
     // Nothing is written unless the frame succeeded and validation reported nothing.
     if ctx.validation_errors() > 0 {

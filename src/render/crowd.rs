@@ -143,6 +143,8 @@ pub struct Crowd {
     bundle_table: Option<Buffer>,
     bundle_count: u32,
     dirty: bool,
+    /// Bumped by every change to the characters (static strands are valid for one version).
+    version: u64,
 }
 
 impl Crowd {
@@ -184,6 +186,7 @@ impl Crowd {
             bundle_table: None,
             bundle_count: 0,
             dirty: false,
+            version: 0,
         })
     }
 
@@ -206,6 +209,7 @@ impl Crowd {
         model: Mat4,
     ) -> GpuResult<CharacterId> {
         params.validate()?;
+        self.version += 1;
         check_model(&model)?;
         let slot = match self.free.pop() {
             Some(s) => s,
@@ -289,6 +293,7 @@ impl Crowd {
     /// Remove a character; its textures and slot must be retired with the last frame that
     /// may use them.
     pub fn remove(&mut self, id: CharacterId) -> GpuResult<RemovedCharacter> {
+        self.version += 1;
         self.get_mut(id)?;
         let c = self.slots[id.slot as usize]
             .take()
@@ -321,6 +326,7 @@ impl Crowd {
 
     /// Set the hair mesh pose of a deformable character for the next frame.
     pub fn set_pose(&mut self, id: CharacterId, positions: &[glam::Vec3]) -> GpuResult<()> {
+        self.version += 1;
         match &mut self.get_mut(id)?.textures.deform {
             Some(d) => d.set_pose(positions),
             None => Err(GpuError::Unsupported(format!(
@@ -387,6 +393,7 @@ impl Crowd {
 
     /// Move a character.
     pub fn set_model(&mut self, id: CharacterId, model: Mat4) -> GpuResult<()> {
+        self.version += 1;
         check_model(&model)?;
         self.get_mut(id)?.model = model;
         Ok(())
@@ -394,12 +401,14 @@ impl Crowd {
 
     /// Show or hide a character.
     pub fn set_visible(&mut self, id: CharacterId, visible: bool) -> GpuResult<()> {
+        self.version += 1;
         self.get_mut(id)?.visible = visible;
         Ok(())
     }
 
     /// Change a character's strand settings.
     pub fn set_params(&mut self, id: CharacterId, params: StrandParams) -> GpuResult<()> {
+        self.version += 1;
         params.validate()?;
         let c = self.get_mut(id)?;
         c.params = params;
@@ -449,6 +458,11 @@ impl Crowd {
                 (wlo - margin, whi + margin)
             })
             .collect()
+    }
+
+    /// A number that changes whenever the characters change.
+    pub fn version(&self) -> u64 {
+        self.version
     }
 
     /// Handles of every live character.

@@ -93,6 +93,9 @@ pub struct Renderer {
     shadow: ShadowMaps,
     /// Per-pixel buffers of the transparent modes.
     transparency: TransparencyBuffers,
+    /// The crowd version whose strands the vertex pool holds (the last compute-path frame's),
+    /// which static-path frames draw again.
+    static_version: Option<u64>,
     work: Workspace,
     completed: VecDeque<FrameReport>,
     /// Background colour (linear RGB).
@@ -188,6 +191,7 @@ impl Renderer {
             targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
             shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
             transparency: TransparencyBuffers::new(ctx)?,
+            static_version: None,
             work,
             completed: VecDeque::new(),
             background: [0.6, 0.65, 0.7],
@@ -434,7 +438,7 @@ impl Renderer {
                 .retired
                 .push(Retired::Resource(Box::new(old)));
         }
-        if path == RenderPath::Compute {
+        if path.pulls_vertices() {
             self.work.ensure_pool(self.desc.vertex_pool_bytes)?;
         }
         let slots = self.crowd.slot_count();
@@ -510,6 +514,11 @@ impl Renderer {
                 "{}: no usable VK_EXT_mesh_shader for the mesh path",
                 self.ctx.info.name
             )));
+        }
+        if path == RenderPath::Static && self.static_version != Some(self.crowd.version()) {
+            return Err(GpuError::Unsupported(
+                "the static path draws the strands of the last compute-path frame: render one first, and again after the characters change".into(),
+            ));
         }
         // Prefix sums and statistics are 32-bit: refuse a crowd that could wrap them (LoD
         // usually needs far less, but a frame without LoD must not produce garbage).
@@ -605,6 +614,13 @@ impl Renderer {
             read_image: opts.read_image,
         });
         self.frame_number += 1;
+        // The pool and draw arguments now hold this frame's strands (compute path), or the mesh
+        // path has overwritten the arguments.
+        match path {
+            RenderPath::Compute => self.static_version = Some(self.crowd.version()),
+            RenderPath::Mesh => self.static_version = None,
+            RenderPath::Static => {}
+        }
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
         Ok(FrameTicket(frame))
     }

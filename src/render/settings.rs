@@ -7,6 +7,17 @@ pub enum RenderPath {
     Mesh,
     /// Compute generation + vertex pulling.
     Compute,
+    /// Static strands, the raster limit: draw the strands the last compute-path frame
+    /// generated again (world space, as they were), with no culling, LoD or generation. Valid
+    /// until the crowd changes (characters added, removed, moved, restyled or reposed).
+    Static,
+}
+
+impl RenderPath {
+    /// Whether strands are drawn from the vertex pool (compute and static paths).
+    pub fn pulls_vertices(self) -> bool {
+        matches!(self, RenderPath::Compute | RenderPath::Static)
+    }
 }
 
 /// How to create a [`Renderer`].

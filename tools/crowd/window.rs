@@ -761,7 +761,8 @@ impl Running {
                 self.path = match self.path {
                     RenderPath::Mesh => RenderPath::Compute,
                     RenderPath::Compute if self.renderer.has_mesh_path() => RenderPath::Mesh,
-                    RenderPath::Compute => RenderPath::Compute,
+                    // The window never picks the static path (the crowd moves).
+                    RenderPath::Compute | RenderPath::Static => RenderPath::Compute,
                 }
             }
             KeyCode::KeyV => {

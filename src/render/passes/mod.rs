@@ -277,8 +277,12 @@ impl FramePasses {
         mesh_query: Option<&mut MeshPrimitivesQuery>,
         inp: FrameInputs,
     ) -> GpuResult<()> {
-        // Statistics accumulate from zero every frame.
-        clear_args(rec, inp.args);
+        // Statistics accumulate from zero every frame; the static path keeps the last compute
+        // frame's draw arguments (and statistics).
+        let keep_args = inp.path == RenderPath::Static;
+        if !keep_args {
+            clear_args(rec, inp.args);
+        }
         let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
         let shadow = inp.shadow;
         match shadow.mode {
@@ -299,7 +303,9 @@ impl FramePasses {
                 };
                 self.shadow.record(rec, profiler, shadow.maps, draw)?;
                 // The camera's statistics start from zero again.
-                clear_args(rec, inp.args);
+                if !keep_args {
+                    clear_args(rec, inp.args);
+                }
             }
             None => ShadowPass::keep_readable(rec, shadow.maps),
         }

@@ -300,7 +300,7 @@ fn draw_strands(
 ) -> GpuResult<()> {
     match path {
         RenderPath::Mesh => strands.record_mesh(rec, *sets, bundles),
-        RenderPath::Compute => {
+        RenderPath::Compute | RenderPath::Static => {
             strands.record_pulled(rec, *sets, args);
             Ok(())
         }
