@@ -53,6 +53,10 @@
 #define DEFORM_POSITION_TEXELS 5
 #define DEFORM_U_TEXELS 6
 #define DEFORM_V_TEXELS 7
+#define LHS_REST 0
+#define LHS_WEIGHTS 1
+#define LHS_GUIDE_DELTA 2
+#define LHS_OUT 3
 #define EMPTY_TEXEL 4294967295u
 // Depth of the hair mesh texture: SLICES_PER_SEGMENT (L - 1) + 1 slices.
 #define POSITION_DEPTH(layers) (SLICES_PER_SEGMENT * ((layers) - 1u) + 1u)
@@ -183,6 +187,11 @@ struct DeformParams {
     vec4 origin;
     vec4 extent;
     uvec4 counts;
+};
+
+struct LhsWeights {
+    uvec4 guides;
+    vec4 weights;
 };
 
 struct StylingTerm {

@@ -163,6 +163,40 @@ impl DeformBinding {
     ];
 }
 
+/// Bindings of the LHS skinning pass's own set (`glsl/lhs_skin.comp`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum LhsBinding {
+    /// `HairVertex[]` the stored strands at rest.
+    Rest = 0,
+    /// `LhsWeights[]` per strand.
+    Weights = 1,
+    /// `vec4[]` per guide vertex: its displacement from rest this frame.
+    GuideDelta = 2,
+    /// `HairVertex[]` out: the vertex pool.
+    Out = 3,
+}
+
+impl LhsBinding {
+    /// Every binding, with its GLSL macro name.
+    pub const ALL: [(LhsBinding, &'static str); 4] = [
+        (LhsBinding::Rest, "LHS_REST"),
+        (LhsBinding::Weights, "LHS_WEIGHTS"),
+        (LhsBinding::GuideDelta, "LHS_GUIDE_DELTA"),
+        (LhsBinding::Out, "LHS_OUT"),
+    ];
+}
+
+/// One stored strand's guides (slots) and weights (`reference::lhs`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LhsWeights {
+    /// Guide slots (xyz; w unused).
+    pub guides: [u32; 4],
+    /// Weights (xyz, sum 1; w unused).
+    pub weights: [f32; 4],
+}
+
 /// Decode box and sizes of one animated character (`DeformBinding::Params`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -511,6 +545,7 @@ pub struct StructInfo {
     /// Rust `size_of`.
     pub rust_size: usize,
 }
+gpu_struct!(LhsWeights as "LhsWeights" { guides: "uvec4", weights: "vec4" });
 gpu_struct!(DeformParams as "DeformParams" { origin: "vec4", extent: "vec4", counts: "uvec4" });
 gpu_struct!(crate::bake::deform::StylingTerm as "StylingTerm" {
     i1: "uint", i2: "uint", u: "vec2", v: "vec2",
@@ -540,6 +575,7 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<PropInstance>(),
         info::<TaskPayload>(),
         info::<DeformParams>(),
+        info::<LhsWeights>(),
         info::<crate::bake::deform::StylingTerm>(),
     ]
 }
@@ -628,6 +664,9 @@ pub fn glsl_header() -> String {
         let _ = writeln!(out, "#define {name} {}", b as u32);
     }
     for (b, name) in DeformBinding::ALL {
+        let _ = writeln!(out, "#define {name} {}", b as u32);
+    }
+    for (b, name) in LhsBinding::ALL {
         let _ = writeln!(out, "#define {name} {}", b as u32);
     }
     let _ = writeln!(

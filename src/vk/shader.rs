@@ -79,6 +79,7 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../glsl/oit_resolve.frag"),
     ),
     ("curve.glsl", include_str!("../../glsl/curve.glsl")),
+    ("lhs_skin.comp", include_str!("../../glsl/lhs_skin.comp")),
     (
         "hair_mesh_update.comp",
         include_str!("../../glsl/hair_mesh_update.comp"),
