@@ -34,7 +34,7 @@ impl LhsModel {
     /// Guides and weights for strands `rest` (strand-major, `verts` each) with `fraction` of
     /// the strands as guides (0.001..=0.1).
     pub fn new(rest: Vec<Vec3>, verts: usize, fraction: f32) -> Result<Self> {
-        if verts < 2 || rest.is_empty() || rest.len() % verts != 0 {
+        if verts < 2 || rest.is_empty() || !rest.len().is_multiple_of(verts) {
             return Err(HairError::invalid(
                 "lhs",
                 "strands must have >= 2 vertices each",

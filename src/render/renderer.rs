@@ -96,6 +96,8 @@ pub struct Renderer {
     /// The crowd version whose strands the vertex pool holds (the last compute-path frame's),
     /// which static-path frames draw again.
     static_version: Option<u64>,
+    /// The LHS baseline's stored strands (`capture_lhs`), with the crowd version they are of.
+    lhs: Option<(u64, super::passes::lhs_skin::LhsState)>,
     work: Workspace,
     completed: VecDeque<FrameReport>,
     /// Background colour (linear RGB).
@@ -192,6 +194,7 @@ impl Renderer {
             shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
             transparency: TransparencyBuffers::new(ctx)?,
             static_version: None,
+            lhs: None,
             work,
             completed: VecDeque::new(),
             background: [0.6, 0.65, 0.7],
@@ -276,6 +279,55 @@ impl Renderer {
         positions: &[glam::Vec3],
     ) -> GpuResult<()> {
         self.crowd.set_pose(id, positions)
+    }
+
+    /// Store the strands of the last compute-path frame for the LHS baseline (`RenderPath::Lhs`):
+    /// its first `vertices` pool vertices (`FrameStats::vertex_slots_written` of that frame,
+    /// rendered with LoD off), `verts_per_strand` each, with `fraction` of them as guides
+    /// (`reference::lhs`). Waits for the frames in flight.
+    pub fn capture_lhs(
+        &mut self,
+        vertices: u32,
+        verts_per_strand: usize,
+        fraction: f32,
+    ) -> GpuResult<&crate::reference::lhs::LhsModel> {
+        if self.static_version != Some(self.crowd.version()) {
+            return Err(GpuError::Unsupported(
+                "capture_lhs needs the strands of a compute-path frame of the current characters"
+                    .into(),
+            ));
+        }
+        let rest = self.read_vertices(vertices)?;
+        if rest.len() != vertices as usize {
+            return Err(GpuError::Unsupported(format!(
+                "capture_lhs: {vertices} vertices asked for, the pool holds {}",
+                rest.len()
+            )));
+        }
+        let positions = rest
+            .iter()
+            .map(|v| glam::Vec3::from_slice(&v.pos_width[..3]))
+            .collect();
+        let model = crate::reference::lhs::LhsModel::new(positions, verts_per_strand, fraction)
+            .map_err(|e| GpuError::Unsupported(e.to_string()))?;
+        let pool = self
+            .work
+            .pool
+            .as_ref()
+            .ok_or_else(|| GpuError::Unsupported("no vertex pool".into()))?;
+        let state = self.passes.lhs_skin.upload(model, &rest, pool)?;
+        let version = self.crowd.version();
+        Ok(self.lhs.insert((version, state)).1.model())
+    }
+
+    /// Set the LHS guides' vertices for the next `RenderPath::Lhs` frame (guide-major, as
+    /// `LhsModel::guide_rest`).
+    pub fn set_lhs_guides(&mut self, now: &[glam::Vec3]) -> GpuResult<()> {
+        self.lhs
+            .as_mut()
+            .ok_or_else(|| GpuError::Unsupported("no LHS strands captured".into()))?
+            .1
+            .set_guides(now)
     }
 
     /// Read back character `id`'s texture `binding` (tightly packed texels, as in the bake).
@@ -515,9 +567,15 @@ impl Renderer {
                 self.ctx.info.name
             )));
         }
-        if path == RenderPath::Static && self.static_version != Some(self.crowd.version()) {
+        let static_ok = self.static_version == Some(self.crowd.version());
+        if matches!(path, RenderPath::Static | RenderPath::Lhs) && !static_ok {
             return Err(GpuError::Unsupported(
-                "the static path draws the strands of the last compute-path frame: render one first, and again after the characters change".into(),
+                "the static and LHS paths draw the strands of the last compute-path frame: render one first, and again after the characters change".into(),
+            ));
+        }
+        if path == RenderPath::Lhs && self.lhs.as_ref().map(|l| l.0) != Some(self.crowd.version()) {
+            return Err(GpuError::Unsupported(
+                "the LHS path needs stored strands: call capture_lhs after a compute frame".into(),
             ));
         }
         // Prefix sums and statistics are 32-bit: refuse a crowd that could wrap them (LoD
@@ -619,7 +677,7 @@ impl Renderer {
         match path {
             RenderPath::Compute => self.static_version = Some(self.crowd.version()),
             RenderPath::Mesh => self.static_version = None,
-            RenderPath::Static => {}
+            RenderPath::Static | RenderPath::Lhs => {}
         }
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
         Ok(FrameTicket(frame))
@@ -651,6 +709,13 @@ impl Renderer {
         let jobs = self.crowd.update_jobs(i, &pose_updates);
         self.passes
             .record_updates(&mut rec, &mut slot.profiler, &jobs);
+        if path == RenderPath::Lhs
+            && let Some((_, lhs)) = self.lhs.as_mut()
+        {
+            self.passes
+                .lhs_skin
+                .record(&mut rec, &mut slot.profiler, lhs, i)?;
+        }
         let inputs = FrameInputs {
             sets: PassSets {
                 frame: &slot.set,

@@ -11,12 +11,18 @@ pub enum RenderPath {
     /// generated again (world space, as they were), with no culling, LoD or generation. Valid
     /// until the crowd changes (characters added, removed, moved, restyled or reposed).
     Static,
+    /// Linear hair skinning, the paper's baseline: the static strands moved each frame by
+    /// their guides (`Renderer::capture_lhs`, `Renderer::set_lhs_guides`), then drawn.
+    Lhs,
 }
 
 impl RenderPath {
     /// Whether strands are drawn from the vertex pool (compute and static paths).
     pub fn pulls_vertices(self) -> bool {
-        matches!(self, RenderPath::Compute | RenderPath::Static)
+        matches!(
+            self,
+            RenderPath::Compute | RenderPath::Static | RenderPath::Lhs
+        )
     }
 }
 

@@ -762,7 +762,7 @@ impl Running {
                     RenderPath::Mesh => RenderPath::Compute,
                     RenderPath::Compute if self.renderer.has_mesh_path() => RenderPath::Mesh,
                     // The window never picks the static path (the crowd moves).
-                    RenderPath::Compute | RenderPath::Static => RenderPath::Compute,
+                    _ => RenderPath::Compute,
                 }
             }
             KeyCode::KeyV => {

@@ -3,6 +3,7 @@
 
 pub mod compute_generate;
 pub mod hair_mesh_update;
+pub mod lhs_skin;
 pub mod props;
 pub mod scalp;
 pub mod shadow;
@@ -198,6 +199,8 @@ pub struct FramePasses {
     strands: StrandDraw,
     transparency: TransparencyPass,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
+    /// The LHS baseline's skinning pass.
+    pub lhs_skin: lhs_skin::LhsSkin,
 }
 
 /// Zero `args` (indirect arguments and statistics) after earlier generation used it.
@@ -240,6 +243,7 @@ impl FramePasses {
             strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
             hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
+            lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
         })
     }
 
@@ -279,7 +283,7 @@ impl FramePasses {
     ) -> GpuResult<()> {
         // Statistics accumulate from zero every frame; the static path keeps the last compute
         // frame's draw arguments (and statistics).
-        let keep_args = inp.path == RenderPath::Static;
+        let keep_args = matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
         if !keep_args {
             clear_args(rec, inp.args);
         }

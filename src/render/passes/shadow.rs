@@ -65,7 +65,7 @@ impl ShadowPass {
         }
         match d.path {
             RenderPath::Mesh => draw.record_mesh(rec, d.sets, d.bundles),
-            RenderPath::Compute | RenderPath::Static => {
+            RenderPath::Compute | RenderPath::Static | RenderPath::Lhs => {
                 draw.record_pulled(rec, d.sets, d.args);
                 Ok(())
             }

@@ -300,7 +300,7 @@ fn draw_strands(
 ) -> GpuResult<()> {
     match path {
         RenderPath::Mesh => strands.record_mesh(rec, *sets, bundles),
-        RenderPath::Compute | RenderPath::Static => {
+        RenderPath::Compute | RenderPath::Static | RenderPath::Lhs => {
             strands.record_pulled(rec, *sets, args);
             Ok(())
         }
