@@ -7,6 +7,10 @@
 //! mid and far distances; strand triangles and median GPU time with LoD on vs off, mesh vs
 //! compute path (timestamp queries); optionally a near/mid/far picture with LoD on.
 //!
+//! `bench paper [--scale small|full] [--csv out.csv]`: the paper's comparison in one run:
+//! hair mesh (both paths) vs LHS vs static strands per model, crowd and distance LoD speedups,
+//! bytes per method.
+//!
 //! `bench animate [--mesh M] [--wind 30] [--frames 90] [--strip out.png]`: one hair mesh in
 //! wind, simulated and re-textured every frame: CPU ms of the dynamics, GPU ms of the texture
 //! rebuild and of the frame (medians); optionally a strip of frames side by side.
@@ -16,6 +20,8 @@ use std::time::Instant;
 
 #[path = "bench/animate.rs"]
 mod animate;
+#[path = "bench/paper.rs"]
+mod paper;
 
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
@@ -89,6 +95,19 @@ enum Cmd {
         /// Campaign seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+    },
+    /// The paper's comparison in one run: hair mesh (mesh and compute paths) vs linear hair
+    /// skinning vs static strands per model, crowd LoD on/off, near/mid/far LoD, GPU bytes.
+    Paper {
+        /// small (lavapipe: about a minute per scenario) or full (the paper's counts).
+        #[arg(long, default_value = "small")]
+        scale: String,
+        /// Write every measurement here as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Choose the GPU by name substring.
+        #[arg(long)]
+        device: Option<String>,
     },
     /// One hair mesh in wind, simulated and re-textured every frame (30 Hz): CPU ms of the
     /// dynamics, GPU ms of the texture rebuild and of the frame; optionally a strip of frames.
@@ -481,6 +500,7 @@ fn main() {
 
 fn run(args: Args) -> Result<()> {
     match args.cmd {
+        Cmd::Paper { scale, csv, device } => paper::bench_paper(&scale, device, csv)?,
         Cmd::Animate {
             mesh,
             frames,

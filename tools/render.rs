@@ -55,11 +55,12 @@ struct Args {
     /// Choose the GPU by name substring (default: discrete, else integrated, else lavapipe).
     #[arg(long)]
     device: Option<String>,
-    /// Generation path: mesh (task + mesh shaders), compute (compute + vertex pulling), or
+    /// Generation path: mesh (task + mesh shaders), compute (compute + vertex pulling),
     /// static (a compute frame generates the strands, then a second frame draws them again
-    /// with no generation: the raster limit; the report is the second frame's); default: mesh
-    /// where the device supports it.
-    #[arg(long, value_parser = ["mesh", "compute", "static"])]
+    /// with no generation: the raster limit), or lhs (the same strands stored with 1% guides
+    /// and skinned by them, the paper's baseline); for static and lhs the report is the
+    /// second frame's. Default: mesh where the device supports it.
+    #[arg(long, value_parser = ["mesh", "compute", "static", "lhs"])]
     path: Option<String>,
     /// Level of detail (paper sec. 3.6).
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
@@ -353,15 +354,30 @@ fn run(args: Args) -> Result<()> {
             ..Default::default()
         },
     )?;
-    if args.path.as_deref() == Some("static") {
+    let second = match args.path.as_deref() {
+        Some("static") => Some(RenderPath::Static),
+        Some("lhs") => Some(RenderPath::Lhs),
+        _ => None,
+    };
+    if let Some(second) = second {
         outln!(
-            "generated (compute path): GPU {:.3} ms; drawing the same strands again:",
+            "generated (compute path): GPU {:.3} ms; then {second:?}:",
             out.gpu_ms()
         )?;
+        if second == RenderPath::Lhs {
+            let verts = (1usize << args.verts_log2) + 1;
+            let m = renderer.capture_lhs(out.stats.vertex_slots_written, verts, 0.01)?;
+            outln!(
+                "LHS: {} strands, {} guides, {:.2} MiB stored",
+                m.weights.len(),
+                m.guides.len(),
+                m.bytes() as f64 / (1 << 20) as f64
+            )?;
+        }
         out = renderer.render_one(
             &view,
             &FrameOptions {
-                path: Some(RenderPath::Static),
+                path: Some(second),
                 read_image: true,
                 ..Default::default()
             },
