@@ -58,6 +58,23 @@ const MODELS: [&str; 3] = [
     "hairmeshes/triangle_tuft.obj",
 ];
 
+/// One CSV row: scenario, model, method, median / min / max GPU ms, strands, triangles,
+/// bytes (empty when not measured).
+fn csv_row(
+    scenario: &str,
+    model: &str,
+    method: &str,
+    t: &(f64, f64, f64, FrameReport),
+    bytes: Option<u64>,
+) -> String {
+    let s = &t.3.stats;
+    let bytes = bytes.map_or(String::new(), |b| b.to_string());
+    format!(
+        "{scenario},{model},{method},{:.3},{:.3},{:.3},{},{},{bytes}\n",
+        t.0, t.1, t.2, s.strands_drawn, s.triangles_drawn
+    )
+}
+
 /// Median and (min, max) of GPU ms over `runs` frames after one warm-up.
 fn time(
     r: &mut Renderer,
@@ -142,34 +159,15 @@ pub fn bench_paper(
         if r.has_mesh_path() {
             let t = time(&mut r, &v, RenderPath::Mesh, scale.runs)?;
             mesh_ms = t.0;
-            rows += &format!(
-                "a,{path},mesh,{:.3},{:.3},{:.3},{},{},{}\n",
-                t.0,
-                t.1,
-                t.2,
-                t.3.stats.strands_drawn,
-                t.3.stats.triangles_drawn,
-                baked.texture_bytes()
-            );
+            rows += &csv_row("a", path, "mesh", &t, Some(baked.texture_bytes() as u64));
         }
         let c = time(&mut r, &v, RenderPath::Compute, scale.runs)?;
-        rows += &format!(
-            "a,{path},compute,{:.3},{:.3},{:.3},{},{},{}\n",
-            c.0,
-            c.1,
-            c.2,
-            c.3.stats.strands_drawn,
-            c.3.stats.triangles_drawn,
-            baked.texture_bytes()
-        );
+        rows += &csv_row("a", path, "compute", &c, Some(baked.texture_bytes() as u64));
         let vertices = c.3.stats.vertex_slots_written;
         let static_bytes =
             vertices as u64 * size_of::<hairmesh::render::shared::HairVertex>() as u64;
         let s = time(&mut r, &v, RenderPath::Static, scale.runs)?;
-        rows += &format!(
-            "a,{path},static,{:.3},{:.3},{:.3},{},{},{static_bytes}\n",
-            s.0, s.1, s.2, s.3.stats.strands_drawn, s.3.stats.triangles_drawn
-        );
+        rows += &csv_row("a", path, "static", &s, Some(static_bytes));
         // A fresh compute frame holds the strands LHS stores.
         r.render_one(
             &v,
@@ -180,10 +178,7 @@ pub fn bench_paper(
         )?;
         let lhs_bytes = r.capture_lhs(vertices, 17, 0.01)?.bytes();
         let l = time(&mut r, &v, RenderPath::Lhs, scale.runs)?;
-        rows += &format!(
-            "a,{path},lhs,{:.3},{:.3},{:.3},{},{},{lhs_bytes}\n",
-            l.0, l.1, l.2, l.3.stats.strands_drawn, l.3.stats.triangles_drawn
-        );
+        rows += &csv_row("a", path, "lhs", &l, Some(lhs_bytes));
         let best = if mesh_ms.is_nan() {
             c.0
         } else {
@@ -237,14 +232,8 @@ pub fn bench_paper(
     for p in paths {
         let on = time(&mut r, &view(camera, true), p, scale.runs)?;
         let off = time(&mut r, &view(camera, false), p, scale.runs)?;
-        rows += &format!(
-            "b,crowd,{p:?} lod on,{:.3},{:.3},{:.3},{},{},\n",
-            on.0, on.1, on.2, on.3.stats.strands_drawn, on.3.stats.triangles_drawn
-        );
-        rows += &format!(
-            "b,crowd,{p:?} lod off,{:.3},{:.3},{:.3},{},{},\n",
-            off.0, off.1, off.2, off.3.stats.strands_drawn, off.3.stats.triangles_drawn
-        );
+        rows += &csv_row("b", "crowd", &format!("{p:?} lod on"), &on, None);
+        rows += &csv_row("b", "crowd", &format!("{p:?} lod off"), &off, None);
         outln!(
             "| {p:?} | {:.0} | {:.0} | {:.1}x | {} / {} |",
             on.0,
@@ -283,14 +272,8 @@ pub fn bench_paper(
         );
         let on = time(&mut r, &view(cam, true), RenderPath::Compute, scale.runs)?;
         let off = time(&mut r, &view(cam, false), RenderPath::Compute, scale.runs)?;
-        rows += &format!(
-            "c,head_long,{name} lod on,{:.3},{:.3},{:.3},{},{},\n",
-            on.0, on.1, on.2, on.3.stats.strands_drawn, on.3.stats.triangles_drawn
-        );
-        rows += &format!(
-            "c,head_long,{name} lod off,{:.3},{:.3},{:.3},{},{},\n",
-            off.0, off.1, off.2, off.3.stats.strands_drawn, off.3.stats.triangles_drawn
-        );
+        rows += &csv_row("c", "head_long", &format!("{name} lod on"), &on, None);
+        rows += &csv_row("c", "head_long", &format!("{name} lod off"), &off, None);
         outln!(
             "| {name} | {:.0} | {:.0} | {:.1}x |",
             on.0,
