@@ -17,7 +17,7 @@ fn lhs_at_rest_equals_the_hair_mesh_and_skins_like_its_twin() {
     let ctx = context();
     let (baked, style) = sample("head_long.obj");
     let mut r = Renderer::new(&ctx, &RendererDesc::default().size(128, 128)).unwrap();
-    upload(&mut r, &baked, &style, 16, 4);
+    let id = upload(&mut r, &baked, &style, 16, 4);
     let view = View {
         camera: framing(&baked),
         light_dir: light(),
@@ -75,6 +75,28 @@ fn lhs_at_rest_equals_the_hair_mesh_and_skins_like_its_twin() {
     assert!(worst < 1e-5, "{worst}");
     let moved = mean_abs_diff(&bent.rgba.unwrap(), &generated_again(&mut r, &view));
     assert!(moved > 1e-3, "bent guides did not move the hair ({moved})");
+    // The guides follow the hair mesh: move the character, regenerate the guides from its
+    // hair mesh at the new place; LHS gives the moved hair-mesh image.
+    let shift = glam::Mat4::from_translation(Vec3::new(0.05, -0.02, 0.0));
+    r.set_model(id, shift).unwrap();
+    let counts = vec![
+        baked
+            .bundles
+            .iter()
+            .map(|b| hairmesh::reference::generate::strands_in_bundle(b, &style, 16))
+            .collect::<Vec<u32>>(),
+    ];
+    let origins = hairmesh::reference::lhs::strand_origins(&counts);
+    assert_eq!(origins.len(), strands);
+    let generator = hairmesh::CpuGenerator::new(&baked, style);
+    let guides =
+        hairmesh::reference::lhs::guide_positions(&model, &origins, &[(&generator, shift)]);
+    let moved_mesh = generated_again(&mut r, &view);
+    r.set_lhs_guides(&guides).unwrap();
+    let moved_lhs = frame(&mut r, RenderPath::Lhs);
+    let d = mean_abs_diff(&moved_mesh, &moved_lhs.rgba.unwrap());
+    println!("moved character: LHS with regenerated guides vs hair mesh {d}");
+    assert!(d <= 1.0 / 255.0, "{d}");
     assert_no_validation_errors(&ctx);
 }
 

@@ -148,6 +148,42 @@ impl LhsModel {
     }
 }
 
+/// Where each stored strand comes from, in the order the compute path stores them
+/// (characters in crowd order, bundles, strands): `(character, bundle, strand)`, from the
+/// strand counts of every bundle of every character.
+pub fn strand_origins(counts: &[Vec<u32>]) -> Vec<(u32, u32, u32)> {
+    let mut out = Vec::new();
+    for (c, bundles) in counts.iter().enumerate() {
+        for (b, &n) in bundles.iter().enumerate() {
+            out.extend((0..n).map(|s| (c as u32, b as u32, s)));
+        }
+    }
+    out
+}
+
+/// The guides' vertices now (guide-major, world space): every guide strand generated again
+/// from its character's current hair mesh (`generators[character]`, e.g. over a bake whose
+/// textures `bake::deform` rebuilt for the current pose) and placed by that character's
+/// current transform: this is how the guides follow an animated hair mesh.
+pub fn guide_positions(
+    model: &LhsModel,
+    origins: &[(u32, u32, u32)],
+    generators: &[(&crate::reference::generate::CpuGenerator, glam::Mat4)],
+) -> Vec<Vec3> {
+    let v = model.verts_per_strand;
+    let mut pos = vec![Vec3::ZERO; v];
+    let mut tan = vec![Vec3::ZERO; v];
+    let mut width = vec![0.0; v];
+    let mut out = Vec::with_capacity(model.guides.len() * v);
+    for &g in &model.guides {
+        let (c, b, s) = origins[g as usize];
+        let (generator, placement) = &generators[c as usize];
+        generator.strand(b, s, (v - 1) as u32, &mut pos, &mut tan, &mut width);
+        out.extend(pos.iter().map(|p| placement.transform_point3(*p)));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

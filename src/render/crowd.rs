@@ -145,6 +145,9 @@ pub struct Crowd {
     dirty: bool,
     /// Bumped by every change to the characters (static strands are valid for one version).
     version: u64,
+    /// Bumped when the strands that exist change (characters added, removed, shown, hidden or
+    /// restyled), not when they move: stored LHS strands are valid for one structure.
+    structure_version: u64,
 }
 
 impl Crowd {
@@ -187,6 +190,7 @@ impl Crowd {
             bundle_count: 0,
             dirty: false,
             version: 0,
+            structure_version: 0,
         })
     }
 
@@ -210,6 +214,7 @@ impl Crowd {
     ) -> GpuResult<CharacterId> {
         params.validate()?;
         self.version += 1;
+        self.structure_version += 1;
         check_model(&model)?;
         let slot = match self.free.pop() {
             Some(s) => s,
@@ -294,6 +299,7 @@ impl Crowd {
     /// may use them.
     pub fn remove(&mut self, id: CharacterId) -> GpuResult<RemovedCharacter> {
         self.version += 1;
+        self.structure_version += 1;
         self.get_mut(id)?;
         let c = self.slots[id.slot as usize]
             .take()
@@ -402,6 +408,7 @@ impl Crowd {
     /// Show or hide a character.
     pub fn set_visible(&mut self, id: CharacterId, visible: bool) -> GpuResult<()> {
         self.version += 1;
+        self.structure_version += 1;
         self.get_mut(id)?.visible = visible;
         Ok(())
     }
@@ -409,6 +416,7 @@ impl Crowd {
     /// Change a character's strand settings.
     pub fn set_params(&mut self, id: CharacterId, params: StrandParams) -> GpuResult<()> {
         self.version += 1;
+        self.structure_version += 1;
         params.validate()?;
         let c = self.get_mut(id)?;
         c.params = params;
@@ -463,6 +471,11 @@ impl Crowd {
     /// A number that changes whenever the characters change.
     pub fn version(&self) -> u64 {
         self.version
+    }
+
+    /// A number that changes whenever the set of strands changes (not when characters move).
+    pub fn structure_version(&self) -> u64 {
+        self.structure_version
     }
 
     /// Handles of every live character.

@@ -96,6 +96,9 @@ pub struct Renderer {
     /// The crowd version whose strands the vertex pool holds (the last compute-path frame's),
     /// which static-path frames draw again.
     static_version: Option<u64>,
+    /// The crowd structure whose strand layout the draw arguments describe (the last compute
+    /// frame's; a mesh frame clears them).
+    args_structure: Option<u64>,
     /// The LHS baseline's stored strands (`capture_lhs`), with the crowd version they are of.
     lhs: Option<(u64, super::passes::lhs_skin::LhsState)>,
     work: Workspace,
@@ -194,6 +197,7 @@ impl Renderer {
             shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
             transparency: TransparencyBuffers::new(ctx)?,
             static_version: None,
+            args_structure: None,
             lhs: None,
             work,
             completed: VecDeque::new(),
@@ -316,7 +320,7 @@ impl Renderer {
             .as_ref()
             .ok_or_else(|| GpuError::Unsupported("no vertex pool".into()))?;
         let state = self.passes.lhs_skin.upload(model, &rest, pool)?;
-        let version = self.crowd.version();
+        let version = self.crowd.structure_version();
         Ok(self.lhs.insert((version, state)).1.model())
     }
 
@@ -567,15 +571,17 @@ impl Renderer {
                 self.ctx.info.name
             )));
         }
-        let static_ok = self.static_version == Some(self.crowd.version());
-        if matches!(path, RenderPath::Static | RenderPath::Lhs) && !static_ok {
+        if path == RenderPath::Static && self.static_version != Some(self.crowd.version()) {
             return Err(GpuError::Unsupported(
-                "the static and LHS paths draw the strands of the last compute-path frame: render one first, and again after the characters change".into(),
+                "the static path draws the strands of the last compute-path frame: render one first, and again after the characters change".into(),
             ));
         }
-        if path == RenderPath::Lhs && self.lhs.as_ref().map(|l| l.0) != Some(self.crowd.version()) {
+        let structure = Some(self.crowd.structure_version());
+        if path == RenderPath::Lhs
+            && (self.lhs.as_ref().map(|l| l.0) != structure || self.args_structure != structure)
+        {
             return Err(GpuError::Unsupported(
-                "the LHS path needs stored strands: call capture_lhs after a compute frame".into(),
+                "the LHS path needs strands stored by capture_lhs for the current characters, and a compute-path frame since the last mesh-path one".into(),
             ));
         }
         // Prefix sums and statistics are 32-bit: refuse a crowd that could wrap them (LoD
@@ -675,8 +681,14 @@ impl Renderer {
         // The pool and draw arguments now hold this frame's strands (compute path), or the mesh
         // path has overwritten the arguments.
         match path {
-            RenderPath::Compute => self.static_version = Some(self.crowd.version()),
-            RenderPath::Mesh => self.static_version = None,
+            RenderPath::Compute => {
+                self.static_version = Some(self.crowd.version());
+                self.args_structure = Some(self.crowd.structure_version());
+            }
+            RenderPath::Mesh => {
+                self.static_version = None;
+                self.args_structure = None;
+            }
             RenderPath::Static | RenderPath::Lhs => {}
         }
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
