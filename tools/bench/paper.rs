@@ -58,6 +58,50 @@ const MODELS: [&str; 3] = [
     "hairmeshes/triangle_tuft.obj",
 ];
 
+/// (d) for the crowd's generated hairstyles (people preset, 8 characters): bytes of the five
+/// textures against the LHS data (stored vertices 16 B, weights 24 B per strand, 1% guides) and
+/// a `.hair` file (points and thickness), at about `strands` strands each, 17 points per strand.
+fn storage_of_generated_styles(strands: u32, rows: &mut String) -> Result<()> {
+    use hairmesh::characters::preset::{self, Preset};
+    outln!(
+        "\n(d) storage of the crowd's generated styles (people, 8 characters), {strands} strands each"
+    )?;
+    outln!("| style | bundles | textures | LHS data | .hair | LHS / textures |")?;
+    outln!("|---|---|---|---|---|---|")?;
+    for c in preset::build(Preset::People, 8, 1)? {
+        let baked = hairmesh::bake(
+            &c.hair.mesh,
+            &c.hair.style,
+            hairmesh::BakeOptions::default(),
+            |_, _| {},
+        )?;
+        let per_bundle = (strands as f32 / baked.bundles.len() as f32).ceil() as u32;
+        let n: u64 = baked
+            .bundles
+            .iter()
+            .map(|b| strands_in_bundle(b, &c.hair.style, per_bundle.clamp(1, 4096)) as u64)
+            .sum();
+        let points = n * 17;
+        let guides = n.div_ceil(100);
+        let lhs = points * 16 + n * 24 + guides * 17 * 16;
+        let hair = 128 + points * 16;
+        let tex = baked.texture_bytes() as u64;
+        *rows += &format!("d,{:?},textures,,,,{n},,{tex}\n", c.hair.family);
+        *rows += &format!("d,{:?},lhs,,,,{n},,{lhs}\n", c.hair.family);
+        *rows += &format!("d,{:?},hair file,,,,{n},,{hair}\n", c.hair.family);
+        outln!(
+            "| {:?} | {} | {:.1} KiB | {:.1} MiB | {:.1} MiB | {:.0}x |",
+            c.hair.family,
+            baked.bundles.len(),
+            tex as f64 / 1024.0,
+            lhs as f64 / (1 << 20) as f64,
+            hair as f64 / (1 << 20) as f64,
+            lhs as f64 / tex as f64
+        )?;
+    }
+    Ok(())
+}
+
 /// One CSV row: scenario, model, method, median / min / max GPU ms, strands, triangles,
 /// bytes (empty when not measured).
 fn csv_row(
@@ -281,6 +325,7 @@ pub fn bench_paper(
             off.0 / on.0
         )?;
     }
+    storage_of_generated_styles(scale.strands, &mut rows)?;
     if let Some(out) = csv_out {
         out.write(rows.as_bytes())?;
         outln!("\nwrote {}", out.path().display())?;
