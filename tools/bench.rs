@@ -102,6 +102,10 @@ enum Cmd {
         /// small (lavapipe: about a minute per scenario) or full (the paper's counts).
         #[arg(long, default_value = "small")]
         scale: String,
+        /// One scenario: models (a, d), crowd (b), distance (c), storage (d for the crowd's
+        /// generated styles), or all.
+        #[arg(long, default_value = "all")]
+        scenario: String,
         /// Write every measurement here as CSV.
         #[arg(long)]
         csv: Option<PathBuf>,
@@ -500,7 +504,12 @@ fn main() {
 
 fn run(args: Args) -> Result<()> {
     match args.cmd {
-        Cmd::Paper { scale, csv, device } => paper::bench_paper(&scale, device, csv)?,
+        Cmd::Paper {
+            scale,
+            scenario,
+            csv,
+            device,
+        } => paper::bench_paper(&scale, &scenario, device, csv)?,
         Cmd::Animate {
             mesh,
             frames,

@@ -4,7 +4,8 @@
 //! on vs off; (c) one head at near / mid / far with LoD on vs off; (d) bytes on the GPU per
 //! model for each method. Warm-up then `runs` timed frames with timestamp queries; medians and
 //! spread; CSV plus a one-screen summary. `--scale small` shrinks strand counts, crowd and image
-//! so lavapipe finishes each scenario in about a minute.
+//! so lavapipe finishes each scenario in about a minute; `--scenario models|crowd|distance|
+//! storage` runs one of them (default all).
 
 use std::sync::Arc;
 
@@ -149,10 +150,16 @@ fn view(camera: Camera, lod_on: bool) -> hairmesh::render::View {
 /// Run every scenario at `scale`; write the CSV to `csv` when given.
 pub fn bench_paper(
     scale_name: &str,
+    scenario: &str,
     device: Option<String>,
     csv: Option<std::path::PathBuf>,
 ) -> Result<()> {
     let scale = Scale::named(scale_name)?;
+    const SCENARIOS: [&str; 5] = ["all", "models", "crowd", "distance", "storage"];
+    if !SCENARIOS.contains(&scenario) {
+        bail!("--scenario {scenario}: one of {}", SCENARIOS.join(", "));
+    }
+    let wants = |name: &str| scenario == "all" || scenario == name;
     let csv_out = csv.map(|p| OutputPath::check(&p, &[])).transpose()?;
     let ctx = Arc::new(Context::new(&ContextDesc::default().device(device))?);
     let (w, h) = scale.size;
@@ -169,66 +176,67 @@ pub fn bench_paper(
         scale.runs
     )?;
     // (a) and (d): per model, LoD off.
-    outln!(
-        "\n(a) {} strands per model, LoD off; (d) GPU bytes per model",
-        scale.strands
-    )?;
-    outln!(
-        "| model | strands | mesh ms | compute ms | LHS ms | static ms | LHS / hair mesh | static / hair mesh | textures | LHS bytes | static bytes |"
-    )?;
-    outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
-    for path in MODELS {
-        let (baked, style) = load_mesh(std::path::Path::new(path), None)?;
-        let per_bundle = (scale.strands as f32 / baked.bundles.len() as f32).ceil() as u32;
-        let params = StrandParams {
-            strands_per_bundle: per_bundle.clamp(1, 4096),
-            verts_log2: 4,
-        };
-        let strands: u64 = baked
-            .bundles
-            .iter()
-            .map(|b| strands_in_bundle(b, &style, params.strands_per_bundle) as u64)
-            .sum();
-        let mut r = Renderer::new(
-            &ctx,
-            &RendererDesc::default().size(w, h).vertex_pool_bytes(pool),
+    if wants("models") {
+        outln!(
+            "\n(a) {} strands per model, LoD off; (d) GPU bytes per model",
+            scale.strands
         )?;
-        r.add_character(&baked, &style, params, Mat4::IDENTITY)?;
-        let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
-        let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
-        let camera = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
-        let v = view(camera, false);
-        let mut cells = Vec::new();
-        let mut mesh_ms = f64::NAN;
-        if r.has_mesh_path() {
-            let t = time(&mut r, &v, RenderPath::Mesh, scale.runs)?;
-            mesh_ms = t.0;
-            rows += &csv_row("a", path, "mesh", &t, Some(baked.texture_bytes() as u64));
-        }
-        let c = time(&mut r, &v, RenderPath::Compute, scale.runs)?;
-        rows += &csv_row("a", path, "compute", &c, Some(baked.texture_bytes() as u64));
-        let vertices = c.3.stats.vertex_slots_written;
-        let static_bytes =
-            vertices as u64 * size_of::<hairmesh::render::shared::HairVertex>() as u64;
-        let s = time(&mut r, &v, RenderPath::Static, scale.runs)?;
-        rows += &csv_row("a", path, "static", &s, Some(static_bytes));
-        // A fresh compute frame holds the strands LHS stores.
-        r.render_one(
-            &v,
-            &FrameOptions {
-                path: Some(RenderPath::Compute),
-                ..Default::default()
-            },
+        outln!(
+            "| model | strands | mesh ms | compute ms | LHS ms | static ms | LHS / hair mesh | static / hair mesh | textures | LHS bytes | static bytes |"
         )?;
-        let lhs_bytes = r.capture_lhs(vertices, 17, 0.01)?.bytes();
-        let l = time(&mut r, &v, RenderPath::Lhs, scale.runs)?;
-        rows += &csv_row("a", path, "lhs", &l, Some(lhs_bytes));
-        let best = if mesh_ms.is_nan() {
-            c.0
-        } else {
-            mesh_ms.min(c.0)
-        };
-        cells.push(format!(
+        outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
+        for path in MODELS {
+            let (baked, style) = load_mesh(std::path::Path::new(path), None)?;
+            let per_bundle = (scale.strands as f32 / baked.bundles.len() as f32).ceil() as u32;
+            let params = StrandParams {
+                strands_per_bundle: per_bundle.clamp(1, 4096),
+                verts_log2: 4,
+            };
+            let strands: u64 = baked
+                .bundles
+                .iter()
+                .map(|b| strands_in_bundle(b, &style, params.strands_per_bundle) as u64)
+                .sum();
+            let mut r = Renderer::new(
+                &ctx,
+                &RendererDesc::default().size(w, h).vertex_pool_bytes(pool),
+            )?;
+            r.add_character(&baked, &style, params, Mat4::IDENTITY)?;
+            let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+            let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
+            let camera = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
+            let v = view(camera, false);
+            let mut cells = Vec::new();
+            let mut mesh_ms = f64::NAN;
+            if r.has_mesh_path() {
+                let t = time(&mut r, &v, RenderPath::Mesh, scale.runs)?;
+                mesh_ms = t.0;
+                rows += &csv_row("a", path, "mesh", &t, Some(baked.texture_bytes() as u64));
+            }
+            let c = time(&mut r, &v, RenderPath::Compute, scale.runs)?;
+            rows += &csv_row("a", path, "compute", &c, Some(baked.texture_bytes() as u64));
+            let vertices = c.3.stats.vertex_slots_written;
+            let static_bytes =
+                vertices as u64 * size_of::<hairmesh::render::shared::HairVertex>() as u64;
+            let s = time(&mut r, &v, RenderPath::Static, scale.runs)?;
+            rows += &csv_row("a", path, "static", &s, Some(static_bytes));
+            // A fresh compute frame holds the strands LHS stores.
+            r.render_one(
+                &v,
+                &FrameOptions {
+                    path: Some(RenderPath::Compute),
+                    ..Default::default()
+                },
+            )?;
+            let lhs_bytes = r.capture_lhs(vertices, 17, 0.01)?.bytes();
+            let l = time(&mut r, &v, RenderPath::Lhs, scale.runs)?;
+            rows += &csv_row("a", path, "lhs", &l, Some(lhs_bytes));
+            let best = if mesh_ms.is_nan() {
+                c.0
+            } else {
+                mesh_ms.min(c.0)
+            };
+            cells.push(format!(
             "| {} | {strands} | {mesh_ms:.0} | {:.0} | {:.0} | {:.0} | {:.2}x | {:.2}x | {:.0} KiB | {:.1} MiB | {:.1} MiB |",
             std::path::Path::new(path).file_stem().unwrap_or_default().to_string_lossy(),
             c.0,
@@ -240,92 +248,99 @@ pub fn bench_paper(
             lhs_bytes as f64 / (1 << 20) as f64,
             static_bytes as f64 / (1 << 20) as f64
         ));
-        for c in cells {
-            outln!("{c}")?;
+            for c in cells {
+                outln!("{c}")?;
+            }
         }
     }
     // (b) crowd, LoD on vs off.
-    outln!(
-        "\n(b) crowd of {} characters (sample meshes), LoD on vs off",
-        scale.crowd
-    )?;
-    outln!("| path | LoD on ms | LoD off ms | speedup | triangles on / off |")?;
-    outln!("|---|---|---|---|---|")?;
-    let meshes: Vec<_> = super::CROWD_MESHES
-        .iter()
-        .map(|m| load_mesh(std::path::Path::new(m), None))
-        .collect::<Result<_, _>>()?;
-    let side = (scale.crowd as f32).sqrt().ceil() as usize;
-    let mut r = Renderer::new(
-        &ctx,
-        &RendererDesc::default().size(w, h).vertex_pool_bytes(pool),
-    )?;
-    let params = StrandParams {
-        strands_per_bundle: 16,
-        verts_log2: 4,
-    };
-    for i in 0..scale.crowd {
-        let (baked, style) = &meshes[i % meshes.len()];
-        r.add_character(baked, style, params, super::crowd_model(i, side, baked))?;
-    }
-    let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
-    let mut paths = vec![RenderPath::Compute];
-    if r.has_mesh_path() {
-        paths.insert(0, RenderPath::Mesh);
-    }
-    for p in paths {
-        let on = time(&mut r, &view(camera, true), p, scale.runs)?;
-        let off = time(&mut r, &view(camera, false), p, scale.runs)?;
-        rows += &csv_row("b", "crowd", &format!("{p:?} lod on"), &on, None);
-        rows += &csv_row("b", "crowd", &format!("{p:?} lod off"), &off, None);
+    if wants("crowd") {
         outln!(
-            "| {p:?} | {:.0} | {:.0} | {:.1}x | {} / {} |",
-            on.0,
-            off.0,
-            off.0 / on.0,
-            on.3.stats.triangles_drawn,
-            off.3.stats.triangles_drawn
+            "\n(b) crowd of {} characters (sample meshes), LoD on vs off",
+            scale.crowd
         )?;
+        outln!("| path | LoD on ms | LoD off ms | speedup | triangles on / off |")?;
+        outln!("|---|---|---|---|---|")?;
+        let meshes: Vec<_> = super::CROWD_MESHES
+            .iter()
+            .map(|m| load_mesh(std::path::Path::new(m), None))
+            .collect::<Result<_, _>>()?;
+        let side = (scale.crowd as f32).sqrt().ceil() as usize;
+        let mut r = Renderer::new(
+            &ctx,
+            &RendererDesc::default().size(w, h).vertex_pool_bytes(pool),
+        )?;
+        let params = StrandParams {
+            strands_per_bundle: 16,
+            verts_log2: 4,
+        };
+        for i in 0..scale.crowd {
+            let (baked, style) = &meshes[i % meshes.len()];
+            r.add_character(baked, style, params, super::crowd_model(i, side, baked))?;
+        }
+        let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
+        let mut paths = vec![RenderPath::Compute];
+        if r.has_mesh_path() {
+            paths.insert(0, RenderPath::Mesh);
+        }
+        for p in paths {
+            let on = time(&mut r, &view(camera, true), p, scale.runs)?;
+            let off = time(&mut r, &view(camera, false), p, scale.runs)?;
+            rows += &csv_row("b", "crowd", &format!("{p:?} lod on"), &on, None);
+            rows += &csv_row("b", "crowd", &format!("{p:?} lod off"), &off, None);
+            outln!(
+                "| {p:?} | {:.0} | {:.0} | {:.1}x | {} / {} |",
+                on.0,
+                off.0,
+                off.0 / on.0,
+                on.3.stats.triangles_drawn,
+                off.3.stats.triangles_drawn
+            )?;
+        }
     }
     // (c) one head at near / mid / far.
-    outln!("\n(c) head_long at near / mid / far (compute path), LoD on vs off")?;
-    outln!("| distance | LoD on ms | LoD off ms | speedup |")?;
-    outln!("|---|---|---|---|")?;
-    let (baked, style) = load_mesh(std::path::Path::new(MODELS[0]), None)?;
-    let mut r = Renderer::new(
-        &ctx,
-        &RendererDesc::default().size(w, h).vertex_pool_bytes(pool),
-    )?;
-    r.add_character(
-        &baked,
-        &style,
-        StrandParams {
-            strands_per_bundle: 64,
-            verts_log2: 5,
-        },
-        Mat4::IDENTITY,
-    )?;
-    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
-    let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    let near = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
-    for (name, k) in [("near", 1.0f32), ("mid", 4.0), ("far", 12.0)] {
-        let cam = Camera::look_at(
-            near.target + (near.eye - near.target) * k,
-            near.target,
-            40.0,
-        );
-        let on = time(&mut r, &view(cam, true), RenderPath::Compute, scale.runs)?;
-        let off = time(&mut r, &view(cam, false), RenderPath::Compute, scale.runs)?;
-        rows += &csv_row("c", "head_long", &format!("{name} lod on"), &on, None);
-        rows += &csv_row("c", "head_long", &format!("{name} lod off"), &off, None);
-        outln!(
-            "| {name} | {:.0} | {:.0} | {:.1}x |",
-            on.0,
-            off.0,
-            off.0 / on.0
+    if wants("distance") {
+        outln!("\n(c) head_long at near / mid / far (compute path), LoD on vs off")?;
+        outln!("| distance | LoD on ms | LoD off ms | speedup |")?;
+        outln!("|---|---|---|---|")?;
+        let (baked, style) = load_mesh(std::path::Path::new(MODELS[0]), None)?;
+        let mut r = Renderer::new(
+            &ctx,
+            &RendererDesc::default().size(w, h).vertex_pool_bytes(pool),
         )?;
+        r.add_character(
+            &baked,
+            &style,
+            StrandParams {
+                strands_per_bundle: 64,
+                verts_log2: 5,
+            },
+            Mat4::IDENTITY,
+        )?;
+        let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+        let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
+        let near = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
+        for (name, k) in [("near", 1.0f32), ("mid", 4.0), ("far", 12.0)] {
+            let cam = Camera::look_at(
+                near.target + (near.eye - near.target) * k,
+                near.target,
+                40.0,
+            );
+            let on = time(&mut r, &view(cam, true), RenderPath::Compute, scale.runs)?;
+            let off = time(&mut r, &view(cam, false), RenderPath::Compute, scale.runs)?;
+            rows += &csv_row("c", "head_long", &format!("{name} lod on"), &on, None);
+            rows += &csv_row("c", "head_long", &format!("{name} lod off"), &off, None);
+            outln!(
+                "| {name} | {:.0} | {:.0} | {:.1}x |",
+                on.0,
+                off.0,
+                off.0 / on.0
+            )?;
+        }
     }
-    storage_of_generated_styles(scale.strands, &mut rows)?;
+    if wants("storage") {
+        storage_of_generated_styles(scale.strands, &mut rows)?;
+    }
     if let Some(out) = csv_out {
         out.write(rows.as_bytes())?;
         outln!("\nwrote {}", out.path().display())?;
