@@ -40,11 +40,7 @@ fn storage(
 ) -> GpuResult<Buffer> {
     Buffer::new(
         ctx,
-        &BufferDesc::new(
-            name,
-            bytes.max(16),
-            vk::BufferUsageFlags::STORAGE_BUFFER | extra,
-        ),
+        &BufferDesc::new(name, bytes, vk::BufferUsageFlags::STORAGE_BUFFER | extra),
     )
 }
 

@@ -162,7 +162,7 @@ fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
         ctx,
         &BufferDesc::new(
             name,
-            bytes.max(16),
+            bytes,
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
         ),
     )

@@ -7,10 +7,9 @@ use std::sync::Arc;
 
 use super::dispatch_2d;
 use crate::render::shared::DeformBinding;
-use crate::vk::shader::compile;
 use crate::vk::{
-    Access, BindingDesc, Buffer, CommandRecorder, Context, DescriptorKind, DescriptorSet,
-    DescriptorSetLayout, GpuResult, Image, Pipeline, PipelineLayout, Profiler,
+    Access, Buffer, CommandRecorder, Context, DescriptorSet, DescriptorSetLayout, GpuResult, Image,
+    Pipeline, Profiler,
 };
 
 /// One character's update this frame.
@@ -34,14 +33,12 @@ pub struct HairMeshUpdate {
 impl HairMeshUpdate {
     /// Compile the pass.
     pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
-        let bindings: Vec<BindingDesc> = DeformBinding::ALL
-            .iter()
-            .map(|(b, _)| BindingDesc::single(*b as u32, DescriptorKind::StorageBuffer))
-            .collect();
-        let set_layout = DescriptorSetLayout::new(ctx, &bindings)?;
-        let layout = PipelineLayout::new(ctx, std::slice::from_ref(&set_layout))?;
-        let spirv = compile("hair_mesh_update.comp", &super::shader_options(1))?;
-        let pipeline = Pipeline::compute(ctx, "hair mesh update", &layout, &spirv)?;
+        let (set_layout, pipeline) = super::own_set_compute(
+            ctx,
+            "hair mesh update",
+            "hair_mesh_update.comp",
+            DeformBinding::ALL.iter().map(|(b, _)| *b as u32),
+        )?;
         Ok(HairMeshUpdate {
             set_layout,
             pipeline,

@@ -11,10 +11,9 @@ use super::dispatch_2d;
 use crate::reference::lhs::LhsModel;
 use crate::render::frame::FRAMES_IN_FLIGHT;
 use crate::render::shared::{HairVertex, LhsBinding, LhsWeights};
-use crate::vk::shader::compile;
 use crate::vk::{
-    Access, BindingDesc, Buffer, BufferDesc, CommandRecorder, Context, DescriptorKind,
-    DescriptorSet, DescriptorSetLayout, GpuError, GpuResult, Pipeline, PipelineLayout, Profiler,
+    Access, Buffer, BufferDesc, CommandRecorder, Context, DescriptorSet, DescriptorSetLayout,
+    GpuError, GpuResult, Pipeline, Profiler,
 };
 
 /// Invocations of one skinning workgroup.
@@ -65,17 +64,16 @@ pub struct LhsSkin {
 impl LhsSkin {
     /// Compile the pass.
     pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
-        let bindings: Vec<BindingDesc> = LhsBinding::ALL
-            .iter()
-            .map(|(b, _)| BindingDesc::single(*b as u32, DescriptorKind::StorageBuffer))
-            .collect();
-        let set_layout = DescriptorSetLayout::new(ctx, &bindings)?;
-        let layout = PipelineLayout::new(ctx, std::slice::from_ref(&set_layout))?;
-        let spirv = compile("lhs_skin.comp", &super::shader_options(1))?;
+        let (set_layout, pipeline) = super::own_set_compute(
+            ctx,
+            "lhs skin",
+            "lhs_skin.comp",
+            LhsBinding::ALL.iter().map(|(b, _)| *b as u32),
+        )?;
         Ok(LhsSkin {
             ctx: ctx.clone(),
             set_layout,
-            pipeline: Pipeline::compute(ctx, "lhs skin", &layout, &spirv)?,
+            pipeline,
         })
     }
 

@@ -147,6 +147,25 @@ pub fn vertex_pipeline(
     crate::vk::Pipeline::graphics(ctx, layout, &desc)
 }
 
+/// A compute pipeline over its own set 0 of `bindings` storage buffers (passes outside the
+/// frame's sets: the hair mesh update, LHS skinning): the set layout and the pipeline.
+pub fn own_set_compute(
+    ctx: &Arc<Context>,
+    name: &str,
+    shader: &str,
+    bindings: impl IntoIterator<Item = u32>,
+) -> GpuResult<(Arc<crate::vk::DescriptorSetLayout>, crate::vk::Pipeline)> {
+    let bindings: Vec<crate::vk::BindingDesc> = bindings
+        .into_iter()
+        .map(|b| crate::vk::BindingDesc::single(b, crate::vk::DescriptorKind::StorageBuffer))
+        .collect();
+    let set_layout = crate::vk::DescriptorSetLayout::new(ctx, &bindings)?;
+    let layout = PipelineLayout::new(ctx, std::slice::from_ref(&set_layout))?;
+    let spirv = compile(shader, &shader_options(1))?;
+    let pipeline = crate::vk::Pipeline::compute(ctx, name, &layout, &spirv)?;
+    Ok((set_layout, pipeline))
+}
+
 /// `(x, y)` workgroup counts for `groups` workgroups with at most `DISPATCH_ROW` per row.
 pub fn dispatch_2d(groups: u32) -> (u32, u32) {
     let row = super::shared::DISPATCH_ROW;

@@ -63,13 +63,7 @@ impl ShadowPass {
         if d.bundles == 0 {
             return Ok(());
         }
-        match d.path {
-            RenderPath::Mesh => draw.record_mesh(rec, d.sets, d.bundles),
-            RenderPath::Compute | RenderPath::Static | RenderPath::Lhs => {
-                draw.record_pulled(rec, d.sets, d.args);
-                Ok(())
-            }
-        }
+        draw.record(rec, d.sets, d.bundles, d.path, d.args)
     }
 
     /// Record the light's passes into `maps` (which end up readable by the camera passes).

@@ -105,6 +105,25 @@ impl StrandDraw {
         rec.draw_indirect(args, GenerateArgs::DRAW_OFFSET);
     }
 
+    /// Draw the crowd's strands as `path` does (inside rendering): the mesh path generates
+    /// `bundles` bundles in its task and mesh shaders; the other paths pull the vertex pool
+    /// with `args`' draw arguments.
+    pub fn record(
+        &self,
+        rec: &mut CommandRecorder,
+        sets: PassSets,
+        bundles: u32,
+        path: crate::render::RenderPath,
+        args: &Buffer,
+    ) -> GpuResult<()> {
+        if path.pulls_vertices() {
+            self.record_pulled(rec, sets, args);
+            Ok(())
+        } else {
+            self.record_mesh(rec, sets, bundles)
+        }
+    }
+
     /// Mesh path: cull, pick LoD, generate and draw the strands of `bundles` bundles (inside
     /// rendering; the statistics in `GenerateArgs` must be cleared before).
     pub fn record_mesh(

@@ -172,14 +172,9 @@ impl TransparencyPass {
                 {
                     q.begin(rec);
                 }
-                let result = draw_strands(
-                    rec,
-                    &p.insert,
-                    &draw.sets,
-                    draw.bundles,
-                    draw.path,
-                    draw.args,
-                );
+                let result = p
+                    .insert
+                    .record(rec, draw.sets, draw.bundles, draw.path, draw.args);
                 if let Some(q) = query.filter(|_| draw.path == RenderPath::Mesh) {
                     q.end(rec);
                 }
@@ -264,14 +259,8 @@ impl TransparencyPass {
                     clear_args(rec, draw.args);
                 }
                 rec.begin_rendering_depth(att(if i == 0 { Some([1.0; 4]) } else { None }));
-                result = result.and(draw_strands(
-                    rec,
-                    strands,
-                    &draw.sets,
-                    draw.bundles,
-                    draw.path,
-                    draw.args,
-                ));
+                result =
+                    result.and(strands.record(rec, draw.sets, draw.bundles, draw.path, draw.args));
                 rec.end_rendering();
             }
             // This layer's depth becomes the next layer's "previous".
@@ -286,23 +275,5 @@ impl TransparencyPass {
         profiler.end(rec);
         *peel_access = Access::TransferRead;
         result
-    }
-}
-
-/// Draw the crowd's strands with `strands` (inside rendering).
-fn draw_strands(
-    rec: &mut CommandRecorder,
-    strands: &StrandDraw,
-    sets: &PassSets,
-    bundles: u32,
-    path: RenderPath,
-    args: &Buffer,
-) -> GpuResult<()> {
-    match path {
-        RenderPath::Mesh => strands.record_mesh(rec, *sets, bundles),
-        RenderPath::Compute | RenderPath::Static | RenderPath::Lhs => {
-            strands.record_pulled(rec, *sets, args);
-            Ok(())
-        }
     }
 }
