@@ -60,6 +60,16 @@ void bind_character(uint c) {
 #define TEX_U tex_u[tex_slot]
 #define TEX_V tex_v[tex_slot]
 
+// bundle_lods[].y: vertex level e in the low byte, LOD_SOFT when the software rasterizer
+// draws the bundle.
+uint lod_segments(uint y) {
+    return 1u << (y & 255u);
+}
+
+bool lod_is_soft(uint y) {
+    return (y & LOD_SOFT) != 0u;
+}
+
 vec3 style_color() {
     return vec3(style.color[0], style.color[1], style.color[2]);
 }

@@ -10,7 +10,29 @@ struct BundleLod {
     uint e;           // eq. 9: 2^e segments
     float gamma;      // eq. 12 geomorph factor toward level e - 1 (0: none)
     float thickness;  // sec. 3.6.1 width factor min(1/L, N)
+    bool soft;        // drawn by the software rasterizer (src/render/soft.rs)
 };
+
+// bundle_lods[] / payload encoding of a decision.
+uvec4 encode_lod(BundleLod r) {
+    return uvec4(r.strands, r.e | (r.soft ? LOD_SOFT : 0u), floatBitsToUint(r.gamma), floatBitsToUint(r.thickness));
+}
+
+// Software or hardware raster (frame.soft.x: 0 hardware, 1 software, 2 auto). Auto: software
+// when the bundle's strands are drawn at most frame.soft_params.x pixels wide at its nearest
+// point `d` (the LoD-thickened width, or the cluster footprint of lod_appearance.glsl).
+bool soft_raster(float d, float width, float thickness, float cap) {
+    if (frame.soft.x != 2u) {
+        return frame.soft.x == 1u;
+    }
+    float pixel = frame.light_dir.w > 0.0 ? 2.0 * max(d, 1e-6) / (frame.camera_pos.w * frame.light_dir.w)
+                                          : frame.lod_ortho.x / frame.camera_pos.w;
+    float drawn = width * thickness;
+    if (frame.shading.y != 0u && thickness > 1.0) {
+        drawn = max(drawn, min(sqrt(thickness) * pixel, cap));
+    }
+    return drawn <= frame.soft_params.x * pixel;
+}
 
 bool box_visible(vec3 lo, vec3 hi) {
     for (int p = 0; p < 6; p++) {
@@ -52,17 +74,18 @@ BundleLod bundle_lod(uint g) {
     uint count = style.density_by_area != 0u ? uint(round(float(n) * desc.density)) : n;
     count = clamp(count, 1u, MAX_STRANDS_PER_BUNDLE);
     uint emax = ch_emax;
-    BundleLod r = BundleLod(count, emax, 0.0, 1.0);
+    BundleLod r = BundleLod(count, emax, 0.0, 1.0, false);
     if (!ch_visible || !box_visible(lo, hi)) {
         r.strands = 0u;
-        return r;
-    }
-    if (frame.counts.z == 0u) {
         return r;
     }
     vec3 eye = frame.camera_pos.xyz;
     float d = length(eye - clamp(eye, lo, hi));
     float h = scale * desc.rest_size;
+    if (frame.counts.z == 0u) {
+        r.soft = soft_raster(d, scale * style.strand_width, 1.0, h);
+        return r;
+    }
     // Strand LoD: eq. 7 and eq. 8 with a per-bundle increment delta_i, clamped to N_i.
     float ls = detail_level(h, d, frame.lod.x);
     float delta = hash_f32(hash_u32(desc.local_index ^ 0x2545f491u) ^ style.seed);
@@ -77,6 +100,7 @@ BundleLod bundle_lod(uint g) {
     if (float(r.e) > e_next && r.e > 0u) {
         r.gamma = clamp(1.0 - (x - e_next) / lambda, 0.0, 1.0);
     }
+    r.soft = soft_raster(d, scale * style.strand_width, r.thickness, h);
     return r;
 }
 

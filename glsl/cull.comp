@@ -15,7 +15,7 @@ void main() {
     }
     bind_character(bundles[g].character);
     BundleLod r = bundle_lod(g);
-    bundle_lods[g] = uvec4(r.strands, r.e, floatBitsToUint(r.gamma), floatBitsToUint(r.thickness));
+    bundle_lods[g] = encode_lod(r);
     if (r.strands > 0u) {
         atomicAdd(args.stats.bundles_visible, 1u);
     }

@@ -28,8 +28,8 @@ void main() {
         }
         uvec4 off = bundle_offsets[lo];
         uvec4 lod = bundle_lods[lo];
-        uint segments = 1u << lod.y;
-        uint fit = min(lod.x, (budget - off.y) / (segments + 1u));
+        uint segments = lod_segments(lod.y);
+        uint fit = lod_is_soft(lod.y) ? lod.x : min(lod.x, (budget - off.y) / (segments + 1u));
         kept = off + bundle_sizes(uvec4(fit, lod.yzw));
     }
     args.dispatch = uvec4(min(kept.w, DISPATCH_ROW), (kept.w + DISPATCH_ROW - 1u) / DISPATCH_ROW, 1u, 0u);

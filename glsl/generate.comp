@@ -1,13 +1,19 @@
 #version 460
 // Compute path, pass 4: one workgroup of S threads per group of strands (one long strand, or
 // several short ones) builds them in shared memory (strand_build.glsl, shared with the mesh
-// shader) and writes HairVertex records into the pool, never past the kept slots.
+// shader) and writes HairVertex records into the pool, never past the kept slots; a bundle
+// the software rasterizer draws appends its segments instead (soft_segments.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 layout(local_size_x = STRAND_GROUP_SIZE) in;
 #include "common.glsl"
 #include "strand_eval.glsl"
 #include "strand_build.glsl"
+// Camera pipelines only (the light's passes draw hardware strips, and its maps are
+// attachments while they draw).
+#ifdef SOFT_RASTER
+#include "soft_segments.glsl"
+#endif
 
 // Last bundle whose first workgroup is <= g (never an empty one for g < total).
 uint find_bundle(uint g) {
@@ -32,7 +38,7 @@ void main() {
     uint bundle = find_bundle(g);
     bind_character(bundles[bundle].character);
     uvec4 lod = bundle_lods[bundle];
-    uint segments = 1u << lod.y;
+    uint segments = lod_segments(lod.y);
     uint per = strands_per_group(segments);
     uint first = (g - bundle_offsets[bundle].w) * per;
     uint t = gl_LocalInvocationID.x;
@@ -40,6 +46,13 @@ void main() {
     float width_scale = model_scale * uintBitsToFloat(lod.w);
     uint stride = segments + 1u;
     uint count = min(per, lod.x - first);
+#ifdef SOFT_RASTER
+    if (lod_is_soft(lod.y)) {
+        float cap = model_scale * bundles[bundle].rest_size;
+        emit_soft_segments(count, segments, width_scale, uintBitsToFloat(lod.w), cap, style_color(), bundles[bundle].character, t);
+        return;
+    }
+#endif
     uint limit = args.stats.vertex_slots_written;
     for (uint idx = t; idx < count * stride; idx += S) {
         uint j = idx / stride;

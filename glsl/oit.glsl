@@ -6,6 +6,7 @@
 #define OIT_GLSL
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
+#include "fragment_pack.glsl"
 
 layout(set = SET_FRAME, binding = BINDING_OIT_NODES, std430) buffer OitNodes { uint64_t oit_nodes[]; };
 // x, y, z: sum of colour x optical depth; w: sum of optical depth; all times OIT_FIXED.
@@ -17,19 +18,13 @@ layout(set = SET_FRAME, binding = BINDING_OIT_TAIL, std430) buffer OitTail { uve
 // capped by the 8-bit alpha), so a lane holds about 740 000 evicted fragments per pixel.
 #define OIT_FIXED 1024.0
 
+// The fragment's pixel (fragment shaders; the software rasterizer, a compute shader, defines
+// OIT_COMPUTE and indexes pixels itself).
+#ifndef OIT_COMPUTE
 uint oit_pixel() {
     return uint(gl_FragCoord.y) * uint(frame.viewport.x) + uint(gl_FragCoord.x);
 }
-
-// Colour in [0, 1] with a square-root curve (more codes for dark hair), alpha linear.
-uint pack_fragment(vec3 c, float a) {
-    return packUnorm4x8(vec4(sqrt(clamp(c, 0.0, 1.0)), a));
-}
-
-vec4 unpack_fragment(uint p) {
-    vec4 v = unpackUnorm4x8(p);
-    return vec4(v.rgb * v.rgb, v.a);
-}
+#endif
 
 // Optical depth of one fragment's alpha (capped below 1 by the 8-bit alpha).
 float optical_depth(float a) {

@@ -27,7 +27,7 @@ void main() {
         }
     }
     bind_character(bundles[lo].character);
-    uint segments = 1u << bundle_lods[lo].y;
+    uint segments = lod_segments(bundle_lods[lo].y);
     uint local = idx - bundle_offsets[lo].z;
     uint strand = local / (segments * 6u);
     uint seg = (local / 6u) % segments;

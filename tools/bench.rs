@@ -11,6 +11,10 @@
 //! hair mesh (both paths) vs LHS vs static strands per model, crowd and distance LoD speedups,
 //! bytes per method.
 //!
+//! `bench raster [--size 1280x720] [--runs 5] [--crowd 100] [--strands 100000]`: the
+//! software rasterizer vs hardware strips (opaque and OIT) and the per-bundle split, for one
+//! head at near / mid / far, ~100K strands, and a crowd; both paths.
+//!
 //! `bench animate [--mesh M] [--wind 30] [--frames 90] [--strip out.png]`: one hair mesh in
 //! wind, simulated and re-textured every frame: CPU ms of the dynamics, GPU ms of the texture
 //! rebuild and of the frame (medians); optionally a strip of frames side by side.
@@ -22,6 +26,8 @@ use std::time::Instant;
 mod animate;
 #[path = "bench/paper.rs"]
 mod paper;
+#[path = "bench/raster.rs"]
+mod raster;
 
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
@@ -109,6 +115,28 @@ enum Cmd {
         /// Write every measurement here as CSV.
         #[arg(long)]
         csv: Option<PathBuf>,
+        /// Choose the GPU by name substring.
+        #[arg(long)]
+        device: Option<String>,
+    },
+    /// The software rasterizer against hardware strips: one head at near / mid / far,
+    /// ~100K strands, a crowd with LoD; median GPU ms and ratios per path.
+    Raster {
+        /// Image size.
+        #[arg(long, default_value = "1280x720")]
+        size: String,
+        /// Timed frames per measurement (after one warm-up).
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..=1000))]
+        runs: u16,
+        /// Characters in the crowd scene.
+        #[arg(long, default_value_t = 100)]
+        crowd: usize,
+        /// Strands of the dense scene.
+        #[arg(long, default_value_t = 100_000, value_parser = clap::value_parser!(u32).range(1..=10000000))]
+        strands: u32,
+        /// Only the scenes whose names start with these (head, crowd, or the strand count).
+        #[arg(long, value_delimiter = ',')]
+        scenes: Vec<String>,
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
@@ -510,6 +538,21 @@ fn run(args: Args) -> Result<()> {
             csv,
             device,
         } => paper::bench_paper(&scale, &scenario, device, csv)?,
+        Cmd::Raster {
+            size,
+            runs,
+            crowd,
+            strands,
+            scenes,
+            device,
+        } => raster::bench_raster(raster::RasterArgs {
+            size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
+            runs: runs as usize,
+            crowd,
+            strands,
+            device,
+            scenes,
+        })?,
         Cmd::Animate {
             mesh,
             frames,

@@ -95,6 +95,12 @@ struct Args {
     /// `[look] lod_appearance`, else true.
     #[arg(long)]
     lod_appearance: Option<bool>,
+    /// Strand rasterization: hw (camera-facing strips through the hardware rasterizer),
+    /// soft or soft:K (the compute software rasterizer keeping K fragments per pixel sorted,
+    /// default 8), auto or auto:K (per bundle: strands drawn at most 1.5 pixels wide to
+    /// software, thicker ones to hardware). With the mesh or compute path.
+    #[arg(long, default_value = "hw")]
+    draw: hairmesh::render::StrandRaster,
     /// Size of the compute path's vertex pool in MiB (frames that need more keep whole strands
     /// up to it and report the overflow).
     #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u64).range(1..=4096))]
@@ -275,6 +281,26 @@ fn print_report(
     if let Some(q) = out.mesh_primitives {
         outln!("  mesh primitives generated (VK_EXT_mesh_shader query): {q}")?;
     }
+    if args.draw.uses_software() {
+        let s = &out.stats;
+        outln!(
+            "  software raster ({}): {} segments, {} tile entries",
+            args.draw,
+            s.segments_written,
+            s.tile_entries_written
+        )?;
+        if s.segments_written < s.segments_demanded
+            || s.tile_entries_written < s.tile_entries_demanded
+        {
+            outln!(
+                "  software raster overflow: kept {} of {} segments and {} of {} tile entries; the rest were dropped",
+                s.segments_written,
+                s.segments_demanded,
+                s.tile_entries_written,
+                s.tile_entries_demanded
+            )?;
+        }
+    }
     for (pass, ms) in &out.pass_ms {
         outln!("  gpu {pass:<10} {ms:9.3} ms")?;
     }
@@ -347,18 +373,22 @@ fn run(args: Args) -> Result<()> {
             .or(inputs.look.lod_appearance)
             .unwrap_or(true),
     };
-    let mut out = renderer.render_one(
-        &view,
-        &FrameOptions {
-            read_image: true,
-            ..Default::default()
-        },
-    )?;
     let second = match args.path.as_deref() {
         Some("static") => Some(RenderPath::Static),
         Some("lhs") => Some(RenderPath::Lhs),
         _ => None,
     };
+    if second.is_some() && args.draw.uses_software() {
+        bail!("--draw {} draws generated strands: use it with --path mesh or compute", args.draw);
+    }
+    let mut out = renderer.render_one(
+        &view,
+        &FrameOptions {
+            read_image: true,
+            raster: args.draw,
+            ..Default::default()
+        },
+    )?;
     if let Some(second) = second {
         outln!(
             "generated (compute path): GPU {:.3} ms; then {second:?}:",

@@ -19,6 +19,11 @@
 #define MARSCHNER_LUT_D 64u
 #define SET_FRAME 0
 #define SET_TEXTURES 1
+#define SOFT_TILE 16u
+#define SOFT_MAX_K 8u
+#define SOFT_BIN_GROUP 256
+#define LOD_SOFT 256u
+#define MAX_OIT_BUDGET 16u
 #define STRAND_OPACITY 0.7
 #define MARSCHNER_LUT_TRT_SCALE 5.0
 #define BINDING_FRAME 0
@@ -40,6 +45,10 @@
 #define BINDING_PEEL_DEPTH 16
 #define BINDING_PEEL_ACCUM 17
 #define BINDING_SHADING_LUT 18
+#define BINDING_SOFT_SEGMENTS 19
+#define BINDING_SOFT_TILES 20
+#define BINDING_SOFT_ENTRIES 21
+#define BINDING_SOFT_DEPTH 22
 #define BINDING_TEX_POSITION 0
 #define BINDING_TEX_UV 1
 #define BINDING_TEX_W 2
@@ -117,6 +126,8 @@ struct FrameBlock {
     uvec4 shadow;
     vec4 shadow_params;
     uvec4 transparency;
+    uvec4 soft;
+    vec4 soft_params;
 };
 
 struct CharacterRecord {
@@ -152,17 +163,27 @@ struct FrameStats {
     uint vertex_slots_demanded;
     uint vertex_slots_written;
     uint groups;
+    uint segments_demanded;
+    uint segments_written;
+    uint tile_entries_demanded;
+    uint tile_entries_written;
 };
 
 struct GenerateArgs {
     uvec4 dispatch;
     uvec4 draw;
+    uvec4 soft_dispatch;
     FrameStats stats;
 };
 
 struct HairVertex {
     vec4 pos_width;
     vec4 tangent_s;
+};
+
+struct SoftSegment {
+    vec4 a;
+    uvec4 b;
 };
 
 struct PropVertex {

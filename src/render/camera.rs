@@ -264,6 +264,9 @@ impl View {
             shadow_params: [0.0; 4],
             // Samples filled in by the renderer.
             transparency: self.transparency.frame_fields(1),
+            // Filled in by the renderer for frames that use the software rasterizer.
+            soft: [0; 4],
+            soft_params: [0.0; 4],
         }
     }
 }
@@ -306,6 +309,6 @@ mod tests {
             (c[0], c[7], c[5]),
             (Vec3::ZERO, Vec3::ONE, Vec3::new(1.0, 0.0, 1.0))
         );
-        assert_eq!(size_of::<FrameBlock>(), 384);
+        assert_eq!(size_of::<FrameBlock>(), 416);
     }
 }

@@ -23,7 +23,8 @@ use super::shadow::{LightView, ShadowMode};
 use super::shared::{FrameBinding, GenerateArgs, HairVertex, SET_FRAME, SET_TEXTURES};
 use super::shared::{PropInstance, PropVertex};
 use super::targets::{RenderTargets, ShadowMaps};
-use super::transparency::TransparencyBuffers;
+use super::soft::{SoftBudget, SoftBuffers, StrandRaster};
+use super::transparency::{Transparency, TransparencyBuffers};
 use super::workspace::FrameBuffers;
 use super::workspace::Workspace;
 use crate::bake::BakedHairMesh;
@@ -93,6 +94,9 @@ pub struct Renderer {
     shadow: ShadowMaps,
     /// Per-pixel buffers of the transparent modes.
     transparency: TransparencyBuffers,
+    /// The software rasterizer's buffers and budgets.
+    soft: SoftBuffers,
+    soft_budget: SoftBudget,
     /// The crowd version whose strands the vertex pool holds (the last compute-path frame's),
     /// which static-path frames draw again.
     static_version: Option<u64>,
@@ -116,6 +120,10 @@ struct FrameWork<'a> {
     shadows: Option<ShadowMode>,
     /// How strands are composited.
     transparency: super::Transparency,
+    /// How strands are rasterized.
+    raster: StrandRaster,
+    /// k-buffer nodes per pixel (OIT budget, or the software rasterizer's K).
+    kbuffer_budget: u32,
     /// Character slots whose hair mesh pose changed (rebuilt this frame).
     pose_updates: Vec<usize>,
 }
@@ -149,6 +157,12 @@ impl Renderer {
                 desc.shadow_resolution
             )));
         }
+        let soft_budget = desc
+            .soft_budget
+            .unwrap_or_else(|| SoftBudget::for_range(range));
+        soft_budget
+            .validate(range)
+            .map_err(GpuError::Unsupported)?;
         let crowd = Crowd::new(ctx, desc.max_characters)?;
         let bindings: Vec<BindingDesc> = FrameBinding::ALL
             .iter()
@@ -196,6 +210,8 @@ impl Renderer {
             targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
             shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
             transparency: TransparencyBuffers::new(ctx)?,
+            soft: SoftBuffers::new(ctx)?,
+            soft_budget,
             static_version: None,
             args_structure: None,
             lhs: None,
@@ -217,6 +233,16 @@ impl Renderer {
     /// Whether the mesh path is available.
     pub fn has_mesh_path(&self) -> bool {
         self.passes.has_mesh_path()
+    }
+
+    /// Whether the software rasterizer is available (64-bit shared and buffer atomics).
+    pub fn has_software_raster(&self) -> bool {
+        self.passes.has_software_raster()
+    }
+
+    /// The software rasterizer's budgets.
+    pub fn soft_budget(&self) -> SoftBudget {
+        self.soft_budget
     }
 
     /// The characters.
@@ -521,6 +547,7 @@ impl Renderer {
                     prop_vertices: self.props.vertices.as_ref(),
                     shadow: &self.shadow,
                     transparency: &self.transparency,
+                    soft: &self.soft,
                 },
             )?;
         }
@@ -592,12 +619,26 @@ impl Renderer {
                 "the crowd needs up to {worst} strand draw vertices at full detail, more than 32-bit frame counters hold; lower strands per bundle or vertex level"
             )));
         }
+        let raster = opts.raster;
+        let kbuffer_budget = self.check_raster(raster, path, view.transparency)?;
         let i = self.next;
         self.retire_slot(i)?;
-        self.passes.prepare_transparency(view.transparency)?;
         let (width, height) = self.targets.size();
-        for old in self.transparency.ensure(view.transparency, width, height)? {
+        // The software rasterizer composites through the k-buffer, in opaque frames too.
+        let buffers_for = match (raster.uses_software(), view.transparency) {
+            (true, Transparency::Opaque) => Transparency::KBuffer {
+                budget: kbuffer_budget,
+            },
+            (_, t) => t,
+        };
+        self.passes.prepare_transparency(buffers_for)?;
+        for old in self.transparency.ensure(buffers_for, width, height)? {
             self.frames[i].retired.push(Retired::Resource(old));
+        }
+        if raster.uses_software() {
+            for old in self.soft.ensure(self.soft_budget, width, height)? {
+                self.frames[i].retired.push(Retired::Resource(old));
+            }
         }
         self.prepare_workspace(i, path)?;
         let pose_updates = self.crowd.write_pending_poses(i)?;
@@ -610,6 +651,14 @@ impl Renderer {
             self.vertex_budget(),
         );
         block.transparency = view.transparency.frame_fields(self.desc.msaa);
+        if raster.uses_software() {
+            block.transparency[1] = kbuffer_budget;
+            let opacity = match view.transparency {
+                Transparency::Opaque => 1.0,
+                _ => super::transparency::STRAND_OPACITY,
+            };
+            super::soft::frame_fields(&mut block, raster, self.soft_budget, opacity);
+        }
         let light = self.light_view(view, &block);
         if let Some(l) = &light {
             (block.light_view_proj, block.shadow, block.shadow_params) =
@@ -653,6 +702,8 @@ impl Renderer {
             props: &prop_draws,
             shadows,
             transparency: view.transparency,
+            raster,
+            kbuffer_budget,
             pose_updates,
         };
         self.record(i, work, opts, present.as_mut())?;
@@ -681,6 +732,11 @@ impl Renderer {
         // The pool and draw arguments now hold this frame's strands (compute path), or the mesh
         // path has overwritten the arguments.
         match path {
+            // Software bundles leave no strands in the pool.
+            RenderPath::Compute if raster.uses_software() => {
+                self.static_version = None;
+                self.args_structure = None;
+            }
             RenderPath::Compute => {
                 self.static_version = Some(self.crowd.version());
                 self.args_structure = Some(self.crowd.structure_version());
@@ -693,6 +749,48 @@ impl Renderer {
         }
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
         Ok(FrameTicket(frame))
+    }
+
+    /// Check that `raster` can draw a frame of `path` with `transparency`; returns the k-buffer
+    /// budget of the frame (the OIT budget, or the software rasterizer's K in opaque frames).
+    fn check_raster(
+        &self,
+        raster: StrandRaster,
+        path: RenderPath,
+        transparency: Transparency,
+    ) -> GpuResult<u32> {
+        raster.validate().map_err(GpuError::Unsupported)?;
+        let budget = match transparency {
+            Transparency::KBuffer { budget } => budget,
+            _ => raster.k(),
+        };
+        if !raster.uses_software() {
+            return Ok(budget);
+        }
+        let refuse = |why: String| Err(GpuError::Unsupported(why));
+        if !self.passes.has_software_raster() {
+            return refuse(format!(
+                "{}: the software rasterizer needs shaderInt64 and 64-bit buffer and shared atomics",
+                self.ctx.info.name
+            ));
+        }
+        if !matches!(path, RenderPath::Mesh | RenderPath::Compute) {
+            return refuse(
+                "the software rasterizer draws generated strands: use the mesh or compute path"
+                    .into(),
+            );
+        }
+        if self.desc.msaa > 1 {
+            return refuse(
+                "the software rasterizer antialiases strands analytically and reads single-sample depth: use it without MSAA".into(),
+            );
+        }
+        if matches!(transparency, Transparency::DepthPeeling { .. }) {
+            return refuse(
+                "the software rasterizer composites through the k-buffer: use it with opaque or oit transparency, not depth peeling".into(),
+            );
+        }
+        Ok(budget)
     }
 
     /// Record frame slot `i`: the passes, then the statistics and (optionally) image readback.
@@ -709,6 +807,8 @@ impl Renderer {
             props,
             shadows,
             transparency,
+            raster,
+            kbuffer_budget,
             pose_updates,
         } = work;
         let slot = &mut self.frames[i];
@@ -749,6 +849,9 @@ impl Renderer {
             },
             transparency,
             transparency_buffers: &mut self.transparency,
+            raster,
+            soft_buffers: &self.soft,
+            kbuffer_budget,
         };
         self.passes.record(
             &mut rec,

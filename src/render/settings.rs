@@ -46,6 +46,9 @@ pub struct RendererDesc {
     pub msaa: u32,
     /// Side of the square shadow maps in texels (16..=8192).
     pub shadow_resolution: u32,
+    /// The software rasterizer's segment and tile-entry budgets (`None`: the most the
+    /// device allows, `SoftBudget::for_range`).
+    pub soft_budget: Option<super::soft::SoftBudget>,
 }
 
 impl Default for RendererDesc {
@@ -59,6 +62,7 @@ impl Default for RendererDesc {
             height: 720,
             msaa: 1,
             shadow_resolution: super::shadow::DEFAULT_SHADOW_RESOLUTION,
+            soft_budget: None,
         }
     }
 }
@@ -89,6 +93,12 @@ impl RendererDesc {
         self
     }
 
+    /// Set the software rasterizer's budgets.
+    pub fn soft_budget(mut self, budget: super::soft::SoftBudget) -> Self {
+        self.soft_budget = Some(budget);
+        self
+    }
+
     /// Set the vertex pool size in bytes.
     pub fn vertex_pool_bytes(mut self, bytes: u64) -> Self {
         self.vertex_pool_bytes = bytes;
@@ -105,6 +115,9 @@ pub struct FrameOptions {
     pub clear: bool,
     /// Read the colour target back into the report.
     pub read_image: bool,
+    /// Hardware strips, the software rasterizer, or a split per bundle (mesh and compute
+    /// paths).
+    pub raster: super::soft::StrandRaster,
 }
 
 impl Default for FrameOptions {
@@ -113,6 +126,7 @@ impl Default for FrameOptions {
             path: None,
             clear: true,
             read_image: false,
+            raster: super::soft::StrandRaster::Hardware,
         }
     }
 }

@@ -168,6 +168,9 @@ impl LightView {
             planes: frustum_planes(self.view_proj),
             lod: [lod.alpha_strands, lod.alpha_verts, lod.lambda, 0.0],
             lod_ortho: [self.size, 0.0, 0.0, 0.0],
+            // The light's passes draw hardware strips only.
+            soft: [0; 4],
+            soft_params: [0.0; 4],
             ..*camera
         }
     }

@@ -36,6 +36,17 @@ pub const MARSCHNER_LUT_D: u32 = 64;
 /// 0.185).
 pub const MARSCHNER_LUT_TRT_SCALE: f32 = 5.0;
 
+/// Software rasterizer: side of a square screen tile in pixels (one raster workgroup).
+pub const SOFT_TILE: u32 = 16;
+/// Software rasterizer: most fragments per pixel it keeps sorted in a tile's shared memory
+/// (`256 x 8 x 8` bytes; the rest merge into the tail).
+pub const SOFT_MAX_K: u32 = 8;
+/// Threads of the software rasterizer's binning workgroups (one segment each).
+pub const SOFT_BIN_GROUP: u32 = 256;
+/// `bundle_lods[].y` bit: the bundle is drawn by the software rasterizer (the low byte is the
+/// vertex level e).
+pub const LOD_SOFT: u32 = 256;
+
 /// Descriptor set 0: per-frame data and the crowd's tables.
 pub const SET_FRAME: u32 = 0;
 /// Descriptor set 1: the bindless texture arrays (one element per character slot).
@@ -86,11 +97,23 @@ pub enum FrameBinding {
     PeelAccum = 17,
     /// The Marschner lookup texture (`shade::lut`, sampled bilinearly).
     ShadingLut = 18,
+    /// Software rasterizer: `SoftSegment[]` projected, shaded strand segments (bounded by
+    /// `FrameBlock::soft.z`).
+    SoftSegments = 19,
+    /// Software rasterizer: per screen tile `uvec4` (segments touching it, first entry,
+    /// scatter cursor, entries kept).
+    SoftTiles = 20,
+    /// Software rasterizer: `uint[]` segment indices, tile by tile (bounded by
+    /// `FrameBlock::soft.w`).
+    SoftEntries = 21,
+    /// Software rasterizer: per pixel, the opaque depth (`float`) the strands are tested
+    /// against.
+    SoftDepth = 22,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 19] = [
+    pub const ALL: [(FrameBinding, &'static str); 23] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -110,6 +133,10 @@ impl FrameBinding {
         (FrameBinding::PeelDepth, "BINDING_PEEL_DEPTH"),
         (FrameBinding::PeelAccum, "BINDING_PEEL_ACCUM"),
         (FrameBinding::ShadingLut, "BINDING_SHADING_LUT"),
+        (FrameBinding::SoftSegments, "BINDING_SOFT_SEGMENTS"),
+        (FrameBinding::SoftTiles, "BINDING_SOFT_TILES"),
+        (FrameBinding::SoftEntries, "BINDING_SOFT_ENTRIES"),
+        (FrameBinding::SoftDepth, "BINDING_SOFT_DEPTH"),
     ];
 
     /// What the binding holds.
@@ -333,12 +360,19 @@ pub struct FrameBlock {
     /// x transparency mode (`render::Transparency`: 0 opaque, 1 k-buffer OIT, 2 depth
     /// peeling), y k-buffer nodes per pixel, z samples per pixel of the targets; w reserved.
     pub transparency: [u32; 4],
+    /// Software rasterizer (`render::StrandRaster`): x mode (0 hardware, 1 software, 2 auto:
+    /// per bundle), y fragments kept sorted per pixel, z segment budget, w tile entry budget.
+    pub soft: [u32; 4],
+    /// Software rasterizer: x auto split (bundles whose strands are drawn at most this many
+    /// pixels wide go to software), y opacity of one strand, z tiles per row, w tile rows.
+    pub soft_params: [f32; 4],
 }
 
 gpu_struct!(FrameBlock as "FrameBlock" {
     view_proj: "mat4", camera_pos: "vec4", light_dir: "vec4", viewport: "vec4",
     planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4", shading: "uvec4",
     light_view_proj: "mat4", shadow: "uvec4", shadow_params: "vec4", transparency: "uvec4",
+    soft: "uvec4", soft_params: "vec4",
 });
 
 /// One character: where its bundles and textures are, how it is placed and styled.
@@ -435,12 +469,21 @@ pub struct FrameStats {
     pub vertex_slots_written: u32,
     /// Compute path: strand workgroups dispatched.
     pub groups: u32,
+    /// Software rasterizer: segments generated for it.
+    pub segments_demanded: u32,
+    /// Software rasterizer: segments stored (<= the segment budget; the rest are dropped).
+    pub segments_written: u32,
+    /// Software rasterizer: (tile, segment) pairs the binning found.
+    pub tile_entries_demanded: u32,
+    /// Software rasterizer: (tile, segment) pairs stored (<= the entry budget).
+    pub tile_entries_written: u32,
 }
 
 gpu_struct!(FrameStats as "FrameStats" {
     bundles_visible: "uint", strands_demanded: "uint", strands_drawn: "uint",
     triangles_demanded: "uint", triangles_drawn: "uint", vertex_slots_demanded: "uint",
-    vertex_slots_written: "uint", groups: "uint",
+    vertex_slots_written: "uint", groups: "uint", segments_demanded: "uint",
+    segments_written: "uint", tile_entries_demanded: "uint", tile_entries_written: "uint",
 });
 
 /// Indirect arguments of the compute path and the frame statistics of both paths.
@@ -451,12 +494,15 @@ pub struct GenerateArgs {
     pub dispatch: [u32; 4],
     /// `VkDrawIndirectCommand` of `strands.vert`.
     pub draw: [u32; 4],
+    /// `VkDispatchIndirectCommand` of the software rasterizer's binning passes (one thread
+    /// per stored segment; w unused).
+    pub soft_dispatch: [u32; 4],
     /// Statistics.
     pub stats: FrameStats,
 }
 
 gpu_struct!(GenerateArgs as "GenerateArgs" {
-    dispatch: "uvec4", draw: "uvec4", stats: "FrameStats",
+    dispatch: "uvec4", draw: "uvec4", soft_dispatch: "uvec4", stats: "FrameStats",
 });
 
 impl GenerateArgs {
@@ -464,6 +510,13 @@ impl GenerateArgs {
     pub const DISPATCH_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, dispatch) as u64;
     /// Byte offset of the draw arguments.
     pub const DRAW_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, draw) as u64;
+    /// Byte offset of the software rasterizer's binning dispatch.
+    pub const SOFT_DISPATCH_OFFSET: u64 =
+        std::mem::offset_of!(GenerateArgs, soft_dispatch) as u64;
+    /// Byte offset of `stats.segments_demanded`.
+    pub const SEGMENTS_DEMANDED_OFFSET: u64 = (std::mem::offset_of!(GenerateArgs, stats)
+        + std::mem::offset_of!(FrameStats, segments_demanded))
+        as u64;
 }
 
 /// A generated strand vertex (compute path).
@@ -477,6 +530,21 @@ pub struct HairVertex {
 }
 
 gpu_struct!(HairVertex as "HairVertex" { pos_width: "vec4", tangent_s: "vec4" });
+
+/// One projected, shaded strand segment for the software rasterizer (32 bytes), written by
+/// the strand builders (`soft_segments.glsl`) and read by the binning and raster passes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SoftSegment {
+    /// x, y: end a in pixels (y down, as `gl_FragCoord`); z, w: depth (0..1) of ends a and b.
+    pub a: [f32; 4],
+    /// x: `packHalf2x16(b.xy - a.xy)`; y, z: colour of ends a and b (`pack_fragment`: sqrt
+    /// RGB, alpha = the share of the drawn width the strand covers); w:
+    /// `packHalf2x16(drawn width in pixels, strands it stands for)`.
+    pub b: [u32; 4],
+}
+
+gpu_struct!(SoftSegment as "SoftSegment" { a: "vec4", b: "uvec4" });
 
 /// A vertex of a prop mesh (bodies, ground): triangle lists, object space.
 #[repr(C)]
@@ -571,6 +639,7 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<FrameStats>(),
         info::<GenerateArgs>(),
         info::<HairVertex>(),
+        info::<SoftSegment>(),
         info::<PropVertex>(),
         info::<PropInstance>(),
         info::<TaskPayload>(),
@@ -619,7 +688,7 @@ pub fn glsl_header() -> String {
          // Shaders are compiled with this text; this copy is for reading.\n\
          #ifndef SHARED_GLSL\n#define SHARED_GLSL\n"
     );
-    let consts: [(&str, u32); 16] = [
+    let consts: [(&str, u32); 21] = [
         ("STRAND_GROUP_SIZE", STRAND_GROUP_SIZE),
         ("MAX_VERTS_LOG2", MAX_VERTS_LOG2),
         ("MAX_SEGMENTS", MAX_SEGMENTS),
@@ -636,6 +705,11 @@ pub fn glsl_header() -> String {
         ("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
         ("SET_FRAME", SET_FRAME),
         ("SET_TEXTURES", SET_TEXTURES),
+        ("SOFT_TILE", SOFT_TILE),
+        ("SOFT_MAX_K", SOFT_MAX_K),
+        ("SOFT_BIN_GROUP", SOFT_BIN_GROUP),
+        ("LOD_SOFT", LOD_SOFT),
+        ("MAX_OIT_BUDGET", super::transparency::MAX_OIT_BUDGET),
     ];
     for (name, v) in consts {
         // Set numbers and local sizes must be int constants in layout qualifiers.
@@ -643,6 +717,7 @@ pub fn glsl_header() -> String {
             || name.ends_with("_GROUP_SIZE")
             || name == "SCAN_THREADS"
             || name == "TASK_PAYLOAD_BUNDLES"
+            || name == "SOFT_BIN_GROUP"
         {
             ""
         } else {

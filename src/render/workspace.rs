@@ -37,6 +37,8 @@ pub struct FrameBuffers<'a> {
     pub shadow: &'a super::targets::ShadowMaps,
     /// The transparent modes' per-pixel buffers.
     pub transparency: &'a super::transparency::TransparencyBuffers,
+    /// The software rasterizer's buffers.
+    pub soft: &'a super::soft::SoftBuffers,
 }
 
 /// The working buffers.
@@ -163,6 +165,10 @@ impl Workspace {
                 FrameBinding::OitTail => &frame.transparency.tail,
                 FrameBinding::PeelDepth => &frame.transparency.peel_depth,
                 FrameBinding::PeelAccum => &frame.transparency.peel_accum,
+                FrameBinding::SoftSegments => &frame.soft.segments,
+                FrameBinding::SoftTiles => &frame.soft.tiles,
+                FrameBinding::SoftEntries => &frame.soft.entries,
+                FrameBinding::SoftDepth => &frame.soft.depth,
                 FrameBinding::ShadowHairDepth
                 | FrameBinding::ShadowPropDepth
                 | FrameBinding::ShadowLayers => {

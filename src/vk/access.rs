@@ -19,6 +19,8 @@ pub enum Access {
     TaskReadWrite,
     /// Storage read in mesh shaders.
     MeshRead,
+    /// Storage read/write in mesh shaders (the software rasterizer's segments).
+    MeshReadWrite,
     /// Storage/uniform read in fragment shaders.
     FragmentRead,
     /// Storage read/write (and atomics) in fragment shaders.
@@ -80,6 +82,12 @@ impl Access {
                 A::SHADER_STORAGE_READ | A::UNIFORM_READ,
                 L::UNDEFINED,
                 false,
+            ),
+            Access::MeshReadWrite => (
+                S::MESH_SHADER_EXT,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                L::GENERAL,
+                true,
             ),
             Access::FragmentRead => (
                 S::FRAGMENT_SHADER,

@@ -89,7 +89,8 @@ pub(super) struct DeviceFeatures {
     host_query_reset: bool,
     pipeline_statistics: bool,
     fragment_stores: bool,
-    /// `shaderInt64` and `shaderBufferInt64Atomics` (the k-buffer's 64-bit `atomicMin`).
+    /// `shaderInt64`, `shaderBufferInt64Atomics` and `shaderSharedInt64Atomics` (the
+    /// k-buffer's and the software rasterizer's 64-bit `atomicMin`).
     int64_atomics: bool,
 }
 
@@ -154,7 +155,9 @@ pub(super) fn query_features(
         host_query_reset: f12.host_query_reset != 0,
         pipeline_statistics: base.pipeline_statistics_query != 0,
         fragment_stores: base.fragment_stores_and_atomics != 0,
-        int64_atomics: base.shader_int64 != 0 && f12.shader_buffer_int64_atomics != 0,
+        int64_atomics: base.shader_int64 != 0
+            && f12.shader_buffer_int64_atomics != 0
+            && f12.shader_shared_int64_atomics != 0,
     })
 }
 
@@ -188,7 +191,8 @@ pub(super) fn create_logical(
         .descriptor_binding_sampled_image_update_after_bind(true)
         .descriptor_binding_update_unused_while_pending(true)
         .shader_sampled_image_array_non_uniform_indexing(true)
-        .shader_buffer_int64_atomics(f.int64_atomics);
+        .shader_buffer_int64_atomics(f.int64_atomics)
+        .shader_shared_int64_atomics(f.int64_atomics);
     let mut enable_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default()
         .mesh_shader(true)
         .task_shader(true)

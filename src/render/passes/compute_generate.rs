@@ -46,13 +46,35 @@ pub fn scan_plan(bundles: u32) -> (Vec<ScanLevel>, u32) {
     }
 }
 
-/// The five compute pipelines of the generation pass.
+/// Which view a generation serves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GenerateView {
+    /// The camera: software bundles append their segments (`soft_segments.glsl`).
+    Camera,
+    /// The light's shadow passes: hardware strips only.
+    Light,
+}
+
+impl GenerateView {
+    /// Profiler scope names of the cull, scan and generate timings.
+    pub fn scopes(self) -> [&'static str; 3] {
+        match self {
+            GenerateView::Camera => ["cull", "scan", "generate"],
+            GenerateView::Light => ["shadow cull", "shadow scan", "shadow generate"],
+        }
+    }
+}
+
+/// The compute pipelines of the generation pass.
 pub struct ComputeGenerate {
     cull: Pipeline,
     scan: Pipeline,
     scan_add: Pipeline,
     finalize: Pipeline,
-    generate: Pipeline,
+    /// Strand workgroups for the light (no software rasterizer).
+    generate_light: Pipeline,
+    /// Strand workgroups for the camera (`SOFT_RASTER`).
+    generate_camera: Pipeline,
 }
 
 impl ComputeGenerate {
@@ -66,18 +88,19 @@ impl ComputeGenerate {
             scan: p("scan", "scan.comp")?,
             scan_add: p("scan add", "scan_add.comp")?,
             finalize: p("finalize", "finalize.comp")?,
-            generate: p("generate", "generate.comp")?,
+            generate_light: p("generate", "generate.comp")?,
+            generate_camera: Pipeline::compute(
+                ctx,
+                "generate (camera)",
+                layout,
+                &compile("generate.comp", &opts.clone().define("SOFT_RASTER", 1))?,
+            )?,
         })
     }
 
-    /// Profiler scope names of the camera's generation.
-    pub const CAMERA_SCOPES: [&'static str; 3] = ["cull", "scan", "generate"];
-    /// Profiler scope names of the light's generation.
-    pub const LIGHT_SCOPES: [&'static str; 3] = ["shadow cull", "shadow scan", "shadow generate"];
-
     /// Record generation of every visible strand of the `bundles` bundles, seen from the view
     /// of `sets`' frame block, into the vertex pool. `args` must have been cleared before
-    /// (statistics accumulate). `scopes` name the cull, scan and generate timings.
+    /// (statistics accumulate).
     pub fn record(
         &self,
         rec: &mut CommandRecorder,
@@ -85,8 +108,9 @@ impl ComputeGenerate {
         sets: PassSets,
         bundles: u32,
         args: &Buffer,
-        scopes: [&'static str; 3],
+        view: GenerateView,
     ) {
+        let scopes = view.scopes();
         let rw = [Access::ComputeReadWrite];
         // Earlier draws (this frame's light passes, earlier frames) read the pool and the
         // offsets: finish them first.
@@ -132,7 +156,11 @@ impl ComputeGenerate {
         rec.barrier(&rw, &[Access::ComputeReadWrite, Access::IndirectRead]);
 
         profiler.begin(rec, scopes[2]);
-        rec.bind(&self.generate, &sets.both());
+        let generate = match view {
+            GenerateView::Camera => &self.generate_camera,
+            GenerateView::Light => &self.generate_light,
+        };
+        rec.bind(generate, &sets.both());
         rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);
         profiler.end(rec);
         rec.barrier(

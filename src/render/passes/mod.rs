@@ -7,6 +7,7 @@ pub mod lhs_skin;
 pub mod props;
 pub mod scalp;
 pub mod shadow;
+pub mod soft_raster;
 pub mod strands;
 pub mod transparency;
 
@@ -20,7 +21,7 @@ use crate::vk::{
     MeshPrimitivesQuery, PipelineLayout, Profiler,
     shader::{ShaderOptions, compile},
 };
-use compute_generate::ComputeGenerate;
+use compute_generate::{ComputeGenerate, GenerateView};
 use props::{PropDraw, PropPass};
 use scalp::ScalpPass;
 use shadow::{ShadowDraw, ShadowPass};
@@ -114,6 +115,12 @@ impl DrawTarget {
         }
     }
 
+    /// Whether this target is drawn from the camera with strands that may go to the software
+    /// rasterizer (the mesh shader then appends their segments, `soft_segments.glsl`).
+    pub fn camera_view(&self) -> bool {
+        matches!(self, DrawTarget::Camera(_) | DrawTarget::OitInsert(_))
+    }
+
     /// The fragment shader strands drawn into this target use (`None`: depth only).
     pub fn strand_fragment_shader(&self) -> Option<&'static str> {
         match self {
@@ -194,6 +201,13 @@ pub struct FrameInputs<'a> {
     pub transparency: super::Transparency,
     /// The transparent modes' per-pixel buffers (sized for this frame's mode).
     pub transparency_buffers: &'a mut super::transparency::TransparencyBuffers,
+    /// How strands are rasterized.
+    pub raster: super::soft::StrandRaster,
+    /// The software rasterizer's buffers (sized for this frame when it is used).
+    pub soft_buffers: &'a super::soft::SoftBuffers,
+    /// k-buffer nodes per pixel of this frame (the OIT budget, or the software
+    /// rasterizer's K in opaque frames).
+    pub kbuffer_budget: u32,
 }
 
 /// What the light's passes need.
@@ -217,6 +231,8 @@ pub struct FramePasses {
     scalp: ScalpPass,
     strands: StrandDraw,
     transparency: TransparencyPass,
+    /// The software rasterizer, on devices with 64-bit shared and buffer atomics.
+    soft: Option<soft_raster::SoftRasterPass>,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
     /// The LHS baseline's skinning pass.
     pub lhs_skin: lhs_skin::LhsSkin,
@@ -261,6 +277,11 @@ impl FramePasses {
             scalp: ScalpPass::new(ctx, layout, targets)?,
             strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
+            soft: if ctx.info.int64_atomics {
+                Some(soft_raster::SoftRasterPass::new(ctx, layout)?)
+            } else {
+                None
+            },
             hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
             lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
         })
@@ -291,6 +312,11 @@ impl FramePasses {
         self.strands.has_mesh_path()
     }
 
+    /// Whether the software rasterizer is available.
+    pub fn has_software_raster(&self) -> bool {
+        self.soft.is_some()
+    }
+
     /// Record the frame's passes. Leaves the targets as colour / depth attachments and
     /// `args` written by the last generating stage.
     pub fn record(
@@ -311,10 +337,15 @@ impl FramePasses {
         match shadow.mode {
             Some(mode) => {
                 if compute {
-                    let scopes = ComputeGenerate::LIGHT_SCOPES;
                     let sets = shadow.light_sets;
-                    self.generate
-                        .record(rec, profiler, sets, inp.bundles, inp.args, scopes);
+                    self.generate.record(
+                        rec,
+                        profiler,
+                        sets,
+                        inp.bundles,
+                        inp.args,
+                        GenerateView::Light,
+                    );
                 }
                 let draw = ShadowDraw {
                     mode,
@@ -333,9 +364,14 @@ impl FramePasses {
             None => ShadowPass::keep_readable(rec, shadow.maps),
         }
         if compute {
-            let scopes = ComputeGenerate::CAMERA_SCOPES;
-            self.generate
-                .record(rec, profiler, inp.sets, inp.bundles, inp.args, scopes);
+            self.generate.record(
+                rec,
+                profiler,
+                inp.sets,
+                inp.bundles,
+                inp.args,
+                GenerateView::Camera,
+            );
         }
         let targets = inp.targets;
         let (color_from, depth_from) = match inp.clear {
@@ -350,13 +386,15 @@ impl FramePasses {
         }
         let mesh = inp.path == RenderPath::Mesh;
         let transparent = inp.bundles > 0 && inp.transparency != super::Transparency::Opaque;
+        let soft = inp.bundles > 0 && inp.raster.uses_software();
         profiler.begin(rec, if mesh { "mesh draw" } else { "draw" });
         rec.begin_rendering(
             Attachment {
                 image: &targets.color,
                 clear: inp.clear,
-                // With transparency the resolve pass ends the frame's colour.
-                resolve: targets.resolved.as_ref().filter(|_| !transparent),
+                // With transparency or software strands the resolve pass ends the frame's
+                // colour.
+                resolve: targets.resolved.as_ref().filter(|_| !transparent && !soft),
             },
             Attachment {
                 image: &targets.depth,
@@ -399,7 +437,34 @@ impl FramePasses {
                 buffers: inp.transparency_buffers,
                 mesh_query: query,
             };
-            self.transparency.record(rec, profiler, draw)?;
+            self.transparency.record_layers(rec, profiler, draw)?;
+        } else if soft {
+            let (w, h) = targets.size();
+            TransparencyPass::clear_kbuffer(
+                rec,
+                inp.transparency_buffers,
+                inp.kbuffer_budget,
+                w as u64 * h as u64,
+            );
+        }
+        if soft {
+            let pass = self.soft.as_ref().ok_or_else(|| {
+                crate::vk::GpuError::Unsupported("no software rasterizer on this device".into())
+            })?;
+            let size = targets.size();
+            let draw = soft_raster::SoftDraw {
+                sets: inp.sets,
+                args: inp.args,
+                buffers: inp.soft_buffers,
+                targets: Some(&mut *targets),
+                size,
+            };
+            pass.record(rec, profiler, draw);
+        }
+        if transparent || soft {
+            let peel = matches!(inp.transparency, super::Transparency::DepthPeeling { .. });
+            self.transparency
+                .record_resolve(rec, profiler, peel, inp.sets, targets)?;
         }
         targets.set_output_access(Access::ColorAttachment);
         Ok(())

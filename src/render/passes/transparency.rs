@@ -137,9 +137,30 @@ impl TransparencyPass {
         Pipeline::graphics(&self.ctx, &self.layout, &desc)
     }
 
-    /// Record the transparent passes of `draw.mode` (prepared with [`Self::prepare`]). Leaves
-    /// the colour target (and resolve image) as colour attachments.
-    pub fn record(
+    /// Empty the k-buffer of `budget` nodes per pixel for `pixels` pixels (before the
+    /// k-buffer insert or the software rasterizer).
+    pub fn clear_kbuffer(
+        rec: &mut CommandRecorder,
+        buffers: &TransparencyBuffers,
+        budget: u32,
+        pixels: u64,
+    ) {
+        rec.barrier(
+            &[Access::FragmentReadWrite, Access::ComputeReadWrite],
+            &[Access::TransferWrite],
+        );
+        rec.fill_buffer(&buffers.nodes, 0, pixels * budget as u64 * 8, u32::MAX);
+        rec.fill_buffer(&buffers.tail, 0, pixels * 16, 0);
+        rec.barrier(
+            &[Access::TransferWrite],
+            &[Access::FragmentReadWrite, Access::ComputeReadWrite],
+        );
+    }
+
+    /// Record the transparent strand passes of `draw.mode` (prepared with [`Self::prepare`]):
+    /// the k-buffer clear and insert, or the peeled layers; [`Self::record_resolve`]
+    /// composites them.
+    pub fn record_layers(
         &self,
         rec: &mut CommandRecorder,
         profiler: &mut Profiler,
@@ -148,15 +169,11 @@ impl TransparencyPass {
         let unprepared = || GpuError::Unsupported("transparency pipelines not prepared".into());
         let (w, h) = draw.targets.size();
         let pixels = w as u64 * h as u64;
-        let resolve = match draw.mode {
-            Transparency::Opaque => return Ok(()),
+        match draw.mode {
+            Transparency::Opaque => Ok(()),
             Transparency::KBuffer { budget } => {
                 let p = self.kbuffer.as_ref().ok_or_else(unprepared)?;
-                rec.barrier(&[Access::FragmentReadWrite], &[Access::TransferWrite]);
-                let b = &*draw.buffers;
-                rec.fill_buffer(&b.nodes, 0, pixels * budget as u64 * 8, u32::MAX);
-                rec.fill_buffer(&b.tail, 0, pixels * 16, 0);
-                rec.barrier(&[Access::TransferWrite], &[Access::FragmentReadWrite]);
+                Self::clear_kbuffer(rec, draw.buffers, budget, pixels);
                 let t = &*draw.targets;
                 rec.image_barrier(&t.depth, t.depth_access, Access::DepthAttachment);
                 profiler.begin(rec, "oit insert");
@@ -182,17 +199,38 @@ impl TransparencyPass {
                 profiler.end(rec);
                 result?;
                 draw.targets.depth_access = Access::DepthAttachment;
-                &p.resolve
+                Ok(())
             }
             Transparency::DepthPeeling { layers } => {
                 let p = self.peel.as_ref().ok_or_else(unprepared)?;
                 Self::record_peeling(rec, profiler, p, &mut draw, layers, pixels)?;
                 draw.targets.depth_access = Access::TransferRead;
-                &p.resolve
+                Ok(())
             }
+        }
+    }
+
+    /// Composite the k-buffer (`peel` false) or the peeling accumulation over the colour
+    /// target (and its MSAA resolve), leaving them as colour attachments.
+    pub fn record_resolve(
+        &self,
+        rec: &mut CommandRecorder,
+        profiler: &mut Profiler,
+        peel: bool,
+        sets: PassSets,
+        targets: &RenderTargets,
+    ) -> GpuResult<()> {
+        let unprepared = || GpuError::Unsupported("transparency pipelines not prepared".into());
+        let resolve = if peel {
+            &self.peel.as_ref().ok_or_else(unprepared)?.resolve
+        } else {
+            &self.kbuffer.as_ref().ok_or_else(unprepared)?.resolve
         };
-        rec.barrier(&[Access::FragmentReadWrite], &[Access::FragmentReadWrite]);
-        let t = &*draw.targets;
+        rec.barrier(
+            &[Access::FragmentReadWrite, Access::ComputeReadWrite],
+            &[Access::FragmentReadWrite],
+        );
+        let t = targets;
         rec.image_barrier(&t.color, Access::ColorAttachment, Access::ColorAttachment);
         profiler.begin(rec, "transparency resolve");
         rec.begin_rendering_color(Attachment {
@@ -200,7 +238,7 @@ impl TransparencyPass {
             clear: None,
             resolve: t.resolved.as_ref(),
         });
-        rec.bind(resolve, &draw.sets.both());
+        rec.bind(resolve, &sets.both());
         rec.draw(3);
         rec.end_rendering();
         profiler.end(rec);

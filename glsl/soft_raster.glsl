@@ -1,0 +1,116 @@
+// Software rasterizer: what the binning (soft_bin.comp) and raster (soft_raster.comp) passes
+// share: the segment buffers, decoding a SoftSegment, the footprint walk and the exact pixel
+// coverage. CPU twin of the coverage: src/render/soft_coverage.rs. Requires bindings.glsl.
+#ifndef SOFT_RASTER_GLSL
+#define SOFT_RASTER_GLSL
+#include "fragment_pack.glsl"
+
+layout(set = SET_FRAME, binding = BINDING_SOFT_SEGMENTS, std430) readonly buffer SoftSegments { SoftSegment soft_segments[]; };
+// Per tile: x segments touching it, y first entry, z scatter cursor, w entries kept.
+layout(set = SET_FRAME, binding = BINDING_SOFT_TILES, std430) buffer SoftTiles { uvec4 soft_tiles[]; };
+layout(set = SET_FRAME, binding = BINDING_SOFT_ENTRIES, std430) buffer SoftEntries { uint soft_entries[]; };
+layout(set = SET_FRAME, binding = BINDING_SOFT_DEPTH, std430) readonly buffer SoftDepth { float soft_depth[]; };
+
+struct Segment {
+    vec2 a;          // end a, pixels
+    vec2 b;          // end b, pixels
+    float za;        // depths (0..1)
+    float zb;
+    float half_width; // half the drawn width, pixels
+    float thickness;  // strands it stands for (lod_appearance.glsl)
+    uint color_a;     // pack_fragment: colour, covered share of the drawn width
+    uint color_b;
+};
+
+Segment load_segment(uint i) {
+    SoftSegment s = soft_segments[i];
+    Segment r;
+    r.a = s.a.xy;
+    r.b = s.a.xy + unpackHalf2x16(s.b.x);
+    r.za = s.a.z;
+    r.zb = s.a.w;
+    vec2 wk = unpackHalf2x16(s.b.w);
+    r.half_width = 0.5 * wk.x;
+    r.thickness = wk.y;
+    r.color_a = s.b.y;
+    r.color_b = s.b.z;
+    return r;
+}
+
+uint tiles_per_row() {
+    return uint(frame.soft_params.z);
+}
+
+uint tile_rows() {
+    return uint(frame.soft_params.w);
+}
+
+// The range of the parameter t in [0, 1] where the centre line a + t (b - a) has its
+// coordinate `axis` in [lo, hi]; empty when x > y.
+vec2 clip_param(vec2 a, vec2 b, int axis, float lo, float hi) {
+    float pa = a[axis];
+    float d = b[axis] - pa;
+    if (abs(d) < 1e-12) {
+        return (pa >= lo && pa <= hi) ? vec2(0.0, 1.0) : vec2(1.0, 0.0);
+    }
+    float t0 = (lo - pa) / d;
+    float t1 = (hi - pa) / d;
+    return vec2(max(min(t0, t1), 0.0), min(max(t0, t1), 1.0));
+}
+
+// Area of the unit pixel square with corner `pmin` covered by the rectangle of half-width
+// `h` around the segment a -> b (no end caps, so consecutive segments of a straight strand
+// tile it exactly): the square in the segment's frame, clipped by the four sides
+// (Sutherland-Hodgman), then the shoelace formula.
+float pixel_coverage(vec2 a, vec2 b, float h, vec2 pmin) {
+    vec2 d = b - a;
+    float len = length(d);
+    if (len < 1e-9) {
+        return 0.0;
+    }
+    d /= len;
+    vec2 n = vec2(-d.y, d.x);
+    vec2 poly[8];
+    vec2 tmp[8];
+    for (int i = 0; i < 4; i++) {
+        vec2 q = pmin + vec2(float(i == 1 || i == 2), float(i >= 2)) - a;
+        poly[i] = vec2(dot(q, d), dot(q, n));
+    }
+    int count = 4;
+    // Keep sign * (p[axis] - bound) <= 0 for (axis, bound, sign) = (u, len, +), (u, 0, -),
+    // (v, h, +), (v, -h, -).
+    for (int side = 0; side < 4; side++) {
+        int axis = side / 2;
+        float bound = side == 0 ? len : (side == 1 ? 0.0 : (side == 2 ? h : -h));
+        float sgn = (side % 2 == 0) ? 1.0 : -1.0;
+        int m = 0;
+        for (int i = 0; i < count; i++) {
+            vec2 p = poly[i];
+            vec2 q = poly[(i + 1) % count];
+            float fp = sgn * (p[axis] - bound);
+            float fq = sgn * (q[axis] - bound);
+            if (fp <= 0.0) {
+                tmp[m++] = p;
+            }
+            if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
+                tmp[m++] = mix(p, q, fp / (fp - fq));
+            }
+        }
+        count = m;
+        for (int i = 0; i < m; i++) {
+            poly[i] = tmp[i];
+        }
+        if (count < 3) {
+            return 0.0;
+        }
+    }
+    float area = 0.0;
+    for (int i = 0; i < count; i++) {
+        vec2 p = poly[i];
+        vec2 q = poly[(i + 1) % count];
+        area += p.x * q.y - q.x * p.y;
+    }
+    return clamp(0.5 * abs(area), 0.0, 1.0);
+}
+
+#endif

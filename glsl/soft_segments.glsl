@@ -1,0 +1,104 @@
+// Software rasterizer, step 1 (src/render/soft.rs): the strand builders (generate.comp,
+// strands.mesh) hand a software bundle's strands, built in shared memory by
+// strand_build.glsl, to emit_soft_segments: every vertex is shaded (strand_radiance.glsl, the
+// same models as the fragment shaders, evaluated at the vertices and interpolated along the
+// segment) and projected; every segment with both ends in the depth range and its footprint
+// on screen is appended to soft_segments[]. The workgroup reserves its segments with one
+// atomic add; those past the budget (frame.soft.z) are counted, not written.
+#ifndef SOFT_SEGMENTS_GLSL
+#define SOFT_SEGMENTS_GLSL
+#include "strip.glsl"
+#include "strand_radiance.glsl"
+#include "fragment_pack.glsl"
+
+layout(set = SET_FRAME, binding = BINDING_SOFT_SEGMENTS, std430) writeonly buffer SoftSegments { SoftSegment soft_segments[]; };
+
+// Per vertex: x, y in pixels, depth, drawn width in pixels (negative: outside the depth range).
+shared vec4 sv_screen[MAX_ENTRIES];
+// Per vertex: pack_fragment(radiance, covered share of the drawn width).
+shared uint sv_color[MAX_ENTRIES];
+shared uint s_soft_count;
+shared uint s_soft_base;
+
+// Longest segment kept, in pixels (the half-float end offset stays well inside its range).
+#define SOFT_MAX_SEGMENT_PIXELS 16384.0
+
+// Width the software rasterizer draws a strand of `width` with: its own width, or with the
+// thick-strand term the footprint of the `thickness` strands it stands for (lod_appearance.glsl,
+// sqrt(k) pixels capped by the bundle). Unlike hardware strips it is not widened to a pixel:
+// coverage is computed exactly.
+float soft_drawn_width(float width, float pixel, float thickness, float cap) {
+    if (frame.shading.y == 0u || thickness <= 1.0) {
+        return width;
+    }
+    return max(width, min(sqrt(thickness) * pixel, cap));
+}
+
+bool soft_segment_kept(uint idx) {
+    vec4 a = sv_screen[idx];
+    vec4 b = sv_screen[idx + 1u];
+    if (a.w < 0.0 || b.w < 0.0) {
+        return false;
+    }
+    vec2 d = b.xy - a.xy;
+    float h = 0.5 * max(a.w, b.w);
+    vec2 lo = min(a.xy, b.xy) - h;
+    vec2 hi = max(a.xy, b.xy) + h;
+    bool on_screen = all(lessThan(lo, frame.viewport.xy)) && all(greaterThan(hi, vec2(0.0)));
+    return on_screen && dot(d, d) > 1e-12 && max(abs(d.x), abs(d.y)) < SOFT_MAX_SEGMENT_PIXELS;
+}
+
+// Shade, project and append the segments of `count` strands of `segments` segments in
+// sp / st (all S threads call it: it contains barriers).
+void emit_soft_segments(uint count, uint segments, float width_scale, float thickness, float cap, vec3 color, uint character, uint t) {
+    uint stride = segments + 1u;
+    uint entries = count * stride;
+    if (t == 0u) {
+        s_soft_count = 0u;
+    }
+    for (uint idx = t; idx < entries; idx += S) {
+        uint k = idx % stride;
+        float s = float(k) / float(segments);
+        vec3 p = sp[idx];
+        vec4 c = frame.view_proj * vec4(p, 1.0);
+        float pixel = pixel_size(p);
+        float width = width_scale * strand_width_at(s);
+        float drawn = soft_drawn_width(width, pixel, thickness, cap);
+        bool in_range = c.w > 1e-6 && c.z >= 0.0 && c.z <= c.w;
+        vec3 ndc = c.xyz / max(c.w, 1e-6);
+        vec2 screen = (ndc.xy * 0.5 + 0.5) * frame.viewport.xy;
+        sv_screen[idx] = vec4(screen, ndc.z, in_range ? drawn / pixel : -1.0);
+        vec3 radiance = strand_radiance(st[idx], s, p, color, character);
+        sv_color[idx] = pack_fragment(radiance, width / max(drawn, 1e-20));
+    }
+    barrier();
+    // Count the kept segments, reserve them with one atomic add, then write them.
+    uint mine = 0u;
+    for (uint idx = t; idx < entries; idx += S) {
+        if (idx % stride < segments && soft_segment_kept(idx)) {
+            mine++;
+        }
+    }
+    uint local = atomicAdd(s_soft_count, mine);
+    barrier();
+    if (t == 0u) {
+        s_soft_base = s_soft_count > 0u ? atomicAdd(args.stats.segments_demanded, s_soft_count) : 0u;
+    }
+    barrier();
+    uint budget = frame.soft.z;
+    uint out_index = s_soft_base + local;
+    for (uint idx = t; idx < entries; idx += S) {
+        if (idx % stride < segments && soft_segment_kept(idx)) {
+            if (out_index < budget) {
+                vec4 a = sv_screen[idx];
+                vec4 b = sv_screen[idx + 1u];
+                soft_segments[out_index].a = vec4(a.xy, a.z, b.z);
+                soft_segments[out_index].b = uvec4(packHalf2x16(b.xy - a.xy), sv_color[idx], sv_color[idx + 1u],
+                                                   packHalf2x16(vec2(0.5 * (a.w + b.w), thickness)));
+            }
+            out_index++;
+        }
+    }
+}
+
+#endif

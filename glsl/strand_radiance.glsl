@@ -1,0 +1,45 @@
+// The radiance of a strand point toward the eye, shared by every strand fragment shader
+// (strand_fragment.glsl) and the software rasterizer's vertex shading (soft_segments.glsl).
+// The model is chosen per frame by frame.shading.x (src/shade/mod.rs ShadingModel):
+// 0 placeholder (Kajiya-Kay diffuse with a half-vector highlight and darker roots),
+// 1 Kajiya-Kay diffuse + specular, 2 Marschner R / TT / TRT. Requires bindings.glsl.
+#ifndef STRAND_RADIANCE_GLSL
+#define STRAND_RADIANCE_GLSL
+#include "hair_shading.glsl"
+#include "shadow_lookup.glsl"
+
+// Irradiance of the directional light, and an ambient term that stands in for multiple
+// scattering (dual scattering is not implemented) in the physically based models.
+#define LIGHT_IRRADIANCE 4.5
+#define AMBIENT 0.25
+
+// Radiance toward the eye at world point `pos` of a strand with unit-ish tangent `tangent`,
+// parameter `s` along it, base colour `base`, of character `character`.
+vec3 strand_radiance(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character) {
+    vec3 t = normalize(tangent);
+    vec3 l = normalize(frame.light_dir.xyz);
+    vec3 e = normalize(frame.camera_pos.xyz - pos);
+    // Direct light reaching this point through the hair and bodies in front of it.
+    float lit = light_transmittance(pos, 0.0);
+    float root_shadow = mix(0.55, 1.0, smoothstep(0.0, 0.3, s_param));
+    vec3 c;
+    if (frame.shading.x == 1u) {
+        vec2 kk = kajiya_kay(t, l, e);
+        c = (base * (AMBIENT + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
+    } else if (frame.shading.x == 2u) {
+        HairStyle s = characters[character].style;
+        vec3 sc = marschner(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees));
+        float cos_i = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));
+        c = (sc * (LIGHT_IRRADIANCE * cos_i * lit) + base * AMBIENT) * root_shadow;
+    } else {
+        float tl = dot(t, l);
+        float diffuse = sqrt(max(1.0 - tl * tl, 0.0));
+        vec3 h = normalize(l + e);
+        float th = dot(t, h);
+        float spec = pow(sqrt(max(1.0 - th * th, 0.0)), 80.0);
+        c = base * (0.25 + 0.75 * diffuse * lit) * root_shadow + vec3(0.25) * (spec * lit) * root_shadow;
+    }
+    return c;
+}
+
+#endif

@@ -1,0 +1,303 @@
+//! The software rasterizer for thin strands ([`StrandRaster`]), the third way strands reach
+//! the image after hardware strips drawn from the mesh path or the vertex pool (after Tafuri,
+//! "Strand-based Hair Rendering in Frostbite", 2019, and Lipp et al., "High-Performance
+//! Real-Time Implicit Strand-Based Hair Rendering via Software Rasterization", 2025).
+//!
+//! 1. **Segments.** The strand builders of either generation path (`generate.comp`,
+//!    `strands.mesh`, through `soft_segments.glsl`) shade each vertex of a software bundle and
+//!    append its projected segments ([`SoftSegment`], 32 bytes) to a bounded buffer; a
+//!    workgroup reserves its segments with one atomic add. Segments past the budget are
+//!    counted and dropped.
+//! 2. **Binning.** One thread per stored segment counts the 16x16-pixel tiles its footprint
+//!    touches (row of tiles by row of tiles, so a long diagonal segment visits only its own
+//!    tiles); one workgroup scans the tile counts into offsets (entries past the entry budget
+//!    are counted and dropped, whole tiles' tails first); the same walk then scatters segment
+//!    indices into each tile's range.
+//! 3. **Raster.** One workgroup per tile: each thread takes segments of the tile, walks the
+//!    pixels of its footprint inside the tile and computes the exact area of the pixel square
+//!    covered by the segment's rectangle (analytic coverage: no MSAA needed), the depth at the
+//!    pixel centre (tested against the opaque depth), and the colour interpolated between the
+//!    shaded ends. Fragments go into per-pixel lists of the `K` nearest in shared memory
+//!    (64-bit `atomicMin` of depth bits << 32 | packed colour, as the k-buffer), evicted ones
+//!    into fixed-point tail sums, so the result does not depend on the order. At the end each
+//!    pixel merges its list with the frame's k-buffer (hardware-drawn transparent strands of
+//!    the same frame), and the k-buffer resolve composites everything front to back.
+//!
+//! In [`StrandRaster::Auto`] the split is per bundle, in `bundle_lod.glsl`: a bundle whose
+//! strands are drawn at most [`AUTO_SPLIT_PIXELS`] wide at its nearest point (strand width,
+//! widened by the LoD thickness, over the pixel size at the bundle's nearest distance) goes
+//! to software, thicker ones stay on hardware strips.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::shared::{FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
+use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
+
+/// Default number of fragments per pixel the software rasterizer keeps sorted.
+pub const DEFAULT_SOFT_K: u32 = 8;
+/// [`StrandRaster::Auto`]: bundles whose strands are drawn at most this many pixels wide go
+/// to the software rasterizer.
+pub const AUTO_SPLIT_PIXELS: f32 = 1.5;
+
+/// How strands are rasterized, chosen per frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StrandRaster {
+    /// Camera-facing strips through the hardware rasterizer.
+    #[default]
+    Hardware,
+    /// Every bundle through the compute software rasterizer, keeping `k` fragments per pixel
+    /// sorted (1..=[`SOFT_MAX_K`]).
+    Software {
+        /// Fragments per pixel kept sorted.
+        k: u32,
+    },
+    /// Per bundle: thin strands to software, thick ones to hardware.
+    Auto {
+        /// Fragments per pixel kept sorted by the software part.
+        k: u32,
+    },
+}
+
+impl StrandRaster {
+    /// Mode number in `FrameBlock::soft.x`.
+    pub fn mode(self) -> u32 {
+        match self {
+            StrandRaster::Hardware => 0,
+            StrandRaster::Software { .. } => 1,
+            StrandRaster::Auto { .. } => 2,
+        }
+    }
+
+    /// Whether the software rasterizer runs.
+    pub fn uses_software(self) -> bool {
+        self != StrandRaster::Hardware
+    }
+
+    /// Fragments per pixel kept sorted (0 for hardware).
+    pub fn k(self) -> u32 {
+        match self {
+            StrandRaster::Hardware => 0,
+            StrandRaster::Software { k } | StrandRaster::Auto { k } => k,
+        }
+    }
+
+    /// Check `k`.
+    pub fn validate(self) -> Result<(), String> {
+        match self {
+            StrandRaster::Hardware => Ok(()),
+            _ if (1..=SOFT_MAX_K).contains(&self.k()) => Ok(()),
+            _ => Err(format!(
+                "software raster K {} must be 1..={SOFT_MAX_K} fragments per pixel",
+                self.k()
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for StrandRaster {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StrandRaster::Hardware => write!(f, "hw"),
+            StrandRaster::Software { k } => write!(f, "soft:{k}"),
+            StrandRaster::Auto { k } => write!(f, "auto:{k}"),
+        }
+    }
+}
+
+impl std::str::FromStr for StrandRaster {
+    type Err = String;
+    /// `hw`, `soft` or `soft:K`, `auto` or `auto:K` (K fragments per pixel kept sorted).
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (name, k) = match s.split_once(':') {
+            Some((n, c)) => (
+                n,
+                Some(
+                    c.parse::<u32>()
+                        .map_err(|_| format!("draw '{s}': '{c}' is not a whole number"))?,
+                ),
+            ),
+            None => (s, None),
+        };
+        let k_or_default = k.unwrap_or(DEFAULT_SOFT_K);
+        let r = match name {
+            "hw" if k.is_none() => StrandRaster::Hardware,
+            "soft" => StrandRaster::Software { k: k_or_default },
+            "auto" => StrandRaster::Auto { k: k_or_default },
+            _ => {
+                return Err(format!(
+                    "unknown draw '{s}' (hw, soft, soft:K, auto, auto:K)"
+                ));
+            }
+        };
+        r.validate()?;
+        Ok(r)
+    }
+}
+
+/// Sizes of the software rasterizer's buffers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SoftBudget {
+    /// Segments stored per frame (32 bytes each); more are counted and dropped.
+    pub segments: u32,
+    /// (tile, segment) entries per frame (4 bytes each); more are counted and dropped.
+    pub tile_entries: u32,
+}
+
+impl SoftBudget {
+    /// The largest budgets the device's `maxStorageBufferRange` allows, at most 4M segments
+    /// and 16M entries (128 MiB + 64 MiB).
+    pub fn for_range(range: u64) -> Self {
+        let seg = size_of::<SoftSegment>() as u64;
+        SoftBudget {
+            segments: (range / seg).min(4 << 20) as u32,
+            tile_entries: (range / 4).min(16 << 20) as u32,
+        }
+    }
+
+    /// Check against the device limit.
+    pub fn validate(&self, range: u64) -> Result<(), String> {
+        let seg = size_of::<SoftSegment>() as u64;
+        if self.segments == 0 || self.segments as u64 * seg > range {
+            return Err(format!(
+                "software raster segment budget {} must be 1..={} ({}-byte segments, maxStorageBufferRange {range})",
+                self.segments,
+                range / seg,
+                seg
+            ));
+        }
+        if self.tile_entries == 0 || self.tile_entries as u64 * 4 > range {
+            return Err(format!(
+                "software raster tile entry budget {} must be 1..={}",
+                self.tile_entries,
+                range / 4
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Tiles per row and tile rows of a `width x height` target.
+pub fn tile_grid(width: u32, height: u32) -> (u32, u32) {
+    (width.div_ceil(SOFT_TILE), height.div_ceil(SOFT_TILE))
+}
+
+/// Fill the software rasterizer's fields of a camera frame block.
+pub fn frame_fields(
+    block: &mut FrameBlock,
+    raster: StrandRaster,
+    budget: SoftBudget,
+    opacity: f32,
+) {
+    let (w, h) = (block.viewport[0] as u32, block.viewport[1] as u32);
+    let (tx, ty) = tile_grid(w, h);
+    block.soft = [
+        raster.mode(),
+        raster.k(),
+        budget.segments,
+        budget.tile_entries,
+    ];
+    block.soft_params = [AUTO_SPLIT_PIXELS, opacity, tx as f32, ty as f32];
+}
+
+/// The software rasterizer's buffers, allocated on first use and grown with the target.
+pub struct SoftBuffers {
+    ctx: Arc<Context>,
+    /// `SoftSegment[]`.
+    pub segments: Buffer,
+    /// Per tile `uvec4`.
+    pub tiles: Buffer,
+    /// Segment indices by tile.
+    pub entries: Buffer,
+    /// The opaque depth, one float per pixel.
+    pub depth: Buffer,
+}
+
+fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            name,
+            bytes,
+            vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::TRANSFER_DST
+                | vk::BufferUsageFlags::TRANSFER_SRC,
+        ),
+    )
+}
+
+impl SoftBuffers {
+    /// Placeholders only.
+    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
+        Ok(SoftBuffers {
+            ctx: ctx.clone(),
+            segments: storage(ctx, "soft segments", 32)?,
+            tiles: storage(ctx, "soft tiles", 16)?,
+            entries: storage(ctx, "soft entries", 16)?,
+            depth: storage(ctx, "soft depth", 16)?,
+        })
+    }
+
+    /// Make the buffers large enough for `budget` and a `width x height` target; returns the
+    /// replaced ones (frames in flight may still use them).
+    pub fn ensure(
+        &mut self,
+        budget: SoftBudget,
+        width: u32,
+        height: u32,
+    ) -> GpuResult<Vec<Box<dyn std::any::Any>>> {
+        let range = self.ctx.info.max_storage_buffer_range;
+        budget.validate(range).map_err(GpuError::Unsupported)?;
+        let (tx, ty) = tile_grid(width, height);
+        let need = [
+            budget.segments as u64 * size_of::<SoftSegment>() as u64,
+            tx as u64 * ty as u64 * 16,
+            budget.tile_entries as u64 * 4,
+            width as u64 * height as u64 * 4,
+        ];
+        let mut replaced: Vec<Box<dyn std::any::Any>> = Vec::new();
+        let slots = [
+            (&mut self.segments, "soft segments", need[0]),
+            (&mut self.tiles, "soft tiles", need[1]),
+            (&mut self.entries, "soft entries", need[2]),
+            (&mut self.depth, "soft depth", need[3]),
+        ];
+        for (buffer, name, bytes) in slots {
+            if bytes > buffer.size {
+                replaced.push(Box::new(std::mem::replace(
+                    buffer,
+                    storage(&self.ctx, name, bytes)?,
+                )));
+            }
+        }
+        Ok(replaced)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_rejects() {
+        assert_eq!("hw".parse(), Ok(StrandRaster::Hardware));
+        assert_eq!(
+            "soft".parse(),
+            Ok(StrandRaster::Software { k: DEFAULT_SOFT_K })
+        );
+        assert_eq!("auto:4".parse(), Ok(StrandRaster::Auto { k: 4 }));
+        for bad in ["soft:0", "soft:9", "hw:2", "auto:x", "sw", ""] {
+            assert!(bad.parse::<StrandRaster>().is_err(), "{bad}");
+        }
+        for t in ["hw", "soft:3", "auto:8"] {
+            assert_eq!(t.parse::<StrandRaster>().unwrap().to_string(), t);
+        }
+        assert_eq!(tile_grid(1280, 720), (80, 45));
+        assert_eq!(tile_grid(17, 1), (2, 1));
+        let b = SoftBudget::for_range(128 << 20);
+        assert_eq!(b.segments, 4 << 20);
+        assert!(b.validate(128 << 20).is_ok());
+        assert!(b.validate(64 << 20).is_err());
+    }
+}

@@ -1,0 +1,195 @@
+//! `bench raster`: the software rasterizer against hardware strips, from one run on one
+//! device. Scenes: one head at near / mid / far (LoD on), about 100K strands of 33 vertices
+//! at mid distance (LoD off), and a crowd of 100 characters with LoD. For each scene and
+//! generation path: median GPU frame time of hardware strips (opaque, and with k-buffer OIT,
+//! the image the software path matches), of the software rasterizer (`soft`) and of the per
+//! bundle split (`auto`), both compositing like OIT; and the ratios to hardware.
+
+use std::sync::Arc;
+
+use anyhow::{Result, bail};
+use glam::{Mat4, Vec3};
+use hairmesh::outln;
+use hairmesh::reference::generate::strands_in_bundle;
+use hairmesh::render::scene::load_mesh;
+use hairmesh::render::{
+    Camera, FrameOptions, RenderPath, Renderer, RendererDesc, StrandParams, StrandRaster,
+    Transparency, View,
+};
+use hairmesh::vk::{Context, ContextDesc};
+
+/// What `bench raster` measures.
+pub struct RasterArgs {
+    /// Image size.
+    pub size: (u32, u32),
+    /// Timed frames per measurement (after one warm-up).
+    pub runs: usize,
+    /// Characters of the crowd scene.
+    pub crowd: usize,
+    /// Strands of the dense scene.
+    pub strands: u32,
+    /// Choose the GPU by name substring.
+    pub device: Option<String>,
+    /// Only these scenes (names as printed); empty: all.
+    pub scenes: Vec<String>,
+}
+
+struct Scene {
+    name: String,
+    renderer: Renderer,
+    camera: Camera,
+    lod: bool,
+}
+
+/// Median GPU ms of `runs` frames after one warm-up, and the warm-up's statistics.
+fn time(
+    r: &mut Renderer,
+    view: &View,
+    opts: FrameOptions,
+    runs: usize,
+) -> Result<(f64, hairmesh::render::FrameStats)> {
+    let first = r.render_one(view, &opts)?;
+    let mut ms = Vec::with_capacity(runs);
+    for _ in 0..runs {
+        ms.push(r.render_one(view, &opts)?.gpu_ms());
+    }
+    Ok((super::median(ms), first.stats))
+}
+
+fn head_scenes(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Vec<Scene>> {
+    let (baked, style) = load_mesh(std::path::Path::new("hairmeshes/head_long.obj"), None)?;
+    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+    let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
+    let frame = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
+    let at = |k: f32| {
+        Camera::look_at(
+            frame.target + (frame.eye - frame.target) * k,
+            frame.target,
+            40.0,
+        )
+    };
+    let head = |strands_per_bundle: u32| -> Result<Renderer> {
+        let mut r = Renderer::new(ctx, &RendererDesc::default().size(a.size.0, a.size.1))?;
+        r.add_character(
+            &baked,
+            &style,
+            StrandParams {
+                strands_per_bundle,
+                verts_log2: 5,
+            },
+            Mat4::IDENTITY,
+        )?;
+        Ok(r)
+    };
+    let mut scenes = Vec::new();
+    for (name, k) in [("head near", 0.6), ("head mid", 2.5), ("head far", 8.0)] {
+        scenes.push(Scene {
+            name: name.into(),
+            renderer: head(64)?,
+            camera: at(k),
+            lod: true,
+        });
+    }
+    let per_bundle = (a.strands as f32 / baked.bundles.len() as f32).ceil() as u32;
+    let per_bundle = per_bundle.clamp(1, 4096);
+    let strands: u64 = baked
+        .bundles
+        .iter()
+        .map(|b| strands_in_bundle(b, &style, per_bundle) as u64)
+        .sum();
+    scenes.push(Scene {
+        name: format!("{}K strands", strands.div_ceil(1000)),
+        renderer: head(per_bundle)?,
+        camera: at(1.0),
+        lod: false,
+    });
+    Ok(scenes)
+}
+
+fn crowd_scene(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Scene> {
+    let meshes = super::CROWD_MESHES
+        .iter()
+        .map(|m| load_mesh(std::path::Path::new(m), None))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut r = Renderer::new(ctx, &RendererDesc::default().size(a.size.0, a.size.1))?;
+    let side = (a.crowd as f32).sqrt().ceil() as usize;
+    let params = StrandParams {
+        strands_per_bundle: 16,
+        verts_log2: 4,
+    };
+    for i in 0..a.crowd {
+        let (baked, style) = &meshes[i % meshes.len()];
+        r.add_character(baked, style, params, super::crowd_model(i, side, baked))?;
+    }
+    Ok(Scene {
+        name: format!("crowd of {}", a.crowd),
+        renderer: r,
+        camera: Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0),
+        lod: true,
+    })
+}
+
+/// Run the comparison and print the table.
+pub fn bench_raster(a: RasterArgs) -> Result<()> {
+    if a.crowd == 0 || a.crowd > 1024 {
+        bail!("--crowd: 1..=1024 characters");
+    }
+    let ctx = Arc::new(Context::new(&ContextDesc::default().device(a.device.clone()))?);
+    let (w, h) = a.size;
+    outln!(
+        "bench raster: {} ({}), {w}x{h}, median GPU ms of {} frames; soft and auto keep {} fragments per pixel and composite like oit:8",
+        ctx.info.name,
+        ctx.info.driver,
+        a.runs,
+        hairmesh::render::soft::DEFAULT_SOFT_K
+    )?;
+    let mut scenes = head_scenes(&ctx, &a)?;
+    scenes.push(crowd_scene(&ctx, &a)?);
+    scenes.retain(|s| a.scenes.is_empty() || a.scenes.iter().any(|n| s.name.starts_with(n)));
+    if !scenes.first().is_some_and(|s| s.renderer.has_software_raster()) {
+        bail!("{}: no software rasterizer (needs 64-bit atomics)", ctx.info.name);
+    }
+    outln!(
+        "| scene | path | strands | hw opaque | hw oit | soft | auto | soft / hw oit | soft / hw opaque | auto / hw oit | segments (soft) |"
+    )?;
+    outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
+    let oit = Transparency::KBuffer { budget: 8 };
+    let soft = StrandRaster::Software { k: 8 };
+    let auto = StrandRaster::Auto { k: 8 };
+    for s in &mut scenes {
+        let mut paths = vec![RenderPath::Compute];
+        if s.renderer.has_mesh_path() {
+            paths.insert(0, RenderPath::Mesh);
+        }
+        let opaque_view = super::bench_view(s.camera, s.lod);
+        let oit_view = View {
+            transparency: oit,
+            ..opaque_view
+        };
+        for path in paths {
+            let opts = |raster| FrameOptions {
+                path: Some(path),
+                raster,
+                ..Default::default()
+            };
+            let r = &mut s.renderer;
+            let (hw_opaque, stats) = time(r, &opaque_view, opts(StrandRaster::Hardware), a.runs)?;
+            let (hw_oit, _) = time(r, &oit_view, opts(StrandRaster::Hardware), a.runs)?;
+            let (sw, soft_stats) = time(r, &oit_view, opts(soft), a.runs)?;
+            let (au, _) = time(r, &oit_view, opts(auto), a.runs)?;
+            let dropped = soft_stats.segments_written < soft_stats.segments_demanded
+                || soft_stats.tile_entries_written < soft_stats.tile_entries_demanded;
+            outln!(
+                "| {} | {path:?} | {} | {hw_opaque:.2} | {hw_oit:.2} | {sw:.2} | {au:.2} | {:.2} | {:.2} | {:.2} | {}{} |",
+                s.name,
+                stats.strands_drawn,
+                sw / hw_oit,
+                sw / hw_opaque,
+                au / hw_oit,
+                soft_stats.segments_written,
+                if dropped { " (overflow)" } else { "" }
+            )?;
+        }
+    }
+    Ok(())
+}
