@@ -26,6 +26,12 @@ shared float s_depth[TILE_PIXELS];
 void insert(uint lp, uint k, float z, vec3 c, float alpha) {
     uint64_t v = (uint64_t(floatBitsToUint(z)) << 32) | uint64_t(pack_fragment(c, alpha));
     for (uint i = 0u; i < k; i++) {
+        // A plain read first: nodes only ever get nearer, so a node already nearer than v
+        // stays so, and the atomic (a compare-and-swap loop on some GPUs, slow where hundreds
+        // of fragments meet in one pixel) is spent only where v displaces something.
+        if (v >= s_nodes[lp * SOFT_MAX_K + i]) {
+            continue;
+        }
         uint64_t old = atomicMin(s_nodes[lp * SOFT_MAX_K + i], v);
         if (old == OIT_EMPTY) {
             return;
@@ -114,35 +120,40 @@ void main() {
     if (!inside) {
         return;
     }
-    // Merge the tile's sorted list with the k-buffer's (both nearest first): the nearest
-    // frame.transparency.y stay nodes, the others join the tail.
+    // Insert the tile's fragments into the k-buffer's sorted list (the pixel is this
+    // thread's alone now): the nearest frame.transparency.y stay nodes, the others join the
+    // tail.
     uint kg = frame.transparency.y;
-    uint64_t global_nodes[MAX_OIT_BUDGET];
-    for (uint i = 0u; i < kg; i++) {
-        global_nodes[i] = oit_nodes[p * kg + i];
-    }
-    uvec4 tail = oit_tail[p] + uvec4(s_tail[lp * 4u], s_tail[lp * 4u + 1u], s_tail[lp * 4u + 2u], s_tail[lp * 4u + 3u]);
-    uint gi = 0u;
-    uint si = 0u;
-    for (uint o = 0u; o < kg + k; o++) {
-        uint64_t g = gi < kg ? global_nodes[gi] : OIT_EMPTY;
-        uint64_t s = si < k ? s_nodes[lp * SOFT_MAX_K + si] : OIT_EMPTY;
-        if (g == OIT_EMPTY && s == OIT_EMPTY) {
+    uvec4 tail = uvec4(s_tail[lp * 4u], s_tail[lp * 4u + 1u], s_tail[lp * 4u + 2u], s_tail[lp * 4u + 3u]);
+    uint start = 0u;
+    for (uint j = 0u; j < k; j++) {
+        uint64_t v = s_nodes[lp * SOFT_MAX_K + j];
+        if (v == OIT_EMPTY) {
             break;
         }
-        uint64_t take = min(g, s);
-        if (s < g) {
-            si++;
-        } else {
-            gi++;
+        // Nodes before `start` are nearer than this fragment (both lists are sorted); the
+        // fragment lands at the first farther node, which moves on down the list.
+        bool placed = false;
+        for (uint i = start; i < kg && v != OIT_EMPTY; i++) {
+            uint64_t old = oit_nodes[p * kg + i];
+            if (v < old) {
+                oit_nodes[p * kg + i] = v;
+                v = old;
+                if (!placed) {
+                    start = i + 1u;
+                    placed = true;
+                }
+            } else if (!placed) {
+                start = i + 1u;
+            }
         }
-        if (o < kg) {
-            oit_nodes[p * kg + o] = take;
-        } else {
-            vec4 f = unpack_fragment(uint(take & 0xFFFFFFFFul));
+        if (v != OIT_EMPTY) {
+            vec4 f = unpack_fragment(uint(v & 0xFFFFFFFFul));
             float tau = optical_depth(f.a);
             tail += uvec4(round(vec4(f.rgb * tau, tau) * OIT_FIXED));
         }
     }
-    oit_tail[p] = tail;
+    if (any(notEqual(tail, uvec4(0u)))) {
+        oit_tail[p] += tail;
+    }
 }

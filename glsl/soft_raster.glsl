@@ -58,11 +58,64 @@ vec2 clip_param(vec2 a, vec2 b, int axis, float lo, float hi) {
     return vec2(max(min(t0, t1), 0.0), min(max(t0, t1), 1.0));
 }
 
+// Length of the segment a -> b (unit direction d, length len) offset by v along its normal n,
+// inside the unit pixel square with corner `pmin` (Liang-Barsky slab clipping).
+float chord_in_pixel(vec2 a, vec2 d, vec2 n, float len, float v, vec2 pmin) {
+    vec2 c = a + v * n;
+    float lo = 0.0;
+    float hi = len;
+    for (int axis = 0; axis < 2; axis++) {
+        float da = d[axis];
+        float p0 = pmin[axis] - c[axis];
+        if (abs(da) < 1e-12) {
+            if (p0 > 0.0 || p0 + 1.0 < 0.0) {
+                return 0.0;
+            }
+        } else {
+            float t0 = p0 / da;
+            float t1 = (p0 + 1.0) / da;
+            lo = max(lo, min(t0, t1));
+            hi = min(hi, max(t0, t1));
+        }
+    }
+    return max(hi - lo, 0.0);
+}
+
+// Strands drawn at most this wide (pixels) take the line-sampled coverage below.
+#define SOFT_THIN_WIDTH 2.0
+
 // Area of the unit pixel square with corner `pmin` covered by the rectangle of half-width
 // `h` around the segment a -> b (no end caps, so consecutive segments of a straight strand
-// tile it exactly): the square in the segment's frame, clipped by the four sides
-// (Sutherland-Hodgman), then the shoelace formula.
+// tile it exactly). Thin strands (2h <= SOFT_THIN_WIDTH): the rectangle as n = ceil(4h)
+// lines across its width, 2h / n each, every line clipped to the pixel (the midpoint rule
+// across, exact along; summed over the pixels it gives exactly the rectangle's area, and
+// n = 1 is the box-filtered centre line). Thicker strands: the exact area, see
+// pixel_coverage_exact.
+float pixel_coverage_exact(vec2 a, vec2 b, float h, vec2 pmin);
+
 float pixel_coverage(vec2 a, vec2 b, float h, vec2 pmin) {
+    if (2.0 * h > SOFT_THIN_WIDTH) {
+        return pixel_coverage_exact(a, b, h, pmin);
+    }
+    vec2 d = b - a;
+    float len = length(d);
+    if (len < 1e-9) {
+        return 0.0;
+    }
+    d /= len;
+    vec2 n = vec2(-d.y, d.x);
+    int lines = max(int(ceil(4.0 * h)), 1);
+    float step = 2.0 * h / float(lines);
+    float sum = 0.0;
+    for (int i = 0; i < lines; i++) {
+        sum += chord_in_pixel(a, d, n, len, -h + (float(i) + 0.5) * step, pmin);
+    }
+    return min(sum * step, 1.0);
+}
+
+// The exact area for thick strands: the square in the segment's frame, clipped by the four
+// sides of the rectangle (Sutherland-Hodgman), then the shoelace formula.
+float pixel_coverage_exact(vec2 a, vec2 b, float h, vec2 pmin) {
     vec2 d = b - a;
     float len = length(d);
     if (len < 1e-9) {

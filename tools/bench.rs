@@ -137,6 +137,9 @@ enum Cmd {
         /// Only the scenes whose names start with these (head, crowd, or the strand count).
         #[arg(long, value_delimiter = ',')]
         scenes: Vec<String>,
+        /// auto: strands drawn at most this many pixels wide go to the software rasterizer.
+        #[arg(long, default_value_t = hairmesh::render::soft::AUTO_SPLIT_PIXELS)]
+        auto_split: f32,
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
@@ -544,8 +547,10 @@ fn run(args: Args) -> Result<()> {
             crowd,
             strands,
             scenes,
+            auto_split,
             device,
         } => raster::bench_raster(raster::RasterArgs {
+            auto_split,
             size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
             runs: runs as usize,
             crowd,

@@ -163,6 +163,12 @@ impl Renderer {
         soft_budget
             .validate(range)
             .map_err(GpuError::Unsupported)?;
+        if !(desc.auto_split_pixels > 0.0 && desc.auto_split_pixels.is_finite()) {
+            return Err(GpuError::Unsupported(format!(
+                "auto split width {} pixels must be finite and positive",
+                desc.auto_split_pixels
+            )));
+        }
         let crowd = Crowd::new(ctx, desc.max_characters)?;
         let bindings: Vec<BindingDesc> = FrameBinding::ALL
             .iter()
@@ -657,7 +663,13 @@ impl Renderer {
                 Transparency::Opaque => 1.0,
                 _ => super::transparency::STRAND_OPACITY,
             };
-            super::soft::frame_fields(&mut block, raster, self.soft_budget, opacity);
+            super::soft::frame_fields(
+                &mut block,
+                raster,
+                self.soft_budget,
+                opacity,
+                self.desc.auto_split_pixels,
+            );
         }
         let light = self.light_view(view, &block);
         if let Some(l) = &light {

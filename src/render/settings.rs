@@ -49,6 +49,9 @@ pub struct RendererDesc {
     /// The software rasterizer's segment and tile-entry budgets (`None`: the most the
     /// device allows, `SoftBudget::for_range`).
     pub soft_budget: Option<super::soft::SoftBudget>,
+    /// `StrandRaster::Auto`: bundles whose strands are drawn at most this many pixels wide
+    /// go to the software rasterizer (finite, > 0).
+    pub auto_split_pixels: f32,
 }
 
 impl Default for RendererDesc {
@@ -63,6 +66,7 @@ impl Default for RendererDesc {
             msaa: 1,
             shadow_resolution: super::shadow::DEFAULT_SHADOW_RESOLUTION,
             soft_budget: None,
+            auto_split_pixels: super::soft::AUTO_SPLIT_PIXELS,
         }
     }
 }

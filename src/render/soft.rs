@@ -38,7 +38,7 @@ use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
 /// Default number of fragments per pixel the software rasterizer keeps sorted.
 pub const DEFAULT_SOFT_K: u32 = 8;
 /// [`StrandRaster::Auto`]: bundles whose strands are drawn at most this many pixels wide go
-/// to the software rasterizer.
+/// to the software rasterizer (default of `RendererDesc::auto_split_pixels`).
 pub const AUTO_SPLIT_PIXELS: f32 = 1.5;
 
 /// How strands are rasterized, chosen per frame.
@@ -189,6 +189,7 @@ pub fn frame_fields(
     raster: StrandRaster,
     budget: SoftBudget,
     opacity: f32,
+    auto_split_pixels: f32,
 ) {
     let (w, h) = (block.viewport[0] as u32, block.viewport[1] as u32);
     let (tx, ty) = tile_grid(w, h);
@@ -198,7 +199,7 @@ pub fn frame_fields(
         budget.segments,
         budget.tile_entries,
     ];
-    block.soft_params = [AUTO_SPLIT_PIXELS, opacity, tx as f32, ty as f32];
+    block.soft_params = [auto_split_pixels, opacity, tx as f32, ty as f32];
 }
 
 /// The software rasterizer's buffers, allocated on first use and grown with the target.

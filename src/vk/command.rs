@@ -320,6 +320,19 @@ impl CommandRecorder<'_> {
         self.begin(&info, area);
     }
 
+    /// Begin dynamic rendering with no attachments over `width x height` (draws whose shaders
+    /// only write buffers, such as the software rasterizer's mesh-shader segment pass).
+    pub fn begin_rendering_empty(&mut self, width: u32, height: u32) {
+        let area = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D { width, height },
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1);
+        self.begin(&info, area);
+    }
+
     /// Begin rendering as `info` says, with viewport and scissor covering `area`.
     fn begin(&mut self, info: &vk::RenderingInfo, area: vk::Rect2D) {
         let viewport = vk::Viewport {

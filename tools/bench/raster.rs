@@ -32,6 +32,8 @@ pub struct RasterArgs {
     pub device: Option<String>,
     /// Only these scenes (names as printed); empty: all.
     pub scenes: Vec<String>,
+    /// `auto`: strands drawn at most this many pixels wide go to software.
+    pub auto_split: f32,
 }
 
 struct Scene {
@@ -41,19 +43,31 @@ struct Scene {
     lod: bool,
 }
 
-/// Median GPU ms of `runs` frames after one warm-up, and the warm-up's statistics.
+fn desc(a: &RasterArgs) -> RendererDesc {
+    RendererDesc {
+        auto_split_pixels: a.auto_split,
+        ..RendererDesc::default().size(a.size.0, a.size.1)
+    }
+}
+
+/// Median GPU ms of `runs` frames after one warm-up, the warm-up's statistics and the
+/// median ms of each pass.
 fn time(
     r: &mut Renderer,
     view: &View,
     opts: FrameOptions,
     runs: usize,
-) -> Result<(f64, hairmesh::render::FrameStats)> {
+) -> Result<(f64, hairmesh::render::FrameStats, String)> {
     let first = r.render_one(view, &opts)?;
-    let mut ms = Vec::with_capacity(runs);
-    for _ in 0..runs {
-        ms.push(r.render_one(view, &opts)?.gpu_ms());
-    }
-    Ok((super::median(ms), first.stats))
+    let reports = (0..runs)
+        .map(|_| r.render_one(view, &opts))
+        .collect::<Result<Vec<_>, _>>()?;
+    let passes: Vec<String> = super::median_passes(&first, &reports)
+        .iter()
+        .map(|(n, ms)| format!("{n} {ms:.2}"))
+        .collect();
+    let ms = super::median(reports.iter().map(|r| r.gpu_ms()).collect());
+    Ok((ms, first.stats, passes.join(", ")))
 }
 
 fn head_scenes(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Vec<Scene>> {
@@ -69,7 +83,7 @@ fn head_scenes(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Vec<Scene>> {
         )
     };
     let head = |strands_per_bundle: u32| -> Result<Renderer> {
-        let mut r = Renderer::new(ctx, &RendererDesc::default().size(a.size.0, a.size.1))?;
+        let mut r = Renderer::new(ctx, &desc(a))?;
         r.add_character(
             &baked,
             &style,
@@ -111,7 +125,7 @@ fn crowd_scene(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Scene> {
         .iter()
         .map(|m| load_mesh(std::path::Path::new(m), None))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut r = Renderer::new(ctx, &RendererDesc::default().size(a.size.0, a.size.1))?;
+    let mut r = Renderer::new(ctx, &desc(a))?;
     let side = (a.crowd as f32).sqrt().ceil() as usize;
     let params = StrandParams {
         strands_per_bundle: 16,
@@ -137,11 +151,12 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
     let ctx = Arc::new(Context::new(&ContextDesc::default().device(a.device.clone()))?);
     let (w, h) = a.size;
     outln!(
-        "bench raster: {} ({}), {w}x{h}, median GPU ms of {} frames; soft and auto keep {} fragments per pixel and composite like oit:8",
+        "bench raster: {} ({}), {w}x{h}, median GPU ms of {} frames; soft and auto keep {} fragments per pixel and composite like oit:8; auto sends strands drawn at most {} px wide to software",
         ctx.info.name,
         ctx.info.driver,
         a.runs,
-        hairmesh::render::soft::DEFAULT_SOFT_K
+        hairmesh::render::soft::DEFAULT_SOFT_K,
+        a.auto_split
     )?;
     let mut scenes = head_scenes(&ctx, &a)?;
     scenes.push(crowd_scene(&ctx, &a)?);
@@ -153,6 +168,7 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
         "| scene | path | strands | hw opaque | hw oit | soft | auto | soft / hw oit | soft / hw opaque | auto / hw oit | segments (soft) |"
     )?;
     outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
+    let mut pass_lines = Vec::new();
     let oit = Transparency::KBuffer { budget: 8 };
     let soft = StrandRaster::Software { k: 8 };
     let auto = StrandRaster::Auto { k: 8 };
@@ -173,10 +189,15 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
                 ..Default::default()
             };
             let r = &mut s.renderer;
-            let (hw_opaque, stats) = time(r, &opaque_view, opts(StrandRaster::Hardware), a.runs)?;
-            let (hw_oit, _) = time(r, &oit_view, opts(StrandRaster::Hardware), a.runs)?;
-            let (sw, soft_stats) = time(r, &oit_view, opts(soft), a.runs)?;
-            let (au, _) = time(r, &oit_view, opts(auto), a.runs)?;
+            let (hw_opaque, stats, _) =
+                time(r, &opaque_view, opts(StrandRaster::Hardware), a.runs)?;
+            let (hw_oit, _, hw_passes) = time(r, &oit_view, opts(StrandRaster::Hardware), a.runs)?;
+            let (sw, soft_stats, soft_passes) = time(r, &oit_view, opts(soft), a.runs)?;
+            let (au, _, _) = time(r, &oit_view, opts(auto), a.runs)?;
+            pass_lines.push(format!(
+                "| {} | {path:?} | {hw_passes} | {soft_passes} |",
+                s.name
+            ));
             let dropped = soft_stats.segments_written < soft_stats.segments_demanded
                 || soft_stats.tile_entries_written < soft_stats.tile_entries_demanded;
             outln!(
@@ -190,6 +211,12 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
                 if dropped { " (overflow)" } else { "" }
             )?;
         }
+    }
+    outln!("\nMedian GPU ms per pass, hardware with oit and software:")?;
+    outln!("| scene | path | hw oit passes | soft passes |")?;
+    outln!("|---|---|---|---|")?;
+    for l in pass_lines {
+        outln!("{l}")?;
     }
     Ok(())
 }

@@ -115,12 +115,6 @@ impl DrawTarget {
         }
     }
 
-    /// Whether this target is drawn from the camera with strands that may go to the software
-    /// rasterizer (the mesh shader then appends their segments, `soft_segments.glsl`).
-    pub fn camera_view(&self) -> bool {
-        matches!(self, DrawTarget::Camera(_) | DrawTarget::OitInsert(_))
-    }
-
     /// The fragment shader strands drawn into this target use (`None`: depth only).
     pub fn strand_fragment_shader(&self) -> Option<&'static str> {
         match self {
@@ -278,7 +272,7 @@ impl FramePasses {
             strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
             soft: if ctx.info.int64_atomics {
-                Some(soft_raster::SoftRasterPass::new(ctx, layout)?)
+                Some(soft_raster::SoftRasterPass::new(ctx, layout, task_bundles)?)
             } else {
                 None
             },
@@ -452,6 +446,9 @@ impl FramePasses {
                 crate::vk::GpuError::Unsupported("no software rasterizer on this device".into())
             })?;
             let size = targets.size();
+            if mesh {
+                pass.record_mesh_segments(rec, profiler, inp.sets, inp.bundles, size)?;
+            }
             let draw = soft_raster::SoftDraw {
                 sets: inp.sets,
                 args: inp.args,

@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 
-use super::{PassSets, shader_options};
+use super::{PassSets, dispatch_2d, shader_options};
 use crate::render::shared::GenerateArgs;
 use crate::render::soft::{SoftBuffers, tile_grid};
 use crate::render::targets::RenderTargets;
@@ -34,6 +34,10 @@ pub struct SoftDraw<'a> {
 
 /// The pipelines of the software rasterizer.
 pub struct SoftRasterPass {
+    /// Mesh path: task + mesh shaders (`SOFT_PASS`) that build the software bundles' strands
+    /// and append their segments, drawing nothing.
+    mesh_segments: Option<Pipeline>,
+    task_bundles: u32,
     bin_args: Pipeline,
     count: Pipeline,
     scan: Pipeline,
@@ -42,9 +46,32 @@ pub struct SoftRasterPass {
 }
 
 impl SoftRasterPass {
-    /// Compile the pipelines (the raster needs 64-bit shared atomics: compiled here, created
-    /// only on devices that have them, see [`Self::new`]'s caller).
-    pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
+    /// Compile the pipelines (the raster needs 64-bit shared atomics: the caller creates this
+    /// pass only on devices that have them); the mesh-path segment pass where the mesh path
+    /// is supported, with `task_bundles` bundles per task workgroup.
+    pub fn new(
+        ctx: &Arc<Context>,
+        layout: &Arc<PipelineLayout>,
+        task_bundles: u32,
+    ) -> GpuResult<Self> {
+        let mesh_segments = if super::strands::mesh_path_supported(ctx) {
+            let opts = shader_options(task_bundles).define("SOFT_PASS", 1);
+            let (task, mesh) = (
+                compile("strands.task", &opts)?,
+                compile("strands.mesh", &opts)?,
+            );
+            let desc = crate::vk::GraphicsDesc::new(
+                "soft segments (mesh)",
+                ash::vk::Format::UNDEFINED,
+                ash::vk::Format::UNDEFINED,
+            )
+            .depth(crate::vk::DepthMode::Off)
+            .stage(ash::vk::ShaderStageFlags::TASK_EXT, &task)
+            .stage(ash::vk::ShaderStageFlags::MESH_EXT, &mesh);
+            Some(Pipeline::graphics(ctx, layout, &desc)?)
+        } else {
+            None
+        };
         let opts = shader_options(1);
         let p = |name: &str, file: &str, scatter: bool| {
             let o = if scatter {
@@ -55,12 +82,41 @@ impl SoftRasterPass {
             Pipeline::compute(ctx, name, layout, &compile(file, &o)?)
         };
         Ok(SoftRasterPass {
+            mesh_segments,
+            task_bundles,
             bin_args: p("soft bin args", "soft_bin_args.comp", false)?,
             count: p("soft bin count", "soft_bin.comp", false)?,
             scan: p("soft tile scan", "soft_tile_scan.comp", false)?,
             scatter: p("soft bin scatter", "soft_bin.comp", true)?,
             raster: p("soft raster", "soft_raster.comp", false)?,
         })
+    }
+
+    /// Mesh path: build the software bundles of `bundles` bundles in task and mesh shaders and
+    /// append their segments (compute generation appends them in `generate.comp`).
+    pub fn record_mesh_segments(
+        &self,
+        rec: &mut CommandRecorder,
+        profiler: &mut Profiler,
+        sets: PassSets,
+        bundles: u32,
+        size: (u32, u32),
+    ) -> GpuResult<()> {
+        let p = self.mesh_segments.as_ref().ok_or_else(|| {
+            crate::vk::GpuError::Unsupported("no usable VK_EXT_mesh_shader".into())
+        })?;
+        profiler.begin(rec, "soft segments");
+        rec.barrier(
+            &[Access::TransferWrite, Access::ComputeReadWrite],
+            &[Access::TaskReadWrite, Access::MeshReadWrite],
+        );
+        rec.begin_rendering_empty(size.0, size.1);
+        rec.bind(p, &sets.both());
+        let (x, y) = dispatch_2d(bundles.div_ceil(self.task_bundles));
+        let result = rec.draw_mesh_tasks(x, y, 1);
+        rec.end_rendering();
+        profiler.end(rec);
+        result
     }
 
     /// Record the binning and raster of the segments generation appended this frame. The

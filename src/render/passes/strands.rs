@@ -73,14 +73,9 @@ impl StrandDraw {
                 .stage(vk::ShaderStageFlags::VERTEX, &v),
         )?;
         let mesh = if mesh_path_supported(ctx) {
-            let mesh_opts = if target.camera_view() {
-                opts.clone().define("SOFT_RASTER", 1)
-            } else {
-                opts.clone()
-            };
             let (t, m) = (
                 compile("strands.task", &opts)?,
-                compile("strands.mesh", &mesh_opts)?,
+                compile("strands.mesh", &opts)?,
             );
             Some(Pipeline::graphics(
                 ctx,
