@@ -1,6 +1,6 @@
 // Software rasterizer: what the binning (soft_bin.comp) and raster (soft_raster.comp) passes
 // share: the segment buffers, decoding a SoftSegment, the footprint walk and the exact pixel
-// coverage. CPU twin of the coverage: src/render/soft_coverage.rs. Requires bindings.glsl.
+// coverage. CPU twin of the coverage: src/render/soft.rs (pixel_coverage). Requires bindings.glsl.
 #ifndef SOFT_RASTER_GLSL
 #define SOFT_RASTER_GLSL
 #include "fragment_pack.glsl"
@@ -68,7 +68,9 @@ float chord_in_pixel(vec2 a, vec2 d, vec2 n, float len, float v, vec2 pmin) {
         float da = d[axis];
         float p0 = pmin[axis] - c[axis];
         if (abs(da) < 1e-12) {
-            if (p0 > 0.0 || p0 + 1.0 < 0.0) {
+            // Parallel to this axis: inside when pmin <= c < pmin + 1 (half-open, so a line
+            // on a pixel edge counts once).
+            if (p0 > 0.0 || p0 + 1.0 <= 0.0) {
                 return 0.0;
             }
         } else {
@@ -81,8 +83,9 @@ float chord_in_pixel(vec2 a, vec2 d, vec2 n, float len, float v, vec2 pmin) {
     return max(hi - lo, 0.0);
 }
 
-// Strands drawn at most this wide (pixels) take the line-sampled coverage below.
-#define SOFT_THIN_WIDTH 2.0
+// Strands drawn at most this wide (pixels) take the line-sampled coverage below (up to 0.7 the
+// samples of one pixel never add up past 1). CPU twin: THIN_WIDTH.
+#define SOFT_THIN_WIDTH 0.7
 
 // Area of the unit pixel square with corner `pmin` covered by the rectangle of half-width
 // `h` around the segment a -> b (no end caps, so consecutive segments of a straight strand

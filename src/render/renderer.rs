@@ -805,6 +805,98 @@ impl Renderer {
         Ok(budget)
     }
 
+    /// Draw `segments` (screen space and shaded, as generation appends them) with the
+    /// software rasterizer alone, over a black image with nothing in front, keeping `k`
+    /// fragments per pixel sorted, each with opacity `opacity` times its coverage; returns
+    /// the image (RGBA8, sRGB). Waits for the frames in flight. For tests and tools that
+    /// check the rasterizer apart from generation (single-sample targets only).
+    pub fn rasterize_segments(
+        &mut self,
+        segments: &[super::shared::SoftSegment],
+        k: u32,
+        opacity: f32,
+    ) -> GpuResult<Vec<u8>> {
+        let raster = StrandRaster::Software { k };
+        let kbuffer = Transparency::KBuffer { budget: k };
+        self.check_raster(raster, RenderPath::Compute, kbuffer)?;
+        if segments.is_empty() || segments.len() as u64 > self.soft_budget.segments as u64 {
+            return Err(GpuError::Unsupported(format!(
+                "rasterize_segments: 1..={} segments",
+                self.soft_budget.segments
+            )));
+        }
+        if !(0.0..=1.0).contains(&opacity) {
+            return Err(GpuError::Unsupported(format!(
+                "rasterize_segments: opacity {opacity} outside 0..=1"
+            )));
+        }
+        self.finish()?;
+        let i = self.next;
+        let (width, height) = self.targets.size();
+        self.passes.prepare_transparency(kbuffer)?;
+        // Nothing is in flight: replaced buffers can go now.
+        drop(self.transparency.ensure(kbuffer, width, height)?);
+        drop(self.soft.ensure(self.soft_budget, width, height)?);
+        self.prepare_workspace(i, RenderPath::Mesh)?;
+        let mut block: super::shared::FrameBlock = bytemuck::Zeroable::zeroed();
+        block.viewport = [
+            width as f32,
+            height as f32,
+            1.0 / width as f32,
+            1.0 / height as f32,
+        ];
+        block.transparency = kbuffer.frame_fields(1);
+        let split = self.desc.auto_split_pixels;
+        super::soft::frame_fields(&mut block, raster, self.soft_budget, opacity, split);
+        self.frames[i].frame_ubo.write(0, bytemuck::bytes_of(&block))?;
+        let upload = Buffer::with_data(
+            &self.ctx,
+            "soft segments upload",
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            bytemuck::cast_slice(segments),
+        )?;
+        let bytes = width as u64 * height as u64 * 4;
+        let mut readback = Buffer::new(
+            &self.ctx,
+            &BufferDesc::new("image readback", bytes, vk::BufferUsageFlags::TRANSFER_DST)
+                .readback(),
+        )?;
+        let ctx = self.ctx.clone();
+        let slot = &mut self.frames[i];
+        let (passes, targets) = (&self.passes, &mut self.targets);
+        let sets = PassSets {
+            frame: &slot.set,
+            textures: self.crowd.texture_set(),
+        };
+        let result = ctx.submit_and_wait(|rec| {
+            slot.profiler.reset(rec);
+            rec.barrier(
+                &[Access::ComputeReadWrite, Access::FragmentReadWrite],
+                &[Access::TransferWrite],
+            );
+            rec.copy_buffer(&upload, 0, &self.soft.segments, 0, upload.size);
+            let counts = (segments.len() as u32, k);
+            let r = passes.record_soft_only(
+                rec,
+                &mut slot.profiler,
+                sets,
+                &self.work.args,
+                &self.soft,
+                &self.transparency,
+                targets,
+                counts,
+            );
+            let output = targets.output();
+            rec.image_barrier(output, Access::ColorAttachment, Access::TransferRead);
+            rec.copy_image_to_buffer(output, &readback);
+            targets.set_output_access(Access::TransferRead);
+            rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
+            r
+        });
+        result??;
+        readback.read()
+    }
+
     /// Record frame slot `i`: the passes, then the statistics and (optionally) image readback.
     fn record(
         &mut self,

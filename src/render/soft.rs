@@ -31,6 +31,7 @@
 use std::sync::Arc;
 
 use ash::vk;
+use glam::Vec2;
 
 use super::shared::{FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
@@ -300,5 +301,203 @@ mod tests {
         assert_eq!(b.segments, 4 << 20);
         assert!(b.validate(128 << 20).is_ok());
         assert!(b.validate(64 << 20).is_err());
+    }
+}
+
+/// Length of the segment from `a` along unit `d` for `len`, offset by `v` along its normal
+/// `n`, inside the unit pixel square with corner `pmin` (CPU twin of `chord_in_pixel`).
+fn chord_in_pixel(a: Vec2, d: Vec2, n: Vec2, len: f32, v: f32, pmin: Vec2) -> f32 {
+    let c = a + v * n;
+    let (mut lo, mut hi) = (0.0f32, len);
+    for axis in 0..2 {
+        let da = d[axis];
+        let p0 = pmin[axis] - c[axis];
+        if da.abs() < 1e-12 {
+            if p0 > 0.0 || p0 + 1.0 <= 0.0 {
+                return 0.0;
+            }
+        } else {
+            let (t0, t1) = (p0 / da, (p0 + 1.0) / da);
+            lo = lo.max(t0.min(t1));
+            hi = hi.min(t0.max(t1));
+        }
+    }
+    (hi - lo).max(0.0)
+}
+
+/// Strands drawn at most this wide (pixels) take the line-sampled coverage
+/// (`SOFT_THIN_WIDTH` of `soft_raster.glsl`): up to 0.7 the samples of one pixel never add up
+/// past 1, so the sum over pixels is the strand's area.
+pub const THIN_WIDTH: f32 = 0.7;
+
+/// Share of the unit pixel square with corner `pmin` covered by the rectangle of half-width
+/// `h` around the segment `a -> b`: CPU twin of `pixel_coverage` in `soft_raster.glsl`
+/// (`ceil(4h)` lines across the width for thin strands, the exact clipped area for thicker
+/// ones).
+pub fn pixel_coverage(a: Vec2, b: Vec2, h: f32, pmin: Vec2) -> f32 {
+    let len = (b - a).length();
+    if len < 1e-9 {
+        return 0.0;
+    }
+    let d = (b - a) / len;
+    let n = Vec2::new(-d.y, d.x);
+    if 2.0 * h > THIN_WIDTH {
+        return exact_coverage(a, d, n, len, h, pmin);
+    }
+    let lines = ((4.0 * h).ceil() as i32).max(1);
+    let step = 2.0 * h / lines as f32;
+    let sum: f32 = (0..lines)
+        .map(|i| chord_in_pixel(a, d, n, len, -h + (i as f32 + 0.5) * step, pmin))
+        .sum();
+    (sum * step).min(1.0)
+}
+
+/// The pixel square in the segment's frame, clipped to `[0, len] x [-h, h]`, its area.
+fn exact_coverage(a: Vec2, d: Vec2, n: Vec2, len: f32, h: f32, pmin: Vec2) -> f32 {
+    let mut poly: Vec<Vec2> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        .iter()
+        .map(|&(x, y)| {
+            let q = pmin + Vec2::new(x, y) - a;
+            Vec2::new(q.dot(d), q.dot(n))
+        })
+        .collect();
+    for (axis, bound, sign) in [(0, len, 1.0), (0, 0.0, -1.0), (1, h, 1.0), (1, -h, -1.0)] {
+        let f = |p: Vec2| sign * (p[axis] - bound);
+        let mut out = Vec::with_capacity(8);
+        for i in 0..poly.len() {
+            let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+            let (fp, fq) = (f(p), f(q));
+            if fp <= 0.0 {
+                out.push(p);
+            }
+            if (fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0) {
+                out.push(p + (q - p) * (fp / (fp - fq)));
+            }
+        }
+        poly = out;
+        if poly.len() < 3 {
+            return 0.0;
+        }
+    }
+    let area: f32 = (0..poly.len())
+        .map(|i| poly[i].perp_dot(poly[(i + 1) % poly.len()]))
+        .sum();
+    (0.5 * area.abs()).min(1.0)
+}
+
+#[cfg(test)]
+mod coverage_tests {
+    use super::*;
+
+    /// Total coverage of a straight strand of `segments` equal segments from `a` to `b`.
+    fn total(a: Vec2, b: Vec2, h: f32, segments: usize) -> f64 {
+        let mut sum = 0.0f64;
+        for s in 0..segments {
+            let p = a + (b - a) * (s as f32 / segments as f32);
+            let q = a + (b - a) * ((s + 1) as f32 / segments as f32);
+            let lo = p.min(q) - Vec2::splat(h + 1.0);
+            let hi = p.max(q) + Vec2::splat(h + 1.0);
+            for y in lo.y.floor() as i32..=hi.y.floor() as i32 {
+                for x in lo.x.floor() as i32..=hi.x.floor() as i32 {
+                    sum += pixel_coverage(p, q, h, Vec2::new(x as f32, y as f32)) as f64;
+                }
+            }
+        }
+        sum
+    }
+
+    /// The check on the CPU twin: widths below and above a pixel, several angles
+    /// and sub-pixel offsets.
+    #[test]
+    fn a_straight_strand_deposits_its_area() {
+        for width in [0.2f32, 0.5, 0.9, 1.5, 3.0] {
+            for degrees in [0.0f32, 7.0, 30.0, 45.0, 61.0, 90.0] {
+                for offset in [0.0f32, 0.3, 0.71] {
+                    let dir = Vec2::from_angle(degrees.to_radians());
+                    let a = Vec2::new(20.0 + offset, 15.0 + offset * 0.5);
+                    let b = a + dir * 100.0;
+                    let area = width as f64 * 100.0;
+                    let got = total(a, b, 0.5 * width, 23);
+                    let tolerance = 1e-3;
+                    assert!(
+                        (got - area).abs() < tolerance * area,
+                        "width {width}, {degrees} deg, offset {offset}: {got} vs {area}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn coverage_is_a_share_of_the_pixel() {
+        let a = Vec2::new(0.5, -3.0);
+        let b = Vec2::new(0.5, 5.0);
+        // A vertical strand through the pixel centre, 0.4 wide: 0.4 of the pixel.
+        let c = pixel_coverage(a, b, 0.2, Vec2::ZERO);
+        assert!((c - 0.4).abs() < 1e-5, "{c}");
+        // Wide strands cover whole pixels, exactly.
+        assert!((pixel_coverage(a, b, 4.0, Vec2::ZERO) - 1.0).abs() < 1e-6);
+        assert_eq!(pixel_coverage(a, b, 0.2, Vec2::new(3.0, 0.0)), 0.0);
+        assert_eq!(pixel_coverage(a, a, 0.2, Vec2::ZERO), 0.0);
+    }
+}
+
+/// IEEE half-precision bits of `x` (round to nearest; the range `packHalf2x16` covers).
+fn f16_bits(x: f32) -> u32 {
+    let b = x.to_bits();
+    let sign = (b >> 16) & 0x8000;
+    let exp = ((b >> 23) & 0xff) as i32 - 127 + 15;
+    let mant = b & 0x7f_ffff;
+    if x == 0.0 || exp <= 0 {
+        return sign; // zero (and the tiny values segments never carry)
+    }
+    if exp >= 31 {
+        return sign | 0x7c00;
+    }
+    let h = ((exp as u32) << 10) | (mant >> 13);
+    // Round to nearest, ties away: carries into the exponent correctly.
+    sign | (h + ((mant >> 12) & 1))
+}
+
+/// `pack_fragment` of `fragment_pack.glsl`: sqrt-encoded RGB and linear alpha, 8 bits each.
+fn pack_fragment(rgb: [f32; 3], alpha: f32) -> u32 {
+    let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u32;
+    q(rgb[0].max(0.0).sqrt())
+        | q(rgb[1].max(0.0).sqrt()) << 8
+        | q(rgb[2].max(0.0).sqrt()) << 16
+        | q(alpha) << 24
+}
+
+impl SoftSegment {
+    /// A segment from `a` to `b` (pixels) at depth `depth` (0..1), `width` pixels wide, of one
+    /// colour, standing for one strand that covers all of its width (for tests and tools that
+    /// feed `Renderer::rasterize_segments`).
+    pub fn flat(a: Vec2, b: Vec2, depth: f32, width: f32, rgb: [f32; 3]) -> Self {
+        let d = b - a;
+        let color = pack_fragment(rgb, 1.0);
+        SoftSegment {
+            a: [a.x, a.y, depth, depth],
+            b: [
+                f16_bits(d.x) | f16_bits(d.y) << 16,
+                color,
+                color,
+                f16_bits(width) | f16_bits(1.0) << 16,
+            ],
+        }
+    }
+}
+
+#[cfg(test)]
+mod pack_tests {
+    use super::*;
+
+    #[test]
+    fn half_bits_match_ieee() {
+        assert_eq!(f16_bits(1.0), 0x3c00);
+        assert_eq!(f16_bits(-2.0), 0xc000);
+        assert_eq!(f16_bits(0.5), 0x3800);
+        assert_eq!(f16_bits(65504.0), 0x7bff);
+        assert_eq!(f16_bits(0.0), 0);
+        assert_eq!(pack_fragment([1.0, 0.0, 0.25], 1.0), 0xff80_00ff);
     }
 }

@@ -311,6 +311,62 @@ impl FramePasses {
         self.soft.is_some()
     }
 
+    /// The software rasterizer alone over `targets` (cleared to black first): `segments`
+    /// segments already in the soft buffers, nothing in front (the soft depth is filled with
+    /// 1), composited through a k-buffer of `budget` nodes (`Renderer::rasterize_segments`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_soft_only(
+        &self,
+        rec: &mut CommandRecorder,
+        profiler: &mut Profiler,
+        sets: PassSets,
+        args: &Buffer,
+        soft_buffers: &super::soft::SoftBuffers,
+        transparency_buffers: &super::transparency::TransparencyBuffers,
+        targets: &mut RenderTargets,
+        (segments, budget): (u32, u32),
+    ) -> GpuResult<()> {
+        let pass = self.soft.as_ref().ok_or_else(|| {
+            crate::vk::GpuError::Unsupported("no software rasterizer on this device".into())
+        })?;
+        let (w, h) = targets.size();
+        clear_args(rec, args);
+        rec.barrier(&[Access::ComputeReadWrite], &[Access::TransferWrite]);
+        let offset = GenerateArgs::SEGMENTS_DEMANDED_OFFSET;
+        rec.fill_buffer(args, offset, 4, segments);
+        rec.fill_buffer(&soft_buffers.depth, 0, w as u64 * h as u64 * 4, 1.0f32.to_bits());
+        rec.image_barrier(&targets.color, Access::Nothing, Access::ColorAttachment);
+        rec.image_barrier(&targets.depth, Access::Nothing, Access::DepthAttachment);
+        rec.begin_rendering(
+            Attachment {
+                image: &targets.color,
+                clear: Some([0.0, 0.0, 0.0, 1.0]),
+                resolve: None,
+            },
+            Attachment {
+                image: &targets.depth,
+                clear: Some([1.0; 4]),
+                resolve: None,
+            },
+        );
+        rec.end_rendering();
+        targets.color_access = Access::ColorAttachment;
+        targets.depth_access = Access::DepthAttachment;
+        TransparencyPass::clear_kbuffer(rec, transparency_buffers, budget, w as u64 * h as u64);
+        let draw = soft_raster::SoftDraw {
+            sets,
+            args,
+            buffers: soft_buffers,
+            targets: None,
+            size: (w, h),
+        };
+        pass.record(rec, profiler, draw);
+        self.transparency
+            .record_resolve(rec, profiler, false, sets, targets)?;
+        targets.set_output_access(Access::ColorAttachment);
+        Ok(())
+    }
+
     /// Record the frame's passes. Leaves the targets as colour / depth attachments and
     /// `args` written by the last generating stage.
     pub fn record(
