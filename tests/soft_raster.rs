@@ -50,8 +50,7 @@ fn a_thin_straight_strand_deposits_its_area() {
                 for y in 0..h {
                     for x in 0..w {
                         let got = srgb_to_linear(rgba[((y * w + x) * 4) as usize]);
-                        let want =
-                            pixel_coverage(a, b, 0.5 * width, Vec2::new(x as f32, y as f32));
+                        let want = pixel_coverage(a, b, 0.5 * width, Vec2::new(x as f32, y as f32));
                         sum += got;
                         max_diff = max_diff.max((got - want as f64).abs());
                     }
@@ -99,13 +98,10 @@ fn scene(ctx: &std::sync::Arc<hairmesh::vk::Context>, size: u32, names: &[&str])
 }
 
 fn view_of(r: &Renderer, transparency: Transparency) -> View {
-    let (lo, hi) = r
-        .crowd()
-        .hair_bounds()
-        .into_iter()
-        .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), (a, b)| {
-            (lo.min(a), hi.max(b))
-        });
+    let (lo, hi) = r.crowd().hair_bounds().into_iter().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+    );
     View {
         camera: hairmesh::render::Camera::framing(lo, hi, hairmesh::render::DEFAULT_VIEW_DIR, 40.0),
         light_dir: light(),
@@ -117,7 +113,12 @@ fn view_of(r: &Renderer, transparency: Transparency) -> View {
     }
 }
 
-fn frame(r: &mut Renderer, view: &View, path: RenderPath, raster: StrandRaster) -> (Vec<u8>, hairmesh::render::FrameStats) {
+fn frame(
+    r: &mut Renderer,
+    view: &View,
+    path: RenderPath,
+    raster: StrandRaster,
+) -> (Vec<u8>, hairmesh::render::FrameStats) {
     let out = r
         .render_one(
             view,
@@ -141,7 +142,12 @@ const SCENES: [(&str, &[&str], f32); 3] = [
     ("sphere_fur", &["sphere_fur.obj"], 0.03),
     (
         "crowd",
-        &["head_long.obj", "sphere_fur.obj", "small_patch.obj", "triangle_tuft.obj"],
+        &[
+            "head_long.obj",
+            "sphere_fur.obj",
+            "small_patch.obj",
+            "triangle_tuft.obj",
+        ],
         0.03,
     ),
 ];
@@ -173,7 +179,13 @@ fn software_matches_hardware_strips() {
                 let (err, mean, p99) = flip_rgba(192, 192, &hw, &soft);
                 println!("{name} {path:?} {raster}: FLIP mean {mean:.4}, p99 {p99:.4}");
                 if mean >= limit {
-                    save_failure(&format!("soft-{name}-{path:?}-{raster}"), 192, 192, &soft, &err);
+                    save_failure(
+                        &format!("soft-{name}-{path:?}-{raster}"),
+                        192,
+                        192,
+                        &soft,
+                        &err,
+                    );
                 }
                 assert!(
                     mean < limit,
@@ -215,7 +227,10 @@ fn overflowing_budgets_are_counted_not_written() {
             assert!(s.segments_demanded > 300, "{path:?}: {s:?}");
             assert_eq!(s.tile_entries_written, 200, "{path:?}");
             assert!(s.tile_entries_demanded > 200, "{path:?}: {s:?}");
-            assert!(rgba.chunks(4).any(|p| p[..3] != rgba[..3]), "something drawn");
+            assert!(
+                rgba.chunks(4).any(|p| p[..3] != rgba[..3]),
+                "something drawn"
+            );
         }
     }
     assert_no_validation_errors(&ctx);
@@ -239,7 +254,9 @@ fn refuses_what_it_cannot_draw() {
         raster,
         ..Default::default()
     };
-    let e = r.render_one(&view, &opts(RenderPath::Compute, soft)).unwrap_err();
+    let e = r
+        .render_one(&view, &opts(RenderPath::Compute, soft))
+        .unwrap_err();
     assert!(e.to_string().contains("MSAA"), "{e}");
     let mut r = Renderer::new(&ctx, &RendererDesc::default().size(64, 64)).unwrap();
     r.add_character(&baked, &style, PARAMS, Mat4::IDENTITY)
@@ -248,15 +265,20 @@ fn refuses_what_it_cannot_draw() {
         transparency: Transparency::DepthPeeling { layers: 4 },
         ..view
     };
-    let e = r.render_one(&peel, &opts(RenderPath::Compute, soft)).unwrap_err();
+    let e = r
+        .render_one(&peel, &opts(RenderPath::Compute, soft))
+        .unwrap_err();
     assert!(e.to_string().contains("peeling"), "{e}");
     // Static strands are not generated: nothing to hand the rasterizer.
     r.render_one(&view, &opts(RenderPath::Compute, StrandRaster::Hardware))
         .unwrap();
-    let e = r.render_one(&view, &opts(RenderPath::Static, soft)).unwrap_err();
+    let e = r
+        .render_one(&view, &opts(RenderPath::Static, soft))
+        .unwrap_err();
     assert!(e.to_string().contains("generated strands"), "{e}");
     // A frame of software strands leaves no strands in the pool for the static path.
-    r.render_one(&view, &opts(RenderPath::Compute, soft)).unwrap();
+    r.render_one(&view, &opts(RenderPath::Compute, soft))
+        .unwrap();
     let e = r
         .render_one(&view, &opts(RenderPath::Static, StrandRaster::Hardware))
         .unwrap_err();

@@ -11,6 +11,8 @@
 //! hair mesh (both paths) vs LHS vs static strands per model, crowd and distance LoD speedups,
 //! bytes per method.
 //!
+//! `bench crowd` takes `--draw hw|soft[:K]|auto[:K]` (the rasterizer of every frame).
+//!
 //! `bench raster [--size 1280x720] [--runs 5] [--crowd 100] [--strands 100000]`: the
 //! software rasterizer vs hardware strips (opaque and OIT) and the per-bundle split, for one
 //! head at near / mid / far, ~100K strands, and a crowd; both paths.
@@ -200,6 +202,9 @@ enum Cmd {
         /// Write the largest crowd's frame (mesh path or compute, LoD on) here.
         #[arg(long)]
         picture: Option<PathBuf>,
+        /// Strand rasterization: hw, soft[:K] or auto[:K] (see `render --help`).
+        #[arg(long, default_value = "hw")]
+        draw: hairmesh::render::StrandRaster,
     },
 }
 
@@ -349,6 +354,7 @@ struct CrowdRun<'a> {
     runs: usize,
     camera: Camera,
     read_image: bool,
+    raster: hairmesh::render::StrandRaster,
 }
 
 impl CrowdRun<'_> {
@@ -382,6 +388,7 @@ impl CrowdRun<'_> {
             let view = bench_view(self.camera, lod_on);
             let opts = FrameOptions {
                 path: Some(path),
+                raster: self.raster,
                 ..Default::default()
             };
             let read_image = self.read_image && lod_on;
@@ -424,6 +431,7 @@ fn bench_crowd(
     runs: usize,
     device: Option<String>,
     picture: Option<PathBuf>,
+    raster: hairmesh::render::StrandRaster,
 ) -> Result<()> {
     if counts.is_empty() || counts.iter().any(|&c| c == 0 || c > 1024) {
         bail!("--counts: every count must be in 1..=1024");
@@ -467,6 +475,7 @@ fn bench_crowd(
         runs,
         camera,
         read_image: picture.is_some(),
+        raster,
     };
     let mut last_picture = None;
     for &count in &counts {
@@ -606,6 +615,7 @@ fn run(args: Args) -> Result<()> {
             runs,
             device,
             picture,
+            draw,
         } => bench_crowd(
             counts,
             width,
@@ -615,6 +625,7 @@ fn run(args: Args) -> Result<()> {
             runs as usize,
             device,
             picture,
+            draw,
         )?,
         Cmd::Lod {
             mesh,

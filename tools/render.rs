@@ -379,7 +379,10 @@ fn run(args: Args) -> Result<()> {
         _ => None,
     };
     if second.is_some() && args.draw.uses_software() {
-        bail!("--draw {} draws generated strands: use it with --path mesh or compute", args.draw);
+        bail!(
+            "--draw {} draws generated strands: use it with --path mesh or compute",
+            args.draw
+        );
     }
     let mut out = renderer.render_one(
         &view,

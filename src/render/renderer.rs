@@ -22,8 +22,8 @@ pub use super::settings::{FrameOptions, FrameTicket, RenderPath, RendererDesc};
 use super::shadow::{LightView, ShadowMode};
 use super::shared::{FrameBinding, GenerateArgs, HairVertex, SET_FRAME, SET_TEXTURES};
 use super::shared::{PropInstance, PropVertex};
-use super::targets::{RenderTargets, ShadowMaps};
 use super::soft::{SoftBudget, SoftBuffers, StrandRaster};
+use super::targets::{RenderTargets, ShadowMaps};
 use super::transparency::{Transparency, TransparencyBuffers};
 use super::workspace::FrameBuffers;
 use super::workspace::Workspace;
@@ -160,9 +160,7 @@ impl Renderer {
         let soft_budget = desc
             .soft_budget
             .unwrap_or_else(|| SoftBudget::for_range(range));
-        soft_budget
-            .validate(range)
-            .map_err(GpuError::Unsupported)?;
+        soft_budget.validate(range).map_err(GpuError::Unsupported)?;
         if !(desc.auto_split_pixels > 0.0 && desc.auto_split_pixels.is_finite()) {
             return Err(GpuError::Unsupported(format!(
                 "auto split width {} pixels must be finite and positive",
@@ -848,7 +846,9 @@ impl Renderer {
         block.transparency = kbuffer.frame_fields(1);
         let split = self.desc.auto_split_pixels;
         super::soft::frame_fields(&mut block, raster, self.soft_budget, opacity, split);
-        self.frames[i].frame_ubo.write(0, bytemuck::bytes_of(&block))?;
+        self.frames[i]
+            .frame_ubo
+            .write(0, bytemuck::bytes_of(&block))?;
         let upload = Buffer::with_data(
             &self.ctx,
             "soft segments upload",

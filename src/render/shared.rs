@@ -511,8 +511,7 @@ impl GenerateArgs {
     /// Byte offset of the draw arguments.
     pub const DRAW_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, draw) as u64;
     /// Byte offset of the software rasterizer's binning dispatch.
-    pub const SOFT_DISPATCH_OFFSET: u64 =
-        std::mem::offset_of!(GenerateArgs, soft_dispatch) as u64;
+    pub const SOFT_DISPATCH_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, soft_dispatch) as u64;
     /// Byte offset of `stats.segments_demanded`.
     pub const SEGMENTS_DEMANDED_OFFSET: u64 = (std::mem::offset_of!(GenerateArgs, stats)
         + std::mem::offset_of!(FrameStats, segments_demanded))

@@ -60,14 +60,35 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../glsl/lod_appearance.glsl"),
     ),
     ("oit.glsl", include_str!("../../glsl/oit.glsl")),
-    ("fragment_pack.glsl", include_str!("../../glsl/fragment_pack.glsl")),
-    ("strand_radiance.glsl", include_str!("../../glsl/strand_radiance.glsl")),
-    ("soft_segments.glsl", include_str!("../../glsl/soft_segments.glsl")),
-    ("soft_raster.glsl", include_str!("../../glsl/soft_raster.glsl")),
+    (
+        "fragment_pack.glsl",
+        include_str!("../../glsl/fragment_pack.glsl"),
+    ),
+    (
+        "strand_radiance.glsl",
+        include_str!("../../glsl/strand_radiance.glsl"),
+    ),
+    (
+        "soft_segments.glsl",
+        include_str!("../../glsl/soft_segments.glsl"),
+    ),
+    (
+        "soft_raster.glsl",
+        include_str!("../../glsl/soft_raster.glsl"),
+    ),
     ("soft_bin.comp", include_str!("../../glsl/soft_bin.comp")),
-    ("soft_bin_args.comp", include_str!("../../glsl/soft_bin_args.comp")),
-    ("soft_tile_scan.comp", include_str!("../../glsl/soft_tile_scan.comp")),
-    ("soft_raster.comp", include_str!("../../glsl/soft_raster.comp")),
+    (
+        "soft_bin_args.comp",
+        include_str!("../../glsl/soft_bin_args.comp"),
+    ),
+    (
+        "soft_tile_scan.comp",
+        include_str!("../../glsl/soft_tile_scan.comp"),
+    ),
+    (
+        "soft_raster.comp",
+        include_str!("../../glsl/soft_raster.comp"),
+    ),
     ("oit.frag", include_str!("../../glsl/oit.frag")),
     ("peel.glsl", include_str!("../../glsl/peel.glsl")),
     (

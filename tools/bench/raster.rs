@@ -148,7 +148,9 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
     if a.crowd == 0 || a.crowd > 1024 {
         bail!("--crowd: 1..=1024 characters");
     }
-    let ctx = Arc::new(Context::new(&ContextDesc::default().device(a.device.clone()))?);
+    let ctx = Arc::new(Context::new(
+        &ContextDesc::default().device(a.device.clone()),
+    )?);
     let (w, h) = a.size;
     outln!(
         "bench raster: {} ({}), {w}x{h}, median GPU ms of {} frames; soft and auto keep {} fragments per pixel and composite like oit:8; auto sends strands drawn at most {} px wide to software",
@@ -161,8 +163,14 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
     let mut scenes = head_scenes(&ctx, &a)?;
     scenes.push(crowd_scene(&ctx, &a)?);
     scenes.retain(|s| a.scenes.is_empty() || a.scenes.iter().any(|n| s.name.starts_with(n)));
-    if !scenes.first().is_some_and(|s| s.renderer.has_software_raster()) {
-        bail!("{}: no software rasterizer (needs 64-bit atomics)", ctx.info.name);
+    if !scenes
+        .first()
+        .is_some_and(|s| s.renderer.has_software_raster())
+    {
+        bail!(
+            "{}: no software rasterizer (needs 64-bit atomics)",
+            ctx.info.name
+        );
     }
     outln!(
         "| scene | path | strands | hw opaque | hw oit | soft | auto | soft / hw oit | soft / hw opaque | auto / hw oit | segments (soft) |"

@@ -85,6 +85,12 @@ pub struct Args {
     /// 8) or peel or peel:N (depth peeling, N layers: the slow reference).
     #[arg(long, default_value = "opaque")]
     transparency: hairmesh::render::Transparency,
+    /// Strand rasterization: hw (hardware strips), soft or soft:K (the compute software
+    /// rasterizer, K fragments per pixel kept sorted), auto or auto:K (per bundle: thin
+    /// strands to software, thick ones to hardware). Software needs --msaa 1 and opaque or
+    /// oit transparency.
+    #[arg(long, default_value = "hw")]
+    draw: hairmesh::render::StrandRaster,
     /// Seed 000's thick-strand appearance term under LoD.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     lod_appearance: bool,
@@ -342,6 +348,7 @@ fn run(args: Args) -> Result<()> {
             &view,
             &FrameOptions {
                 read_image: true,
+                raster: args.draw,
                 ..Default::default()
             },
         )?;

@@ -16,6 +16,7 @@ use anyhow::{Context as _, Result};
 use glam::Vec3;
 use hairmesh::characters::preset;
 use hairmesh::outln;
+use hairmesh::render::soft::{DEFAULT_SOFT_K, StrandRaster};
 use hairmesh::render::transparency::{DEFAULT_OIT_BUDGET, DEFAULT_PEEL_LAYERS, MAX_OIT_BUDGET};
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, FrameTicket, LodSettings, PresentTarget, RenderPath,
@@ -41,6 +42,7 @@ struct Controls {
     shading: ShadingModel,
     shadows: ShadowMode,
     transparency: Transparency,
+    raster: StrandRaster,
     lod_appearance: bool,
     moving: bool,
     simulating: bool,
@@ -54,7 +56,13 @@ struct Controls {
 }
 
 impl Controls {
-    fn show(&mut self, ctx: &egui::Context, total: usize, mesh_ok: bool, stats: &str) {
+    fn show(
+        &mut self,
+        ctx: &egui::Context,
+        total: usize,
+        (mesh_ok, soft_ok): (bool, bool),
+        stats: &str,
+    ) {
         egui::Window::new("crowd")
             .default_width(260.0)
             .show(ctx, |ui| {
@@ -153,6 +161,15 @@ impl Controls {
                         ui.radio_value(&mut self.path, RenderPath::Mesh, "mesh");
                     });
                     ui.radio_value(&mut self.path, RenderPath::Compute, "compute");
+                });
+                ui.horizontal(|ui| {
+                    ui.label("draw");
+                    ui.radio_value(&mut self.raster, StrandRaster::Hardware, "hw");
+                    ui.add_enabled_ui(soft_ok, |ui| {
+                        let k = DEFAULT_SOFT_K;
+                        ui.radio_value(&mut self.raster, StrandRaster::Software { k }, "soft");
+                        ui.radio_value(&mut self.raster, StrandRaster::Auto { k }, "auto");
+                    });
                 });
                 ui.horizontal(|ui| {
                     ui.label("present");
@@ -257,6 +274,9 @@ struct Running {
     shading: ShadingModel,
     shadows: ShadowMode,
     transparency: Transparency,
+    raster: StrandRaster,
+    /// The software rasterizer can draw this window's frames (device support, no MSAA).
+    soft_ok: bool,
     lod_appearance: bool,
     animation: hairmesh::animate::CrowdAnimation,
     last_draw: Instant,
@@ -373,7 +393,9 @@ impl App {
         let acquire = (0..hairmesh::render::FRAMES_IN_FLIGHT)
             .map(|_| Semaphore::new(&ctx))
             .collect::<Result<_, _>>()?;
+        let soft_ok = renderer.has_software_raster() && self.args.msaa == 1;
         self.running = Some(Running {
+            soft_ok,
             panel,
             swapchain: None,
             acquire,
@@ -411,6 +433,7 @@ impl App {
             shading: self.args.shading,
             shadows: self.args.shadows,
             transparency: self.args.transparency,
+            raster: self.args.draw,
             lod_appearance: self.args.lod_appearance,
             animation,
             last_draw: Instant::now(),
@@ -509,6 +532,7 @@ impl Running {
             lod_appearance: self.lod_appearance,
         };
         let (primitives, ppp, freed) = self.panel_frame(scene_len)?;
+        let raster = self.frame_raster();
         let chain = self.swapchain.as_ref().expect("created above");
         let semaphore = &self.acquire[(self.frame % self.acquire.len() as u64) as usize];
         let ui = &mut self.panel.ui;
@@ -520,6 +544,7 @@ impl Running {
             &view,
             &FrameOptions {
                 path: Some(self.path),
+                raster,
                 ..Default::default()
             },
             Some(PresentTarget {
@@ -563,6 +588,7 @@ impl Running {
             shading: self.shading,
             shadows: self.shadows,
             transparency: self.transparency,
+            raster: self.raster,
             lod_appearance: self.lod_appearance,
             moving: self.animation.moving,
             simulating: self.animation.simulating,
@@ -575,8 +601,8 @@ impl Running {
             present_mode: self.present_mode,
         };
         let stats = self.stats_text(scene_len);
-        let mesh_ok = self.renderer.has_mesh_path();
-        let output = egui_ctx.run_ui(input, |ui| c.show(ui.ctx(), scene_len, mesh_ok, &stats));
+        let ok = (self.renderer.has_mesh_path(), self.soft_ok());
+        let output = egui_ctx.run_ui(input, |ui| c.show(ui.ctx(), scene_len, ok, &stats));
         self.panel
             .egui_state
             .handle_platform_output(&self.window, output.platform_output);
@@ -589,6 +615,22 @@ impl Running {
             ppp,
             output.textures_delta.free.iter().copied().collect(),
         ))
+    }
+
+    /// Whether the software rasterizer can draw this window's frames (device support and
+    /// single-sample targets).
+    fn soft_ok(&self) -> bool {
+        self.soft_ok
+    }
+
+    /// The raster of the next frame: the chosen one, or hardware strips where the software
+    /// rasterizer cannot composite (depth peeling).
+    fn frame_raster(&self) -> StrandRaster {
+        match self.transparency {
+            Transparency::DepthPeeling { .. } => StrandRaster::Hardware,
+            _ if !self.soft_ok() => StrandRaster::Hardware,
+            _ => self.raster,
+        }
     }
 
     fn apply(&mut self, c: Controls) -> Result<()> {
@@ -609,6 +651,7 @@ impl Running {
         self.shading = c.shading;
         self.shadows = c.shadows;
         self.transparency = c.transparency;
+        self.raster = c.raster;
         self.lod_appearance = c.lod_appearance;
         self.animation.moving = c.moving;
         self.animation.simulating = c.simulating;
@@ -743,6 +786,14 @@ impl Running {
                     ShadingModel::Placeholder => ShadingModel::KajiyaKay,
                     ShadingModel::KajiyaKay => ShadingModel::Marschner,
                     ShadingModel::Marschner => ShadingModel::Placeholder,
+                }
+            }
+            KeyCode::KeyR if self.soft_ok() => {
+                let k = DEFAULT_SOFT_K;
+                self.raster = match self.raster {
+                    StrandRaster::Hardware => StrandRaster::Software { k },
+                    StrandRaster::Software { .. } => StrandRaster::Auto { k },
+                    StrandRaster::Auto { .. } => StrandRaster::Hardware,
                 }
             }
             KeyCode::KeyT => {

@@ -334,7 +334,12 @@ impl FramePasses {
         rec.barrier(&[Access::ComputeReadWrite], &[Access::TransferWrite]);
         let offset = GenerateArgs::SEGMENTS_DEMANDED_OFFSET;
         rec.fill_buffer(args, offset, 4, segments);
-        rec.fill_buffer(&soft_buffers.depth, 0, w as u64 * h as u64 * 4, 1.0f32.to_bits());
+        rec.fill_buffer(
+            &soft_buffers.depth,
+            0,
+            w as u64 * h as u64 * 4,
+            1.0f32.to_bits(),
+        );
         rec.image_barrier(&targets.color, Access::Nothing, Access::ColorAttachment);
         rec.image_barrier(&targets.depth, Access::Nothing, Access::DepthAttachment);
         rec.begin_rendering(

@@ -163,10 +163,7 @@ impl SoftRasterPass {
         rec.dispatch_indirect(draw.args, GenerateArgs::SOFT_DISPATCH_OFFSET);
         profiler.end(rec);
         // The k-buffer may hold this frame's hardware transparent fragments.
-        rec.barrier(
-            &[Access::ComputeReadWrite, Access::FragmentReadWrite],
-            &rw,
-        );
+        rec.barrier(&[Access::ComputeReadWrite, Access::FragmentReadWrite], &rw);
         profiler.begin(rec, "soft raster");
         rec.bind(&self.raster, &draw.sets.both());
         rec.dispatch(tx, ty, 1);
