@@ -9,6 +9,7 @@ pub mod animate;
 pub mod bake;
 pub mod characters;
 pub mod error;
+pub mod fit;
 pub mod fsutil;
 pub mod fuzz;
 pub mod model;

@@ -403,9 +403,15 @@ pub fn parse_scalp(name: &str, bytes: &[u8]) -> Result<Scalp> {
 
 /// Write a hair mesh as OBJ in the layer convention (positions per layer, shared root `vt`).
 pub fn write_hair_mesh_obj(mesh: &HairMesh, path: &Path, comment: &str) -> Result<()> {
+    let out = hair_mesh_obj_bytes(mesh, comment).map_err(|e| HairError::io(path, e))?;
+    crate::fsutil::OutputPath::check(path, &[])?.write(&out)
+}
+
+/// The OBJ text of a hair mesh in the layer convention, with `comment` lines on top.
+pub fn hair_mesh_obj_bytes(mesh: &HairMesh, comment: &str) -> std::io::Result<Vec<u8>> {
     let mut out = Vec::new();
     let n = mesh.vertices_per_layer();
-    let io = |e| HairError::io(path, e);
+    let io = |e| e;
     writeln!(
         out,
         "# hair mesh: {} layers, {} faces",
@@ -434,5 +440,28 @@ pub fn write_hair_mesh_obj(mesh: &HairMesh, path: &Path, comment: &str) -> Resul
             writeln!(out).map_err(io)?;
         }
     }
-    crate::fsutil::OutputPath::check(path, &[])?.write(&out)
+    Ok(out)
+}
+
+/// Load the triangles of any OBJ (every face, any groups, fanned into triangles): a head mesh
+/// for `fit`. Positions must be finite (checked by the parser).
+pub fn load_triangles(path: &Path) -> Result<Vec<[Vec3; 3]>> {
+    let bytes = crate::fsutil::read_input(path, crate::fsutil::MAX_MESH_FILE_BYTES)?;
+    let name = path.display().to_string();
+    let (raw, _) = parse(&name, &bytes)?;
+    let mut out = Vec::new();
+    for poly in &raw.polygons {
+        let cs = corners(poly);
+        for k in 1..cs.len().saturating_sub(1) {
+            out.push([
+                position(&raw, cs[0].0),
+                position(&raw, cs[k].0),
+                position(&raw, cs[k + 1].0),
+            ]);
+        }
+    }
+    if out.is_empty() {
+        return Err(HairError::invalid(name, "no faces"));
+    }
+    Ok(out)
 }

@@ -473,14 +473,20 @@ impl SoftSegment {
     /// colour, standing for one strand that covers all of its width (for tests and tools that
     /// feed `Renderer::rasterize_segments`).
     pub fn flat(a: Vec2, b: Vec2, depth: f32, width: f32, rgb: [f32; 3]) -> Self {
+        Self::shaded(a.extend(depth), b.extend(depth), width, [rgb, rgb])
+    }
+
+    /// A segment between `a` and `b` (x, y in pixels, z depth 0..1), `width` pixels wide,
+    /// coloured `rgb[0]` at `a` and `rgb[1]` at `b`, standing for one strand that covers all of
+    /// its width.
+    pub fn shaded(a: glam::Vec3, b: glam::Vec3, width: f32, rgb: [[f32; 3]; 2]) -> Self {
         let d = b - a;
-        let color = pack_fragment(rgb, 1.0);
         SoftSegment {
-            a: [a.x, a.y, depth, depth],
+            a: [a.x, a.y, a.z, b.z],
             b: [
                 f16_bits(d.x) | f16_bits(d.y) << 16,
-                color,
-                color,
+                pack_fragment(rgb[0], 1.0),
+                pack_fragment(rgb[1], 1.0),
                 f16_bits(width) | f16_bits(1.0) << 16,
             ],
         }

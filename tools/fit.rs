@@ -1,0 +1,237 @@
+//! `fit`: turn a strand model (TressFX `.tfx` or Yuksel's `.hair`) into a hair mesh OBJ and a
+//! style TOML beside it, ready for `bake` (method: `src/fit/mod.rs`); `--report` measures the
+//! fitted hair mesh against the input strands.
+//!
+//! `fit STRANDS.tfx|.hair [--head HEAD.obj] -o OUT.obj [--bundles 64] [--layers L] [--report]
+//! [--picture side_by_side.png]`
+
+use std::io::Write as _;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use anyhow::{Context as _, Result, bail};
+use clap::Parser;
+use glam::Vec3;
+use hairmesh::fit::metric::compare;
+use hairmesh::fit::picture::{StrandLook, draw_strands};
+use hairmesh::fit::{FitOptions, fit};
+use hairmesh::fsutil::OutputPath;
+use hairmesh::model::strands::StrandModel;
+use hairmesh::reference::generate::strands_in_bundle;
+use hairmesh::render::{Camera, Renderer, RendererDesc};
+use hairmesh::vk::{Context, ContextDesc};
+use hairmesh::{BakeOptions, CpuGenerator, bake, outln};
+
+/// Fit a hair mesh to a strand model.
+#[derive(Parser)]
+#[command(version, about)]
+struct Args {
+    /// Strand model: TressFX 4.0 `.tfx` or `.hair`.
+    strands: PathBuf,
+    /// Head mesh OBJ: the scalp is placed on its surface.
+    #[arg(long)]
+    head: Option<PathBuf>,
+    /// Output hair mesh OBJ; the style is written beside it as .toml.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Target number of bundles.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    bundles: u32,
+    /// Layers including the scalp (default: from the strands' curvature).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=16))]
+    layers: Option<u32>,
+    /// Measure the fitted hair mesh against the input: distances, coverage, storage, and the
+    /// FLIP mean of the two drawn side by side (needs Vulkan).
+    #[arg(long)]
+    report: bool,
+    /// With --report: write the input (left) and the fitted hair mesh (right) here.
+    #[arg(long)]
+    picture: Option<PathBuf>,
+    /// Enable Vulkan validation layers (--report).
+    #[arg(long)]
+    validation: bool,
+    /// Choose the GPU by name substring (--report).
+    #[arg(long)]
+    device: Option<String>,
+}
+
+fn run(args: Args) -> Result<()> {
+    let mut inputs = vec![args.strands.as_path()];
+    if let Some(h) = &args.head {
+        inputs.push(h.as_path());
+    }
+    let obj_out = OutputPath::check(&args.output, &inputs)?;
+    let toml_path = args.output.with_extension("toml");
+    if toml_path == args.output {
+        bail!(
+            "{}: the output needs an extension other than .toml",
+            args.output.display()
+        );
+    }
+    let toml_out = OutputPath::check(&toml_path, &inputs)?;
+    let picture = args
+        .picture
+        .as_ref()
+        .map(|p| OutputPath::check(p, &inputs))
+        .transpose()?;
+    if picture.is_some() && !args.report {
+        bail!("--picture needs --report");
+    }
+    let model = StrandModel::load(&args.strands)?;
+    let head = args
+        .head
+        .as_deref()
+        .map(hairmesh::model::obj_io::load_triangles)
+        .transpose()?;
+    let opts = FitOptions {
+        bundles: args.bundles as usize,
+        layers: args.layers.map(|l| l as usize),
+    };
+    let fitted = fit(&model, head.as_deref(), &opts)?;
+    let baked = bake(
+        &fitted.mesh,
+        &fitted.style,
+        BakeOptions::default(),
+        |_, _| {},
+    )
+    .context("the fitted hair mesh does not bake")?;
+    let comment = format!(
+        "fitted by hairmesh fit from {} ({} strands)",
+        args.strands.display(),
+        model.strands.len()
+    );
+    let obj = hairmesh::model::obj_io::hair_mesh_obj_bytes(&fitted.mesh, &comment)?;
+    let toml = format!("# {comment}\n{}", toml::to_string(&fitted.style)?);
+    outln!(
+        "{}: {} strands, {} points -> {} bundles, {} layers; textures {:.1} KiB vs {:.1} KiB input ({:.1}x smaller)",
+        args.strands.display(),
+        model.strands.len(),
+        model.point_count(),
+        fitted.mesh.faces.len(),
+        fitted.mesh.layer_count(),
+        baked.texture_bytes() as f64 / 1024.0,
+        model.file_bytes as f64 / 1024.0,
+        model.file_bytes as f64 / baked.texture_bytes().max(1) as f64
+    )?;
+    let s = &fitted.style;
+    outln!(
+        "style: length_variation {:.3}, clump_strength {:.3}, frizz_amplitude {:.4}, frizz_frequency {:.3}, strand_width {:.4}",
+        s.length_variation,
+        s.clump_strength,
+        s.frizz_amplitude,
+        s.frizz_frequency,
+        s.strand_width
+    )?;
+    let mut png = None;
+    if args.report {
+        png = report(&args, &model, &fitted, &baked)?;
+    }
+    obj_out.write(&obj)?;
+    toml_out.write(toml.as_bytes())?;
+    if let (Some(out), Some(bytes)) = (picture, png) {
+        out.write(&bytes)?;
+        outln!("wrote {}", out.path().display())?;
+    }
+    outln!(
+        "wrote {} and {}",
+        args.output.display(),
+        toml_path.display()
+    )?;
+    Ok(())
+}
+
+/// The strands the fitted hair mesh generates (CPU reference, 33 points each), about as
+/// many as the input has.
+fn generated(
+    model: &StrandModel,
+    fitted: &hairmesh::fit::Fitted,
+    baked: &hairmesh::BakedHairMesh,
+) -> Vec<Vec<Vec3>> {
+    let per = (model.strands.len() as f32 / baked.bundles.len() as f32).ceil() as u32;
+    let per = per.clamp(1, 4096);
+    let _total: u64 = baked
+        .bundles
+        .iter()
+        .map(|b| strands_in_bundle(b, &fitted.style, per) as u64)
+        .sum();
+    let set = CpuGenerator::new(baked, fitted.style).generate(per, 5);
+    set.positions
+        .chunks(set.verts_per_strand)
+        .map(|c| c.to_vec())
+        .collect()
+}
+
+fn report(
+    args: &Args,
+    model: &StrandModel,
+    fitted: &hairmesh::fit::Fitted,
+    baked: &hairmesh::BakedHairMesh,
+) -> Result<Option<Vec<u8>>> {
+    let strands = generated(model, fitted, baked);
+    let f = compare(
+        &model.strands,
+        &strands,
+        model.diagonal(),
+        fitted.bundle_size,
+    );
+    outln!(
+        "fidelity ({} generated strands; distances in % of the {:.3} bounding-box diagonal): input->fit mean {:.2} p95 {:.2}; fit->input mean {:.2} p95 {:.2}; two-sided mean {:.2} p95 {:.2}; coverage {:.1}% of roots within {:.3} (bundle size)",
+        strands.len(),
+        model.diagonal(),
+        100.0 * f.input_to_fit.0,
+        100.0 * f.input_to_fit.1,
+        100.0 * f.fit_to_input.0,
+        100.0 * f.fit_to_input.1,
+        100.0 * f.two_sided.0,
+        100.0 * f.two_sided.1,
+        100.0 * f.coverage,
+        fitted.bundle_size
+    )?;
+    let ctx = Arc::new(Context::new(
+        &ContextDesc::default()
+            .validation(args.validation)
+            .device(args.device.clone()),
+    )?);
+    let size = 384;
+    let mut r = Renderer::new(&ctx, &RendererDesc::default().size(size, size))?;
+    let (lo, hi) = model.bounds();
+    let look = StrandLook {
+        camera: Camera::framing(lo, hi, Vec3::new(0.0, 0.2, 1.0), 40.0),
+        color: Vec3::from_array(fitted.style.color),
+        light: Vec3::new(0.4, 1.0, 0.6),
+        width_px: 0.8,
+    };
+    let input_img = draw_strands(&mut r, &model.strands, &look)?;
+    let fit_img = draw_strands(&mut r, &strands, &look)?;
+    if ctx.validation_errors() > 0 {
+        bail!("{} Vulkan validation error(s)", ctx.validation_errors());
+    }
+    let rgb = |img: &[u8]| -> Vec<u8> { img.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
+    let err = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(size, size, &rgb(&input_img)),
+        nv_flip::FlipImageRgb8::with_data(size, size, &rgb(&fit_img)),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let mean = nv_flip::FlipPool::from_image(&err).mean();
+    outln!(
+        "FLIP mean {mean:.4} (input strands vs fitted hair mesh, {size}x{size}, software rasterizer, {})",
+        ctx.info.name
+    )?;
+    if args.picture.is_none() {
+        return Ok(None);
+    }
+    let mut side = image::RgbaImage::new(2 * size, size);
+    let left = image::RgbaImage::from_raw(size, size, input_img).context("image size")?;
+    let right = image::RgbaImage::from_raw(size, size, fit_img).context("image size")?;
+    image::imageops::replace(&mut side, &left, 0, 0);
+    image::imageops::replace(&mut side, &right, size as i64, 0);
+    let png = hairmesh::fsutil::encode_png("picture", 2 * size, size, side.into_raw())?;
+    Ok(Some(png))
+}
+
+fn main() {
+    if let Err(e) = run(Args::parse()) {
+        let _ = std::io::stdout().flush();
+        hairmesh::fsutil::exit_with_error("fit", &e, 1);
+    }
+}
