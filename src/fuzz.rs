@@ -29,16 +29,19 @@ pub enum Reader {
     Hmb,
     /// `HairFile::parse` (`.hair` strand files).
     Hair,
+    /// `StrandModel::from_tfx` (TressFX strand files) and `fit` of small accepted models.
+    Tfx,
 }
 
 impl Reader {
     /// Every reader.
-    pub const ALL: [Reader; 5] = [
+    pub const ALL: [Reader; 6] = [
         Reader::Obj,
         Reader::Style,
         Reader::Scene,
         Reader::Hmb,
         Reader::Hair,
+        Reader::Tfx,
     ];
 }
 
@@ -269,6 +272,57 @@ fn hair_seeds() -> [Vec<u8>; 2] {
 
 /// Mutations of a `.hair` file: header words set to extremes, default floats to NaN/inf, bit
 /// flips, truncation and extension.
+/// A small TressFX file: 6 curved strands of 8 vertices.
+fn tfx_seed() -> Vec<u8> {
+    let mut b = Vec::new();
+    b.extend_from_slice(&4.0f32.to_le_bytes());
+    b.extend_from_slice(&6u32.to_le_bytes());
+    b.extend_from_slice(&8u32.to_le_bytes());
+    b.extend_from_slice(&160u32.to_le_bytes());
+    b.resize(160, 0);
+    for s in 0..6 {
+        let a = s as f32 * 0.9;
+        for v in 0..8 {
+            let t = v as f32 * 0.1;
+            for x in [a.cos() * (1.0 + t), 1.0 - t * t, a.sin() * (1.0 + t), 1.0] {
+                b.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+    }
+    b
+}
+
+fn mutate_tfx(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
+    let mut out = seed.to_vec();
+    const EXTREMES: [u32; 8] = [0, 1, 2, 7, 160, 0x7fff_ffff, 0xffff_ffff, 65535];
+    for _ in 0..1 + below(rng, 3) {
+        match below(rng, 5) {
+            0 | 1 => {
+                let at = 4 + 4 * below(rng, 3);
+                let v = *pick(rng, &EXTREMES);
+                out[at..at + 4].copy_from_slice(&v.to_le_bytes());
+            }
+            2 => {
+                let at = 4 * below(rng, out.len() / 4);
+                let v = *pick(rng, &[f32::NAN, f32::INFINITY, -1e38, 0.0, 1e30]);
+                out[at..at + 4].copy_from_slice(&v.to_le_bytes());
+            }
+            3 => {
+                let i = below(rng, out.len());
+                out[i] ^= 1 << below(rng, 8);
+            }
+            _ => {
+                let n = out.len();
+                out.truncate(below(rng, n + 1));
+                if out.len() < 16 {
+                    return out;
+                }
+            }
+        }
+    }
+    out
+}
+
 fn mutate_hair(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
     let mut out = seed.to_vec();
     const EXTREMES: [u32; 8] = [0, 1, 2, 0x1f, 0x20, 0x7fff_ffff, 0xffff_ffff, 65535];
@@ -337,6 +391,17 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
         }),
         Reader::Hmb => crate::bake::baked_file::from_bytes("fuzz.hmb", input).is_ok(),
         Reader::Hair => crate::model::hair_file::HairFile::parse("fuzz.hair", input).is_ok(),
+        Reader::Tfx => match crate::model::strands::StrandModel::from_tfx("fuzz.tfx", input) {
+            Ok(m) if m.point_count() <= 4096 => {
+                let opts = crate::fit::FitOptions {
+                    bundles: 4,
+                    layers: None,
+                };
+                crate::fit::fit(&m, None, &opts).is_ok()
+            }
+            Ok(_) => true,
+            Err(_) => false,
+        },
     }));
     result.map_err(|p| {
         p.downcast_ref::<&str>()
@@ -368,6 +433,7 @@ pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
                 let seed = pick(&mut rng, &hair).clone();
                 mutate_hair(&mut rng, &seed)
             }
+            Reader::Tfx => mutate_tfx(&mut rng, &tfx_seed()),
         };
         let start = Instant::now();
         let outcome = run_one(reader, &input);

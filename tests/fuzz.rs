@@ -92,3 +92,8 @@ fn fuzz_hmb_reader() {
 fn fuzz_hair_reader() {
     check(Reader::Hair);
 }
+
+#[test]
+fn fuzz_tfx_reader() {
+    check(Reader::Tfx);
+}

@@ -286,6 +286,12 @@ fn golden_small_patch() {
     check("small_patch", "small_patch.obj", 64, 5);
 }
 
+/// The hair mesh `fit` made from the Sintel Lite guides (hairmeshes/SINTEL_LICENSE.md).
+#[test]
+fn golden_sintel() {
+    check("sintel", "sintel.obj", 32, 4);
+}
+
 #[test]
 fn golden_triangle_tuft() {
     check("triangle_tuft", "triangle_tuft.obj", 64, 4);
