@@ -29,11 +29,14 @@ pub enum StyleFamily {
     Afro,
     /// Short fur all over a ball.
     Fur,
+    /// The hair mesh `fit` made from the Sintel Lite strands (`hairmeshes/sintel.obj`),
+    /// placed on the head.
+    Fitted,
 }
 
 impl StyleFamily {
     /// The families people get.
-    pub const PEOPLE: [StyleFamily; 7] = [
+    pub const PEOPLE: [StyleFamily; 8] = [
         StyleFamily::ShortCrop,
         StyleFamily::Bob,
         StyleFamily::LongStraight,
@@ -41,6 +44,7 @@ impl StyleFamily {
         StyleFamily::Ponytail,
         StyleFamily::Mohawk,
         StyleFamily::Afro,
+        StyleFamily::Fitted,
     ];
 }
 
@@ -90,7 +94,7 @@ fn growth(family: StyleFamily) -> Growth {
     match family {
         StyleFamily::ShortCrop => g(full, 14, 3, (0.009, 0.014), 0.35),
         StyleFamily::Bob => g(full, 14, 6, (0.026, 0.034), 0.9),
-        StyleFamily::LongStraight => g(full, 14, 10, (0.04, 0.055), 0.95),
+        StyleFamily::LongStraight | StyleFamily::Fitted => g(full, 14, 10, (0.04, 0.055), 0.95),
         StyleFamily::LongCurly => g(full, 14, 9, (0.035, 0.045), 0.8),
         StyleFamily::Ponytail => g(full, 14, 10, (0.035, 0.05), 1.0),
         StyleFamily::Mohawk => g(
@@ -137,7 +141,10 @@ fn style_for(family: StyleFamily, seed: u32, rng: &mut Pcg32) -> HairStyle {
             s.clump_strength = range(rng, 0.5, 0.8);
             s.clump_power = 1.0;
         }
-        StyleFamily::Bob | StyleFamily::LongStraight | StyleFamily::Ponytail => {
+        StyleFamily::Bob
+        | StyleFamily::LongStraight
+        | StyleFamily::Ponytail
+        | StyleFamily::Fitted => {
             s.wave_amplitude = range(rng, 0.0, 0.006);
             s.wave_frequency = range(rng, 2.0, 5.0);
             s.wave_angle = range(rng, 0.0, std::f32::consts::PI);
@@ -151,9 +158,54 @@ fn style_for(family: StyleFamily, seed: u32, rng: &mut Pcg32) -> HairStyle {
     s
 }
 
+/// The Sintel hair mesh (`fit` of the Sintel Lite strands, `hairmeshes/sintel.obj`) scaled
+/// and moved onto `head` (its roots' width to the head's, its crown to the head's top), with
+/// the fitted style scaled alike and this character's colour.
+fn fitted_sintel(seed: u32, head: &HeadShape, rng: &mut Pcg32) -> Result<Hairstyle> {
+    let mesh = crate::model::obj_io::parse_hair_mesh_obj(
+        "hairmeshes/sintel.obj",
+        include_bytes!("../../hairmeshes/sintel.obj"),
+    )?;
+    let fitted = HairStyle::from_toml(
+        "hairmeshes/sintel.toml",
+        include_str!("../../hairmeshes/sintel.toml"),
+    )?;
+    let (lo, hi) = crate::model::hair_mesh::bounds(mesh.layers[0].iter().copied());
+    let scale = 2.1 * head.radii.x / (hi.x - lo.x).max(1e-6);
+    let crown = Vec3::new(0.5 * (lo.x + hi.x), hi.y, 0.5 * (lo.z + hi.z));
+    let top = head.centre + Vec3::new(0.0, head.radii.y * 1.02, 0.0);
+    let layers = mesh
+        .layers
+        .iter()
+        .map(|l| l.iter().map(|p| top + (*p - crown) * scale).collect())
+        .collect();
+    let name = format!("Fitted #{seed}");
+    let mesh = HairMesh::new(name, layers, None, mesh.uv.clone(), mesh.faces.clone())?;
+    let own = style_for(StyleFamily::Fitted, seed, rng);
+    let style = HairStyle {
+        seed,
+        strand_width: own.strand_width,
+        root_ramp: fitted.root_ramp * scale,
+        frizz_amplitude: fitted.frizz_amplitude * scale,
+        frizz_frequency: fitted.frizz_frequency / scale,
+        curl_radius: fitted.curl_radius * scale,
+        curl_frequency: fitted.curl_frequency / scale,
+        color: own.color,
+        ..fitted
+    };
+    Ok(Hairstyle {
+        family: StyleFamily::Fitted,
+        mesh,
+        style,
+    })
+}
+
 /// Generate a hairstyle of `family` for `head` from `seed`.
 pub fn generate(family: StyleFamily, seed: u32, head: &HeadShape) -> Result<Hairstyle> {
     let mut rng = Pcg32::new(seed as u64 ^ (family as u64) << 40);
+    if family == StyleFamily::Fitted {
+        return fitted_sintel(seed, head, &mut rng);
+    }
     let g = growth(family);
     let step = range(&mut rng, g.step.0, g.step.1);
     let style = style_for(family, seed, &mut rng);
@@ -261,6 +313,13 @@ mod tests {
             assert!(h.mesh.faces.len() >= 10, "{family:?}");
             h.style.validate("test").unwrap();
         }
+        // The fitted Sintel hair sits on the head: its roots within the head's box (grown by
+        // a fifth), its crown at the head's top.
+        let h = generate(StyleFamily::Fitted, 7, &head).unwrap();
+        let (lo, hi) = crate::model::hair_mesh::bounds(h.mesh.layers[0].iter().copied());
+        let margin = head.radii * 1.2;
+        assert!(lo.cmpge(head.centre - margin).all() && hi.cmple(head.centre + margin).all());
+        assert!((hi.y - (head.centre.y + head.radii.y)).abs() < 0.01, "{hi}");
         let fur = teapot_fur(3, 0.27).unwrap();
         assert!(fur.mesh.faces.len() > 500);
         fur.style.validate("test").unwrap();
