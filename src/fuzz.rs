@@ -292,18 +292,34 @@ fn tfx_seed() -> Vec<u8> {
     b
 }
 
-fn mutate_tfx(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
+/// Where a binary strand format keeps what mutations aim at.
+struct BinaryLayout {
+    /// Byte offset of the first header count and how many u32 counts follow.
+    counts: (usize, usize),
+    /// Byte offset of the first float to break and how many (`None`: anywhere in the file).
+    floats: Option<(usize, usize)>,
+    /// Count values tried.
+    extremes: [u32; 8],
+    /// Truncations shorter than this end the mutation.
+    min_len: usize,
+}
+
+/// One to three mutations of `seed`: an extreme header count, a non-finite or huge float, a
+/// flipped bit, or a truncation.
+fn mutate_binary(rng: &mut Pcg32, seed: &[u8], layout: &BinaryLayout) -> Vec<u8> {
     let mut out = seed.to_vec();
-    const EXTREMES: [u32; 8] = [0, 1, 2, 7, 160, 0x7fff_ffff, 0xffff_ffff, 65535];
     for _ in 0..1 + below(rng, 3) {
         match below(rng, 5) {
             0 | 1 => {
-                let at = 4 + 4 * below(rng, 3);
-                let v = *pick(rng, &EXTREMES);
+                let at = layout.counts.0 + 4 * below(rng, layout.counts.1);
+                let v = *pick(rng, &layout.extremes);
                 out[at..at + 4].copy_from_slice(&v.to_le_bytes());
             }
             2 => {
-                let at = 4 * below(rng, out.len() / 4);
+                let at = match layout.floats {
+                    Some((first, n)) => first + 4 * below(rng, n),
+                    None => 4 * below(rng, out.len() / 4),
+                };
                 let v = *pick(rng, &[f32::NAN, f32::INFINITY, -1e38, 0.0, 1e30]);
                 out[at..at + 4].copy_from_slice(&v.to_le_bytes());
             }
@@ -314,7 +330,7 @@ fn mutate_tfx(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
             _ => {
                 let n = out.len();
                 out.truncate(below(rng, n + 1));
-                if out.len() < 16 {
+                if out.len() < layout.min_len {
                     return out;
                 }
             }
@@ -323,35 +339,24 @@ fn mutate_tfx(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
     out
 }
 
+fn mutate_tfx(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
+    let layout = BinaryLayout {
+        counts: (4, 3),
+        floats: None,
+        extremes: [0, 1, 2, 7, 160, 0x7fff_ffff, 0xffff_ffff, 65535],
+        min_len: 16,
+    };
+    mutate_binary(rng, seed, &layout)
+}
+
 fn mutate_hair(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
-    let mut out = seed.to_vec();
-    const EXTREMES: [u32; 8] = [0, 1, 2, 0x1f, 0x20, 0x7fff_ffff, 0xffff_ffff, 65535];
-    for _ in 0..1 + below(rng, 3) {
-        match below(rng, 5) {
-            0 | 1 => {
-                let at = 4 + 4 * below(rng, 4);
-                let v = *pick(rng, &EXTREMES);
-                out[at..at + 4].copy_from_slice(&v.to_le_bytes());
-            }
-            2 => {
-                let at = 20 + 4 * below(rng, 5);
-                let v = *pick(rng, &[f32::NAN, f32::INFINITY, -1e38, 0.0]);
-                out[at..at + 4].copy_from_slice(&v.to_le_bytes());
-            }
-            3 => {
-                let i = below(rng, out.len());
-                out[i] ^= 1 << below(rng, 8);
-            }
-            _ => {
-                let n = out.len();
-                out.truncate(below(rng, n + 1));
-                if out.len() < 40 {
-                    return out;
-                }
-            }
-        }
-    }
-    out
+    let layout = BinaryLayout {
+        counts: (4, 4),
+        floats: Some((20, 5)),
+        extremes: [0, 1, 2, 0x1f, 0x20, 0x7fff_ffff, 0xffff_ffff, 65535],
+        min_len: 40,
+    };
+    mutate_binary(rng, seed, &layout)
 }
 
 fn hmb_seed() -> Vec<u8> {

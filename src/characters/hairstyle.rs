@@ -174,10 +174,20 @@ fn fitted_sintel(seed: u32, head: &HeadShape, rng: &mut Pcg32) -> Result<Hairsty
     let scale = 2.1 * head.radii.x / (hi.x - lo.x).max(1e-6);
     let crown = Vec3::new(0.5 * (lo.x + hi.x), hi.y, 0.5 * (lo.z + hi.z));
     let top = head.centre + Vec3::new(0.0, head.radii.y * 1.02, 0.0);
+    // Every character's copy differs: turned a little about the vertical, the hair (not the
+    // scalp) longer or shorter.
+    let turn = glam::Quat::from_rotation_y(range(rng, -0.3, 0.3));
+    let stretch = range(rng, 0.8, 1.2);
+    let place = |p: Vec3| top + turn * ((p - crown) * scale);
     let layers = mesh
         .layers
         .iter()
-        .map(|l| l.iter().map(|p| top + (*p - crown) * scale).collect())
+        .map(|l| {
+            l.iter()
+                .zip(&mesh.layers[0])
+                .map(|(p, root)| place(*root) + (place(*p) - place(*root)) * stretch)
+                .collect()
+        })
         .collect();
     let name = format!("Fitted #{seed}");
     let mesh = HairMesh::new(name, layers, None, mesh.uv.clone(), mesh.faces.clone())?;

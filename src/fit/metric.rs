@@ -154,12 +154,16 @@ mod tests {
         let line = |x: f32| vec![Vec3::new(x, 0.0, 0.0), Vec3::new(x, 10.0, 0.0)];
         let a = vec![line(0.0), line(1.0)];
         let same = compare(&a, &a, 10.0, 0.5);
-        assert!(same.two_sided.0 < 1e-6 && same.coverage == 1.0);
+        // Dense points 0.2% of the diagonal apart: distances are exact to 0.1%.
+        assert!(
+            same.two_sided.0 < 1.1e-3 && same.coverage == 1.0,
+            "{same:?}"
+        );
         // Moved by 0.1: every distance is 0.1 = 1% of the diagonal.
         let b = vec![line(0.1), line(1.1)];
         let f = compare(&a, &b, 10.0, 0.5);
-        assert!((f.two_sided.0 - 0.01).abs() < 1e-4, "{f:?}");
-        assert!((f.two_sided.1 - 0.01).abs() < 1e-4, "{f:?}");
+        assert!((f.two_sided.0 - 0.01).abs() < 1.1e-3, "{f:?}");
+        assert!((f.two_sided.1 - 0.01).abs() < 1.1e-3, "{f:?}");
         // Roots 0.6 apart are not within a bundle of 0.5.
         let c = vec![line(0.6), line(1.6)];
         assert_eq!(compare(&a, &c, 10.0, 0.5).coverage, 0.5);

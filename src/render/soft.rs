@@ -111,16 +111,7 @@ impl std::str::FromStr for StrandRaster {
     type Err = String;
     /// `hw`, `soft` or `soft:K`, `auto` or `auto:K` (K fragments per pixel kept sorted).
     fn from_str(s: &str) -> Result<Self, String> {
-        let (name, k) = match s.split_once(':') {
-            Some((n, c)) => (
-                n,
-                Some(
-                    c.parse::<u32>()
-                        .map_err(|_| format!("draw '{s}': '{c}' is not a whole number"))?,
-                ),
-            ),
-            None => (s, None),
-        };
+        let (name, k) = super::transparency::name_and_count("draw", s)?;
         let k_or_default = k.unwrap_or(DEFAULT_SOFT_K);
         let r = match name {
             "hw" if k.is_none() => StrandRaster::Hardware,
@@ -258,22 +249,13 @@ impl SoftBuffers {
             budget.tile_entries as u64 * 4,
             width as u64 * height as u64 * 4,
         ];
-        let mut replaced: Vec<Box<dyn std::any::Any>> = Vec::new();
         let slots = [
             (&mut self.segments, "soft segments", need[0]),
             (&mut self.tiles, "soft tiles", need[1]),
             (&mut self.entries, "soft entries", need[2]),
             (&mut self.depth, "soft depth", need[3]),
         ];
-        for (buffer, name, bytes) in slots {
-            if bytes > buffer.size {
-                replaced.push(Box::new(std::mem::replace(
-                    buffer,
-                    storage(&self.ctx, name, bytes)?,
-                )));
-            }
-        }
-        Ok(replaced)
+        super::transparency::grow_buffers(slots, |name, bytes| storage(&self.ctx, name, bytes))
     }
 }
 

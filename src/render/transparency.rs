@@ -106,20 +106,23 @@ impl std::fmt::Display for Transparency {
     }
 }
 
+/// `name` or `name:count` (a whole number) of a mode flag such as `oit:8`; `what` names the
+/// flag in errors.
+pub(crate) fn name_and_count<'a>(what: &str, s: &'a str) -> Result<(&'a str, Option<u32>), String> {
+    match s.split_once(':') {
+        Some((n, c)) => c
+            .parse::<u32>()
+            .map(|c| (n, Some(c)))
+            .map_err(|_| format!("{what} '{s}': '{c}' is not a whole number")),
+        None => Ok((s, None)),
+    }
+}
+
 impl std::str::FromStr for Transparency {
     type Err = String;
     /// `opaque`, `oit` or `oit:K` (K nodes per pixel), `peel` or `peel:N` (N layers).
     fn from_str(s: &str) -> Result<Self, String> {
-        let (name, count) = match s.split_once(':') {
-            Some((n, c)) => (
-                n,
-                Some(
-                    c.parse::<u32>()
-                        .map_err(|_| format!("transparency '{s}': '{c}' is not a whole number"))?,
-                ),
-            ),
-            None => (s, None),
-        };
+        let (name, count) = name_and_count("transparency", s)?;
         let t = match name {
             "opaque" if count.is_none() => Transparency::Opaque,
             "oit" => Transparency::KBuffer {
@@ -224,16 +227,26 @@ impl TransparencyBuffers {
             (&mut self.peel_depth, "peel depth", need[2]),
             (&mut self.peel_accum, "peel accumulation", need[3]),
         ];
-        for (buffer, name, bytes) in slots {
-            if bytes > buffer.size {
-                replaced.push(Box::new(std::mem::replace(
-                    buffer,
-                    storage(&self.ctx, name, bytes)?,
-                )));
-            }
-        }
+        replaced.extend(grow_buffers(slots, |name, bytes| {
+            storage(&self.ctx, name, bytes)
+        })?);
         Ok(replaced)
     }
+}
+
+/// Replace every `(buffer, name, bytes)` smaller than `bytes` by `make(name, bytes)`; returns
+/// the replaced buffers (frames in flight may still use them).
+pub(crate) fn grow_buffers<'a>(
+    slots: impl IntoIterator<Item = (&'a mut Buffer, &'a str, u64)>,
+    make: impl Fn(&str, u64) -> GpuResult<Buffer>,
+) -> GpuResult<Vec<Box<dyn std::any::Any>>> {
+    let mut replaced: Vec<Box<dyn std::any::Any>> = Vec::new();
+    for (buffer, name, bytes) in slots {
+        if bytes > buffer.size {
+            replaced.push(Box::new(std::mem::replace(buffer, make(name, bytes)?)));
+        }
+    }
+    Ok(replaced)
 }
 
 #[cfg(test)]
