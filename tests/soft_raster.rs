@@ -57,6 +57,10 @@ fn a_thin_straight_strand_deposits_its_area() {
                 }
                 let area = width as f64 * 100.0;
                 let err = (sum - area).abs() / area;
+                println!(
+                    "width {width}, {degrees} deg, offset {offset}: coverage {sum:.3} of {area:.3} ({:+.2}%), worst pixel {max_diff:.3}",
+                    100.0 * (sum - area) / area
+                );
                 worst = worst.max(err);
                 assert!(
                     err < 0.02,

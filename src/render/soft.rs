@@ -308,14 +308,15 @@ fn chord_in_pixel(a: Vec2, d: Vec2, n: Vec2, len: f32, v: f32, pmin: Vec2) -> f3
 }
 
 /// Strands drawn at most this wide (pixels) take the line-sampled coverage
-/// (`SOFT_THIN_WIDTH` of `soft_raster.glsl`): up to 0.7 the samples of one pixel never add up
-/// past 1, so the sum over pixels is the strand's area.
-pub const THIN_WIDTH: f32 = 0.7;
+/// (`SOFT_THIN_WIDTH` of `soft_raster.glsl`): much cheaper on GPUs than the exact area; the
+/// sum over pixels is still the strand's area (a pixel may get a little more than 1 and its
+/// neighbours as much less).
+pub const THIN_WIDTH: f32 = 2.0;
 
 /// Share of the unit pixel square with corner `pmin` covered by the rectangle of half-width
 /// `h` around the segment `a -> b`: CPU twin of `pixel_coverage` in `soft_raster.glsl`
-/// (`ceil(4h)` lines across the width for thin strands, the exact clipped area for thicker
-/// ones).
+/// (`ceil(8h)` lines across the width for strands up to [`THIN_WIDTH`], the exact clipped
+/// area for thicker ones).
 pub fn pixel_coverage(a: Vec2, b: Vec2, h: f32, pmin: Vec2) -> f32 {
     let len = (b - a).length();
     if len < 1e-9 {
@@ -326,12 +327,13 @@ pub fn pixel_coverage(a: Vec2, b: Vec2, h: f32, pmin: Vec2) -> f32 {
     if 2.0 * h > THIN_WIDTH {
         return exact_coverage(a, d, n, len, h, pmin);
     }
-    let lines = ((4.0 * h).ceil() as i32).max(1);
+    let lines = ((8.0 * h).ceil() as i32).max(1);
     let step = 2.0 * h / lines as f32;
     let sum: f32 = (0..lines)
         .map(|i| chord_in_pixel(a, d, n, len, -h + (i as f32 + 0.5) * step, pmin))
         .sum();
-    (sum * step).min(1.0)
+    // Not clamped: see pixel_coverage in soft_raster.glsl.
+    sum * step
 }
 
 /// The pixel square in the segment's frame, clipped to `[0, len] x [-h, h]`, its area.
