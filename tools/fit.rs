@@ -103,7 +103,7 @@ fn run(args: Args) -> Result<()> {
     let obj = hairmesh::model::obj_io::hair_mesh_obj_bytes(&fitted.mesh, &comment)?;
     let toml = format!("# {comment}\n{}", toml::to_string(&fitted.style)?);
     outln!(
-        "{}: {} strands, {} points -> {} bundles, {} layers; textures {:.1} KiB vs {:.1} KiB input ({:.1}x smaller)",
+        "{}: {} strands, {} points -> {} bundles, {} layers; textures {:.1} KiB vs {:.1} KiB input (input / textures = {:.1})",
         args.strands.display(),
         model.strands.len(),
         model.point_count(),
