@@ -51,6 +51,8 @@ void insert(uint lp, uint k, float z, vec3 c, float alpha) {
 // inside the image).
 void raster_segment(Segment s, ivec2 origin, ivec2 extent, uint k) {
     float h = s.half_width;
+    // The coverage frame once per segment, not per pixel.
+    SegmentFrame frame_ab = segment_frame(s.a, s.b);
     vec2 d = s.b - s.a;
     float len2 = dot(d, d);
     vec4 ca = unpack_fragment(s.color_a);
@@ -69,7 +71,7 @@ void raster_segment(Segment s, ivec2 origin, ivec2 extent, uint k) {
         int x1 = min(int(floor(max(xa, xb) + h)), origin.x + extent.x - 1);
         for (int x = x0; x <= x1; x++) {
             vec2 pmin = vec2(x, y);
-            float cov = pixel_coverage(s.a, s.b, h, pmin);
+            float cov = pixel_coverage(frame_ab, h, pmin);
             if (cov <= 0.0) {
                 continue;
             }

@@ -58,14 +58,30 @@ vec2 clip_param(vec2 a, vec2 b, int axis, float lo, float hi) {
     return vec2(max(min(t0, t1), 0.0), min(max(t0, t1), 1.0));
 }
 
-// Length of the segment a -> b (unit direction d, length len) offset by v along its normal n,
-// inside the unit pixel square with corner `pmin` (Liang-Barsky slab clipping).
-float chord_in_pixel(vec2 a, vec2 d, vec2 n, float len, float v, vec2 pmin) {
-    vec2 c = a + v * n;
+// A segment's frame for the coverage, computed once per segment: end a, unit direction d,
+// its normal n, length len.
+struct SegmentFrame {
+    vec2 a;
+    vec2 d;
+    vec2 n;
+    float len;
+};
+
+SegmentFrame segment_frame(vec2 a, vec2 b) {
+    vec2 d = b - a;
+    float len = length(d);
+    d = len > 0.0 ? d / len : vec2(1.0, 0.0);
+    return SegmentFrame(a, d, vec2(-d.y, d.x), len);
+}
+
+// Length of the segment offset by v along its normal inside the unit pixel square with
+// corner `pmin` (Liang-Barsky slab clipping).
+float chord_in_pixel(SegmentFrame f, float v, vec2 pmin) {
+    vec2 c = f.a + v * f.n;
     float lo = 0.0;
-    float hi = len;
+    float hi = f.len;
     for (int axis = 0; axis < 2; axis++) {
-        float da = d[axis];
+        float da = f.d[axis];
         float p0 = pmin[axis] - c[axis];
         if (abs(da) < 1e-12) {
             // Parallel to this axis: inside when pmin <= c < pmin + 1 (half-open, so a line
@@ -87,59 +103,22 @@ float chord_in_pixel(vec2 a, vec2 d, vec2 n, float len, float v, vec2 pmin) {
 // THIN_WIDTH.
 #define SOFT_THIN_WIDTH 2.0
 
-// Area of the unit pixel square with corner `pmin` covered by the rectangle of half-width
-// `h` around the segment a -> b (no end caps, so consecutive segments of a straight strand
-// tile it exactly). Thin strands (2h <= SOFT_THIN_WIDTH): the rectangle as n = ceil(8h)
-// lines across its width (at most a quarter pixel apart), 2h / n each, every line clipped to
-// the pixel (the midpoint rule across, exact along; summed over the pixels it gives exactly
-// the rectangle's area, and n = 1 is the box-filtered centre line). The exact area below costs local-memory arrays on GPUs: 4-5x slower. Thicker strands: the exact area, see
-// pixel_coverage_exact.
-float pixel_coverage_exact(vec2 a, vec2 b, float h, vec2 pmin);
-
-float pixel_coverage(vec2 a, vec2 b, float h, vec2 pmin) {
-    if (2.0 * h > SOFT_THIN_WIDTH) {
-        return pixel_coverage_exact(a, b, h, pmin);
-    }
-    vec2 d = b - a;
-    float len = length(d);
-    if (len < 1e-9) {
-        return 0.0;
-    }
-    d /= len;
-    vec2 n = vec2(-d.y, d.x);
-    int lines = max(int(ceil(8.0 * h)), 1);
-    float step = 2.0 * h / float(lines);
-    float sum = 0.0;
-    for (int i = 0; i < lines; i++) {
-        sum += chord_in_pixel(a, d, n, len, -h + (float(i) + 0.5) * step, pmin);
-    }
-    // Not clamped at 1: a pixel's samples may add up a little past it (the neighbours get as
-    // much less), and the total stays the strand's area.
-    return sum * step;
-}
-
 // The exact area for thick strands: the square in the segment's frame, clipped by the four
-// sides of the rectangle (Sutherland-Hodgman), then the shoelace formula.
-float pixel_coverage_exact(vec2 a, vec2 b, float h, vec2 pmin) {
-    vec2 d = b - a;
-    float len = length(d);
-    if (len < 1e-9) {
-        return 0.0;
-    }
-    d /= len;
-    vec2 n = vec2(-d.y, d.x);
+// sides of the rectangle (Sutherland-Hodgman), then the shoelace formula. Its arrays land in
+// local memory on GPUs (4-5x slower than the line samples), hence only beyond SOFT_THIN_WIDTH.
+float pixel_coverage_exact(SegmentFrame f, float h, vec2 pmin) {
     vec2 poly[8];
     vec2 tmp[8];
     for (int i = 0; i < 4; i++) {
-        vec2 q = pmin + vec2(float(i == 1 || i == 2), float(i >= 2)) - a;
-        poly[i] = vec2(dot(q, d), dot(q, n));
+        vec2 q = pmin + vec2(float(i == 1 || i == 2), float(i >= 2)) - f.a;
+        poly[i] = vec2(dot(q, f.d), dot(q, f.n));
     }
     int count = 4;
     // Keep sign * (p[axis] - bound) <= 0 for (axis, bound, sign) = (u, len, +), (u, 0, -),
     // (v, h, +), (v, -h, -).
     for (int side = 0; side < 4; side++) {
         int axis = side / 2;
-        float bound = side == 0 ? len : (side == 1 ? 0.0 : (side == 2 ? h : -h));
+        float bound = side == 0 ? f.len : (side == 1 ? 0.0 : (side == 2 ? h : -h));
         float sgn = (side % 2 == 0) ? 1.0 : -1.0;
         int m = 0;
         for (int i = 0; i < count; i++) {
@@ -169,6 +148,31 @@ float pixel_coverage_exact(vec2 a, vec2 b, float h, vec2 pmin) {
         area += p.x * q.y - q.x * p.y;
     }
     return clamp(0.5 * abs(area), 0.0, 1.0);
+}
+
+// Area of the unit pixel square with corner `pmin` covered by the rectangle of half-width
+// `h` around the segment (no end caps, so consecutive segments of a straight strand tile it
+// exactly). Thin strands (2h <= SOFT_THIN_WIDTH): the rectangle as n = ceil(8h) lines
+// across its width (at most a quarter pixel apart), 2h / n each, every line clipped to the
+// pixel (the midpoint rule across, exact along; summed over the pixels it gives exactly the
+// rectangle's area, and n = 1 is the box-filtered centre line). Thicker strands: the exact
+// area.
+float pixel_coverage(SegmentFrame f, float h, vec2 pmin) {
+    if (f.len < 1e-9) {
+        return 0.0;
+    }
+    if (2.0 * h > SOFT_THIN_WIDTH) {
+        return pixel_coverage_exact(f, h, pmin);
+    }
+    int lines = max(int(ceil(8.0 * h)), 1);
+    float step = 2.0 * h / float(lines);
+    float sum = 0.0;
+    for (int i = 0; i < lines; i++) {
+        sum += chord_in_pixel(f, -h + (float(i) + 0.5) * step, pmin);
+    }
+    // Not clamped at 1: a pixel's samples may add up a little past it (the neighbours get as
+    // much less), and the total stays the strand's area.
+    return sum * step;
 }
 
 #endif

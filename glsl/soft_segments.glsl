@@ -72,11 +72,14 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
         sv_color[idx] = pack_fragment(radiance, width / max(drawn, 1e-20));
     }
     barrier();
-    // Count the kept segments, reserve them with one atomic add, then write them.
+    // Count the kept segments (bit i of `kept`: this thread's i-th entry), reserve them with
+    // one atomic add, then write them.
     uint mine = 0u;
-    for (uint idx = t; idx < entries; idx += S) {
+    uint kept = 0u;
+    for (uint idx = t, i = 0u; idx < entries; idx += S, i++) {
         if (idx % stride < segments && soft_segment_kept(idx)) {
             mine++;
+            kept |= 1u << i;
         }
     }
     uint local = atomicAdd(s_soft_count, mine);
@@ -87,8 +90,8 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
     barrier();
     uint budget = frame.soft.z;
     uint out_index = s_soft_base + local;
-    for (uint idx = t; idx < entries; idx += S) {
-        if (idx % stride < segments && soft_segment_kept(idx)) {
+    for (uint idx = t, i = 0u; idx < entries; idx += S, i++) {
+        if ((kept & (1u << i)) != 0u) {
             if (out_index < budget) {
                 vec4 a = sv_screen[idx];
                 vec4 b = sv_screen[idx + 1u];
