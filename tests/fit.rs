@@ -8,6 +8,7 @@ use glam::Vec3;
 use hairmesh::fit::metric::{Fidelity, compare};
 use hairmesh::fit::{FitOptions, fit};
 use hairmesh::model::strands::StrandModel;
+use hairmesh::reference::generate::strands_per_bundle_for;
 use hairmesh::{BakeOptions, CpuGenerator, bake};
 
 fn strands_of(
@@ -15,11 +16,17 @@ fn strands_of(
     style: hairmesh::HairStyle,
     per: u32,
 ) -> Vec<Vec<Vec3>> {
-    let set = CpuGenerator::new(baked, style).generate(per, 5);
-    set.positions
-        .chunks(set.verts_per_strand)
-        .map(|c| c.to_vec())
-        .collect()
+    CpuGenerator::new(baked, style).generate(per, 5).polylines()
+}
+
+/// About `count` strands from `baked` (as `fit --report` generates them).
+fn strands_like(
+    baked: &hairmesh::BakedHairMesh,
+    style: hairmesh::HairStyle,
+    count: usize,
+) -> Vec<Vec<Vec3>> {
+    let (per, _) = strands_per_bundle_for(baked, &style, count as u64);
+    strands_of(baked, style, per)
 }
 
 /// Strands from a sample hair mesh -> fit -> strands again, compared with the first.
@@ -57,8 +64,7 @@ fn round_trip(name: &str, per: u32) -> (Fidelity, usize, usize) {
         |_, _| {},
     )
     .unwrap();
-    let per2 = (input.len() as f32 / rebaked.bundles.len() as f32).ceil() as u32;
-    let output = strands_of(&rebaked, fitted.style, per2);
+    let output = strands_like(&rebaked, fitted.style, input.len());
     let f = compare(&input, &output, model.diagonal(), fitted.bundle_size);
     (f, fitted.mesh.faces.len(), fitted.mesh.layer_count())
 }
@@ -74,16 +80,7 @@ fn synthetic_round_trips_come_back_close() {
         ("small_patch.obj", 64, 0.009, 0.018),
     ] {
         let (f, bundles, layers) = round_trip(name, per);
-        println!(
-            "{name}: {bundles} bundles, {layers} layers: two-sided mean {:.3}% p95 {:.3}%, input->fit {:.3}/{:.3}%, fit->input {:.3}/{:.3}%, coverage {:.1}%",
-            100.0 * f.two_sided.0,
-            100.0 * f.two_sided.1,
-            100.0 * f.input_to_fit.0,
-            100.0 * f.input_to_fit.1,
-            100.0 * f.fit_to_input.0,
-            100.0 * f.fit_to_input.1,
-            100.0 * f.coverage
-        );
+        println!("{name}: {bundles} bundles, {layers} layers: {f}");
         assert!(f.two_sided.0 <= mean_max, "{name}: mean {:?}", f.two_sided);
         assert!(f.two_sided.1 <= p95_max, "{name}: p95 {:?}", f.two_sided);
     }
@@ -110,14 +107,13 @@ fn sintel_fits_bakes_and_renders() {
     );
     let (baked, style) = sample("sintel.obj");
     assert_eq!(style, fitted.style, "hairmeshes/sintel.toml is stale");
-    let per = (model.strands.len() as f32 / baked.bundles.len() as f32).ceil() as u32;
     let f = compare(
         &model.strands,
-        &strands_of(&baked, style, per),
+        &strands_like(&baked, style, model.strands.len()),
         model.diagonal(),
         fitted.bundle_size,
     );
-    println!("sintel: {f:?}");
+    println!("sintel: {f}");
     // Measured: two-sided mean 1.88%, p95 4.98%, coverage 100% (README).
     assert!(f.two_sided.0 <= 0.022 && f.two_sided.1 <= 0.055, "{f:?}");
     assert!(f.coverage >= 0.98, "{f:?}");

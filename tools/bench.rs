@@ -232,16 +232,7 @@ fn bench_lod(
         },
         Mat4::IDENTITY,
     )?;
-    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
-    let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    let frame = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
-    let at = |k: f32| {
-        Camera::look_at(
-            frame.target + (frame.eye - frame.target) * k,
-            frame.target,
-            40.0,
-        )
-    };
+    let at = dolly(&baked);
     let views = [("near", at(0.6)), ("mid", at(2.5)), ("far", at(8.0))];
     outln!(
         "device: {} ({}), {}x{}, {} strands/bundle, 33 vertices at full detail",
@@ -305,6 +296,22 @@ fn bench_lod(
         write_png(&p, strip.into_raw(), width * 3, height)?;
     }
     Ok(())
+}
+
+/// Cameras on the line from the mesh's framing view (40 degrees, `DEFAULT_VIEW_DIR`) to its
+/// target, `k` times the framing distance away: the near / mid / far views of `bench lod` and
+/// `bench raster`.
+fn dolly(baked: &hairmesh::BakedHairMesh) -> impl Fn(f32) -> Camera {
+    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
+    let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
+    let frame = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
+    move |k| {
+        Camera::look_at(
+            frame.target + (frame.eye - frame.target) * k,
+            frame.target,
+            40.0,
+        )
+    }
 }
 
 /// Most vertices `bench cpu-generate` generates (about 0.9 GB of positions, tangents, widths).

@@ -17,7 +17,7 @@ use hairmesh::fit::picture::{StrandLook, draw_strands};
 use hairmesh::fit::{FitOptions, fit};
 use hairmesh::fsutil::OutputPath;
 use hairmesh::model::strands::StrandModel;
-use hairmesh::reference::generate::strands_in_bundle;
+use hairmesh::reference::generate::strands_per_bundle_for;
 use hairmesh::render::{Camera, Renderer, RendererDesc};
 use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakeOptions, CpuGenerator, bake, outln};
@@ -147,18 +147,10 @@ fn generated(
     fitted: &hairmesh::fit::Fitted,
     baked: &hairmesh::BakedHairMesh,
 ) -> Vec<Vec<Vec3>> {
-    let per = (model.strands.len() as f32 / baked.bundles.len() as f32).ceil() as u32;
-    let per = per.clamp(1, 4096);
-    let _total: u64 = baked
-        .bundles
-        .iter()
-        .map(|b| strands_in_bundle(b, &fitted.style, per) as u64)
-        .sum();
-    let set = CpuGenerator::new(baked, fitted.style).generate(per, 5);
-    set.positions
-        .chunks(set.verts_per_strand)
-        .map(|c| c.to_vec())
-        .collect()
+    let (per, _) = strands_per_bundle_for(baked, &fitted.style, model.strands.len() as u64);
+    CpuGenerator::new(baked, fitted.style)
+        .generate(per, 5)
+        .polylines()
 }
 
 fn report(
@@ -175,16 +167,9 @@ fn report(
         fitted.bundle_size,
     );
     outln!(
-        "fidelity ({} generated strands; distances in % of the {:.3} bounding-box diagonal): input->fit mean {:.2} p95 {:.2}; fit->input mean {:.2} p95 {:.2}; two-sided mean {:.2} p95 {:.2}; coverage {:.1}% of roots within {:.3} (bundle size)",
+        "fidelity ({} generated strands; distances in % of the {:.3} bounding-box diagonal, coverage of roots within {:.3}, the bundle size): {f}",
         strands.len(),
         model.diagonal(),
-        100.0 * f.input_to_fit.0,
-        100.0 * f.input_to_fit.1,
-        100.0 * f.fit_to_input.0,
-        100.0 * f.fit_to_input.1,
-        100.0 * f.two_sided.0,
-        100.0 * f.two_sided.1,
-        100.0 * f.coverage,
         fitted.bundle_size
     )?;
     let ctx = Arc::new(Context::new(

@@ -24,6 +24,24 @@ pub struct Fidelity {
     pub coverage: f32,
 }
 
+impl std::fmt::Display for Fidelity {
+    /// Distances in % of the diagonal, then coverage.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let pct = |x: f32| 100.0 * x;
+        write!(
+            f,
+            "two-sided mean {:.2}% p95 {:.2}%; input->fit mean {:.2}% p95 {:.2}%; fit->input mean {:.2}% p95 {:.2}%; coverage {:.1}%",
+            pct(self.two_sided.0),
+            pct(self.two_sided.1),
+            pct(self.input_to_fit.0),
+            pct(self.input_to_fit.1),
+            pct(self.fit_to_input.0),
+            pct(self.fit_to_input.1),
+            pct(self.coverage)
+        )
+    }
+}
+
 /// Nearest-point queries over points densely sampled along polylines (spacing at most
 /// `spacing`, so a distance is off by at most half of it), hashed into a uniform grid.
 struct Nearest {

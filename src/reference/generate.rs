@@ -269,6 +269,23 @@ pub fn strands_in_bundle(b: &BundleDesc, style: &HairStyle, n: u32) -> u32 {
     count.clamp(1, MAX_STRANDS_PER_BUNDLE as u32)
 }
 
+/// Strands per (average) bundle that give about `target` strands over `baked`'s bundles
+/// (1..=4096), and the strands that makes.
+pub fn strands_per_bundle_for(
+    baked: &crate::bake::BakedHairMesh,
+    style: &HairStyle,
+    target: u64,
+) -> (u32, u64) {
+    let per = (target as f32 / baked.bundles.len().max(1) as f32).ceil() as u32;
+    let per = per.clamp(1, 4096);
+    let total = baked
+        .bundles
+        .iter()
+        .map(|b| strands_in_bundle(b, style, per) as u64)
+        .sum();
+    (per, total)
+}
+
 /// Styled offset of a vertex in the `u v w` frame (object units), section 3.4.
 /// `s` is the normalised position along the strand, `w` the styling coordinate.
 pub fn styling_offset(style: &HairStyle, key: u32, s: f32, w: f32) -> Vec3 {
@@ -318,6 +335,14 @@ impl StrandSet {
     /// Number of strands.
     pub fn strand_count(&self) -> usize {
         self.strand_bundle.len()
+    }
+
+    /// The strands as polylines, root first.
+    pub fn polylines(&self) -> Vec<Vec<Vec3>> {
+        self.positions
+            .chunks(self.verts_per_strand)
+            .map(|c| c.to_vec())
+            .collect()
     }
 }
 

@@ -13,7 +13,7 @@ use anyhow::{Result, bail};
 use glam::{Mat4, Vec3};
 use hairmesh::fsutil::OutputPath;
 use hairmesh::outln;
-use hairmesh::reference::generate::strands_in_bundle;
+use hairmesh::reference::generate::strands_per_bundle_for;
 use hairmesh::render::scene::load_mesh;
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, RenderPath, Renderer, RendererDesc, StrandParams,
@@ -76,12 +76,7 @@ fn storage_of_generated_styles(strands: u32, rows: &mut String) -> Result<()> {
             hairmesh::BakeOptions::default(),
             |_, _| {},
         )?;
-        let per_bundle = (strands as f32 / baked.bundles.len() as f32).ceil() as u32;
-        let n: u64 = baked
-            .bundles
-            .iter()
-            .map(|b| strands_in_bundle(b, &c.hair.style, per_bundle.clamp(1, 4096)) as u64)
-            .sum();
+        let (_, n) = strands_per_bundle_for(&baked, &c.hair.style, strands as u64);
         let points = n * 17;
         let guides = n.div_ceil(100);
         let lhs = points * 16 + n * 24 + guides * 17 * 16;
@@ -187,16 +182,12 @@ pub fn bench_paper(
         outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
         for path in MODELS {
             let (baked, style) = load_mesh(std::path::Path::new(path), None)?;
-            let per_bundle = (scale.strands as f32 / baked.bundles.len() as f32).ceil() as u32;
+            let (per_bundle, strands) =
+                strands_per_bundle_for(&baked, &style, scale.strands as u64);
             let params = StrandParams {
-                strands_per_bundle: per_bundle.clamp(1, 4096),
+                strands_per_bundle: per_bundle,
                 verts_log2: 4,
             };
-            let strands: u64 = baked
-                .bundles
-                .iter()
-                .map(|b| strands_in_bundle(b, &style, params.strands_per_bundle) as u64)
-                .sum();
             let mut r = Renderer::new(
                 &ctx,
                 &RendererDesc::default().size(w, h).vertex_pool_bytes(pool),

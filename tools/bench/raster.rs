@@ -10,7 +10,7 @@ use std::sync::Arc;
 use anyhow::{Result, bail};
 use glam::{Mat4, Vec3};
 use hairmesh::outln;
-use hairmesh::reference::generate::strands_in_bundle;
+use hairmesh::reference::generate::strands_per_bundle_for;
 use hairmesh::render::scene::load_mesh;
 use hairmesh::render::{
     Camera, FrameOptions, RenderPath, Renderer, RendererDesc, StrandParams, StrandRaster,
@@ -72,16 +72,7 @@ fn time(
 
 fn head_scenes(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Vec<Scene>> {
     let (baked, style) = load_mesh(std::path::Path::new("hairmeshes/head_long.obj"), None)?;
-    let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
-    let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    let frame = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
-    let at = |k: f32| {
-        Camera::look_at(
-            frame.target + (frame.eye - frame.target) * k,
-            frame.target,
-            40.0,
-        )
-    };
+    let at = super::dolly(&baked);
     let head = |strands_per_bundle: u32| -> Result<Renderer> {
         let mut r = Renderer::new(ctx, &desc(a))?;
         r.add_character(
@@ -104,13 +95,7 @@ fn head_scenes(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Vec<Scene>> {
             lod: true,
         });
     }
-    let per_bundle = (a.strands as f32 / baked.bundles.len() as f32).ceil() as u32;
-    let per_bundle = per_bundle.clamp(1, 4096);
-    let strands: u64 = baked
-        .bundles
-        .iter()
-        .map(|b| strands_in_bundle(b, &style, per_bundle) as u64)
-        .sum();
+    let (per_bundle, strands) = strands_per_bundle_for(&baked, &style, a.strands as u64);
     scenes.push(Scene {
         name: format!("{}K strands", strands.div_ceil(1000)),
         renderer: head(per_bundle)?,
