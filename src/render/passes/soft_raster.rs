@@ -158,7 +158,8 @@ impl SoftRasterPass {
         rec.barrier(&rw, &rw);
         rec.bind(&self.scan, &draw.sets.both());
         rec.dispatch(1, 1, 1);
-        rec.barrier(&rw, &rw);
+        // The scan writes `GenerateArgs` statistics beside the scatter's indirect arguments.
+        rec.barrier(&rw, &[Access::ComputeReadWrite, Access::IndirectRead]);
         rec.bind(&self.scatter, &draw.sets.both());
         rec.dispatch_indirect(draw.args, GenerateArgs::SOFT_DISPATCH_OFFSET);
         profiler.end(rec);
