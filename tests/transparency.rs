@@ -23,21 +23,15 @@ fn frame(
     let (baked, style) = sample("head_long.obj");
     let mut r = Renderer::new(ctx, &RendererDesc::default().size(SIZE, SIZE).msaa(msaa)).unwrap();
     upload(&mut r, &baked, &style, 32, 5);
-    let view = View {
-        camera: framing(&baked),
-        light_dir: light(),
+    let settings = RenderSettings {
+        path: Some(path),
         lod: LodSettings::off(),
         shading: ShadingModel::KajiyaKay,
         shadows: ShadowMode::Off,
         transparency,
         lod_appearance: true,
     };
-    let opts = FrameOptions {
-        path: Some(path),
-        read_image: true,
-        ..Default::default()
-    };
-    let rgba = r.render_one(&view, &opts).unwrap().rgba.unwrap();
+    let rgba = render(&mut r, &framing(&baked), &settings).rgba;
     assert_no_validation_errors(ctx);
     rgba
 }
