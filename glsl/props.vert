@@ -15,7 +15,8 @@ void main() {
     PropVertex v = prop_vertices[gl_VertexIndex];
     PropInstance inst = prop_instances[gl_InstanceIndex];
     vec4 world = inst.model * vec4(v.position.xyz, 1.0);
-    out_normal = normalize(mat3(inst.model) * v.normal.xyz);
+    // Inverse transpose: people are scaled non-uniformly (head proportions).
+    out_normal = normalize(transpose(inverse(mat3(inst.model))) * v.normal.xyz);
     out_color = inst.color.rgb;
     out_pos = world.xyz;
     gl_Position = frame.view_proj * world;

@@ -25,6 +25,8 @@ pub struct AnimatedCharacter {
     bounds: (Vec3, f32),
     /// Seconds since its hair was last simulated.
     pending_dt: f32,
+    /// Its hair roots as last handed to the renderer (character frame).
+    roots: Vec<Vec3>,
 }
 
 /// What the last [`CrowdAnimation::advance`] did.
@@ -85,6 +87,10 @@ impl CrowdAnimation {
         motion: CharacterMotion,
         hair: Option<(&HairMesh, Vec<Collider>)>,
     ) {
+        let roots = hair
+            .as_ref()
+            .map(|(mesh, _)| mesh.layers[0].clone())
+            .unwrap_or_default();
         let (bounds, dynamics) = match hair {
             Some((mesh, colliders)) => {
                 let (lo, hi) =
@@ -111,7 +117,17 @@ impl CrowdAnimation {
             dynamics,
             bounds,
             pending_dt: 0.0,
+            roots,
         });
+    }
+
+    /// Hair roots of simulated character `id` as last handed to the renderer (its frame), or
+    /// `None` if its hair is not simulated.
+    pub fn roots(&self, id: CharacterId) -> Option<&[Vec3]> {
+        self.characters
+            .iter()
+            .find(|c| c.id == id && c.dynamics.is_some())
+            .map(|c| c.roots.as_slice())
     }
 
     /// Seconds of animation so far.
@@ -173,9 +189,12 @@ impl CrowdAnimation {
                 });
             }
         });
-        for (c, _) in &due {
+        for (c, _) in due.iter_mut() {
             if let Some(d) = &c.dynamics {
-                renderer.set_hair_mesh_pose(c.id, &d.pose())?;
+                let pose = d.pose();
+                renderer.set_hair_mesh_pose(c.id, &pose)?;
+                let n = c.roots.len();
+                c.roots.copy_from_slice(&pose[..n]);
                 stats.simulated += 1;
                 stats.vertices += d.vertex_count();
             }
@@ -195,24 +214,6 @@ pub fn update_interval(pixels: f32) -> u64 {
         threshold *= 0.5;
     }
     interval
-}
-
-/// Colliders of a person with `head` (the scalp lies on the head surface, so the head
-/// collider sits just inside it): the head and a capsule across the shoulders.
-pub fn person_colliders(head: &crate::characters::head::HeadShape) -> Vec<Collider> {
-    let r = head.radii;
-    let shoulders = head.centre - Vec3::new(0.0, 2.1 * r.y, 0.0);
-    vec![
-        Collider::Ellipsoid {
-            centre: head.centre,
-            radii: r * 0.97,
-        },
-        Collider::Capsule {
-            a: shoulders - Vec3::new(2.0 * r.x, 0.0, 0.0),
-            b: shoulders + Vec3::new(2.0 * r.x, 0.0, 0.0),
-            radius: 0.8 * r.x,
-        },
-    ]
 }
 
 #[cfg(test)]

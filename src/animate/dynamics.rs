@@ -28,6 +28,17 @@ pub enum Collider {
         /// Radii.
         radii: Vec3,
     },
+    /// The human head ([`crate::characters::human`]) placed by `to_person` (canonical head to
+    /// the character's frame; `to_canonical` its inverse): pushed out radially to `margin`
+    /// canonical metres outside it.
+    Human {
+        /// Canonical head to the character's frame.
+        to_person: Mat4,
+        /// The inverse.
+        to_canonical: Mat4,
+        /// Distance kept outside the head, canonical metres.
+        margin: f32,
+    },
     /// A capsule (shoulders, necks).
     Capsule {
         /// One end of the axis.
@@ -40,6 +51,15 @@ pub enum Collider {
 }
 
 impl Collider {
+    /// The human head placed by `to_person`, kept `margin` canonical metres away.
+    pub fn human(to_person: Mat4, margin: f32) -> Collider {
+        Collider::Human {
+            to_person,
+            to_canonical: to_person.inverse(),
+            margin,
+        }
+    }
+
     /// `p` moved out of the collider (unchanged if outside).
     pub fn push_out(&self, p: Vec3) -> Vec3 {
         match *self {
@@ -52,6 +72,22 @@ impl Collider {
                     p
                 }
             }
+            Collider::Human {
+                to_person,
+                to_canonical,
+                margin,
+            } => match crate::characters::human::human_head() {
+                Ok(head) => {
+                    let q = to_canonical.transform_point3(p);
+                    let moved = head.push_out(q, margin);
+                    if moved == q {
+                        p
+                    } else {
+                        to_person.transform_point3(moved)
+                    }
+                }
+                Err(_) => p,
+            },
             Collider::Capsule { a, b, radius } => {
                 let ab = b - a;
                 let t = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
@@ -122,6 +158,9 @@ impl Collider {
                 // holds for the turns about the vertical the crowd uses and is close for sway.
                 radii: radii * scale,
             },
+            Collider::Human {
+                to_person, margin, ..
+            } => Collider::human(*m * to_person, margin),
             Collider::Capsule { a, b, radius } => Collider::Capsule {
                 a: m.transform_point3(a),
                 b: m.transform_point3(b),

@@ -1,51 +1,107 @@
 //! The hairstyle generator: a distinct hair mesh and style from a seed and a style family,
-//! grown from the scalp region of a [`HeadShape`]. Deterministic: the same family, seed and
-//! head give byte-identical meshes (and bakes).
+//! grown on a person's head ([`PlacedHead`]). Deterministic: the same family, seed and person
+//! give byte-identical meshes (and bakes).
+//!
+//! Every family is a *cut*: a scalp region bounded by a smooth hairline, covered by one square
+//! grid of bundles (mapped onto the region by the elliptical square-to-disc map, so the outer
+//! ring of the grid *is* the hairline: no stair steps, no holes, one texture chart), a comb
+//! direction field on the scalp (away from a parting, from a crown whorl, toward a tie, or
+//! outward), and a length with an optional hem. Each vertex column is then *settled*: walked
+//! from its root in small steps along the comb direction, bent toward the ground by gravity,
+//! kept at a growing height above the scalp (a few millimetres at the root, up to the cut's
+//! lift where hair lies on hair) and outside the neck, shoulders and torso. That quasi-static
+//! walk is the rest shape the dynamics hold (sag-free: they treat the authored mesh as the
+//! equilibrium under gravity, after Hsu et al. 2022 as paper 003 does). Its arc-length
+//! samples are the hair mesh's layers, denser near the root where the hair turns around the
+//! head.
 
 use glam::{Vec2, Vec3};
 
-use super::head::{HeadShape, ScalpRegion, scalp};
+use super::person::{PersonShape, PlacedHead};
+use crate::animate::Collider;
 use crate::error::Result;
-use crate::model::hair_mesh::{ExtrudeDesc, HairMesh, extrude};
+use crate::model::hair_mesh::{ExtrudeDesc, Face, HairMesh, extrude};
 use crate::model::style::HairStyle;
 use crate::rng::Pcg32;
 
 /// Style families.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum StyleFamily {
-    /// Short hair close to the head.
+    /// A few millimetres of hair lying on the scalp.
+    Buzz,
+    /// Short hair combed from the crown whorl, close to the head.
     ShortCrop,
-    /// Chin-length hair falling straight.
+    /// Jaw-length hair falling straight from a parting, cut level.
     Bob,
-    /// Long straight hair.
+    /// Long straight hair from a centre parting, over the shoulders.
     LongStraight,
-    /// Long curly hair.
+    /// Long wavy hair.
+    LongWavy,
+    /// Long curly hair with volume.
     LongCurly,
-    /// Hair gathered at the back of the head and falling from there.
+    /// Hair combed to a tie at the back of the head and falling from it.
     Ponytail,
-    /// A spiky strip over the top.
+    /// Hair combed to a tie high at the back and coiled around it.
+    Bun,
+    /// Side parting, shoulder-length, with bangs over the forehead.
+    SideBangs,
+    /// A strip of hair standing up over the top.
     Mohawk,
     /// Voluminous, very curly hair standing away from the head.
     Afro,
+    /// The hair mesh `fit` made from the Sintel Lite strands (`hairmeshes/sintel.obj`) on its
+    /// own head.
+    Fitted,
     /// Short fur all over a ball.
     Fur,
-    /// The hair mesh `fit` made from the Sintel Lite strands (`hairmeshes/sintel.obj`),
-    /// placed on the head.
-    Fitted,
 }
 
 impl StyleFamily {
     /// The families people get.
-    pub const PEOPLE: [StyleFamily; 8] = [
+    pub const PEOPLE: [StyleFamily; 12] = [
+        StyleFamily::Buzz,
         StyleFamily::ShortCrop,
         StyleFamily::Bob,
         StyleFamily::LongStraight,
+        StyleFamily::LongWavy,
         StyleFamily::LongCurly,
         StyleFamily::Ponytail,
+        StyleFamily::Bun,
+        StyleFamily::SideBangs,
         StyleFamily::Mohawk,
         StyleFamily::Afro,
         StyleFamily::Fitted,
     ];
+
+    /// Lower-case name (gallery files, reports).
+    pub fn name(self) -> String {
+        format!("{self:?}").to_lowercase()
+    }
+
+    /// Largest width of this family's hair across the head, in head widths (the bounding
+    /// box test's bound; the afro and long curly hair have volume, short hair hugs the head).
+    pub fn max_width(self) -> f32 {
+        match self {
+            StyleFamily::Buzz | StyleFamily::ShortCrop | StyleFamily::Mohawk => 1.2,
+            StyleFamily::Bun | StyleFamily::Ponytail | StyleFamily::Fitted => 1.3,
+            StyleFamily::Bob | StyleFamily::SideBangs => 1.4,
+            StyleFamily::LongStraight | StyleFamily::LongWavy => 1.6,
+            StyleFamily::LongCurly => 1.8,
+            StyleFamily::Afro => 2.3,
+            StyleFamily::Fur => f32::INFINITY,
+        }
+    }
+}
+
+impl std::str::FromStr for StyleFamily {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        let all = StyleFamily::PEOPLE.iter().chain(&[StyleFamily::Fur]);
+        all.clone().find(|f| f.name() == s).copied().ok_or_else(|| {
+            let names: Vec<String> = all.map(|f| f.name()).collect();
+            format!("unknown hairstyle family '{s}' ({})", names.join(", "))
+        })
+    }
 }
 
 /// A generated hairstyle.
@@ -58,110 +114,690 @@ pub struct Hairstyle {
     pub style: HairStyle,
 }
 
-/// Hair colours (linear RGB): black, dark brown, brown, auburn, blonde, grey.
-const PALETTE: [[f32; 3]; 6] = [
-    [0.02, 0.018, 0.016],
-    [0.07, 0.04, 0.022],
-    [0.18, 0.1, 0.045],
-    [0.28, 0.085, 0.035],
-    [0.55, 0.4, 0.2],
-    [0.42, 0.4, 0.38],
-];
-
 /// Uniform in `[lo, hi)`.
 fn range(rng: &mut Pcg32, lo: f32, hi: f32) -> f32 {
     lo + (hi - lo) * rng.next_f32()
 }
 
-/// Extrusion of one family: layers, step range, gravity.
-struct Growth {
-    region: ScalpRegion,
-    grid: usize,
-    layers: usize,
-    step: (f32, f32),
-    gravity: f32,
+/// Hair colour from melanin: eumelanin and pheomelanin concentrations drawn with a realistic
+/// spread (about 45% black and dark brown, 25% brown, 10% blond, 8% red, 12% grey), turned
+/// into the fibre colour by the absorption of [`crate::shade::melanin_color`].
+pub fn hair_color(rng: &mut Pcg32) -> [f32; 3] {
+    let u = rng.next_f32();
+    let (eu, pheo) = if u < 0.45 {
+        (range(rng, 4.0, 8.5), range(rng, 0.0, 0.3))
+    } else if u < 0.70 {
+        (range(rng, 1.5, 4.0), range(rng, 0.2, 0.6))
+    } else if u < 0.80 {
+        (range(rng, 0.15, 0.7), range(rng, 0.05, 0.3))
+    } else if u < 0.88 {
+        (range(rng, 0.3, 1.2), range(rng, 1.0, 2.5))
+    } else {
+        (range(rng, 0.03, 0.35), range(rng, 0.0, 0.05))
+    };
+    crate::shade::melanin_color(eu, pheo).to_array()
 }
 
-fn growth(family: StyleFamily) -> Growth {
-    let full = ScalpRegion::Full;
-    let g = |region, grid, layers, step, gravity| Growth {
-        region,
-        grid,
-        layers,
-        step,
-        gravity,
+/// Where a cut grows.
+#[derive(Clone, Copy)]
+enum Region {
+    /// Inside the hairline, its polar angle scaled by the factor.
+    Full(f32),
+    /// A strip about `half_width` metres wide over the top, front to nape.
+    Strip,
+}
+
+/// The direction hair is combed in at the root.
+#[derive(Clone, Copy)]
+enum Comb {
+    /// Sideways away from a parting at canonical `x` (metres from the middle), a little back.
+    Parting(f32),
+    /// Back over the top, then down ([`combed_back`]).
+    Back,
+    /// Along the scalp normal (standing hair).
+    Out,
+    /// Toward the cut's tie.
+    Tie,
+}
+
+/// What the gathered hair does after the tie.
+#[derive(Clone, Copy, PartialEq)]
+enum TieKind {
+    /// Falls as a tail.
+    Tail,
+    /// Coils around the tie.
+    Bun,
+}
+
+/// A tie the hair is gathered at.
+#[derive(Clone, Copy)]
+struct Tie {
+    /// Canonical polar angle and azimuth of the tie on the head.
+    theta: f32,
+    phi: f32,
+    kind: TieKind,
+    /// Layers from the root up to the tie (the rest are after it).
+    scalp_layers: usize,
+}
+
+/// How a family is cut and combed.
+#[derive(Clone, Copy)]
+struct Cut {
+    region: Region,
+    /// Grid side: `grid x grid` bundles.
+    grid: usize,
+    layers: usize,
+    /// Longest strand, metres (range drawn per person).
+    length: (f32, f32),
+    /// Hem: hair ends where it falls this far below the head centre, metres (range).
+    hem: Option<(f32, f32)>,
+    comb: Comb,
+    /// Height above the scalp at the root and the most it grows to, metres.
+    lift: (f32, f32),
+    /// Arc length over which the lift grows, metres.
+    lift_length: f32,
+    /// Angle at which hair leaves the scalp, radians (0: along it).
+    rise: f32,
+    /// Curvature toward the ground, 1/m.
+    gravity: f32,
+    /// Layer spacing exponent along the column (> 1: denser near the root).
+    spacing: f32,
+    tie: Option<Tie>,
+}
+
+fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
+    let parting = if rng.next_f32() < 0.5 {
+        0.0
+    } else {
+        range(rng, -0.035, 0.035)
+    };
+    let base = Cut {
+        region: Region::Full(1.0),
+        grid: 5,
+        layers: 7,
+        length: (0.4, 0.5),
+        hem: None,
+        comb: Comb::Parting(parting),
+        lift: (0.007, 0.022),
+        lift_length: 0.12,
+        rise: 0.15,
+        gravity: 25.0,
+        spacing: 1.6,
+        tie: None,
     };
     match family {
-        StyleFamily::ShortCrop => g(full, 14, 3, (0.009, 0.014), 0.35),
-        StyleFamily::Bob => g(full, 14, 6, (0.026, 0.034), 0.9),
-        StyleFamily::LongStraight | StyleFamily::Fitted => g(full, 14, 10, (0.04, 0.055), 0.95),
-        StyleFamily::LongCurly => g(full, 14, 9, (0.035, 0.045), 0.8),
-        StyleFamily::Ponytail => g(full, 14, 10, (0.035, 0.05), 1.0),
-        StyleFamily::Mohawk => g(
-            ScalpRegion::Strip { half_width: 0.02 },
-            16,
-            4,
-            (0.025, 0.04),
-            0.0,
-        ),
-        StyleFamily::Afro => g(full, 14, 5, (0.024, 0.032), 0.0),
-        StyleFamily::Fur => g(ScalpRegion::All, 12, 3, (0.012, 0.02), 0.25),
+        StyleFamily::Buzz => Cut {
+            grid: 8,
+            layers: 3,
+            length: (0.008, 0.014),
+            comb: Comb::Back,
+            lift: (0.0035, 0.0045),
+            lift_length: 0.01,
+            rise: 0.2,
+            gravity: 0.0,
+            spacing: 1.0,
+            ..base
+        },
+        StyleFamily::ShortCrop => Cut {
+            layers: 4,
+            length: (0.04, 0.065),
+            comb: Comb::Back,
+            lift: (0.013, 0.018),
+            lift_length: 0.05,
+            rise: 0.3,
+            gravity: 6.0,
+            spacing: 1.1,
+            ..base
+        },
+        StyleFamily::Bob => Cut {
+            layers: 6,
+            length: (0.26, 0.32),
+            hem: Some((0.09, 0.12)),
+            ..base
+        },
+        StyleFamily::LongStraight | StyleFamily::LongWavy => Cut {
+            length: (0.45, 0.6),
+            hem: Some((0.3, 0.42)),
+            ..base
+        },
+        StyleFamily::LongCurly => Cut {
+            length: (0.35, 0.45),
+            hem: Some((0.22, 0.32)),
+            lift: (0.009, 0.032),
+            gravity: 18.0,
+            ..base
+        },
+        StyleFamily::Ponytail => Cut {
+            layers: 7,
+            length: (0.22, 0.36),
+            comb: Comb::Tie,
+            lift: (0.007, 0.01),
+            gravity: 22.0,
+            tie: Some(Tie {
+                theta: range(rng, 1.75, 1.95),
+                phi: 1.5 * std::f32::consts::PI,
+                kind: TieKind::Tail,
+                scalp_layers: 3,
+            }),
+            ..base
+        },
+        StyleFamily::Bun => Cut {
+            layers: 6,
+            length: (0.18, 0.22),
+            comb: Comb::Tie,
+            lift: (0.007, 0.01),
+            tie: Some(Tie {
+                theta: range(rng, 0.85, 1.15),
+                phi: 1.5 * std::f32::consts::PI,
+                kind: TieKind::Bun,
+                scalp_layers: 3,
+            }),
+            ..base
+        },
+        StyleFamily::SideBangs => Cut {
+            layers: 6,
+            length: (0.26, 0.34),
+            hem: Some((0.14, 0.2)),
+            comb: Comb::Parting(if rng.next_f32() < 0.5 { -0.04 } else { 0.04 }),
+            ..base
+        },
+        StyleFamily::Mohawk => Cut {
+            region: Region::Strip,
+            layers: 4,
+            length: (0.08, 0.14),
+            comb: Comb::Out,
+            lift: (0.0, 0.0),
+            rise: 1.35,
+            gravity: 0.0,
+            spacing: 1.0,
+            ..base
+        },
+        StyleFamily::Afro => Cut {
+            region: Region::Full(1.02),
+            layers: 4,
+            length: (0.09, 0.13),
+            comb: Comb::Out,
+            lift: (0.007, 0.01),
+            rise: 1.1,
+            gravity: 3.0,
+            spacing: 1.0,
+            ..base
+        },
+        StyleFamily::Fitted | StyleFamily::Fur => base,
     }
 }
 
 /// Styling parameters of a family with per-character variation.
 fn style_for(family: StyleFamily, seed: u32, rng: &mut Pcg32) -> HairStyle {
-    let base = PALETTE[rng.next_u32() as usize % PALETTE.len()];
-    let jitter = range(rng, 0.85, 1.15);
     let mut s = HairStyle {
         seed,
-        strand_width: range(rng, 0.0007, 0.0011),
-        tip_width_ratio: range(rng, 0.25, 0.45),
-        length_variation: range(rng, 0.08, 0.25),
-        root_ramp: 0.02,
-        clump_strength: range(rng, 0.05, 0.3),
+        strand_width: range(rng, 0.0008, 0.0012),
+        tip_width_ratio: range(rng, 0.3, 0.5),
+        length_variation: range(rng, 0.05, 0.15),
+        root_ramp: 0.03,
+        clump_strength: range(rng, 0.03, 0.15),
         clump_power: range(rng, 1.0, 2.0),
-        frizz_amplitude: range(rng, 0.0005, 0.002),
-        frizz_frequency: range(rng, 6.0, 14.0),
-        color: base.map(|c| (c * jitter).min(1.0)),
+        frizz_amplitude: range(rng, 0.0004, 0.0015),
+        frizz_frequency: range(rng, 20.0, 40.0),
+        color: hair_color(rng),
         ..HairStyle::default()
     };
     match family {
+        StyleFamily::Buzz => {
+            s.length_variation = range(rng, 0.2, 0.4);
+            s.root_ramp = 0.0;
+            s.frizz_amplitude = 0.0002;
+        }
+        StyleFamily::ShortCrop => s.length_variation = range(rng, 0.2, 0.35),
+        StyleFamily::LongWavy => {
+            s.wave_amplitude = range(rng, 0.008, 0.016);
+            s.wave_frequency = range(rng, 5.0, 8.0);
+            s.wave_angle = range(rng, 0.0, std::f32::consts::PI);
+            s.root_ramp = 0.08;
+        }
         StyleFamily::LongCurly => {
-            s.curl_radius = range(rng, 0.006, 0.012);
-            s.curl_frequency = range(rng, 5.0, 11.0);
+            s.curl_radius = range(rng, 0.006, 0.011);
+            s.curl_frequency = range(rng, 14.0, 22.0);
+            s.root_ramp = 0.05;
         }
         StyleFamily::Afro => {
-            s.curl_radius = range(rng, 0.008, 0.014);
-            s.curl_frequency = range(rng, 12.0, 22.0);
-            s.frizz_amplitude = range(rng, 0.003, 0.006);
-            s.clump_strength = range(rng, 0.0, 0.1);
+            s.curl_radius = range(rng, 0.004, 0.007);
+            s.curl_frequency = range(rng, 40.0, 70.0);
+            s.frizz_amplitude = range(rng, 0.002, 0.004);
+            s.clump_strength = range(rng, 0.0, 0.06);
+            s.root_ramp = 0.01;
         }
         StyleFamily::Mohawk => {
-            s.clump_strength = range(rng, 0.5, 0.8);
+            s.clump_strength = range(rng, 0.5, 0.75);
             s.clump_power = 1.0;
         }
         StyleFamily::Bob
         | StyleFamily::LongStraight
         | StyleFamily::Ponytail
+        | StyleFamily::Bun
+        | StyleFamily::SideBangs
         | StyleFamily::Fitted => {
-            s.wave_amplitude = range(rng, 0.0, 0.006);
-            s.wave_frequency = range(rng, 2.0, 5.0);
+            s.wave_amplitude = range(rng, 0.0, 0.003);
+            s.wave_frequency = range(rng, 3.0, 6.0);
             s.wave_angle = range(rng, 0.0, std::f32::consts::PI);
         }
-        StyleFamily::ShortCrop => s.length_variation = range(rng, 0.2, 0.4),
         StyleFamily::Fur => {
             s.strand_width = range(rng, 0.001, 0.0016);
             s.frizz_amplitude = range(rng, 0.001, 0.003);
+            s.frizz_frequency = range(rng, 6.0, 14.0);
+            s.clump_strength = range(rng, 0.05, 0.3);
         }
     }
     s
 }
 
-/// The Sintel hair mesh (`fit` of the Sintel Lite strands, `hairmeshes/sintel.obj`) scaled
-/// and moved onto `head` (its roots' width to the head's, its crown to the head's top), with
-/// the fitted style scaled alike and this character's colour.
-fn fitted_sintel(seed: u32, head: &HeadShape, rng: &mut Pcg32) -> Result<Hairstyle> {
+/// Hairline: polar angle from the crown at which hair stops, every 30 degrees of azimuth
+/// from +X (the person's left) through the forehead (+Z, 90) and the nape (270): above the
+/// forehead, around the temples and over the ears, down behind them to the nape.
+const HAIRLINE_DEGREES: [f32; 12] = [
+    84.0, 78.0, 66.0, 58.0, 66.0, 78.0, 84.0, 96.0, 114.0, 122.0, 114.0, 96.0,
+];
+
+/// The hairline at azimuth `phi` (radians): a periodic Catmull-Rom curve through
+/// [`HAIRLINE_DEGREES`], so the hairline is smooth.
+pub fn hairline(phi: f32) -> f32 {
+    let n = HAIRLINE_DEGREES.len();
+    let x = phi.rem_euclid(std::f32::consts::TAU) / std::f32::consts::TAU * n as f32;
+    let i = x.floor() as usize % n;
+    let t = x.fract();
+    let p = |k: isize| HAIRLINE_DEGREES[(i as isize + k).rem_euclid(n as isize) as usize];
+    let (p0, p1, p2, p3) = (p(-1), p(0), p(1), p(2));
+    let v = 0.5
+        * (2.0 * p1
+            + (p2 - p0) * t
+            + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t * t
+            + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t * t * t);
+    v.to_radians()
+}
+
+/// A scalp vertex: canonical polar angle and azimuth, grid uv, and how near the region's
+/// edge it is (0 centre .. 1 hairline).
+struct Root {
+    theta: f32,
+    phi: f32,
+    uv: Vec2,
+    edge: f32,
+}
+
+/// The scalp grid of `region`: `(grid + 1)^2` vertices (strip: `3 x (2 grid + 1)`) and their
+/// quads, counter-clockwise seen from outside.
+fn scalp_grid(region: Region, grid: usize) -> (Vec<Root>, Vec<Face>) {
+    let (nx, nz) = match region {
+        Region::Full(_) => (grid, grid),
+        Region::Strip => (2, 2 * grid),
+    };
+    let mut roots = Vec::with_capacity((nx + 1) * (nz + 1));
+    for j in 0..=nz {
+        for i in 0..=nx {
+            let a = 2.0 * i as f32 / nx as f32 - 1.0;
+            let b = 2.0 * j as f32 / nz as f32 - 1.0;
+            let uv = Vec2::new(a, b) * 0.5 + 0.5;
+            roots.push(match region {
+                Region::Full(scale) => {
+                    // Elliptical grid mapping of the square onto the disc (Fong 2015): the
+                    // square's border becomes the circle, here the hairline.
+                    let x = a * (1.0 - 0.5 * b * b).sqrt();
+                    let z = b * (1.0 - 0.5 * a * a).sqrt();
+                    let rho = (x * x + z * z).sqrt().min(1.0);
+                    let phi = z.atan2(x).rem_euclid(std::f32::consts::TAU);
+                    Root {
+                        theta: rho * hairline(phi) * scale,
+                        phi,
+                        uv,
+                        edge: rho,
+                    }
+                }
+                Region::Strip => {
+                    // Over the top from the forehead (b = 1) to the nape (b = -1), 4 cm wide.
+                    let beta = if b >= 0.0 { b * 1.05 } else { b * 1.95 };
+                    let d = Vec3::new(a * 0.2, beta.cos(), beta.sin()).normalize();
+                    let (theta, phi) = super::human::angles(d);
+                    Root {
+                        theta,
+                        phi,
+                        uv,
+                        edge: a.abs().max(b.abs()),
+                    }
+                }
+            });
+        }
+    }
+    let mut faces = Vec::with_capacity(nx * nz);
+    for j in 0..nz {
+        for i in 0..nx {
+            let v = |di: usize, dj: usize| ((j + dj) * (nx + 1) + i + di) as u32;
+            faces.push(Face::Quad([v(0, 0), v(0, 1), v(1, 1), v(1, 0)]));
+        }
+    }
+    (roots, faces)
+}
+
+/// Steps of the settling walk, metres.
+const STEP: f32 = 0.003;
+
+/// The world a column settles in: the head, the body colliders below it, and a shield over
+/// the face (canonical ellipsoid: centre, radii) so that hair combed toward the sides falls
+/// beside the face instead of sliding down over it.
+struct Settle<'a> {
+    head: &'a PlacedHead,
+    body: Vec<Collider>,
+    face: Collider,
+}
+
+/// The face shield in the canonical frame: from the brows to below the chin, cheek to cheek.
+const FACE_SHIELD: (Vec3, Vec3) = (Vec3::new(0.0, 1.47, 0.055), Vec3::new(0.078, 0.115, 0.075));
+
+impl Settle<'_> {
+    fn new<'a>(head: &'a PlacedHead, person: &PersonShape) -> Result<Settle<'a>> {
+        let place = person.head_transform()?;
+        let (c, r) = FACE_SHIELD;
+        let s = person.head * person.height;
+        Ok(Settle {
+            head,
+            body: person.colliders()?.into_iter().skip(1).collect(),
+            face: Collider::Ellipsoid {
+                centre: place.transform_point3(c),
+                radii: r * s,
+            },
+        })
+    }
+
+    /// `p` kept `lift` outside the head, the face shield and the body.
+    fn constrain(&self, p: Vec3, lift: f32) -> Vec3 {
+        let mut q = self.face.push_out(self.head.push_out(p, lift));
+        for c in &self.body {
+            q = match *c {
+                Collider::Capsule { a, b, radius } => Collider::Capsule {
+                    a,
+                    b,
+                    radius: radius + lift.max(0.004),
+                }
+                .push_out(q),
+                other => other.push_out(q),
+            };
+        }
+        q
+    }
+
+    /// Walk from `start` along `dir` for `length` metres, turned by `steer(p, on_scalp)`
+    /// (a curvature, 1/m: the comb's pull while on the scalp, gravity), stopping below
+    /// `hem_y`. Hair that starts `on_scalp` lies on it at `lift(s)` above it as long as the
+    /// head holds it up against gravity; where the scalp faces down it hangs free, kept
+    /// outside the head, the face shield and the body.
+    #[allow(clippy::too_many_arguments)]
+    fn walk(
+        &self,
+        start: Vec3,
+        dir: Vec3,
+        length: f32,
+        hem_y: f32,
+        mut on_scalp: bool,
+        lift: impl Fn(f32) -> f32,
+        steer: impl Fn(Vec3, bool) -> Vec3,
+    ) -> Vec<Vec3> {
+        let mut out = vec![start];
+        let (mut p, mut d) = (start, dir.normalize_or(Vec3::NEG_Y));
+        let steps = (length / STEP).ceil().max(1.0) as usize;
+        let centre = self.head.centre();
+        for k in 1..=steps {
+            let s = k as f32 * STEP;
+            d = (d + steer(p, on_scalp) * STEP).normalize_or(d);
+            let mut q = p + d * STEP;
+            if on_scalp {
+                q = self.head.project(q, lift(s));
+                let n = (q - centre).normalize_or(Vec3::Y);
+                // Released where the scalp faces down and the hair moves down.
+                on_scalp = !(n.y < -0.2 && d.y < 0.0);
+            }
+            let q = self.constrain(q, lift(s));
+            d = (q - p).normalize_or(d);
+            p = q;
+            out.push(p);
+            if p.y < hem_y {
+                break;
+            }
+        }
+        out
+    }
+}
+
+/// Length of polyline `p`.
+fn polyline_length(p: &[Vec3]) -> f32 {
+    p.windows(2).map(|w| w[0].distance(w[1])).sum()
+}
+
+/// `count >= 2` points along polyline `p` at arc lengths `L (k / (count - 1))^gamma`.
+fn resample(p: &[Vec3], count: usize, gamma: f32) -> Vec<Vec3> {
+    let total = polyline_length(p);
+    let mut out = Vec::with_capacity(count);
+    let (mut seg, mut walked) = (0usize, 0.0f32);
+    for k in 0..count {
+        let target = total * (k as f32 / (count - 1) as f32).powf(gamma);
+        while seg + 1 < p.len() - 1 && walked + p[seg].distance(p[seg + 1]) < target {
+            walked += p[seg].distance(p[seg + 1]);
+            seg += 1;
+        }
+        if p.len() < 2 {
+            out.push(p[0]);
+            continue;
+        }
+        let l = p[seg].distance(p[seg + 1]).max(1e-9);
+        let t = ((target - walked) / l).clamp(0.0, 1.0);
+        out.push(p[seg].lerp(p[seg + 1], t));
+    }
+    out
+}
+
+/// `0` below `a`, `1` above `b`, smooth between.
+fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// The combed-back field at canonical offset `c` from the head centre: back over the top,
+/// turning down behind the crown. It is never normal to the scalp inside the hairline, so
+/// its tangent never vanishes there (a cap has no hairy-ball whorl unless one is wanted).
+fn combed_back(c: Vec3) -> Vec3 {
+    let back = smoothstep(0.03, -0.07, c.z);
+    Vec3::new(0.0, -(0.3 + 0.7 * back), -(1.0 - 0.8 * back))
+}
+
+/// Pull of the comb on hair lying on the scalp, 1/m.
+const COMB_PULL: f32 = 45.0;
+
+/// Tangent comb direction at `root` on the scalp (`n` the scalp normal there).
+fn comb_direction(comb: Comb, head: &PlacedHead, root: Vec3, n: Vec3, tie: Option<Vec3>) -> Vec3 {
+    let tangent = |v: Vec3| (v - n * v.dot(n)).normalize_or(Vec3::NEG_Y - n * n.y);
+    let c = head.to_canonical.transform_point3(root) - head.shape.centre;
+    match comb {
+        Comb::Parting(x) => {
+            // Sideways from the parting over the front half of the head only; behind the
+            // crown the hair falls.
+            let front = smoothstep(-0.03, 0.02, c.z);
+            let side = ((c.x - x) / 0.012).tanh() * front;
+            tangent(combed_back(c) + Vec3::X * side)
+        }
+        Comb::Back => tangent(combed_back(c)),
+        Comb::Out => (n + Vec3::new(0.0, 0.15, -0.1)).normalize(),
+        Comb::Tie => tangent(tie.unwrap_or(head.centre()) - root),
+    }
+}
+
+/// One column's layers, settled (see the module documentation).
+struct ColumnPlan<'a> {
+    cut: &'a Cut,
+    settle: &'a Settle<'a>,
+    length: f32,
+    hem_y: f32,
+    bangs: bool,
+}
+
+impl ColumnPlan<'_> {
+    fn lift(&self, edge: f32) -> impl Fn(f32) -> f32 + '_ {
+        let (lo, hi) = self.cut.lift;
+        let hi = hi * (1.0 - 0.5 * edge * edge);
+        move |s: f32| lo + (hi - lo) * (s / self.cut.lift_length).min(1.0)
+    }
+
+    /// Layers of a free column (no tie).
+    fn free(&self, root: Vec3, n: Vec3, tangent: Vec3, edge: f32) -> Vec<Vec3> {
+        let cut = self.cut;
+        let dir = (tangent * cut.rise.cos() + n * cut.rise.sin()).normalize();
+        // Short families keep their hairline soft: shorter hair at the edge.
+        let length = if cut.length.1 < 0.1 {
+            self.length * (1.0 - 0.45 * edge.powi(4))
+        } else {
+            self.length
+        };
+        let (length, hem_y) = if self.bangs {
+            (length.min(0.16), self.settle.head.centre().y + 0.03)
+        } else {
+            (length, self.hem_y)
+        };
+        let settle = self.settle;
+        let (comb, gravity) = (cut.comb, cut.gravity);
+        let bangs = self.bangs;
+        let steer = |p: Vec3, on_scalp: bool| {
+            let mut a = Vec3::NEG_Y * gravity;
+            if on_scalp && !bangs && !matches!(comb, Comb::Out) {
+                let n = (p - settle.head.centre()).normalize_or(Vec3::Y);
+                a += comb_direction(comb, settle.head, p, n, None) * COMB_PULL;
+            }
+            a
+        };
+        let lies = !matches!(comb, Comb::Out);
+        let path = settle.walk(root, dir, length, hem_y, lies, self.lift(edge), steer);
+        resample(&path, cut.layers, cut.spacing)
+    }
+
+    /// Layers of a column gathered at a tie at `tie_point` (outward normal `tie_normal`),
+    /// continuing along the shared `tail` (offset by this column's place in the tie).
+    fn tied(&self, root: Vec3, tangent: Vec3, edge: f32, tie: &Tie, tail: &[Vec3]) -> Vec<Vec3> {
+        let settle = self.settle;
+        let head = settle.head;
+        let tie_point = head.surface(tie.theta, tie.phi);
+        let to_tie = root.distance(tie_point);
+        // Along the scalp to the tie: no gravity (the hair is pulled taut).
+        let lift = self.lift(edge);
+        let mut path = vec![root];
+        let (mut p, mut d) = (root, tangent);
+        for k in 1..((to_tie * 2.0 / STEP) as usize).max(2) {
+            let want = (tie_point - p).normalize_or(d);
+            d = (d * 0.6 + want * 0.4).normalize_or(d);
+            let s = k as f32 * STEP;
+            let q = settle.constrain(head.project(p + d * STEP, lift(s)), lift(s));
+            d = (q - p).normalize_or(d);
+            p = q;
+            path.push(p);
+            if p.distance(tie_point) < 0.02 {
+                break;
+            }
+        }
+        let offset = (p - tie_point) * 0.35;
+        let mut out = resample(&path, tie.scalp_layers, 1.0);
+        let rest = self.cut.layers - tie.scalp_layers;
+        let tail_points = resample(tail, rest, 1.0);
+        for (k, t) in tail_points.iter().enumerate() {
+            let spread = 1.0 + 1.5 * k as f32 / rest.max(1) as f32;
+            out.push(settle.constrain(*t + offset * spread, 0.003));
+        }
+        out
+    }
+}
+
+/// The shared path of the gathered hair after `tie`: a tail falling from it, or a coil around
+/// it.
+fn tail_path(settle: &Settle, tie: &Tie, length: f32, gravity: f32) -> Vec<Vec3> {
+    let head = settle.head;
+    let at = head.surface(tie.theta, tie.phi);
+    let n = head.normal(tie.theta, tie.phi);
+    let start = at + n * 0.015;
+    match tie.kind {
+        TieKind::Tail => {
+            let dir = (n * 0.8 + Vec3::NEG_Y * 0.2).normalize();
+            let mut path = vec![at];
+            let steer = |_: Vec3, _: bool| Vec3::NEG_Y * gravity;
+            let (free, lift) = (false, |_: f32| 0.012);
+            path.extend(settle.walk(start, dir, length, f32::NEG_INFINITY, free, lift, steer));
+            path
+        }
+        TieKind::Bun => {
+            let e1 = n.any_orthonormal_vector();
+            let e2 = n.cross(e1);
+            let centre = at + n * 0.03;
+            let turns = 1.25;
+            let count = 48;
+            let mut path = vec![at];
+            for k in 0..=count {
+                let a = std::f32::consts::TAU * turns * k as f32 / count as f32;
+                let r = 0.032 - 0.012 * k as f32 / count as f32;
+                let lift = n * (0.01 * k as f32 / count as f32);
+                path.push(centre + (e1 * a.cos() + e2 * a.sin()) * r + lift);
+            }
+            path
+        }
+    }
+}
+
+/// A hair mesh of `family` for `person`, drawn from `rng`.
+fn grown(
+    family: StyleFamily,
+    person: &PersonShape,
+    rng: &mut Pcg32,
+    name: &str,
+) -> Result<HairMesh> {
+    let cut = cut(family, rng);
+    let head = person.head()?;
+    let settle = Settle::new(&head, person)?;
+    let scale = person.height;
+    let length = range(rng, cut.length.0, cut.length.1) * scale;
+    let hem_y = cut.hem.map_or(f32::NEG_INFINITY, |(a, b)| {
+        head.centre().y - range(rng, a, b) * scale
+    });
+    let (roots, faces) = scalp_grid(cut.region, cut.grid);
+    let tail = cut.tie.map(|t| tail_path(&settle, &t, length, cut.gravity));
+    let tie_point = cut.tie.map(|t| head.surface(t.theta, t.phi));
+    let mut columns = Vec::with_capacity(roots.len());
+    for r in &roots {
+        let p = head.surface(r.theta, r.phi);
+        let n = head.normal(r.theta, r.phi);
+        let t = comb_direction(cut.comb, &head, p, n, tie_point);
+        // Bangs: the front of a side-parted cut falls over the forehead.
+        let front = r.phi > 0.9 && r.phi < 2.25 && r.edge > 0.45;
+        let bangs = family == StyleFamily::SideBangs && front;
+        let t = if bangs {
+            (t * 0.3 + (n.cross(Vec3::X).normalize_or(Vec3::Z) * -1.0)).normalize()
+        } else {
+            t
+        };
+        let plan = ColumnPlan {
+            cut: &cut,
+            settle: &settle,
+            length: length * range(rng, 0.92, 1.0),
+            hem_y,
+            bangs,
+        };
+        columns.push(match (&cut.tie, &tail) {
+            (Some(tie), Some(tail)) => plan.tied(p, t, r.edge, tie, tail),
+            _ => plan.free(p, n, t, r.edge),
+        });
+    }
+    let layers = (0..cut.layers)
+        .map(|k| columns.iter().map(|c| c[k]).collect())
+        .collect();
+    let uv = roots.iter().map(|r| r.uv).collect();
+    HairMesh::new(name, layers, None, uv, faces)
+}
+
+/// The Sintel hair mesh (`fit` of the Sintel Lite strands, `hairmeshes/sintel.obj`) on its own
+/// head, placed like the person's head; each copy's hair (not its scalp) is a little longer or
+/// shorter, in the person's own colour.
+fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hairstyle> {
     let mesh = crate::model::obj_io::parse_hair_mesh_obj(
         "hairmeshes/sintel.obj",
         include_bytes!("../../hairmeshes/sintel.obj"),
@@ -170,27 +806,29 @@ fn fitted_sintel(seed: u32, head: &HeadShape, rng: &mut Pcg32) -> Result<Hairsty
         "hairmeshes/sintel.toml",
         include_str!("../../hairmeshes/sintel.toml"),
     )?;
-    let (lo, hi) = crate::model::hair_mesh::bounds(mesh.layers[0].iter().copied());
-    let scale = 2.1 * head.radii.x / (hi.x - lo.x).max(1e-6);
-    let crown = Vec3::new(0.5 * (lo.x + hi.x), hi.y, 0.5 * (lo.z + hi.z));
-    let top = head.centre + Vec3::new(0.0, head.radii.y * 1.02, 0.0);
-    // Every character's copy differs: turned a little about the vertical, the hair (not the
-    // scalp) longer or shorter.
-    let turn = glam::Quat::from_rotation_y(range(rng, -0.3, 0.3));
-    let stretch = range(rng, 0.8, 1.2);
-    let place = |p: Vec3| top + turn * ((p - crown) * scale);
+    let place = person.head_transform()? * super::human::file_to_canonical();
+    let scale = super::human::FILE_SCALE * person.head_scale();
+    let stretch = range(rng, 0.85, 1.15);
     let layers = mesh
         .layers
         .iter()
         .map(|l| {
             l.iter()
                 .zip(&mesh.layers[0])
-                .map(|(p, root)| place(*root) + (place(*p) - place(*root)) * stretch)
+                .map(|(p, root)| {
+                    let r = place.transform_point3(*root);
+                    r + (place.transform_point3(*p) - r) * stretch
+                })
                 .collect()
         })
         .collect();
-    let name = format!("Fitted #{seed}");
-    let mesh = HairMesh::new(name, layers, None, mesh.uv.clone(), mesh.faces.clone())?;
+    let mesh = HairMesh::new(
+        format!("Fitted #{seed}"),
+        layers,
+        None,
+        mesh.uv.clone(),
+        mesh.faces.clone(),
+    )?;
     let own = style_for(StyleFamily::Fitted, seed, rng);
     let style = HairStyle {
         seed,
@@ -210,35 +848,39 @@ fn fitted_sintel(seed: u32, head: &HeadShape, rng: &mut Pcg32) -> Result<Hairsty
     })
 }
 
-/// Generate a hairstyle of `family` for `head` from `seed`.
-pub fn generate(family: StyleFamily, seed: u32, head: &HeadShape) -> Result<Hairstyle> {
+/// Generate a hairstyle of `family` for `person` from `seed`.
+pub fn generate(family: StyleFamily, seed: u32, person: &PersonShape) -> Result<Hairstyle> {
     let mut rng = Pcg32::new(seed as u64 ^ (family as u64) << 40);
     if family == StyleFamily::Fitted {
-        return fitted_sintel(seed, head, &mut rng);
+        return fitted_sintel(seed, person, &mut rng);
     }
-    let g = growth(family);
-    let step = range(&mut rng, g.step.0, g.step.1);
     let style = style_for(family, seed, &mut rng);
-    let patch = scalp(head, g.region, g.grid);
     let name = format!("{family:?} #{seed}");
-    let mesh = if family == StyleFamily::Ponytail {
-        ponytail(
-            &name,
-            head,
-            &patch.positions,
-            patch.uv.clone(),
-            patch.faces.clone(),
-            g.layers,
-            step,
-        )?
-    } else {
-        // Layers bend from the scalp normal toward down-and-back (hair falls behind the face,
-        // not over it) and stay outside the head.
-        let desc = ExtrudeDesc::new(g.layers, step)
-            .gravity(g.gravity, Vec3::new(0.0, -1.0, -0.45).normalize())
-            .avoid_sphere(head.centre, head.bounding_radius() * 1.02);
-        extrude(name, &patch.positions, &patch.uv, &patch.faces, &desc)?
-    };
+    let mesh = grown(family, person, &mut rng, &name)?;
+    Ok(Hairstyle {
+        family,
+        mesh,
+        style,
+    })
+}
+
+/// Short fur all over a ball (`head`), from `seed`.
+pub fn ball_fur(seed: u32, head: &super::head::HeadShape) -> Result<Hairstyle> {
+    let family = StyleFamily::Fur;
+    let mut rng = Pcg32::new(seed as u64 ^ (family as u64) << 40);
+    let step = range(&mut rng, 0.012, 0.02);
+    let style = style_for(family, seed, &mut rng);
+    let patch = super::head::scalp(head, 12);
+    let desc = ExtrudeDesc::new(3, step)
+        .gravity(0.25, Vec3::new(0.0, -1.0, -0.45).normalize())
+        .avoid_sphere(head.centre, head.bounding_radius() * 1.02);
+    let mesh = extrude(
+        format!("{family:?} #{seed}"),
+        &patch.positions,
+        &patch.uv,
+        &patch.faces,
+        &desc,
+    )?;
     Ok(Hairstyle {
         family,
         mesh,
@@ -251,14 +893,13 @@ pub fn generate(family: StyleFamily, seed: u32, head: &HeadShape) -> Result<Hair
 pub fn teapot_fur(seed: u32, height: f32) -> Result<Hairstyle> {
     let family = StyleFamily::Fur;
     let mut rng = Pcg32::new(seed as u64 ^ (0x007e_a907_u64 << 40));
-    let g = growth(family);
-    let step = range(&mut rng, g.step.0, g.step.1) * 1.25;
+    let step = range(&mut rng, 0.012, 0.02) * 1.25;
     let gravity = range(&mut rng, 0.0, 0.5);
     let mut style = style_for(family, seed, &mut rng);
     // Teapot bundles are large: strong clumping would show the patch grid as tufts.
     style.clump_strength = range(&mut rng, 0.0, 0.08);
     let surface = super::teapot::fur_scalp(height, 5);
-    let desc = ExtrudeDesc::new(g.layers, step).gravity(gravity, Vec3::NEG_Y);
+    let desc = ExtrudeDesc::new(3, step).gravity(gravity, Vec3::NEG_Y);
     let mesh = extrude(
         format!("teapot #{seed}"),
         &surface.positions,
@@ -273,65 +914,31 @@ pub fn teapot_fur(seed: u32, height: f32) -> Result<Hairstyle> {
     })
 }
 
-/// A ponytail: layers 1-3 gather the scalp toward a tie at the back of the head, the rest
-/// hang from the tie as one narrow bundle of bundles.
-fn ponytail(
-    name: &str,
-    head: &HeadShape,
-    scalp: &[Vec3],
-    uv: Vec<Vec2>,
-    faces: Vec<crate::model::hair_mesh::Face>,
-    layers: usize,
-    step: f32,
-) -> Result<HairMesh> {
-    let tie = head.centre + Vec3::new(0.0, 0.02, -head.radii.z * 1.08);
-    let lifted: Vec<Vec3> = scalp
-        .iter()
-        .map(|p| *p + (*p - head.centre).normalize_or(Vec3::Y) * 0.006)
-        .collect();
-    let gathered: Vec<Vec3> = lifted.iter().map(|p| tie + (*p - tie) * 0.12).collect();
-    let mut out = vec![scalp.to_vec(), lifted.clone()];
-    for k in 2..layers {
-        let layer = if k <= 3 {
-            let t = (k - 1) as f32 / 3.0;
-            lifted
-                .iter()
-                .zip(&gathered)
-                .map(|(a, b)| a.lerp(*b, t * t * (3.0 - 2.0 * t)))
-                .collect()
-        } else {
-            let drop = (k - 3) as f32 * step;
-            gathered
-                .iter()
-                .map(|p| *p + Vec3::new(0.0, -drop, -0.25 * drop))
-                .collect()
-        };
-        out.push(layer);
-    }
-    HairMesh::new(name, out, None, uv, faces)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn every_family_generates_a_valid_mesh() {
-        let head = HeadShape::default();
-        for family in StyleFamily::PEOPLE.into_iter().chain([StyleFamily::Fur]) {
-            let h = generate(family, 7, &head).unwrap();
+        let person = PersonShape::draw(3);
+        for family in StyleFamily::PEOPLE {
+            let h = generate(family, 7, &person).unwrap();
             assert!(h.mesh.faces.len() >= 10, "{family:?}");
             h.style.validate("test").unwrap();
         }
-        // The fitted Sintel hair sits on the head: its roots within the head's box (grown by
-        // a fifth), its crown at the head's top.
-        let h = generate(StyleFamily::Fitted, 7, &head).unwrap();
-        let (lo, hi) = crate::model::hair_mesh::bounds(h.mesh.layers[0].iter().copied());
-        let margin = head.radii * 1.2;
-        assert!(lo.cmpge(head.centre - margin).all() && hi.cmple(head.centre + margin).all());
-        assert!((hi.y - (head.centre.y + head.radii.y)).abs() < 0.01, "{hi}");
         let fur = teapot_fur(3, 0.27).unwrap();
         assert!(fur.mesh.faces.len() > 500);
         fur.style.validate("test").unwrap();
+    }
+
+    #[test]
+    fn the_hairline_is_smooth_and_periodic() {
+        for k in 0..360 {
+            let a = (k as f32).to_radians();
+            let step = (hairline(a + 0.01) - hairline(a)).abs();
+            assert!(step < 0.01, "{k}: {step}");
+        }
+        assert!((hairline(0.0) - hairline(std::f32::consts::TAU)).abs() < 1e-5);
+        assert!(hairline(std::f32::consts::FRAC_PI_2) < hairline(1.5 * std::f32::consts::PI));
     }
 }

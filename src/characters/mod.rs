@@ -1,8 +1,11 @@
-//! Characters for crowds: a procedural head-and-body figure ([`head`]), the hairstyle
-//! generator ([`hairstyle`]) and scene presets ([`preset`]) that give every character its own
-//! hair mesh, style and placement.
+//! Characters for crowds: people ([`person`]: the human head of [`human`] on a mannequin
+//! body), furry balls ([`head`]) and teapots ([`teapot`]), the hairstyle generator
+//! ([`hairstyle`]) and scene presets ([`preset`]) that give every character its own hair
+//! mesh, style and placement.
 
 pub mod hairstyle;
 pub mod head;
+pub mod human;
+pub mod person;
 pub mod preset;
 pub mod teapot;

@@ -4,8 +4,9 @@
 
 use glam::{Mat4, Quat, Vec3};
 
-use super::hairstyle::{Hairstyle, StyleFamily, generate, teapot_fur};
-use super::head::{HeadShape, body_mesh, ground_mesh};
+use super::hairstyle::{Hairstyle, StyleFamily, ball_fur, generate, teapot_fur};
+use super::head::{HeadShape, ground_mesh};
+use super::person::PersonShape;
 use crate::error::{HairError, Result};
 use crate::render::StrandParams;
 use crate::render::shared::{PropInstance, PropVertex};
@@ -17,7 +18,7 @@ pub const MAX_CROWD: usize = 4096;
 /// Which characters a crowd has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
-    /// People with the seven hairstyle families.
+    /// People with the twelve hairstyle families.
     People,
     /// People and furry balls.
     Mixed,
@@ -48,10 +49,10 @@ impl std::str::FromStr for Preset {
 }
 
 /// What a character stands on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Body {
-    /// Head, neck, shoulders and body ([`body_mesh`]).
-    Person,
+    /// A person: the human head and shoulders on a mannequin body.
+    Person(PersonShape),
     /// A ball the fur grows on.
     Ball,
     /// A Utah teapot the fur grows on.
@@ -70,6 +71,20 @@ pub struct CrowdCharacter {
     pub skin: [f32; 3],
 }
 
+/// Indices of [`prop_meshes`].
+pub mod prop_mesh {
+    /// The ground.
+    pub const GROUND: usize = 0;
+    /// A person's head and shoulders (the bust).
+    pub const HEAD: usize = 1;
+    /// A person's mannequin body below the bust.
+    pub const BODY: usize = 2;
+    /// A ball.
+    pub const BALL: usize = 3;
+    /// A teapot.
+    pub const TEAPOT: usize = 4;
+}
+
 /// Most vertex level fur uses: 2^3 = 8 segments are plenty for strands a few centimetres long.
 pub const FUR_MAX_VERTS_LOG2: u32 = 3;
 
@@ -78,18 +93,13 @@ impl CrowdCharacter {
     /// teapots) caps the vertex level at [`FUR_MAX_VERTS_LOG2`].
     pub fn strand_params(&self, crowd: StrandParams) -> StrandParams {
         match self.body {
-            Body::Person => crowd,
+            Body::Person(_) => crowd,
             Body::Ball | Body::Teapot => StrandParams {
                 verts_log2: crowd.verts_log2.min(FUR_MAX_VERTS_LOG2),
                 ..crowd
             },
         }
     }
-}
-
-/// The head every person has.
-pub fn person_head() -> HeadShape {
-    HeadShape::default()
 }
 
 /// The ball furry characters are.
@@ -108,6 +118,19 @@ pub const SPACING: f32 = 0.9;
 
 /// Build `count` characters of `preset` from `seed`.
 pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharacter>> {
+    build_families(preset, count, seed, &StyleFamily::PEOPLE)
+}
+
+/// [`build`] with people's hairstyles taken in turn from `families` (non-empty).
+pub fn build_families(
+    preset: Preset,
+    count: usize,
+    seed: u32,
+    families: &[StyleFamily],
+) -> Result<Vec<CrowdCharacter>> {
+    if families.is_empty() {
+        return Err(HairError::invalid("crowd", "no hairstyle families"));
+    }
     if count == 0 || count > MAX_CROWD {
         return Err(HairError::invalid(
             "crowd",
@@ -116,13 +139,6 @@ pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharact
     }
     let mut rng = Pcg32::new(seed as u64);
     let side = (count as f32).sqrt().ceil() as usize;
-    const SKIN: [[f32; 3]; 5] = [
-        [0.62, 0.43, 0.33],
-        [0.45, 0.28, 0.18],
-        [0.25, 0.14, 0.08],
-        [0.7, 0.52, 0.42],
-        [0.55, 0.36, 0.24],
-    ];
     let mut out = Vec::with_capacity(count);
     for i in 0..count {
         let ball = preset == Preset::Mixed && i % 4 == 3;
@@ -130,13 +146,11 @@ pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharact
         let (hair, body) = if preset == Preset::Teapots {
             (teapot_fur(character_seed, TEAPOT_HEIGHT)?, Body::Teapot)
         } else if ball {
-            (
-                generate(StyleFamily::Fur, character_seed, &ball_head())?,
-                Body::Ball,
-            )
+            (ball_fur(character_seed, &ball_head())?, Body::Ball)
         } else {
-            let f = StyleFamily::PEOPLE[(i + (seed as usize)) % StyleFamily::PEOPLE.len()];
-            (generate(f, character_seed, &person_head())?, Body::Person)
+            let f = families[(i + (seed as usize)) % families.len()];
+            let person = PersonShape::draw(character_seed);
+            (generate(f, character_seed, &person)?, Body::Person(person))
         };
         let x = (i % side) as f32 - (side as f32 - 1.0) * 0.5;
         let z = (i / side) as f32;
@@ -146,10 +160,9 @@ pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharact
             Quat::from_rotation_y(yaw),
             Vec3::new(x, 0.0, z) * SPACING + jitter,
         );
-        let skin = if body != Body::Person {
-            hair.style.color.map(|c| c * 0.8)
-        } else {
-            SKIN[rng.next_u32() as usize % SKIN.len()]
+        let skin = match body {
+            Body::Person(p) => p.skin,
+            _ => hair.style.color.map(|c| c * 0.8),
         };
         out.push(CrowdCharacter {
             hair,
@@ -161,39 +174,48 @@ pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharact
     Ok(out)
 }
 
-/// Prop meshes of crowds: 0 the ground, 1 a person's body, 2 a ball, 3 a teapot.
-pub fn prop_meshes() -> Vec<Vec<PropVertex>> {
+/// Prop meshes of crowds, indexed by [`prop_mesh`].
+pub fn prop_meshes() -> Result<Vec<Vec<PropVertex>>> {
     let ball = ball_head();
-    vec![
+    Ok(vec![
         ground_mesh(60.0),
-        body_mesh(&person_head()),
+        super::person::head_mesh()?,
+        super::person::body_mesh(),
         super::head::sphere_mesh(ball.centre, ball.radii * 0.985),
         super::teapot::teapot_mesh(TEAPOT_HEIGHT),
-    ]
+    ])
 }
 
-/// Prop instances for `characters`: the ground and one body each.
-pub fn prop_instances(characters: &[CrowdCharacter]) -> Vec<(usize, PropInstance)> {
-    let mut out = vec![(
-        0,
+/// The world props: the ground.
+pub fn world_props() -> Vec<(usize, PropInstance)> {
+    vec![(
+        prop_mesh::GROUND,
         PropInstance {
             model: Mat4::IDENTITY.to_cols_array_2d(),
             color: [0.32, 0.34, 0.3, 1.0],
         },
-    )];
-    for c in characters {
-        let mesh = match c.body {
-            Body::Person => 1,
-            Body::Ball => 2,
-            Body::Teapot => 3,
-        };
-        out.push((
+    )]
+}
+
+/// The props that move with character `c`, in its own frame: a person's head and body, a
+/// ball or a teapot.
+pub fn character_props(c: &CrowdCharacter) -> Result<Vec<(usize, PropInstance)>> {
+    let color = [c.skin[0], c.skin[1], c.skin[2], 1.0];
+    let at = |mesh: usize, model: Mat4| {
+        (
             mesh,
             PropInstance {
-                model: c.model.to_cols_array_2d(),
-                color: [c.skin[0], c.skin[1], c.skin[2], 1.0],
+                model: model.to_cols_array_2d(),
+                color,
             },
-        ));
-    }
-    out
+        )
+    };
+    Ok(match c.body {
+        Body::Person(p) => vec![
+            at(prop_mesh::HEAD, p.head_transform()?),
+            at(prop_mesh::BODY, p.body_transform()),
+        ],
+        Body::Ball => vec![at(prop_mesh::BALL, Mat4::IDENTITY)],
+        Body::Teapot => vec![at(prop_mesh::TEAPOT, Mat4::IDENTITY)],
+    })
 }

@@ -138,29 +138,6 @@ impl Chart {
     }
 }
 
-/// Möller-Trumbore: distance along `dir` from `origin` to triangle `t`.
-fn ray_triangle(origin: Vec3, dir: Vec3, t: &[Vec3; 3]) -> Option<f32> {
-    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
-    let p = dir.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-12 {
-        return None;
-    }
-    let inv = 1.0 / det;
-    let s = origin - t[0];
-    let u = s.dot(p) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let q = s.cross(e1);
-    let v = dir.dot(q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let d = e2.dot(q) * inv;
-    (d > 0.0).then_some(d)
-}
-
 /// Number of grid cells of size `h` (from `lo`) that hold points.
 fn occupied(points: &[Vec2], lo: Vec2, h: f32) -> usize {
     let mut cells: Vec<(i64, i64)> = points
@@ -293,7 +270,7 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
         // On the head: of the surfaces the ray crosses, the one nearest the roots around.
         let hit = head.and_then(|tris| {
             tris.iter()
-                .filter_map(|t| ray_triangle(chart.centre, dir, t))
+                .filter_map(|t| crate::model::obj_io::ray_triangle(chart.centre, dir, t))
                 .min_by(|a, b| (a - from_roots).abs().total_cmp(&(b - from_roots).abs()))
         });
         chart.centre + dir * hit.unwrap_or(from_roots)

@@ -447,8 +447,12 @@ pub fn hair_mesh_obj_bytes(mesh: &HairMesh, comment: &str) -> std::io::Result<Ve
 /// for `fit`. Positions must be finite (checked by the parser).
 pub fn load_triangles(path: &Path) -> Result<Vec<[Vec3; 3]>> {
     let bytes = crate::fsutil::read_input(path, crate::fsutil::MAX_MESH_FILE_BYTES)?;
-    let name = path.display().to_string();
-    let (raw, _) = parse(&name, &bytes)?;
+    parse_triangles(&path.display().to_string(), &bytes)
+}
+
+/// The triangles of OBJ text `bytes` named `name` in errors (as [`load_triangles`]).
+pub fn parse_triangles(name: &str, bytes: &[u8]) -> Result<Vec<[Vec3; 3]>> {
+    let (raw, _) = parse(name, bytes)?;
     let mut out = Vec::new();
     for poly in &raw.polygons {
         let cs = corners(poly);
@@ -464,4 +468,27 @@ pub fn load_triangles(path: &Path) -> Result<Vec<[Vec3; 3]>> {
         return Err(HairError::invalid(name, "no faces"));
     }
     Ok(out)
+}
+
+/// Möller-Trumbore: distance along `dir` from `origin` to triangle `t`.
+pub fn ray_triangle(origin: Vec3, dir: Vec3, t: &[Vec3; 3]) -> Option<f32> {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = origin - t[0];
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let d = e2.dot(q) * inv;
+    (d > 0.0).then_some(d)
 }

@@ -295,6 +295,23 @@ impl Crowd {
             .ok_or_else(|| GpuError::Unsupported(format!("no character {id:?}")))
     }
 
+    /// Whether `id` names a character of the crowd.
+    pub fn contains(&self, id: CharacterId) -> bool {
+        self.slots
+            .get(id.slot as usize)
+            .and_then(|c| c.as_ref())
+            .is_some_and(|c| c.generation == id.generation)
+    }
+
+    /// Where character `id` is drawn this frame: its model, or `None` if it is hidden or gone.
+    pub fn drawn_model(&self, id: CharacterId) -> Option<Mat4> {
+        self.slots
+            .get(id.slot as usize)
+            .and_then(|c| c.as_ref())
+            .filter(|c| c.generation == id.generation && c.visible)
+            .map(|c| c.model)
+    }
+
     /// Remove a character; its textures and slot must be retired with the last frame that
     /// may use them.
     pub fn remove(&mut self, id: CharacterId) -> GpuResult<RemovedCharacter> {

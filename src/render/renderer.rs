@@ -57,14 +57,32 @@ struct Props {
     vertices: Option<Buffer>,
     meshes: Vec<(u32, u32)>,
     instances: Vec<(usize, PropInstance)>,
+    /// Props that move with a character: `(character, mesh, instance in its frame)`.
+    attached: Vec<(CharacterId, usize, PropInstance)>,
 }
 
 impl Props {
-    /// This frame's instance records (sorted by mesh) and one draw per mesh.
-    fn frame_lists(&self) -> (Vec<PropInstance>, Vec<PropDraw>) {
-        let records = self.instances.iter().map(|(_, i)| *i).collect();
+    /// This frame's instance records (sorted by mesh) and one draw per mesh: the world props
+    /// and, placed by `model_of` (`None`: not drawn), the characters' own.
+    fn frame_lists(
+        &self,
+        model_of: impl Fn(CharacterId) -> Option<Mat4>,
+    ) -> (Vec<PropInstance>, Vec<PropDraw>) {
+        let mut all = self.instances.clone();
+        all.extend(self.attached.iter().filter_map(|(id, mesh, inst)| {
+            let model = model_of(*id)? * Mat4::from_cols_array_2d(&inst.model);
+            Some((
+                *mesh,
+                PropInstance {
+                    model: model.to_cols_array_2d(),
+                    color: inst.color,
+                },
+            ))
+        }));
+        all.sort_by_key(|(m, _)| *m);
+        let records = all.iter().map(|(_, i)| *i).collect();
         let mut draws: Vec<PropDraw> = Vec::new();
-        for (k, (mesh, _)) in self.instances.iter().enumerate() {
+        for (k, (mesh, _)) in all.iter().enumerate() {
             let (first_vertex, vertex_count) = self.meshes[*mesh];
             match draws.last_mut() {
                 Some(d) if d.first_vertex == first_vertex => d.instance_count += 1,
@@ -273,6 +291,7 @@ impl Renderer {
     /// Remove a character; its textures are released after the frames using them.
     pub fn remove_character(&mut self, id: CharacterId) -> GpuResult<()> {
         let removed = self.crowd.remove(id)?;
+        self.props.attached.retain(|(c, ..)| *c != id);
         self.retire(Retired::Resource(Box::new(removed.textures)));
         self.retire(Retired::CharacterSlot(removed.slot));
         Ok(())
@@ -420,11 +439,12 @@ impl Renderer {
         }
         self.props.meshes = ranges;
         self.props.instances.clear();
+        self.props.attached.clear();
         Ok(())
     }
 
-    /// Place props for the next frames: `(mesh index, instance)`.
-    pub fn set_prop_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
+    /// Refuse instances of meshes that do not exist or with non-finite values.
+    fn check_prop_instances(&self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
         if let Some((m, _)) = instances
             .iter()
             .find(|(m, _)| *m >= self.props.meshes.len())
@@ -440,9 +460,53 @@ impl Renderer {
         }) {
             return Err(GpuError::Unsupported("prop transform is not finite".into()));
         }
-        self.props.instances = instances.to_vec();
-        self.props.instances.sort_by_key(|(m, _)| *m);
         Ok(())
+    }
+
+    /// Place world props for the next frames: `(mesh index, instance)`.
+    pub fn set_prop_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
+        self.check_prop_instances(instances)?;
+        self.props.instances = instances.to_vec();
+        Ok(())
+    }
+
+    /// Give character `id` props that move with it (its head and body): `(mesh index,
+    /// instance in the character's frame)`, drawn every frame at the character's current
+    /// model, and not at all while it is hidden or after it is removed. Replaces its earlier
+    /// props.
+    pub fn set_character_props(
+        &mut self,
+        id: CharacterId,
+        instances: &[(usize, PropInstance)],
+    ) -> GpuResult<()> {
+        if !self.crowd.contains(id) {
+            return Err(GpuError::Unsupported(format!("no character {id:?}")));
+        }
+        self.check_prop_instances(instances)?;
+        self.props.attached.retain(|(c, ..)| *c != id);
+        self.props
+            .attached
+            .extend(instances.iter().map(|(m, i)| (id, *m, *i)));
+        Ok(())
+    }
+
+    /// Where character `id`'s props are drawn this frame (world transforms, in the order
+    /// given to [`Self::set_character_props`]); empty while it is hidden.
+    pub fn character_prop_models(&self, id: CharacterId) -> Vec<Mat4> {
+        let Some(model) = self.crowd.drawn_model(id) else {
+            return Vec::new();
+        };
+        self.props
+            .attached
+            .iter()
+            .filter(|(c, ..)| *c == id)
+            .map(|(_, _, i)| model * Mat4::from_cols_array_2d(&i.model))
+            .collect()
+    }
+
+    /// Where character `id` is drawn this frame (`None`: hidden or removed).
+    pub fn drawn_model(&self, id: CharacterId) -> Option<Mat4> {
+        self.crowd.drawn_model(id)
     }
 
     /// Target size.
@@ -532,7 +596,7 @@ impl Renderer {
         if slot.records.size < slots as u64 * size_of::<super::shared::CharacterRecord>() as u64 {
             slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
         }
-        let instances = self.props.instances.len() as u32;
+        let instances = (self.props.instances.len() + self.props.attached.len()) as u32;
         if slot.prop_instances.size < instances as u64 * size_of::<PropInstance>() as u64 {
             slot.prop_instances = prop_instance_buffer(&self.ctx, instances.next_power_of_two())?;
         }
@@ -676,7 +740,8 @@ impl Renderer {
         }
         let light_block = light.map(|l| l.frame_block(&block, &view.lod));
         let records = self.crowd.records();
-        let (prop_instances, prop_draws) = self.props.frame_lists();
+        let crowd = &self.crowd;
+        let (prop_instances, prop_draws) = self.props.frame_lists(|id| crowd.drawn_model(id));
         {
             let slot = &mut self.frames[i];
             slot.frame_ubo.write(0, bytemuck::bytes_of(&block))?;

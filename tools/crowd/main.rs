@@ -17,7 +17,6 @@ use std::time::Instant;
 use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::Vec3;
-use hairmesh::animate::crowd::person_colliders;
 use hairmesh::animate::{CharacterMotion, Collider, CrowdAnimation, Wind};
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::characters::preset::{self, Preset, SPACING};
@@ -59,14 +58,23 @@ pub struct Args {
     /// Scene preset: people, mixed (people and furry balls) or teapots (furry Utah teapots).
     #[arg(long, default_value = "people")]
     preset: Preset,
+    /// People's hairstyle families, comma-separated (default: all twelve in turn): buzz,
+    /// shortcrop, bob, longstraight, longwavy, longcurly, ponytail, bun, sidebangs, mohawk,
+    /// afro, fitted.
+    #[arg(long, value_delimiter = ',')]
+    family: Vec<hairmesh::characters::hairstyle::StyleFamily>,
+    /// Headless camera: orbit (around the crowd) or front, side, back (a portrait of the
+    /// first character's head).
+    #[arg(long, default_value = "orbit", value_parser = ["orbit", "front", "side", "back"])]
+    view: String,
     /// Number of characters.
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=preset::MAX_CROWD as i64))]
     count: u32,
     /// Seed of the hairstyles and placement.
     #[arg(long, default_value_t = 1)]
     seed: u32,
-    /// Strands per average bundle.
-    #[arg(long, default_value_t = 24, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    /// Strands per average bundle (people's hair meshes have 25-64 bundles).
+    #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u32).range(1..=4096))]
     strands_per_bundle: u32,
     /// Vertices per strand are 2^e + 1 (e in 0..=6).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=6))]
@@ -139,6 +147,18 @@ pub fn orbit_camera(preset: Preset, count: u32, f: u32) -> Camera {
     Camera::look_at(eye, centre, 45.0)
 }
 
+/// A portrait of the head of a character placed by `model`: from the front, side or back,
+/// at eye height, 0.8 m away.
+pub fn portrait_camera(model: glam::Mat4, view: &str) -> Camera {
+    let eye_local = match view {
+        "side" => Vec3::new(0.8, 1.6, 0.0),
+        "back" => Vec3::new(0.0, 1.62, -0.8),
+        _ => Vec3::new(0.0, 1.6, 0.8),
+    };
+    let at = model.transform_point3(Vec3::new(0.0, 1.52, 0.0));
+    Camera::look_at(model.transform_point3(eye_local), at, 35.0)
+}
+
 /// The crowd: generated characters and their bakes.
 pub struct Scene {
     characters: Vec<preset::CrowdCharacter>,
@@ -151,7 +171,13 @@ impl Scene {
     /// Generate and bake the characters the flags ask for.
     pub fn build(args: &Args) -> Result<Self> {
         let start = Instant::now();
-        let characters = preset::build(args.preset, args.count as usize, args.seed)?;
+        let families = if args.family.is_empty() {
+            hairmesh::characters::hairstyle::StyleFamily::PEOPLE.to_vec()
+        } else {
+            args.family.clone()
+        };
+        let characters =
+            preset::build_families(args.preset, args.count as usize, args.seed, &families)?;
         let mut baked = Vec::with_capacity(characters.len());
         for c in &characters {
             baked.push(hairmesh::bake(
@@ -191,11 +217,13 @@ impl Scene {
             strands_per_bundle: args.strands_per_bundle,
             verts_log2: args.verts_log2,
         };
+        renderer.set_prop_meshes(&preset::prop_meshes()?)?;
+        renderer.set_prop_instances(&preset::world_props())?;
         for (c, b) in self.characters.iter().zip(&self.baked) {
-            renderer.add_character(b, &c.hair.style, c.strand_params(params), c.model)?;
+            let id = renderer.add_character(b, &c.hair.style, c.strand_params(params), c.model)?;
+            // Heads and bodies move with their characters: drawn at the same model as the hair.
+            renderer.set_character_props(id, &preset::character_props(c)?)?;
         }
-        renderer.set_prop_meshes(&preset::prop_meshes())?;
-        renderer.set_prop_instances(&preset::prop_instances(&self.characters))?;
         Ok(renderer)
     }
 
@@ -220,7 +248,7 @@ impl Scene {
         let ids = renderer.crowd().ids();
         for (k, ((c, b), id)) in self.characters.iter().zip(&self.baked).zip(ids).enumerate() {
             let motion = match c.body {
-                preset::Body::Person => CharacterMotion::idle(c.model, args.seed ^ k as u32),
+                preset::Body::Person(_) => CharacterMotion::idle(c.model, args.seed ^ k as u32),
                 // Fur sways gently in place.
                 _ => CharacterMotion {
                     walk_radius: 0.0,
@@ -228,7 +256,7 @@ impl Scene {
                 },
             };
             let colliders = match c.body {
-                preset::Body::Person => Some(person_colliders(&preset::person_head())),
+                preset::Body::Person(p) => Some(p.colliders()?),
                 preset::Body::Ball => {
                     let h = preset::ball_head();
                     Some(vec![Collider::Ellipsoid {
@@ -249,6 +277,29 @@ impl Scene {
             anim.add(id, motion, hair);
         }
         Ok(anim)
+    }
+
+    /// Largest distance of a person's hair roots from the scalp of the head drawn with them
+    /// this frame, in head radii (0 without people): the roots as last posed by `animation`
+    /// (or at rest), both placed as `renderer` draws them.
+    pub fn root_gap(&self, renderer: &Renderer, animation: &CrowdAnimation) -> Result<f32> {
+        let mut worst = 0.0f32;
+        for (c, id) in self.characters.iter().zip(renderer.crowd().ids()) {
+            if !matches!(c.body, preset::Body::Person(_)) {
+                continue;
+            }
+            let (Some(model), Some(head)) = (
+                renderer.drawn_model(id),
+                renderer.character_prop_models(id).first().copied(),
+            ) else {
+                continue;
+            };
+            let roots = animation
+                .roots(id)
+                .unwrap_or(c.hair.mesh.layers[0].as_slice());
+            worst = worst.max(hairmesh::characters::person::root_gap(head, model, roots)?);
+        }
+        Ok(worst)
     }
 
     /// Number of characters.
@@ -311,7 +362,7 @@ fn run(args: Args) -> Result<()> {
     let csv_path = args.out.join("stats.csv");
     let csv_out = OutputPath::check(&csv_path, &[])?;
     let mut csv = String::from(
-        "frame,gpu_ms,record_ms,wall_ms,simulate_ms,simulated,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
+        "frame,gpu_ms,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
     );
     outln!(
         "device: {} ({}); {} characters ({:?}), generated and baked in {generate_s:.2} s, textures {:.1} MiB",
@@ -327,11 +378,14 @@ fn run(args: Args) -> Result<()> {
         LodSettings::off()
     };
     for f in 0..args.frames {
-        let camera = orbit_camera(
-            args.preset,
-            args.count,
-            if args.orbit == "on" { f } else { 0 },
-        );
+        let camera = match args.view.as_str() {
+            "orbit" => orbit_camera(
+                args.preset,
+                args.count,
+                if args.orbit == "on" { f } else { 0 },
+            ),
+            view => portrait_camera(characters[0].model, view),
+        };
         // Headless frames are 1/30 s apart in animation time.
         animation.advance(&mut renderer, 1.0 / 30.0, &camera, height)?;
         let view = View {
@@ -353,6 +407,7 @@ fn run(args: Args) -> Result<()> {
             },
         )?;
         let wall_ms = t.elapsed().as_secs_f64() * 1e3;
+        let root_gap = scene.root_gap(&renderer, &animation)?;
         if ctx.validation_errors() > 0 {
             bail!(
                 "{} Vulkan validation error(s) in frame {f}; no image written",
@@ -366,7 +421,7 @@ fn run(args: Args) -> Result<()> {
             .map(|(n, ms)| format!("{n}={ms:.2}"))
             .collect();
         csv.push_str(&format!(
-            "{f},{:.3},{:.3},{wall_ms:.1},{:.3},{},{},{},{},{},{},{}\n",
+            "{f},{:.3},{:.3},{wall_ms:.1},{:.3},{},{root_gap:.6},{},{},{},{},{},{}\n",
             report.gpu_ms(),
             report.record_ms,
             animation.stats.simulate_ms,
@@ -379,7 +434,7 @@ fn run(args: Args) -> Result<()> {
             passes.join(" ")
         ));
         outln!(
-            "frame {f}: {:?} path, {} strands, {} triangles, GPU {:.1} ms ({}), record {:.3} ms, hair simulation {:.1} ms ({} characters)",
+            "frame {f}: {:?} path, {} strands, {} triangles, GPU {:.1} ms ({}), record {:.3} ms, hair simulation {:.1} ms ({} characters), root gap {root_gap:.5} head radii",
             report.path,
             s.strands_drawn,
             s.triangles_drawn,

@@ -1,0 +1,250 @@
+//! The human head every person of a crowd wears: the Sintel Lite bust (head, neck and
+//! shoulders; `hairmeshes/sintel_head.obj`, "Sintel Lite 2.57b" by BenDansie, CC-BY 3.0, see
+//! `hairmeshes/SINTEL_LICENSE.md`), in metres and the canonical character frame (feet at the
+//! origin, +Y up, facing +Z, the top of the head at [`CANONICAL_TOP`]).
+//!
+//! Hair needs the head as a surface it can lie on and never enter, cheaply and the same way
+//! for the hairstyle generator, the dynamics colliders and the tests: a *radial map*, the
+//! head's distance from its centre in every direction (the farthest crossing of the mesh along
+//! the ray within [`RADIAL_REACH`], so every point beyond the map lies outside the mesh). The
+//! drawn mesh and the map come from the same triangles.
+
+use std::sync::OnceLock;
+
+use glam::Vec3;
+
+use crate::error::{HairError, Result};
+use crate::render::shared::PropVertex;
+
+/// The bust file's units (centimetres) to metres.
+pub const FILE_SCALE: f32 = 0.01;
+/// Height of the top of the head above the feet, metres, before per-person scaling.
+pub const CANONICAL_TOP: f32 = 1.70;
+/// Top of the head in the file's units.
+const FILE_TOP: f32 = 45.52;
+/// Centre of the cranium in the file's units (the radial map's origin).
+const FILE_CENTRE: Vec3 = Vec3::new(0.0, 33.0, 0.0);
+/// Farthest crossing the radial map keeps, metres from the centre (the head, not the
+/// shoulders below it).
+pub const RADIAL_REACH: f32 = 0.165;
+/// Radial map resolution: polar rows (0..=pi) and azimuth columns (0..2pi).
+const MAP_ROWS: usize = 72;
+const MAP_COLS: usize = 144;
+
+/// The bust file's frame (and that of `hairmeshes/sintel.obj`, fitted on it) to the
+/// canonical character frame.
+pub fn file_to_canonical() -> glam::Mat4 {
+    glam::Mat4::from_translation(Vec3::new(0.0, CANONICAL_TOP - FILE_TOP * FILE_SCALE, 0.0))
+        * glam::Mat4::from_scale(Vec3::splat(FILE_SCALE))
+}
+
+/// A point of the bust file in the canonical character frame.
+fn from_file(p: Vec3) -> Vec3 {
+    file_to_canonical().transform_point3(p)
+}
+
+/// Direction from polar angle `theta` (from +Y) and azimuth `phi` (from +X toward +Z).
+pub fn direction(theta: f32, phi: f32) -> Vec3 {
+    Vec3::new(
+        theta.sin() * phi.cos(),
+        theta.cos(),
+        theta.sin() * phi.sin(),
+    )
+}
+
+/// Polar angle and azimuth (in `0..2pi`) of unit direction `d` (inverse of [`direction`]).
+pub fn angles(d: Vec3) -> (f32, f32) {
+    let theta = d.y.clamp(-1.0, 1.0).acos();
+    let phi = d.z.atan2(d.x).rem_euclid(std::f32::consts::TAU);
+    (theta, phi)
+}
+
+/// The canonical head: its triangles and radial map.
+pub struct HumanHead {
+    /// Triangles, canonical character frame, metres.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Centre of the cranium (origin of the radial map).
+    pub centre: Vec3,
+    /// `radius[row * MAP_COLS + col]`: distance of the surface from the centre.
+    radius: Vec<f32>,
+}
+
+static HEAD: OnceLock<std::result::Result<HumanHead, String>> = OnceLock::new();
+
+/// The canonical head (parsed and mapped once).
+pub fn human_head() -> Result<&'static HumanHead> {
+    HEAD.get_or_init(|| {
+        HumanHead::from_obj(
+            "hairmeshes/sintel_head.obj",
+            include_bytes!("../../hairmeshes/sintel_head.obj"),
+        )
+        .map_err(|e| e.to_string())
+    })
+    .as_ref()
+    .map_err(|e| HairError::invalid("hairmeshes/sintel_head.obj", e.clone()))
+}
+
+impl HumanHead {
+    /// Parse the bust and build its radial map.
+    pub fn from_obj(name: &str, bytes: &[u8]) -> Result<Self> {
+        let triangles: Vec<[Vec3; 3]> = crate::model::obj_io::parse_triangles(name, bytes)?
+            .into_iter()
+            .map(|t| t.map(from_file))
+            .collect();
+        let centre = from_file(FILE_CENTRE);
+        let mut radius = vec![f32::NAN; MAP_ROWS * MAP_COLS];
+        // Only triangles that reach within RADIAL_REACH can be hit within it.
+        let near: Vec<&[Vec3; 3]> = triangles
+            .iter()
+            .filter(|t| t.iter().any(|p| p.distance(centre) < RADIAL_REACH * 1.2))
+            .collect();
+        for row in 0..MAP_ROWS {
+            for col in 0..MAP_COLS {
+                let d = map_direction(row, col);
+                radius[row * MAP_COLS + col] = near
+                    .iter()
+                    .filter_map(|t| crate::model::obj_io::ray_triangle(centre, d, t))
+                    .filter(|&t| t <= RADIAL_REACH)
+                    .fold(f32::NAN, f32::max);
+            }
+        }
+        fill_missing(&mut radius).ok_or_else(|| {
+            HairError::invalid(name, "the head mesh does not surround its centre")
+        })?;
+        Ok(HumanHead {
+            triangles,
+            centre,
+            radius,
+        })
+    }
+
+    /// Distance of the head surface from [`Self::centre`] in unit direction `d` (bilinear in
+    /// the map).
+    pub fn radius(&self, d: Vec3) -> f32 {
+        let (theta, phi) = angles(d);
+        let y = theta / std::f32::consts::PI * (MAP_ROWS - 1) as f32;
+        let x = phi / std::f32::consts::TAU * MAP_COLS as f32;
+        let (r0, fy) = ((y.floor() as usize).min(MAP_ROWS - 2), y.fract());
+        let (c0, fx) = (x.floor() as usize % MAP_COLS, x.fract());
+        let c1 = (c0 + 1) % MAP_COLS;
+        let at = |r: usize, c: usize| self.radius[r * MAP_COLS + c];
+        let top = at(r0, c0) * (1.0 - fx) + at(r0, c1) * fx;
+        let bottom = at(r0 + 1, c0) * (1.0 - fx) + at(r0 + 1, c1) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+
+    /// Head surface point at polar angle `theta`, azimuth `phi` about the centre.
+    pub fn surface(&self, theta: f32, phi: f32) -> Vec3 {
+        let d = direction(theta, phi);
+        self.centre + d * self.radius(d)
+    }
+
+    /// Signed radial distance of `p` outside the head (negative inside), metres.
+    pub fn radial_gap(&self, p: Vec3) -> f32 {
+        let r = p - self.centre;
+        let l = r.length();
+        if l < 1e-9 {
+            return -self.radius(Vec3::Y);
+        }
+        l - self.radius(r / l)
+    }
+
+    /// `p` moved radially to at least `margin` outside the head (unchanged if already there).
+    pub fn push_out(&self, p: Vec3, margin: f32) -> Vec3 {
+        let r = p - self.centre;
+        let l = r.length();
+        let d = if l < 1e-9 { Vec3::Y } else { r / l };
+        let min = self.radius(d) + margin;
+        if l < min { self.centre + d * min } else { p }
+    }
+
+    /// The bust as a prop mesh (triangle list, normals averaged over shared positions).
+    pub fn prop_mesh(&self) -> Vec<PropVertex> {
+        smooth_prop_mesh(&self.triangles)
+    }
+}
+
+/// Direction of radial map cell `(row, col)`.
+fn map_direction(row: usize, col: usize) -> Vec3 {
+    let theta = std::f32::consts::PI * row as f32 / (MAP_ROWS - 1) as f32;
+    let phi = std::f32::consts::TAU * col as f32 / MAP_COLS as f32;
+    direction(theta, phi)
+}
+
+/// Fill map cells without a crossing (down the neck) from the row above, smoothed around the
+/// row; `None` if the top row has none (the mesh does not surround the centre).
+fn fill_missing(radius: &mut [f32]) -> Option<()> {
+    if radius[..MAP_COLS].iter().any(|r| r.is_nan()) {
+        return None;
+    }
+    for row in 1..MAP_ROWS {
+        for col in 0..MAP_COLS {
+            let k = row * MAP_COLS + col;
+            if radius[k].is_nan() {
+                let up = |c: usize| radius[(row - 1) * MAP_COLS + c % MAP_COLS];
+                radius[k] = (up(col + MAP_COLS - 1) + 2.0 * up(col) + up(col + 1)) * 0.25;
+            }
+        }
+    }
+    Some(())
+}
+
+/// A triangle list with normals averaged over the triangles sharing each position (area
+/// weighted), so a faceted mesh shades smoothly.
+pub fn smooth_prop_mesh(triangles: &[[Vec3; 3]]) -> Vec<PropVertex> {
+    let key = |p: Vec3| (p * 1e5).round().as_ivec3().to_array();
+    let mut normals: std::collections::HashMap<[i32; 3], Vec3> = Default::default();
+    for t in triangles {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        for p in t {
+            *normals.entry(key(*p)).or_default() += n;
+        }
+    }
+    triangles
+        .iter()
+        .flat_map(|t| {
+            let face = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or(Vec3::Y);
+            t.map(|p| {
+                let n = normals[&key(p)].normalize_or(face);
+                PropVertex {
+                    position: p.extend(1.0).to_array(),
+                    normal: n.extend(0.0).to_array(),
+                }
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_radial_map_follows_the_mesh() {
+        let head = human_head().unwrap();
+        // Top of the head at CANONICAL_TOP, about 12.5 cm above the cranium centre.
+        let top = head.surface(0.0, 0.0);
+        assert!((top.y - CANONICAL_TOP).abs() < 0.005, "{top}");
+        // Every mapped point lies on the mesh: a ray from the centre meets a triangle there.
+        for (theta, phi) in [(0.4f32, 1.0f32), (1.2, 2.0), (1.0, 4.5), (1.5, 0.3)] {
+            let d = direction(theta, phi);
+            let r = head.radius(d);
+            let hit = head
+                .triangles
+                .iter()
+                .filter_map(|t| crate::model::obj_io::ray_triangle(head.centre, d, t))
+                .filter(|&t| t <= RADIAL_REACH)
+                .fold(0.0f32, f32::max);
+            assert!(
+                (hit - r).abs() < 0.004,
+                "theta {theta} phi {phi}: {hit} vs {r}"
+            );
+        }
+        let p = head.surface(1.0, 1.0);
+        assert!(head.radial_gap(p).abs() < 1e-4);
+        assert!(
+            head.radial_gap(head.push_out(head.centre + (p - head.centre) * 0.9, 0.01)) > 0.0099
+        );
+        assert_eq!(head.prop_mesh().len(), head.triangles.len() * 3);
+    }
+}
