@@ -107,6 +107,23 @@ fn sintel_fits_bakes_and_renders() {
     );
     let (baked, style) = sample("sintel.obj");
     assert_eq!(style, fitted.style, "hairmeshes/sintel.toml is stale");
+    // The crowd's smaller fit (`fit ... --bundles 20 --layers 6 -o hairmeshes/sintel_crowd.obj`).
+    let small = fit(
+        &model,
+        Some(&head),
+        &FitOptions {
+            bundles: 20,
+            layers: Some(6),
+        },
+    )
+    .unwrap();
+    let crowd_sample =
+        hairmesh::model::obj_io::load_hair_mesh_obj(&dir.join("sintel_crowd.obj")).unwrap();
+    assert_eq!(
+        (crowd_sample.faces, crowd_sample.layers),
+        (small.mesh.faces, small.mesh.layers),
+        "hairmeshes/sintel_crowd.obj is stale"
+    );
     let f = compare(
         &model.strands,
         &strands_like(&baked, style, model.strands.len()),

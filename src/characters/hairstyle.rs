@@ -794,31 +794,38 @@ fn grown(
     HairMesh::new(name, layers, None, uv, faces)
 }
 
-/// The Sintel hair mesh (`fit` of the Sintel Lite strands, `hairmeshes/sintel.obj`) on its own
-/// head, placed like the person's head; each copy's hair (not its scalp) is a little longer or
+/// The Sintel hair mesh (`fit` of the Sintel Lite strands with 20 bundles and 6 layers,
+/// `hairmeshes/sintel_crowd.obj`) on its own head, its roots snapped onto the scalp, placed like the person's head; each copy's hair (not its scalp) is a little longer or
 /// shorter, in the person's own colour.
 fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hairstyle> {
     let mesh = crate::model::obj_io::parse_hair_mesh_obj(
-        "hairmeshes/sintel.obj",
-        include_bytes!("../../hairmeshes/sintel.obj"),
+        "hairmeshes/sintel_crowd.obj",
+        include_bytes!("../../hairmeshes/sintel_crowd.obj"),
     )?;
     let fitted = HairStyle::from_toml(
-        "hairmeshes/sintel.toml",
-        include_str!("../../hairmeshes/sintel.toml"),
+        "hairmeshes/sintel_crowd.toml",
+        include_str!("../../hairmeshes/sintel_crowd.toml"),
     )?;
     let place = person.head_transform()? * super::human::file_to_canonical();
     let scale = super::human::FILE_SCALE * person.head_scale();
     let stretch = range(rng, 0.85, 1.15);
+    let head = person.head()?;
+    // Each column moves with its root, snapped radially onto the scalp.
+    let snapped: Vec<(Vec3, Vec3)> = mesh.layers[0]
+        .iter()
+        .map(|root| {
+            let r = place.transform_point3(*root);
+            let (theta, phi) = head.angles(r);
+            (r, head.surface(theta, phi))
+        })
+        .collect();
     let layers = mesh
         .layers
         .iter()
         .map(|l| {
             l.iter()
-                .zip(&mesh.layers[0])
-                .map(|(p, root)| {
-                    let r = place.transform_point3(*root);
-                    r + (place.transform_point3(*p) - r) * stretch
-                })
+                .zip(&snapped)
+                .map(|(p, (r, on))| *on + (place.transform_point3(*p) - *r) * stretch)
                 .collect()
         })
         .collect();

@@ -94,7 +94,7 @@ impl PersonShape {
     pub fn colliders(&self) -> Result<Vec<Collider>> {
         let b = self.body_transform();
         let h = self.height;
-        let mut out = vec![Collider::human(self.head_transform()?, 0.002)];
+        let mut out = vec![Collider::human(self.head_transform()?, 0.005)];
         for part in BODY.iter().filter(|p| p.collides) {
             out.push(Collider::Capsule {
                 a: b.transform_point3(part.a),
