@@ -17,6 +17,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::human::direction;
 use super::person::{PersonShape, PlacedHead};
 use crate::animate::Collider;
 use crate::error::Result;
@@ -415,6 +416,19 @@ pub fn hairline(phi: f32) -> f32 {
     v.to_radians()
 }
 
+/// Middle of the scalp region (canonical direction from the head centre): 32 degrees behind
+/// the crown, half way between the forehead's hairline (58) and the nape's (122).
+const SCALP_MIDDLE: Vec3 = Vec3::new(0.0, 0.848_048, -0.529_919);
+
+/// Spherical interpolation of unit vectors `a` to `b` at `t`.
+fn slerp(a: Vec3, b: Vec3, t: f32) -> Vec3 {
+    let omega = a.dot(b).clamp(-1.0, 1.0).acos();
+    if omega < 1e-5 {
+        return a;
+    }
+    (a * ((1.0 - t) * omega).sin() + b * (t * omega).sin()) / omega.sin()
+}
+
 /// A scalp vertex: canonical polar angle and azimuth, grid uv, and how near the region's
 /// edge it is (0 centre .. 1 hairline).
 struct Root {
@@ -445,8 +459,13 @@ fn scalp_grid(region: Region, grid: usize) -> (Vec<Root>, Vec<Face>) {
                     let z = b * (1.0 - 0.5 * a * a).sqrt();
                     let rho = (x * x + z * z).sqrt().min(1.0);
                     let phi = z.atan2(x).rem_euclid(std::f32::consts::TAU);
+                    // Along the great circle from the region's middle (behind the crown, where
+                    // the hairline is about equally far all round) to the hairline, so the
+                    // bundles are of similar size front and back.
+                    let edge = direction(hairline(phi) * scale, phi);
+                    let (theta, phi) = super::human::angles(slerp(SCALP_MIDDLE, edge, rho));
                     Root {
-                        theta: rho * hairline(phi) * scale,
+                        theta,
                         phi,
                         uv,
                         edge: rho,
@@ -475,6 +494,16 @@ fn scalp_grid(region: Region, grid: usize) -> (Vec<Root>, Vec<Face>) {
         }
     }
     (roots, faces)
+}
+
+/// How far the middle of a bundle lies below the scalp at its corners: a square of
+/// `grid x grid` bundles spans about half the head (pi radians across), and the generator
+/// interpolates strands bilinearly between the corner columns, so the middle of a bundle of
+/// angular side `pi / grid` sits `r (1 - cos(half diagonal))` below the surface. Hair is lifted
+/// by that much more, so the strands in the middle of a bundle are outside the head too.
+fn bundle_sag(grid: usize, radius: f32) -> f32 {
+    let half_diagonal = std::f32::consts::PI / grid as f32 * std::f32::consts::FRAC_1_SQRT_2;
+    radius * (1.0 - half_diagonal.cos())
 }
 
 /// Steps of the settling walk, metres.
@@ -631,6 +660,8 @@ fn comb_direction(comb: Comb, head: &PlacedHead, root: Vec3, n: Vec3, tie: Optio
 /// One column's layers, settled (see the module documentation).
 struct ColumnPlan<'a> {
     cut: &'a Cut,
+    /// How far a bundle's middle lies below its corners on the scalp ([`bundle_sag`]).
+    sag: f32,
     settle: &'a Settle<'a>,
     length: f32,
     hem_y: f32,
@@ -638,10 +669,12 @@ struct ColumnPlan<'a> {
 }
 
 impl ColumnPlan<'_> {
+    /// Height above the scalp after `s` metres: the cut's lift plus the bundle sag.
     fn lift(&self, edge: f32) -> impl Fn(f32) -> f32 + '_ {
         let (lo, hi) = self.cut.lift;
         let hi = hi * (1.0 - 0.5 * edge * edge);
-        move |s: f32| lo + (hi - lo) * (s / self.cut.lift_length).min(1.0)
+        let sag = self.sag;
+        move |s: f32| sag + lo + (hi - lo) * (s / self.cut.lift_length).min(1.0)
     }
 
     /// Layers of a free column (no tie).
@@ -760,6 +793,10 @@ fn grown(
         head.centre().y - range(rng, a, b) * scale
     });
     let (roots, faces) = scalp_grid(cut.region, cut.grid);
+    let sag = match cut.region {
+        Region::Full(_) => bundle_sag(cut.grid, head.radius()),
+        Region::Strip => 0.0,
+    };
     let tail = cut.tie.map(|t| tail_path(&settle, &t, length, cut.gravity));
     let tie_point = cut.tie.map(|t| head.surface(t.theta, t.phi));
     let mut columns = Vec::with_capacity(roots.len());
@@ -777,6 +814,7 @@ fn grown(
         };
         let plan = ColumnPlan {
             cut: &cut,
+            sag,
             settle: &settle,
             length: length * range(rng, 0.92, 1.0),
             hem_y,
