@@ -480,8 +480,14 @@ impl HairDynamics {
                     p[below] + dir * self.edge[j]
                 };
                 let mut q = on_edge(collide(p[j]));
-                for _ in 0..2 {
-                    q = on_edge(collide(q));
+                // Alternate until the push-out no longer moves it (at most 8 rounds; a point
+                // outside every collider costs one).
+                for _ in 0..8 {
+                    let out = collide(q);
+                    if out == q {
+                        break;
+                    }
+                    q = on_edge(out);
                 }
                 correction[j] = q - p[j];
                 p[j] = q;
