@@ -99,27 +99,6 @@ pub fn scalp(head: &HeadShape, n: usize) -> ScalpPatch {
     patch
 }
 
-/// Triangles of an ellipsoid around `centre` with `radii`, `rings x segments`.
-fn ellipsoid(out: &mut Vec<PropVertex>, centre: Vec3, radii: Vec3, rings: usize, segments: usize) {
-    let point = |ring: usize, seg: usize| {
-        let theta = std::f32::consts::PI * ring as f32 / rings as f32;
-        let phi = std::f32::consts::TAU * seg as f32 / segments as f32;
-        let d = direction(theta, phi);
-        (centre + d * radii, (d / radii).normalize_or(d))
-    };
-    for ring in 0..rings {
-        for seg in 0..segments {
-            let a = point(ring, seg);
-            let b = point(ring + 1, seg);
-            let c = point(ring + 1, seg + 1);
-            let d = point(ring, seg + 1);
-            for (p, n) in [a, b, c, a, c, d] {
-                out.push(vertex(p, n));
-            }
-        }
-    }
-}
-
 fn vertex(p: Vec3, n: Vec3) -> PropVertex {
     PropVertex {
         position: p.extend(1.0).to_array(),
@@ -129,9 +108,9 @@ fn vertex(p: Vec3, n: Vec3) -> PropVertex {
 
 /// An ellipsoid prop mesh (a ball, a bare head).
 pub fn sphere_mesh(centre: Vec3, radii: Vec3) -> Vec<PropVertex> {
-    let mut out = Vec::new();
-    ellipsoid(&mut out, centre, radii, 16, 32);
-    out
+    let mut tris = Vec::new();
+    super::person::ellipsoid(&mut tris, centre, radii, 16, 32);
+    super::human::smooth_prop_mesh(&tris)
 }
 
 /// A flat square of `half` metres around the origin at y = 0, facing up.
@@ -160,6 +139,14 @@ mod tests {
         assert!(s.faces.len() > 80, "{} faces", s.faces.len());
         for p in &s.positions {
             assert!(((*p - head.centre) / head.radii).length() - 1.0 < 1e-4);
+        }
+        // The ball's prop mesh faces outward.
+        for v in sphere_mesh(head.centre, head.radii) {
+            let (p, n) = (
+                Vec3::from_slice(&v.position[..3]),
+                Vec3::from_slice(&v.normal[..3]),
+            );
+            assert!(n.dot(p - head.centre) > 0.0, "{p} {n}");
         }
     }
 }
