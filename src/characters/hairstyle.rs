@@ -258,6 +258,8 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
         },
         StyleFamily::LongStraight | StyleFamily::LongWavy => Cut {
             length: (0.45, 0.6),
+            // The first layer close to the root: the strands leave the scalp sooner.
+            spacing: 2.0,
             hem: Some((0.3, 0.42)),
             ..base
         },
@@ -269,7 +271,8 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
             ..base
         },
         StyleFamily::Ponytail => Cut {
-            layers: 7,
+            layers: 8,
+            spacing: 2.0,
             length: (0.22, 0.36),
             comb: Comb::Tie,
             lift: (0.007, 0.01),
@@ -278,12 +281,12 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
                 theta: range(rng, 1.75, 1.95),
                 phi: 1.5 * std::f32::consts::PI,
                 kind: TieKind::Tail,
-                scalp_layers: 3,
+                scalp_layers: 4,
             }),
             ..base
         },
         StyleFamily::Bun => Cut {
-            layers: 6,
+            layers: 7,
             length: (0.18, 0.22),
             comb: Comb::Tie,
             lift: (0.007, 0.01),
@@ -291,7 +294,7 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
                 theta: range(rng, 0.85, 1.15),
                 phi: 1.5 * std::f32::consts::PI,
                 kind: TieKind::Bun,
-                scalp_layers: 3,
+                scalp_layers: 4,
             }),
             ..base
         },
@@ -648,7 +651,7 @@ fn comb_direction(comb: Comb, head: &PlacedHead, root: Vec3, n: Vec3, tie: Optio
             // Sideways from the parting over the front half of the head only; behind the
             // crown the hair falls.
             let front = smoothstep(-0.03, 0.02, c.z);
-            let side = ((c.x - x) / 0.012).tanh() * front;
+            let side = ((c.x - x) / 0.03).tanh() * front;
             tangent(combed_back(c) + Vec3::X * side)
         }
         Comb::Back => tangent(combed_back(c)),
@@ -732,7 +735,7 @@ impl ColumnPlan<'_> {
             }
         }
         let offset = (p - tie_point) * 0.35;
-        let mut out = resample(&path, tie.scalp_layers, 1.0);
+        let mut out = resample(&path, tie.scalp_layers, self.cut.spacing);
         let rest = self.cut.layers - tie.scalp_layers;
         let tail_points = resample(tail, rest, 1.0);
         for (k, t) in tail_points.iter().enumerate() {
@@ -857,13 +860,23 @@ fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hai
             (r, head.surface(theta, phi))
         })
         .collect();
+    // The fitted strands lie on the head; above the roots they are lifted by the bundle sag
+    // (as grown hair is) so the strands inside the bundles lie outside it too.
+    let lift = bundle_sag(
+        (mesh.faces.len() as f32).sqrt().round() as usize,
+        head.radius(),
+    ) + 0.004;
     let layers = mesh
         .layers
         .iter()
-        .map(|l| {
+        .enumerate()
+        .map(|(k, l)| {
             l.iter()
                 .zip(&snapped)
-                .map(|(p, (r, on))| *on + (place.transform_point3(*p) - *r) * stretch)
+                .map(|(p, (r, on))| {
+                    let q = *on + (place.transform_point3(*p) - *r) * stretch;
+                    if k == 0 { q } else { head.push_out(q, lift) }
+                })
                 .collect()
         })
         .collect();
