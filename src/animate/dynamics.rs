@@ -480,9 +480,9 @@ impl HairDynamics {
                     p[below] + dir * self.edge[j]
                 };
                 let mut q = on_edge(collide(p[j]));
-                // Alternate until the push-out no longer moves it (at most 8 rounds; a point
+                // Alternate until the push-out no longer moves it (at most 16 rounds; a point
                 // outside every collider costs one).
-                for _ in 0..8 {
+                for _ in 0..16 {
                     let out = collide(q);
                     if out == q {
                         break;

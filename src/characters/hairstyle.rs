@@ -287,7 +287,7 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
         },
         StyleFamily::Bun => Cut {
             layers: 7,
-            length: (0.18, 0.22),
+            length: (0.25, 0.3),
             comb: Comb::Tie,
             lift: (0.007, 0.01),
             tie: Some(Tie {
@@ -531,7 +531,11 @@ impl Settle<'_> {
         let s = person.head * person.height;
         Ok(Settle {
             head,
-            body: person.colliders()?.into_iter().skip(1).collect(),
+            body: person
+                .colliders()?
+                .into_iter()
+                .filter(|c| !matches!(c, Collider::Human { .. }))
+                .collect(),
             face: Collider::Ellipsoid {
                 centre: place.transform_point3(c),
                 radii: r * s,
@@ -713,15 +717,16 @@ impl ColumnPlan<'_> {
 
     /// Layers of a column gathered at a tie at `tie_point` (outward normal `tie_normal`),
     /// continuing along the shared `tail` (offset by this column's place in the tie).
-    fn tied(&self, root: Vec3, tangent: Vec3, edge: f32, tie: &Tie, tail: &[Vec3]) -> Vec<Vec3> {
+    fn tied(&self, root: &Root, at: Vec3, tangent: Vec3, tie: &Tie, tail: &[Vec3]) -> Vec<Vec3> {
+        let (root_point, edge) = (at, root.edge);
         let settle = self.settle;
         let head = settle.head;
         let tie_point = head.surface(tie.theta, tie.phi);
-        let to_tie = root.distance(tie_point);
+        let to_tie = root_point.distance(tie_point);
         // Along the scalp to the tie: no gravity (the hair is pulled taut).
         let lift = self.lift(edge);
-        let mut path = vec![root];
-        let (mut p, mut d) = (root, tangent);
+        let mut path = vec![root_point];
+        let (mut p, mut d) = (root_point, tangent);
         for k in 1..((to_tie * 2.0 / STEP) as usize).max(2) {
             let want = (tie_point - p).normalize_or(d);
             d = (d * 0.6 + want * 0.4).normalize_or(d);
@@ -734,12 +739,21 @@ impl ColumnPlan<'_> {
                 break;
             }
         }
-        let offset = (p - tie_point) * 0.35;
+        // This column's place in the gathered hair: its scalp uv laid across the tie (so
+        // neighbouring columns stay neighbours), 2 cm either way.
+        let along = (tail[tail.len().min(2) - 1] - tail[0]).normalize_or(Vec3::NEG_Z);
+        let e1 = (Vec3::X - along * along.x).normalize_or(Vec3::X);
+        let e2 = along.cross(e1);
+        let offset = (e1 * (2.0 * root.uv.x - 1.0) + e2 * (2.0 * root.uv.y - 1.0)) * 0.02;
         let mut out = resample(&path, tie.scalp_layers, self.cut.spacing);
         let rest = self.cut.layers - tie.scalp_layers;
         let tail_points = resample(tail, rest, 1.0);
         for (k, t) in tail_points.iter().enumerate() {
-            let spread = 1.0 + 1.5 * k as f32 / rest.max(1) as f32;
+            // A tail is tight at the tie and fans out a little; a bun is a thick coil.
+            let spread = match tie.kind {
+                TieKind::Tail => 0.6 + 0.8 * k as f32 / rest.max(1) as f32,
+                TieKind::Bun => 1.0,
+            };
             out.push(settle.constrain(*t + offset * spread, 0.003));
         }
         out
@@ -755,27 +769,23 @@ fn tail_path(settle: &Settle, tie: &Tie, length: f32, gravity: f32) -> Vec<Vec3>
     let start = at + n * 0.015;
     match tie.kind {
         TieKind::Tail => {
+            // From the tie, which sits on the hair 1.5 cm out from the scalp.
             let dir = (n * 0.8 + Vec3::NEG_Y * 0.2).normalize();
-            let mut path = vec![at];
             let steer = |_: Vec3, _: bool| Vec3::NEG_Y * gravity;
             let (free, lift) = (false, |_: f32| 0.012);
-            path.extend(settle.walk(start, dir, length, f32::NEG_INFINITY, free, lift, steer));
-            path
+            settle.walk(start, dir, length, f32::NEG_INFINITY, free, lift, steer)
         }
         TieKind::Bun => {
-            let e1 = n.any_orthonormal_vector();
-            let e2 = n.cross(e1);
-            let centre = at + n * 0.03;
-            let turns = 1.25;
-            let count = 48;
-            let mut path = vec![at];
-            for k in 0..=count {
-                let a = std::f32::consts::TAU * turns * k as f32 / count as f32;
-                let r = 0.032 - 0.012 * k as f32 / count as f32;
-                let lift = n * (0.01 * k as f32 / count as f32);
-                path.push(centre + (e1 * a.cos() + e2 * a.sin()) * r + lift);
-            }
-            path
+            // A loop out from the tie, over the top and back under: with the columns spread
+            // across it (`ColumnPlan::tied`) it is a round knot 5-6 cm across.
+            let up = (Vec3::Y - n * n.y).normalize_or(Vec3::Z);
+            let centre = start + n * 0.03;
+            (0..=24)
+                .map(|k| {
+                    let a = 1.5 * std::f32::consts::PI * k as f32 / 24.0;
+                    centre + (-n * a.cos() + up * a.sin()) * 0.03
+                })
+                .collect()
         }
     }
 }
@@ -824,7 +834,7 @@ fn grown(
             bangs,
         };
         columns.push(match (&cut.tie, &tail) {
-            (Some(tie), Some(tail)) => plan.tied(p, t, r.edge, tie, tail),
+            (Some(tie), Some(tail)) => plan.tied(r, p, t, tie, tail),
             _ => plan.free(p, n, t, r.edge),
         });
     }

@@ -89,19 +89,22 @@ impl PersonShape {
         })
     }
 
-    /// Colliders for the hair dynamics: the head itself, the neck, the shoulders and the
-    /// upper torso (the body's own shapes, [`body_mesh`]).
+    /// Colliders for the hair dynamics: the neck, the shoulders and the upper torso (the
+    /// body's own shapes, [`body_mesh`]), then the head itself.
     pub fn colliders(&self) -> Result<Vec<Collider>> {
         let b = self.body_transform();
         let h = self.height;
-        let mut out = vec![Collider::human(self.head_transform()?, 0.005)];
-        for part in BODY.iter().filter(|p| p.collides) {
-            out.push(Collider::Capsule {
+        let mut out: Vec<Collider> = BODY
+            .iter()
+            .filter(|p| p.collides)
+            .map(|part| Collider::Capsule {
                 a: b.transform_point3(part.a),
                 b: b.transform_point3(part.b),
                 radius: part.ra.max(part.rb) * h,
-            });
-        }
+            })
+            .collect();
+        // The head last: where the neck capsule and the jaw disagree, the head wins.
+        out.push(Collider::human(self.head_transform()?, 0.005));
         Ok(out)
     }
 }
