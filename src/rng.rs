@@ -16,6 +16,15 @@ impl Pcg32 {
         r
     }
 
+    /// A generator seeded with `key` scrambled by SplitMix64's finaliser, so that keys that
+    /// differ in a few low bits (consecutive seeds) give independent first draws.
+    pub fn hashed(key: u64) -> Self {
+        let mut z = key.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        Pcg32::new(z ^ (z >> 31))
+    }
+
     /// Next 32 random bits.
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;

@@ -481,13 +481,19 @@ impl HairDynamics {
                 };
                 let mut q = on_edge(collide(p[j]));
                 // Alternate until the push-out no longer moves it (at most 16 rounds; a point
-                // outside every collider costs one).
+                // outside every collider costs one). Where they never agree (hair squeezed
+                // between two colliders) the colliders win over the exact edge length.
+                let mut settled = false;
                 for _ in 0..16 {
                     let out = collide(q);
                     if out == q {
+                        settled = true;
                         break;
                     }
                     q = on_edge(out);
+                }
+                if !settled {
+                    q = collide(q);
                 }
                 correction[j] = q - p[j];
                 p[j] = q;

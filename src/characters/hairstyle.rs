@@ -916,9 +916,16 @@ fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hai
     })
 }
 
+/// A generator for `seed` and `family` whose first draws are independent across neighbouring
+/// seeds (a crowd's consecutive seeds otherwise start correlated, and half of its people drew
+/// the same pale hair colour).
+fn family_rng(seed: u32, family: StyleFamily) -> Pcg32 {
+    Pcg32::hashed(seed as u64 ^ (family as u64) << 40)
+}
+
 /// Generate a hairstyle of `family` for `person` from `seed`.
 pub fn generate(family: StyleFamily, seed: u32, person: &PersonShape) -> Result<Hairstyle> {
-    let mut rng = Pcg32::new(seed as u64 ^ (family as u64) << 40);
+    let mut rng = family_rng(seed, family);
     if family == StyleFamily::Fitted {
         return fitted_sintel(seed, person, &mut rng);
     }

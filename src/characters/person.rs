@@ -48,7 +48,7 @@ impl PersonShape {
     /// A person drawn from `seed`: height 0.92-1.08 of the canonical figure, head width,
     /// height and depth each 0.94-1.06, a skin tone anywhere in [`SKIN_TONES`].
     pub fn draw(seed: u32) -> Self {
-        let mut rng = Pcg32::new(seed as u64 ^ 0x7065_7273_6f6e);
+        let mut rng = Pcg32::hashed(seed as u64 ^ 0x7065_7273_6f6e);
         let mut r = |lo: f32, hi: f32| lo + (hi - lo) * rng.next_f32();
         let height = r(0.92, 1.08);
         let head = Vec3::new(r(0.94, 1.06), r(0.94, 1.06), r(0.94, 1.06));
