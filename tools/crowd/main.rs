@@ -63,9 +63,9 @@ pub struct Args {
     /// afro, fitted.
     #[arg(long, value_delimiter = ',')]
     family: Vec<hairmesh::characters::hairstyle::StyleFamily>,
-    /// Headless camera: orbit (around the crowd) or front, side, back (a portrait of the
-    /// first character's head).
-    #[arg(long, default_value = "orbit", value_parser = ["orbit", "front", "side", "back"])]
+    /// Headless camera: orbit (around the crowd), eye (at eye height in front of the crowd,
+    /// looking into it) or front, side, back (a portrait of the first character's head).
+    #[arg(long, default_value = "orbit", value_parser = ["orbit", "eye", "front", "side", "back"])]
     view: String,
     /// Number of characters.
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=preset::MAX_CROWD as i64))]
@@ -384,6 +384,15 @@ fn run(args: Args) -> Result<()> {
                 args.count,
                 if args.orbit == "on" { f } else { 0 },
             ),
+            "eye" => {
+                let side = (args.count as f32).sqrt().ceil();
+                let depth = (side - 1.0) * SPACING;
+                Camera::look_at(
+                    Vec3::new(0.4, 1.65, -1.6),
+                    Vec3::new(0.0, 1.45, depth * 0.5),
+                    50.0,
+                )
+            }
             view => portrait_camera(characters[0].model, view),
         };
         // Headless frames are 1/30 s apart in animation time.
