@@ -75,7 +75,10 @@ BundleLod bundle_lod(uint g) {
     count = clamp(count, 1u, MAX_STRANDS_PER_BUNDLE);
     uint emax = ch_emax;
     BundleLod r = BundleLod(count, emax, 0.0, 1.0, false);
-    if (!ch_visible || !box_visible(lo, hi)) {
+    // Curved roots leave the hull by at most the root cell's bulge bound; the LoD distance
+    // below stays that of the hull (src/reference/root_surface.rs).
+    float bulge = scale * root_bulge_bound(root_cell(desc.origin));
+    if (!ch_visible || !box_visible(lo - bulge, hi + bulge)) {
         r.strands = 0u;
         return r;
     }

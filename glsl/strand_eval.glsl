@@ -15,18 +15,76 @@ vec2 root_sample(GpuBundle b, uint bundle_index, uint strand) {
     return fract(root_samples[s] + vec2(hash_f32(h), hash_f32(h + 1u)));
 }
 
-// Normalised root-slice coordinate; triangles map xi -> (xi.x / (1 - xi.y), xi.y).
-vec2 root_coord(GpuBundle b, vec2 xi) {
+vec3 decode_position(vec3 t) {
+    return mesh.pos_origin.xyz + mesh.pos_extent.xyz * t;
+}
+
+// Local cell coordinate of root sample xi; triangles map xi -> (xi.x / (1 - xi.y), xi.y)
+// (src/reference/root_surface.rs: local_coord).
+vec2 root_local(GpuBundle b, vec2 xi) {
     vec2 local = xi;
     if ((b.flags & BUNDLE_TRIANGLE) != 0u) {
         local = vec2(xi.x / max(1.0 - xi.y, 1e-6), xi.y);
     }
-    local = clamp(local, vec2(0.0), vec2(1.0));
+    return clamp(local, vec2(0.0), vec2(1.0));
+}
+
+// Normalised root-slice coordinate of local cell coordinate `local`.
+vec2 root_coord_local(GpuBundle b, vec2 local) {
     return (vec2(b.origin) + 0.5 + local) / vec2(mesh.root_size);
 }
 
-vec3 decode_position(vec3 t) {
-    return mesh.pos_origin.xyz + mesh.pos_extent.xyz * t;
+vec2 root_coord(GpuBundle b, vec2 xi) {
+    return root_coord_local(b, root_local(b, xi));
+}
+
+// A bundle's root cell: corners and root-layer normals (u x v, eq. 1-3), texel order
+// (0,0) (1,0) (0,1) (1,1) (src/reference/root_surface.rs: RootCell::from_baked).
+struct RootCell {
+    vec3 p[4];
+    vec3 n[4];
+};
+
+RootCell root_cell(uvec2 origin) {
+    RootCell c;
+    for (int i = 0; i < 4; i++) {
+        ivec3 t = ivec3(ivec2(origin) + ivec2(i & 1, i >> 1), 0);
+        c.p[i] = decode_position(texelFetch(TEX_POSITION, t, 0).xyz);
+        vec3 n = cross(texelFetch(TEX_U, t, 0).xyz, texelFetch(TEX_V, t, 0).xyz);
+        float l = length(n);
+        c.n[i] = l > 0.0 ? n / l : vec3(0.0);
+    }
+    return c;
+}
+
+// Phong offset of the root at `local` (Boubekeur and Alexa 2008, eq. 4):
+// -alpha sum_i w_i ((q - p_i) . n_i) n_i with q the bilinear root (RootCell::bulge).
+vec3 root_bulge(RootCell c, vec2 local) {
+    float w[4] = float[4]((1.0 - local.x) * (1.0 - local.y), local.x * (1.0 - local.y),
+                          (1.0 - local.x) * local.y, local.x * local.y);
+    vec3 q = c.p[0] * w[0] + c.p[1] * w[1] + c.p[2] * w[2] + c.p[3] * w[3];
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < 4; i++) {
+        sum += c.n[i] * (w[i] * dot(q - c.p[i], c.n[i]));
+    }
+    return -ROOT_PHONG_SHAPE * sum;
+}
+
+// Largest root offset in the cell (RootCell::bulge_bound).
+float root_bulge_bound(RootCell c) {
+    float most = 0.0;
+    for (int i = 0; i < 4; i++) {
+        for (int j = 0; j < 4; j++) {
+            most = max(most, abs(dot(c.p[j] - c.p[i], c.n[i])));
+        }
+    }
+    return ROOT_PHONG_SHAPE * most;
+}
+
+// Share of the root offset left at curve parameter r: (1 - r)^2 over the first segment.
+float root_bulge_fade(float r) {
+    float x = max(1.0 - r, 0.0);
+    return x * x;
 }
 
 // Curve point at parameter r in [0, L-1]: two trilinear fetches + one lerp (sec. 3.1).
@@ -95,6 +153,8 @@ float strand_width_at(float s) {
 struct StrandInfo {
     vec2 coord;         // root-slice coordinate of the root sample
     vec2 centre_coord;  // bundle centre (clumping target)
+    uvec2 origin;       // the bundle's root cell
+    vec2 local;         // local cell coordinate of the root
     uint key;           // per-strand random key
     float span;         // curve parameter at the tip
 };
@@ -104,7 +164,9 @@ StrandInfo strand_info(uint g, uint strand) {
     GpuBundle b = bundles[g];
     StrandInfo si;
     si.key = strand_key(style.seed, b.local_index, strand);
-    si.coord = root_coord(b, root_sample(b, b.local_index, strand));
+    si.local = root_local(b, root_sample(b, b.local_index, strand));
+    si.coord = root_coord_local(b, si.local);
+    si.origin = b.origin;
     vec2 centre = (b.flags & BUNDLE_TRIANGLE) != 0u ? vec2(1.0 / 3.0) : vec2(0.5);
     si.centre_coord = root_coord(b, centre);
     float length_factor = 1.0 - style.length_variation * strand_rand(si.key, 0u);
@@ -115,10 +177,13 @@ StrandInfo strand_info(uint g, uint strand) {
 // Position of vertex k of `segments` (k = 0 is the root: one lookup, no styling).
 vec3 strand_vertex(StrandInfo si, uint k, uint segments) {
     if (k == 0u) {
-        return root_point(si.coord);
+        return root_point(si.coord) + root_bulge(root_cell(si.origin), si.local);
     }
     float s = float(k) / float(segments);
     float r = s * si.span;
+    // Curved roots over the first segment only (src/reference/root_surface.rs).
+    float fade = root_bulge_fade(r);
+    vec3 bulge = fade > 0.0 ? root_bulge(root_cell(si.origin), si.local) * fade : vec3(0.0);
     vec3 p = curve_point(si.coord, r);
     if (style.clump_strength > 0.0) {
         vec3 c = curve_point(si.centre_coord, r);
@@ -128,7 +193,7 @@ vec3 strand_vertex(StrandInfo si, uint k, uint segments) {
     float w;
     styling_frame(si.coord, r, fu, fv, fw, w);
     vec3 off = styling_offset(si.key, s, w);
-    return p + fu * off.x + fv * off.y + fw * off.z;
+    return p + fu * off.x + fv * off.y + fw * off.z + bulge;
 }
 
 // Tangents from positions (sec. 3.5): central differences, eq. 5 / eq. 6 at the ends.

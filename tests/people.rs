@@ -96,6 +96,7 @@ fn hair_is_sized_to_its_head() {
                     .filter(|p| p.y > jaw),
             );
             let width = (hi.x - lo.x) / (head_width * person.head.x * person.height);
+            println!("{family:?} #{seed}: {width:.3}");
             assert!(
                 width <= family.max_width(),
                 "{family:?} #{seed}: {width:.2} head widths (at most {})",

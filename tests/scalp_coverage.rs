@@ -13,14 +13,18 @@ use hairmesh::render::shared::PropInstance;
 use hairmesh::render::{Camera, StrandParams};
 use hairmesh::{BakeOptions, bake};
 
-/// Least share of the scalp's pixels the hair must cover. Issue 20 asks for 0.98; measured
-/// (this test, lavapipe, 400 strands per bundle, about 10,000 strands): 97-100% for buzz,
-/// crop, wavy, curly, bun, mohawk and afro, 97.9% bob, 94.9% ponytail, 93.4% long straight,
-/// 90.2% side bangs, 86.2% the fitted Sintel hair. What is left uncovered lies behind the
-/// front hairline and at partings, where each strand's first centimetre runs inside the head
-/// (its root is interpolated across a bundle, below the curved scalp). The bound is the
-/// lowest measurement less 1.5 points.
-const MIN_COVERAGE: f64 = 0.847;
+/// Least share of the scalp's pixels the hair must cover (issue 20 asks for 0.98). Measured
+/// (this test, lavapipe, 400 strands per bundle, about 10,000 strands): 98.35% side bangs,
+/// 99.1-100% the other grown families. Two things closed the holes the first version left
+/// (86-98%): strand roots on the curved root surface (`reference::root_surface`) instead of
+/// the chords between root corners, and bundle interiors lifted outside the head where
+/// neighbouring columns spread or part (`hairstyle::lift_bundle_interiors`).
+const MIN_COVERAGE: f64 = 0.98;
+
+/// The fitted Sintel hair's bound: measured 96.9%. Its 20 bundles (a fit of 228 guide
+/// strands) radiate from a crown whorl, and the scalp shows between the spokes; a finer fit
+/// would pass the 21 KB texture budget.
+const MIN_COVERAGE_FITTED: f64 = 0.96;
 
 /// The root faces of `mesh`, each cut into `k x k` and laid 1.5 mm above the head.
 fn scalp_mesh(mesh: &hairmesh::HairMesh, person: &PersonShape, k: usize) -> Vec<[Vec3; 3]> {
@@ -108,19 +112,22 @@ fn hair_covers_the_scalp_seen_from_above() {
             "{family:?}: hair covers {:.2}% of {bare} scalp pixels",
             coverage * 100.0
         );
-        if coverage < MIN_COVERAGE {
+        let bound = if family == StyleFamily::Fitted {
+            MIN_COVERAGE_FITTED
+        } else {
+            MIN_COVERAGE
+        };
+        if coverage < bound {
             let path = output_dir().join(format!("scalp_coverage_{}.png", family.name()));
             save_png(&path, size, size, &out.rgba);
             failures.push(format!(
-                "{family:?}: {:.2}% ({})",
+                "{family:?}: {:.2}% < {:.0}% ({})",
                 coverage * 100.0,
+                bound * 100.0,
                 path.display()
             ));
         }
     }
     assert_no_validation_errors(&ctx);
-    assert!(
-        failures.is_empty(),
-        "scalp coverage below {MIN_COVERAGE}: {failures:#?}"
-    );
+    assert!(failures.is_empty(), "scalp coverage too low: {failures:#?}");
 }

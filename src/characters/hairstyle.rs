@@ -84,8 +84,9 @@ impl StyleFamily {
     pub fn max_width(self) -> f32 {
         match self {
             StyleFamily::Buzz | StyleFamily::ShortCrop | StyleFamily::Mohawk => 1.2,
-            StyleFamily::Bun | StyleFamily::Ponytail | StyleFamily::Fitted => 1.3,
-            StyleFamily::Bob | StyleFamily::SideBangs => 1.4,
+            StyleFamily::Bun | StyleFamily::Ponytail => 1.3,
+            StyleFamily::Fitted => 1.35,
+            StyleFamily::Bob | StyleFamily::SideBangs => 1.45,
             StyleFamily::LongStraight | StyleFamily::LongWavy => 1.6,
             StyleFamily::LongCurly => 1.8,
             StyleFamily::Afro => 2.3,
@@ -499,6 +500,12 @@ fn scalp_grid(region: Region, grid: usize) -> (Vec<Root>, Vec<Face>) {
     (roots, faces)
 }
 
+/// Weight of the parting's sideways comb at canonical offset `c`: the front of the head only
+/// (behind the crown the hair falls).
+fn parting_front(c: Vec3) -> f32 {
+    smoothstep(-0.03, 0.02, c.z)
+}
+
 /// How far the middle of a bundle lies below the scalp at its corners: a square of
 /// `grid x grid` bundles spans about half the head (pi radians across), and the generator
 /// interpolates strands bilinearly between the corner columns, so the middle of a bundle of
@@ -654,7 +661,7 @@ fn comb_direction(comb: Comb, head: &PlacedHead, root: Vec3, n: Vec3, tie: Optio
         Comb::Parting(x) => {
             // Sideways from the parting over the front half of the head only; behind the
             // crown the hair falls.
-            let front = smoothstep(-0.03, 0.02, c.z);
+            let front = parting_front(c);
             let side = ((c.x - x) / 0.03).tanh() * front;
             tangent(combed_back(c) + Vec3::X * side)
         }
@@ -796,6 +803,7 @@ fn grown(
     person: &PersonShape,
     rng: &mut Pcg32,
     name: &str,
+    margin: f32,
 ) -> Result<HairMesh> {
     let cut = cut(family, rng);
     let head = person.head()?;
@@ -838,11 +846,125 @@ fn grown(
             _ => plan.free(p, n, t, r.edge),
         });
     }
-    let layers = (0..cut.layers)
+    let mut layers: Vec<Vec<Vec3>> = (0..cut.layers)
         .map(|k| columns.iter().map(|c| c[k]).collect())
         .collect();
+    lift_bundle_interiors(&mut layers, &faces, &head, margin, MAX_TOTAL_RAISE);
     let uv = roots.iter().map(|r| r.uv).collect();
     HairMesh::new(name, layers, None, uv, faces)
+}
+
+/// Polar angle (canonical, from the crown) below which [`lift_bundle_interiors`] looks: the
+/// nape's hairline is at 122 degrees.
+const CRANIUM_POLAR: f32 = 125.0 * std::f32::consts::PI / 180.0;
+
+/// Most a vertex is raised in one round of [`lift_bundle_interiors`], metres.
+const MAX_INTERIOR_RAISE: f32 = 0.005;
+
+/// Most a grown cut's vertex is raised in all, metres: hair that would need more lies across
+/// a whorl or a parting's end, where no lift makes its strands lie flat.
+const MAX_TOTAL_RAISE: f32 = 0.016;
+
+/// [`MAX_TOTAL_RAISE`] of the fitted Sintel hair, whose 20 bundles are four times as large.
+const MAX_TOTAL_RAISE_FITTED: f32 = 0.03;
+
+/// Deepest point inside the head [`lift_bundle_interiors`] lifts, metres.
+const MAX_INTERIOR_DEPTH: f32 = 0.02;
+
+/// Height the interpolated hair keeps above the head: 2 mm plus half of how far the style's
+/// curls and waves move strands off their bundle's curve (half: the offsets swing both ways,
+/// and hair lying on hair hides the inner half).
+fn interior_margin(style: &HairStyle) -> f32 {
+    0.002 + 0.5 * (style.curl_radius + style.wave_amplitude)
+}
+
+/// Raise the layers (`layers[k][v]`, root layer fixed) until every bundle's interior, as the
+/// generator interpolates it (bilinear between the corner columns' curves,
+/// [`crate::bake::curve::eval_column`]), lies at least `margin` outside the head (its
+/// cranium: hair between two columns over an ear passes beside the ear). Columns that
+/// are settled one by one can still cut the head between them: where neighbouring columns
+/// spread over the curved scalp (or part), the strands between them are chords of it.
+fn lift_bundle_interiors(
+    layers: &mut [Vec<Vec3>],
+    faces: &[Face],
+    head: &PlacedHead,
+    margin: f32,
+    max_total: f32,
+) {
+    use crate::bake::curve::{column_control_points, eval_column};
+    let count = layers.len();
+    let verts = layers[0].len();
+    const SAMPLES: [f32; 3] = [0.2, 0.5, 0.8];
+    let mut total = vec![0.0f32; count * verts];
+    for _ in 0..6 {
+        let ctrl: Vec<Vec<Vec3>> = (0..verts)
+            .map(|v| column_control_points(&layers.iter().map(|l| l[v]).collect::<Vec<_>>()))
+            .collect();
+        let mut raise = vec![0.0f32; count * verts];
+        for f in faces {
+            let corner = f.vertices();
+            let quad = [
+                corner[0],
+                corner[1],
+                corner[2],
+                *corner.get(3).unwrap_or(&corner[2]),
+            ];
+            for half in 1..2 * (count - 1) + 1 {
+                let r = half as f32 * 0.5;
+                for (s, t) in SAMPLES
+                    .iter()
+                    .flat_map(|&s| SAMPLES.iter().map(move |&t| (s, t)))
+                {
+                    let w = [(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t];
+                    let q: Vec3 = (0..4)
+                        .map(|i| eval_column(&ctrl[quad[i] as usize], r) * w[i])
+                        .sum();
+                    // Over the cranium only: below it the head's radial map is the bust's
+                    // neck and shoulders, which the body colliders keep the hair off.
+                    let need = margin - head.cranium_gap(q);
+                    // Deeper than MAX_INTERIOR_DEPTH: the bundle's columns went opposite ways
+                    // round the head (torn at a parting); lifting would only inflate it.
+                    if need <= 0.0 || need > MAX_INTERIOR_DEPTH || head.angles(q).0 > CRANIUM_POLAR
+                    {
+                        continue;
+                    }
+                    // The least raise of the corners around r that lifts this point by
+                    // `need` (each in proportion to its weight; the root layer stays on the
+                    // scalp).
+                    let tau = r.fract();
+                    let layer_weights = [(r.floor() as usize, 1.0 - tau), (r.ceil() as usize, tau)];
+                    let norm: f32 = layer_weights
+                        .iter()
+                        .filter(|(k, _)| *k > 0)
+                        .flat_map(|(_, lw)| w.iter().map(move |wi| (lw * wi).powi(2)))
+                        .sum();
+                    for (k, lw) in layer_weights {
+                        if k == 0 || lw == 0.0 {
+                            continue;
+                        }
+                        for (i, &v) in quad.iter().enumerate() {
+                            let slot = &mut raise[k * verts + v as usize];
+                            *slot = slot.max(need * lw * w[i] / norm.max(1e-6));
+                        }
+                    }
+                }
+            }
+        }
+        if raise.iter().all(|&x| x <= 1e-5) {
+            return;
+        }
+        let centre = head.centre();
+        for (k, layer) in layers.iter_mut().enumerate().skip(1) {
+            for (v, p) in layer.iter_mut().enumerate() {
+                let slot = k * verts + v;
+                let step = raise[slot]
+                    .min(MAX_INTERIOR_RAISE)
+                    .min(max_total - total[slot]);
+                total[slot] += step;
+                *p += (*p - centre).normalize_or(Vec3::Y) * step;
+            }
+        }
+    }
 }
 
 /// The Sintel hair mesh (`fit` of the Sintel Lite strands with 20 bundles and 6 layers,
@@ -876,7 +998,7 @@ fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hai
         (mesh.faces.len() as f32).sqrt().round() as usize,
         head.radius(),
     ) + 0.004;
-    let layers = mesh
+    let mut layers: Vec<Vec<Vec3>> = mesh
         .layers
         .iter()
         .enumerate()
@@ -890,13 +1012,6 @@ fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hai
                 .collect()
         })
         .collect();
-    let mesh = HairMesh::new(
-        format!("Fitted #{seed}"),
-        layers,
-        None,
-        mesh.uv.clone(),
-        mesh.faces.clone(),
-    )?;
     let own = style_for(StyleFamily::Fitted, seed, rng);
     let style = HairStyle {
         seed,
@@ -909,6 +1024,21 @@ fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hai
         color: own.color,
         ..fitted
     };
+    let margin = interior_margin(&style);
+    lift_bundle_interiors(
+        &mut layers,
+        &mesh.faces,
+        &head,
+        margin,
+        MAX_TOTAL_RAISE_FITTED,
+    );
+    let mesh = HairMesh::new(
+        format!("Fitted #{seed}"),
+        layers,
+        None,
+        mesh.uv.clone(),
+        mesh.faces.clone(),
+    )?;
     Ok(Hairstyle {
         family: StyleFamily::Fitted,
         mesh,
@@ -931,7 +1061,7 @@ pub fn generate(family: StyleFamily, seed: u32, person: &PersonShape) -> Result<
     }
     let style = style_for(family, seed, &mut rng);
     let name = format!("{family:?} #{seed}");
-    let mesh = grown(family, person, &mut rng, &name)?;
+    let mesh = grown(family, person, &mut rng, &name, interior_margin(&style))?;
     Ok(Hairstyle {
         family,
         mesh,

@@ -67,6 +67,8 @@ pub struct HumanHead {
     pub centre: Vec3,
     /// `radius[row * MAP_COLS + col]`: distance of the surface from the centre.
     radius: Vec<f32>,
+    /// The same map without the ears ([`opened`]).
+    cranium: Vec<f32>,
 }
 
 static HEAD: OnceLock<std::result::Result<HumanHead, String>> = OnceLock::new();
@@ -111,26 +113,30 @@ impl HumanHead {
         fill_missing(&mut radius).ok_or_else(|| {
             HairError::invalid(name, "the head mesh does not surround its centre")
         })?;
+        let cranium = opened(&radius, EAR_WINDOW);
         Ok(HumanHead {
             triangles,
             centre,
             radius,
+            cranium,
         })
     }
 
     /// Distance of the head surface from [`Self::centre`] in unit direction `d` (bilinear in
     /// the map).
     pub fn radius(&self, d: Vec3) -> f32 {
-        let (theta, phi) = angles(d);
-        let y = theta / std::f32::consts::PI * (MAP_ROWS - 1) as f32;
-        let x = phi / std::f32::consts::TAU * MAP_COLS as f32;
-        let (r0, fy) = ((y.floor() as usize).min(MAP_ROWS - 2), y.fract());
-        let (c0, fx) = (x.floor() as usize % MAP_COLS, x.fract());
-        let c1 = (c0 + 1) % MAP_COLS;
-        let at = |r: usize, c: usize| self.radius[r * MAP_COLS + c];
-        let top = at(r0, c0) * (1.0 - fx) + at(r0, c1) * fx;
-        let bottom = at(r0 + 1, c0) * (1.0 - fx) + at(r0 + 1, c1) * fx;
-        top * (1.0 - fy) + bottom * fy
+        sample_map(&self.radius, d)
+    }
+
+    /// [`Self::radial_gap`] to the head without its ears: what hair lying between two columns
+    /// over an ear must clear (it passes beside the ear, not over its far side).
+    pub fn cranium_gap(&self, p: Vec3) -> f32 {
+        let r = p - self.centre;
+        let l = r.length();
+        if l < 1e-9 {
+            return -sample_map(&self.cranium, Vec3::Y);
+        }
+        l - sample_map(&self.cranium, r / l)
     }
 
     /// Head surface point at polar angle `theta`, azimuth `phi` about the centre.
@@ -162,6 +168,47 @@ impl HumanHead {
     pub fn prop_mesh(&self) -> Vec<PropVertex> {
         smooth_prop_mesh(&self.triangles)
     }
+}
+
+/// Half-width, in map cells (2.5 degrees each), of the window that removes the ears from the
+/// radial map: an ear spans about 35 x 17 degrees seen from the centre.
+const EAR_WINDOW: usize = 8;
+
+/// Morphological opening of the radial map over `(2 w + 1)^2` cells (minimum, then maximum):
+/// removes bumps narrower than the window (the ears) and keeps the broad shape, lowering a
+/// smooth dome by the little it varies within the window.
+fn opened(map: &[f32], w: usize) -> Vec<f32> {
+    let filter = |src: &[f32], pick: fn(f32, f32) -> f32| -> Vec<f32> {
+        let mut out = vec![0.0; src.len()];
+        for row in 0..MAP_ROWS {
+            for col in 0..MAP_COLS {
+                let mut v = src[row * MAP_COLS + col];
+                for r in row.saturating_sub(w)..(row + w + 1).min(MAP_ROWS) {
+                    for dc in 0..2 * w + 1 {
+                        let c = (col + MAP_COLS + dc - w) % MAP_COLS;
+                        v = pick(v, src[r * MAP_COLS + c]);
+                    }
+                }
+                out[row * MAP_COLS + col] = v;
+            }
+        }
+        out
+    };
+    filter(&filter(map, f32::min), f32::max)
+}
+
+/// Bilinear sample of a radial map in unit direction `d`.
+fn sample_map(map: &[f32], d: Vec3) -> f32 {
+    let (theta, phi) = angles(d);
+    let y = theta / std::f32::consts::PI * (MAP_ROWS - 1) as f32;
+    let x = phi / std::f32::consts::TAU * MAP_COLS as f32;
+    let (r0, fy) = ((y.floor() as usize).min(MAP_ROWS - 2), y.fract());
+    let (c0, fx) = (x.floor() as usize % MAP_COLS, x.fract());
+    let c1 = (c0 + 1) % MAP_COLS;
+    let at = |r: usize, c: usize| map[r * MAP_COLS + c];
+    let top = at(r0, c0) * (1.0 - fx) + at(r0, c1) * fx;
+    let bottom = at(r0 + 1, c0) * (1.0 - fx) + at(r0 + 1, c1) * fx;
+    top * (1.0 - fy) + bottom * fy
 }
 
 /// Direction of radial map cell `(row, col)`.

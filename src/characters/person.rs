@@ -160,6 +160,13 @@ impl PlacedHead {
         self.shape.radial_gap(self.to_canonical.transform_point3(p)) * self.scale
     }
 
+    /// [`Self::gap`] to the head without its ears ([`super::human::HumanHead::cranium_gap`]).
+    pub fn cranium_gap(&self, p: Vec3) -> f32 {
+        self.shape
+            .cranium_gap(self.to_canonical.transform_point3(p))
+            * self.scale
+    }
+
     /// `p` moved radially to at least `margin` metres outside the head.
     pub fn push_out(&self, p: Vec3, margin: f32) -> Vec3 {
         let q = self.to_canonical.transform_point3(p);

@@ -4,13 +4,15 @@
 //! texture coordinates, clamp-to-edge linear filtering of the decoded texel values (the texture
 //! unit's two trilinear fetches per quadratic Bezier), one software lerp (paper 003, section 3.1),
 //! root placement from the shared blue-noise sets (section 3.3), styling in the `u v w` frame
-//! (section 3.4) and tangents by eq. 5-6 (section 3.5). `glsl/strand_eval.glsl` is the GPU twin.
+//! (section 3.4), roots on a curved root surface ([`crate::reference::root_surface`]) and
+//! tangents by eq. 5-6 (section 3.5). `glsl/strand_eval.glsl` is the GPU twin.
 
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::bake::blue_noise::{MAX_STRANDS_PER_BUNDLE, quad_samples, triangle_samples};
 use crate::bake::{BakedHairMesh, BundleDesc, MeshInfo};
 use crate::model::style::HairStyle;
+use crate::reference::root_surface::{RootCell, bulge_fade, local_coord};
 use crate::rng::{hash_f32, hash_u32};
 
 /// A decoded texture sampled like a GPU texture unit: normalised coordinates, linear filter,
@@ -151,12 +153,7 @@ impl HairTextures {
     /// `(xi.x / (1 - xi.y), xi.y)`: bilinear weights then equal barycentrics, with `xi.y` the
     /// weight of the duplicated vertex. (The paper prints `xi_s (1 - xi_t)`, the inverse map.)
     pub fn root_coord(&self, b: &BundleDesc, xi: Vec2) -> Vec2 {
-        let local = if b.is_triangle() {
-            Vec2::new(xi.x / (1.0 - xi.y).max(1e-6), xi.y)
-        } else {
-            xi
-        }
-        .clamp(Vec2::ZERO, Vec2::ONE);
+        let local = local_coord(b, xi);
         let [w, h] = self.info.root_size;
         Vec2::new(
             (b.origin[0] as f32 + 0.5 + local.x) / w as f32,
@@ -352,6 +349,8 @@ pub struct CpuGenerator {
     pub tex: HairTextures,
     /// Style in use.
     pub style: HairStyle,
+    /// Root cell of every bundle (curved roots, [`crate::reference::root_surface`]).
+    cells: Vec<RootCell>,
 }
 
 impl CpuGenerator {
@@ -360,6 +359,11 @@ impl CpuGenerator {
         CpuGenerator {
             tex: HairTextures::new(baked),
             style,
+            cells: baked
+                .bundles
+                .iter()
+                .map(|b| RootCell::from_baked(baked, b))
+                .collect(),
         }
     }
 
@@ -377,9 +381,9 @@ impl CpuGenerator {
         let b = &self.tex.bundles[bundle as usize];
         let style = &self.style;
         let key = strand_key(style.seed, bundle, strand);
-        let fp = self
-            .tex
-            .footprint(self.tex.root_coord(b, root_sample(b, bundle, strand)));
+        let xi = root_sample(b, bundle, strand);
+        let fp = self.tex.footprint(self.tex.root_coord(b, xi));
+        let bulge = self.cells[bundle as usize].bulge(local_coord(b, xi));
         let centre_xi = if b.is_triangle() {
             Vec2::new(1.0 / 3.0, 1.0 / 3.0)
         } else {
@@ -388,7 +392,7 @@ impl CpuGenerator {
         let centre_fp = self.tex.footprint(self.tex.root_coord(b, centre_xi));
         let length = 1.0 - style.length_variation * strand_rand(key, 0);
         let span = (self.tex.info.layers - 1) as f32 * length;
-        pos[0] = self.tex.root_point(&fp);
+        pos[0] = self.tex.root_point(&fp) + bulge;
         width[0] = strand_width(style, 0.0);
         for k in 1..=segments as usize {
             let s = k as f32 / segments as f32;
@@ -400,7 +404,7 @@ impl CpuGenerator {
             }
             let ([fu, fv, fw], w) = self.tex.frame(&fp, r);
             let off = styling_offset(style, key, s, w);
-            pos[k] = p + fu * off.x + fv * off.y + fw * off.z;
+            pos[k] = p + fu * off.x + fv * off.y + fw * off.z + bulge * bulge_fade(r);
             width[k] = strand_width(style, s);
         }
         crate::bake::curve::strand_tangents(pos, tan);

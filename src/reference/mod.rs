@@ -5,3 +5,4 @@
 pub mod generate;
 pub mod lhs;
 pub mod lod;
+pub mod root_surface;

@@ -15,6 +15,7 @@ use super::shared::{
 use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::bake::{BakedHairMesh, MeshInfo};
 use crate::model::style::HairStyle;
+use crate::reference::root_surface::RootCell;
 use crate::vk::{
     BindingDesc, Buffer, Context, DescriptorKind, DescriptorSet, DescriptorSetLayout, GpuError,
     GpuResult, Image, ImageDesc, Sampler,
@@ -112,6 +113,8 @@ pub struct CharacterTextures {
 struct Character {
     generation: u32,
     max_draw_vertices: u64,
+    /// Largest root offset of a bundle at rest ([`RootCell::bulge_bound`]), object units.
+    root_bulge: f32,
     info: MeshInfo,
     style: HairStyle,
     params: StrandParams,
@@ -242,6 +245,11 @@ impl Crowd {
         self.slots[slot as usize] = Some(Character {
             generation,
             max_draw_vertices: max_draw_vertices(&baked.bundles, style, params),
+            root_bulge: baked
+                .bundles
+                .iter()
+                .map(|b| RootCell::from_baked(baked, b).bulge_bound())
+                .fold(0.0, f32::max),
             info: baked.info,
             style: *style,
             params,
@@ -453,7 +461,7 @@ impl Crowd {
 
     /// World-space bounds of every visible character's hair: the box of its latest pose for
     /// animated characters, else of its hair mesh texture, transformed, grown by the styling
-    /// offsets (as `bundle_lod.glsl` grows bundle bounds).
+    /// offsets and the curved roots (as `bundle_lod.glsl` grows bundle bounds).
     pub fn hair_bounds(&self) -> Vec<(glam::Vec3, glam::Vec3)> {
         use glam::Vec3;
         self.slots
@@ -478,8 +486,13 @@ impl Crowd {
                     whi = whi.max(p);
                 }
                 let st = &c.style;
+                // Animated roots follow the scalp rigidly, so the bulge at rest bounds theirs.
                 let margin = model_scale(&c.model)
-                    * (st.curl_radius + st.wave_amplitude + st.frizz_amplitude + st.strand_width);
+                    * (st.curl_radius
+                        + st.wave_amplitude
+                        + st.frizz_amplitude
+                        + st.strand_width
+                        + c.root_bulge);
                 (wlo - margin, whi + margin)
             })
             .collect()

@@ -727,6 +727,10 @@ pub fn glsl_header() -> String {
     let float_consts = [
         ("STRAND_OPACITY", super::transparency::STRAND_OPACITY),
         ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
+        (
+            "ROOT_PHONG_SHAPE",
+            crate::reference::root_surface::ROOT_PHONG_SHAPE,
+        ),
     ];
     for (name, v) in float_consts {
         let _ = writeln!(out, "#define {name} {v:?}");
