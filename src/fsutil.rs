@@ -154,6 +154,71 @@ impl OutputPath {
     }
 }
 
+/// Every file one run of a tool reads and writes, checked together before any work: an
+/// output may be none of the inputs (also those a run reads without naming them: the style
+/// beside a mesh, the files a scene names, a `fit` head) and no two outputs may be the same
+/// path (else one would silently replace the other).
+#[derive(Default)]
+pub struct RunFiles {
+    inputs: Vec<PathBuf>,
+    outputs: Vec<(PathBuf, PathBuf)>,
+}
+
+/// `path` made absolute with its folder resolved (links included), for comparing outputs that
+/// do not exist yet; unchanged where its folder cannot be resolved.
+fn resolved(path: &Path) -> PathBuf {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    match (std::fs::canonicalize(parent), path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
+impl RunFiles {
+    /// An empty plan.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Count `path` as read by this run (register every input before the first output).
+    pub fn input(&mut self, path: &Path) -> &mut Self {
+        self.inputs.push(path.to_path_buf());
+        self
+    }
+
+    /// Count every path of `paths` as read by this run.
+    pub fn inputs<'a>(&mut self, paths: impl IntoIterator<Item = &'a Path>) -> &mut Self {
+        for p in paths {
+            self.input(p);
+        }
+        self
+    }
+
+    /// Check `path` as an output ([`OutputPath::check`] against every input so far) that no
+    /// earlier output of this run already is; `what` names it in the error (a flag).
+    pub fn output(&mut self, path: &Path, what: &str) -> Result<OutputPath> {
+        let inputs: Vec<&Path> = self.inputs.iter().map(PathBuf::as_path).collect();
+        let out = OutputPath::check(path, &inputs)?;
+        let key = resolved(path);
+        if let Some((earlier, _)) = self.outputs.iter().find(|(_, k)| *k == key)
+            && out.kind == OutputKind::Atomic
+        {
+            return Err(HairError::invalid(
+                path.display().to_string(),
+                format!(
+                    "{what} is also this run's output {}; give each output its own path",
+                    earlier.display()
+                ),
+            ));
+        }
+        self.outputs.push((path.to_path_buf(), key));
+        Ok(out)
+    }
+}
+
 #[cfg(unix)]
 fn is_char_device(m: &std::fs::Metadata) -> bool {
     use std::os::unix::fs::FileTypeExt;

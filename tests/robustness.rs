@@ -335,3 +335,86 @@ fn messages_name_the_argument_and_say_things_once() {
         "the OS message once: {err}"
     );
 }
+
+/// The small patch as real exporters write it: a byte-order mark, CRLF line ends, tabs,
+/// comments, `o` / `s` / `usemtl` / `mtllib`, a group line naming two groups, free-form
+/// attribute statements (on which obj-rs 0.7 panics) and negative (relative) indices.
+fn exported_like_a_tool(original: &str) -> String {
+    let mut out = String::from("\u{feff}# exported by a tool\r\nmtllib patch.mtl\r\no Patch\r\n");
+    out.push_str("g hair scalp\r\ncstype bezier\r\ndeg 3\r\nbmat u 1 0 0 0\r\nstep 1\r\n");
+    out.push_str("ctech cparm 1.0\r\nstech cparm 1.0 1.0\r\nlod 1\r\nbevel off\r\n");
+    out.push_str("c_interp off\r\nd_interp off\r\nshadow_obj a.obj\r\ntrace_obj a.obj\r\n");
+    let (mut v, mut vt) = (0i64, 0i64);
+    for line in original.lines() {
+        let mut tok = line.split_whitespace();
+        match tok.next() {
+            Some("v") => v += 1,
+            Some("vt") => vt += 1,
+            Some("f") => {
+                // Relative indices: -1 is the latest vertex defined so far.
+                let corners: Vec<String> = tok
+                    .map(|c| {
+                        let mut parts = c.split('/');
+                        let p: i64 = parts.next().unwrap().parse().unwrap();
+                        match parts.next() {
+                            Some(t) if !t.is_empty() => {
+                                let t: i64 = t.parse().unwrap();
+                                format!("{}/{}", p - v - 1, t - vt - 1)
+                            }
+                            _ => format!("{}", p - v - 1),
+                        }
+                    })
+                    .collect();
+                out.push_str(&format!("f\t{}\t# a face\r\n", corners.join("\t")));
+                continue;
+            }
+            Some(g) if g == "g" && line.contains("layer0") => {
+                out.push_str(&format!("{line}\r\ns 1\r\nusemtl skin\r\n"));
+                continue;
+            }
+            _ => {}
+        }
+        out.push_str(&line.replace(' ', "\t"));
+        out.push_str("\r\n");
+    }
+    out
+}
+
+#[test]
+fn obj_files_real_exporters_write_are_accepted() {
+    use hairmesh::model::obj_io::load_hair_mesh_obj;
+    let dir = tempfile::tempdir().unwrap();
+    let original = root().join("hairmeshes/small_patch.obj");
+    let text = std::fs::read_to_string(&original).unwrap();
+    let exported = dir.path().join("exported.obj");
+    std::fs::write(&exported, exported_like_a_tool(&text)).unwrap();
+    let a = load_hair_mesh_obj(&original).unwrap();
+    let b = load_hair_mesh_obj(&exported).unwrap();
+    assert_eq!(a.layers, b.layers);
+    assert_eq!(a.uv, b.uv);
+    assert_eq!(a.faces, b.faces);
+    let out = dir.path().join("exported.hmb");
+    let o = bake(&[s(&exported), "-o", s(&out)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Free-form geometry carries shape a hair mesh cannot hold: refused, its line named.
+    for (stmt, what) in [
+        ("curv 0 1 1 2", "free-form curve"),
+        ("surf 0 1 0 1 1 2 3 4", "free-form surface"),
+    ] {
+        let p = dir.path().join("curve.obj");
+        std::fs::write(&p, format!("{text}{stmt}\n")).unwrap();
+        let lines = text.lines().count() + 1;
+        let out = dir.path().join("curve.hmb");
+        let o = bake(&[s(&p), "-o", s(&out)]);
+        assert_fails(&o, what);
+        assert_fails(&o, &format!("line {lines}"));
+        assert!(!out.exists());
+    }
+    // Unknown statements are named with their line, not reported by the parser's wording.
+    let p = dir.path().join("unknown.obj");
+    std::fs::write(&p, format!("{text}frobnicate 1 2\n")).unwrap();
+    assert_fails(
+        &bake(&[s(&p), "-o", s(&dir.path().join("u.hmb"))]),
+        "'frobnicate'",
+    );
+}

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use clap::Parser;
-use hairmesh::fsutil::OutputPath;
+use hairmesh::fsutil::RunFiles;
 use hairmesh::model::hair_file::{HairFile, MAX_POINTS};
 use hairmesh::reference::generate::strands_in_bundle;
 use hairmesh::render::scene::load_mesh;
@@ -38,11 +38,11 @@ struct Args {
 }
 
 fn run(args: Args) -> Result<()> {
-    let mut inputs = vec![args.mesh.as_path()];
-    if let Some(s) = &args.style {
-        inputs.push(s.as_path());
-    }
-    let out = OutputPath::check(&args.output, &inputs)?;
+    // The style beside an OBJ mesh is read too: never overwritten.
+    let inputs = hairmesh::render::scene::mesh_inputs(&args.mesh, args.style.as_deref());
+    let out = RunFiles::new()
+        .inputs(inputs.iter().map(PathBuf::as_path))
+        .output(&args.output, "-o")?;
     let (baked, style) = load_mesh(&args.mesh, args.style.as_deref())?;
     // Refuse absurd counts before generating anything.
     let strands: u64 = baked

@@ -15,7 +15,7 @@ use glam::Vec3;
 use hairmesh::fit::metric::compare;
 use hairmesh::fit::picture::{StrandLook, draw_strands};
 use hairmesh::fit::{FitOptions, fit};
-use hairmesh::fsutil::OutputPath;
+use hairmesh::fsutil::RunFiles;
 use hairmesh::model::strands::StrandModel;
 use hairmesh::reference::generate::strands_per_bundle_for;
 use hairmesh::render::{Camera, Renderer, RendererDesc};
@@ -60,7 +60,9 @@ fn run(args: Args) -> Result<()> {
     if let Some(h) = &args.head {
         inputs.push(h.as_path());
     }
-    let obj_out = OutputPath::check(&args.output, &inputs)?;
+    let mut files = RunFiles::new();
+    files.inputs(inputs.iter().copied());
+    let obj_out = files.output(&args.output, "-o")?;
     let toml_path = args.output.with_extension("toml");
     if toml_path == args.output {
         bail!(
@@ -68,11 +70,11 @@ fn run(args: Args) -> Result<()> {
             args.output.display()
         );
     }
-    let toml_out = OutputPath::check(&toml_path, &inputs)?;
+    let toml_out = files.output(&toml_path, "the style beside -o")?;
     let picture = args
         .picture
         .as_ref()
-        .map(|p| OutputPath::check(p, &inputs))
+        .map(|p| files.output(p, "--picture"))
         .transpose()?;
     if picture.is_some() && !args.report {
         bail!("--picture needs --report");

@@ -12,14 +12,14 @@ use std::time::Instant;
 use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::{Mat4, Vec3};
-use hairmesh::fsutil::OutputPath;
+use hairmesh::fsutil::RunFiles;
+use hairmesh::outln;
 use hairmesh::render::scene::{SceneDesc, load_mesh};
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, LodSettings, RenderPath, Renderer, RendererDesc,
     StrandParams, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
-use hairmesh::{HairStyle, outln};
 
 /// Render hair generated on the GPU from hair-mesh textures.
 #[derive(Parser)]
@@ -180,8 +180,10 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
         }
         inputs.look = scene.look.clone();
         for c in &scene.characters {
-            inputs.files.push(c.mesh.clone());
-            inputs.files.extend(c.style.clone());
+            inputs.files.extend(hairmesh::render::scene::mesh_inputs(
+                &c.mesh,
+                c.style.as_deref(),
+            ));
             let (baked, style) = load_mesh(&c.mesh, c.style.as_deref())?;
             inputs.characters.push(Character {
                 baked,
@@ -197,9 +199,10 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
         let Some(mesh) = &args.mesh else {
             bail!("give --mesh or --scene")
         };
-        inputs.files.push(mesh.clone());
-        inputs.files.extend(args.style.clone());
-        inputs.files.extend(HairStyle::beside(mesh));
+        inputs.files.extend(hairmesh::render::scene::mesh_inputs(
+            mesh,
+            args.style.as_deref(),
+        ));
         let (baked, style) = load_mesh(mesh, args.style.as_deref())?;
         inputs.characters.push(Character {
             baked,
@@ -321,10 +324,9 @@ fn run(args: Args) -> Result<()> {
     // Load and validate every input, and the output path, before touching the GPU.
     let inputs = load_inputs(&args)?;
     let camera = pick_camera(&args, &inputs)?;
-    let output = OutputPath::check(
-        &args.output,
-        &inputs.files.iter().map(|p| p.as_path()).collect::<Vec<_>>(),
-    )?;
+    let output = RunFiles::new()
+        .inputs(inputs.files.iter().map(PathBuf::as_path))
+        .output(&args.output, "-o")?;
     let (width, height) = inputs.size;
 
     let start = Instant::now();
@@ -333,13 +335,29 @@ fn run(args: Args) -> Result<()> {
             .validation(args.validation)
             .device(args.device.clone()),
     )?);
+    let msaa = args.msaa.or(inputs.look.msaa).unwrap_or(1);
+    let supported = hairmesh::render::supported_msaa(&ctx);
+    if !supported.contains(&msaa) {
+        let list: Vec<String> = supported.iter().map(|c| c.to_string()).collect();
+        let flag = if args.msaa.is_some() {
+            "--msaa"
+        } else {
+            "the scene's [look] msaa"
+        };
+        anyhow::bail!(
+            "{flag} {msaa}: {} supports {} samples per pixel",
+            ctx.info.name,
+            list.join(", ")
+        );
+    }
     let mut renderer = Renderer::new(
         &ctx,
         &RendererDesc::default()
             .size(width, height)
             .path(path)
             .vertex_pool_bytes(args.vertex_pool_mib << 20)
-            .msaa(args.msaa.or(inputs.look.msaa).unwrap_or(1)),
+            .msaa(msaa)
+            .max_characters(inputs.characters.len().max(1) as u32),
     )?;
     for c in &inputs.characters {
         renderer.add_character(&c.baked, &c.style, c.params, c.model)?;

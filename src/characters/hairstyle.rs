@@ -849,7 +849,10 @@ fn grown(
     let mut layers: Vec<Vec<Vec3>> = (0..cut.layers)
         .map(|k| columns.iter().map(|c| c[k]).collect())
         .collect();
-    lift_bundle_interiors(&mut layers, &faces, &head, margin, MAX_TOTAL_RAISE);
+    // Hair that lies on the scalp; standing hair (mohawk, afro) leaves it at once.
+    if !matches!(cut.comb, Comb::Out) {
+        lift_bundle_interiors(&mut layers, &faces, &head, margin, MAX_TOTAL_RAISE);
+    }
     let uv = roots.iter().map(|r| r.uv).collect();
     HairMesh::new(name, layers, None, uv, faces)
 }

@@ -70,6 +70,81 @@ pub struct Fitted {
     pub bundle_size: f32,
 }
 
+/// Chart positions hashed into square cells, for neighbour queries.
+struct ChartGrid {
+    cell: f32,
+    cells: std::collections::HashMap<(i64, i64), Vec<u32>>,
+}
+
+impl ChartGrid {
+    fn new(points: &[Vec2], cell: f32) -> Self {
+        let cell = cell.max(1e-12);
+        let mut cells: std::collections::HashMap<(i64, i64), Vec<u32>> = Default::default();
+        for (i, p) in points.iter().enumerate() {
+            cells.entry(Self::key(*p, cell)).or_default().push(i as u32);
+        }
+        ChartGrid { cell, cells }
+    }
+
+    fn key(p: Vec2, cell: f32) -> (i64, i64) {
+        ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64)
+    }
+
+    /// The points within `radius` of `g`, or its `least` nearest if fewer lie there (all of
+    /// them if there are fewer than `least`), with squared distances.
+    fn nearest(&self, points: &[Vec2], g: Vec2, radius: f32, least: usize) -> Vec<(usize, f32)> {
+        let (cx, cy) = Self::key(g, self.cell);
+        let least = least.min(points.len());
+        let mut found: Vec<(usize, f32)> = Vec::new();
+        // Rings of cells around g's cell: after ring k every point within k cells is found.
+        let max_ring = self.cells.len() as i64 + 2;
+        for k in 0..=max_ring {
+            for dy in -k..=k {
+                for dx in -k..=k {
+                    if dx.abs().max(dy.abs()) != k {
+                        continue;
+                    }
+                    if let Some(ids) = self.cells.get(&(cx + dx, cy + dy)) {
+                        found.extend(
+                            ids.iter()
+                                .map(|&i| (i as usize, points[i as usize].distance_squared(g))),
+                        );
+                    }
+                }
+            }
+            let reach = k as f32 * self.cell;
+            let within = found
+                .iter()
+                .filter(|(_, d2)| *d2 <= radius * radius)
+                .count();
+            let complete = reach >= radius;
+            let enough = within >= least
+                || (found.len() >= least && {
+                    let mut d: Vec<f32> = found.iter().map(|f| f.1).collect();
+                    d.select_nth_unstable_by(least - 1, f32::total_cmp);
+                    d[least - 1] <= reach * reach
+                });
+            if (complete && enough) || found.len() == points.len() {
+                break;
+            }
+        }
+        let within = found
+            .iter()
+            .filter(|(_, d2)| *d2 <= radius * radius)
+            .count()
+            .max(least)
+            .min(found.len());
+        if within > 0 && within < found.len() {
+            found.select_nth_unstable_by(within - 1, |a, b| a.1.total_cmp(&b.1));
+            found.truncate(within);
+        }
+        // Index order: the weighted sums over them do not depend on the search.
+        found.sort_unstable_by_key(|f| f.0);
+        found.shrink_to_fit();
+        found
+    }
+}
+
 /// The chart of step 1.
 struct Chart {
     centre: Vec3,
@@ -236,26 +311,15 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
         .iter()
         .map(|&(i, j)| lo + Vec2::new(i as f32, j as f32) * h)
         .collect();
-    // Neighbour strands of every corner, with weights.
+    // Neighbour strands of every corner, with weights: found through a grid of the roots'
+    // chart positions, so the work and memory grow with strands + corners, not their product.
+    let grid = ChartGrid::new(&x, 1.5 * h);
     let neighbours: Vec<Vec<(usize, f32)>> = corner_chart
         .iter()
         .map(|&g| {
-            let mut d: Vec<(usize, f32)> = x
-                .iter()
-                .enumerate()
-                .map(|(i, p)| (i, p.distance_squared(g)))
-                .collect();
-            let r2 = (1.5 * h) * (1.5 * h);
-            let within = d
-                .iter()
-                .filter(|(_, d2)| *d2 <= r2)
-                .count()
-                .max(4)
-                .min(d.len());
-            d.select_nth_unstable_by(within - 1, |a, b| a.1.total_cmp(&b.1));
-            d.truncate(within);
             let soft = (0.25 * h) * (0.25 * h);
-            d.into_iter()
+            grid.nearest(&x, g, 1.5 * h, 4)
+                .into_iter()
                 .map(|(i, d2)| (i, 1.0 / (d2 + soft)))
                 .collect()
         })

@@ -22,9 +22,46 @@ use obj::raw::object::{Polygon, RawObj};
 use crate::error::{HairError, Result};
 use crate::model::hair_mesh::{Face, HairMesh, split_polygon};
 
-/// Statements obj-rs does not implement (it panics on them); rejected with their line number.
-const UNSUPPORTED: &[&str] = &[
-    "curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con",
+/// Free-form geometry: curves and surfaces carry shape a hair mesh cannot hold, so a file
+/// with them is refused (line named) rather than read without them.
+const FREE_FORM_GEOMETRY: &[&str] = &["curv", "curv2", "surf"];
+
+/// Statements that carry no hair-mesh data, ignored (obj-rs 0.7 panics on most of them, or
+/// refuses them as unknown): free-form attributes and bodies, which mean nothing without a
+/// curve or surface, display and render attributes, and point, line and parameter data.
+const IGNORED: &[&str] = &[
+    "cstype",
+    "deg",
+    "bmat",
+    "step",
+    "parm",
+    "trim",
+    "hole",
+    "scrv",
+    "sp",
+    "end",
+    "con",
+    "ctech",
+    "stech",
+    "bevel",
+    "c_interp",
+    "d_interp",
+    "lod",
+    "shadow_obj",
+    "trace_obj",
+    "maplib",
+    "usemap",
+    "call",
+    "csh",
+    "mg",
+    "vp",
+    "p",
+    "l",
+];
+
+/// Statements handed to obj-rs.
+const PARSED: &[&str] = &[
+    "v", "vt", "vn", "f", "fo", "g", "o", "s", "usemtl", "mtllib",
 ];
 
 /// Largest coordinate magnitude accepted (positions, uv, w): beyond it, 32-bit floats lose
@@ -80,9 +117,16 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
     };
     let mut vt_count = 0;
     let mut in_layer = false;
+    let mut continued = false;
     for (n, line) in text.lines().enumerate() {
         let line_no = n + 1;
-        let mut tok = line.split('#').next().unwrap_or("").split_whitespace();
+        let body = line.split('#').next().unwrap_or("");
+        // A line after one ending in a backslash continues that statement.
+        let was_continued = std::mem::replace(&mut continued, body.trim_end().ends_with('\\'));
+        if was_continued {
+            continue;
+        }
+        let mut tok = body.split_whitespace();
         let Some(stmt) = tok.next() else { continue };
         let args: Vec<&str> = tok.collect();
         match stmt {
@@ -131,23 +175,71 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
                 }
                 idx.face_lines.push(line_no);
             }
-            s if UNSUPPORTED.contains(&s) => {
+            s if FREE_FORM_GEOMETRY.contains(&s) => {
                 return Err(HairError::invalid(
                     name,
-                    format!("line {line_no}: free-form statement '{s}' is not supported"),
+                    format!(
+                        "line {line_no}: free-form {} ('{s}') cannot be read as a hair mesh; export polygons",
+                        if s == "surf" { "surface" } else { "curve" }
+                    ),
                 ));
             }
-            _ => {}
+            s if PARSED.contains(&s) || IGNORED.contains(&s) => {}
+            s => {
+                return Err(HairError::invalid(
+                    name,
+                    format!(
+                        "line {line_no}: unknown OBJ statement '{}'",
+                        s.escape_debug()
+                    ),
+                ));
+            }
         }
     }
     idx.all_vt_have_w &= vt_count > 0;
     Ok(idx)
 }
 
+/// `text` as obj-rs should see it: ignored statements (and their continuation lines) blanked,
+/// a group line reduced to its first name (obj-rs refuses `g a b`; layer groups name one),
+/// line numbers kept.
+fn for_obj_rs(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut dropping = false;
+    for line in text.lines() {
+        let body = line.split('#').next().unwrap_or("");
+        let continues = body.trim_end().ends_with('\\');
+        if dropping {
+            dropping = continues;
+            out.push('\n');
+            continue;
+        }
+        let mut tok = body.split_whitespace();
+        match tok.next() {
+            Some(s) if IGNORED.contains(&s) => {
+                dropping = continues;
+            }
+            Some("g") => {
+                out.push('g');
+                if let Some(first) = tok.next() {
+                    out.push(' ');
+                    out.push_str(first);
+                }
+            }
+            _ => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    out
+}
+
 fn parse(name: &str, bytes: &[u8]) -> Result<(RawObj, LineIndex)> {
     let text = std::str::from_utf8(bytes)
         .map_err(|e| HairError::invalid(name, format!("not UTF-8 text: {e}")))?;
+    // A UTF-8 byte-order mark (some Windows tools write one) is not part of the first line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let lines = scan_lines(name, text)?;
+    let text = for_obj_rs(text);
     // obj-rs may panic on inputs it does not implement; never let that escape as a crash.
     let parsed = std::panic::catch_unwind(|| obj::raw::parse_obj(text.as_bytes()));
     match parsed {

@@ -33,16 +33,29 @@ pub fn validate_camera(eye: Vec3, target: Vec3, fov_y_degrees: f32) -> Result<()
             "camera eye {eye} and target {target} must be finite"
         ));
     }
+    if eye.abs().max(target.abs()).max_element() > MAX_CAMERA_COORDINATE {
+        return Err(format!(
+            "camera eye {eye} and target {target} must lie within {MAX_CAMERA_COORDINATE:e} of the origin (32-bit floats are 2 mm apart there)"
+        ));
+    }
     if eye.distance(target) <= 1e-6 * eye.length().max(1.0) {
         return Err(format!("camera eye and target are the same point {eye}"));
     }
-    if !(fov_y_degrees > 0.0 && fov_y_degrees < 180.0) {
+    if !(MIN_FOV_DEGREES..=MAX_FOV_DEGREES).contains(&fov_y_degrees) {
         return Err(format!(
-            "field of view {fov_y_degrees} degrees is outside (0, 180)"
+            "field of view {fov_y_degrees} degrees is outside {MIN_FOV_DEGREES}..={MAX_FOV_DEGREES}"
         ));
     }
     Ok(())
 }
+
+/// Narrowest vertical field of view accepted, degrees.
+pub const MIN_FOV_DEGREES: f32 = 0.1;
+/// Widest vertical field of view accepted, degrees.
+pub const MAX_FOV_DEGREES: f32 = 179.0;
+/// Largest camera coordinate accepted, metres: the world is rendered in 32-bit floats, whose
+/// spacing at 2e4 is 2 mm (characters stand within `scene::MAX_TRANSLATION`).
+pub const MAX_CAMERA_COORDINATE: f32 = 2e4;
 
 /// Check a light direction: finite and not zero.
 pub fn validate_light(direction: Vec3) -> Result<(), String> {

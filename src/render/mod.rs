@@ -21,7 +21,9 @@ pub mod workspace;
 pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use frame::{FRAMES_IN_FLIGHT, FrameReport};
-pub use renderer::{FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc};
+pub use renderer::{
+    FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc, supported_msaa,
+};
 pub use shadow::ShadowMode;
 pub use shared::FrameStats;
 pub use soft::StrandRaster;

@@ -155,6 +155,14 @@ fn check_size(width: u32, height: u32) -> GpuResult<()> {
     Ok(())
 }
 
+/// Sample counts `ctx`'s device supports for the renderer's colour and depth targets.
+pub fn supported_msaa(ctx: &Context) -> Vec<u32> {
+    (0..7)
+        .map(|b| 1u32 << b)
+        .filter(|c| ctx.info.attachment_sample_counts & c != 0)
+        .collect()
+}
+
 impl Renderer {
     /// Create pipelines, targets and frame slots; checks the device limits the settings need.
     pub fn new(ctx: &Arc<Context>, desc: &RendererDesc) -> GpuResult<Self> {
@@ -195,13 +203,9 @@ impl Renderer {
         set_layouts[SET_FRAME as usize] = frame_layout.clone();
         set_layouts[SET_TEXTURES as usize] = crowd.texture_layout().clone();
         let layout = PipelineLayout::new(ctx, &set_layouts)?;
-        let supported = ctx.info.attachment_sample_counts;
-        if !desc.msaa.is_power_of_two() || supported & desc.msaa == 0 {
-            let counts: Vec<String> = (0..7)
-                .map(|b| 1u32 << b)
-                .filter(|c| supported & c != 0)
-                .map(|c| c.to_string())
-                .collect();
+        let supported = supported_msaa(ctx);
+        if !supported.contains(&desc.msaa) {
+            let counts: Vec<String> = supported.iter().map(|c| c.to_string()).collect();
             return Err(GpuError::Unsupported(format!(
                 "{}: {}x MSAA is not supported for colour and depth (supported: {})",
                 ctx.info.name,

@@ -157,8 +157,9 @@ pub const MAX_SCENE_CHARACTERS: usize = 4096;
 pub const MAX_IMAGE_SIDE: u32 = 8192;
 /// Largest uniform scale of a character.
 pub const MAX_SCALE: f32 = 1e4;
-/// Largest translation component of a character.
-pub const MAX_TRANSLATION: f32 = 1e6;
+/// Largest translation component of a character, metres: strands are placed in 32-bit world
+/// coordinates, whose spacing at 1e4 is 1 mm (at 1e6 it is 6 cm, coarser than a strand).
+pub const MAX_TRANSLATION: f32 = 1e4;
 
 /// Parse `x,y,z` (three finite numbers).
 pub fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
@@ -292,6 +293,20 @@ impl CharacterDesc {
             Vec3::from(self.translation),
         )
     }
+}
+
+/// Every file [`load_mesh`] reads for `mesh` and `style`: the mesh, the style given, and the
+/// style beside an OBJ mesh.
+pub fn mesh_inputs(mesh: &Path, style: Option<&Path>) -> Vec<PathBuf> {
+    let mut files = vec![mesh.to_path_buf()];
+    let is_obj = mesh
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj && let Some(beside) = HairStyle::beside(mesh) {
+        files.push(beside);
+    }
+    files.extend(style.map(Path::to_path_buf));
+    files
 }
 
 /// Load a mesh (`.obj` is baked on load, anything else is read as a baked file) and its style:

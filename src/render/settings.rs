@@ -72,6 +72,12 @@ impl Default for RendererDesc {
 }
 
 impl RendererDesc {
+    /// Set the most characters at once.
+    pub fn max_characters(mut self, count: u32) -> Self {
+        self.max_characters = count;
+        self
+    }
+
     /// Set the initial target size.
     pub fn size(mut self, width: u32, height: u32) -> Self {
         self.width = width;
