@@ -219,6 +219,111 @@ impl RunFiles {
     }
 }
 
+/// A folder of outputs written over a long run (frames) that appear only if the run succeeds:
+/// every file's path is checked first ([`RunFiles::output`]), files go to a hidden staging
+/// folder beside the target as they are made, and [`StagedFolder::publish`] moves them in at
+/// the end. Dropped without publishing (an error, a panic), the staging folder is removed:
+/// a failed run leaves the target as it was, and creates nothing.
+pub struct StagedFolder {
+    target: PathBuf,
+    staging: PathBuf,
+    existed: bool,
+    created: bool,
+    written: Vec<String>,
+}
+
+impl StagedFolder {
+    /// Check folder `target` (existing, or new in an existing folder) and the files `names`
+    /// in it as outputs of `files`' run; `what` names the folder in errors (a flag).
+    pub fn check(
+        target: &Path,
+        names: &[String],
+        files: &mut RunFiles,
+        what: &str,
+    ) -> Result<Self> {
+        let name = format!("{what} {}", target.display());
+        let existed = match std::fs::symlink_metadata(target) {
+            Ok(m) if m.is_dir() => true,
+            Ok(_) => return Err(HairError::invalid(name, "not a folder")),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
+            Err(e) => return Err(HairError::io(target, e)),
+        };
+        let leaf = target
+            .file_name()
+            .ok_or_else(|| HairError::invalid(&name, "not a folder path"))?;
+        let parent = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        if !existed && !parent.is_dir() {
+            return Err(HairError::invalid(
+                name,
+                format!("folder {} does not exist", parent.display()),
+            ));
+        }
+        // Nothing lies in a folder that does not exist yet: only an existing one's entries
+        // can be links, folders or inputs.
+        if existed {
+            for n in names {
+                files.output(&target.join(n), what)?;
+            }
+        }
+        let staging = parent.join(format!(
+            ".{}.partial{}",
+            leaf.to_string_lossy(),
+            std::process::id()
+        ));
+        Ok(StagedFolder {
+            target: target.to_path_buf(),
+            staging,
+            existed,
+            created: false,
+            written: Vec::new(),
+        })
+    }
+
+    /// Write file `name` (one of the checked names) into the staging folder.
+    pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<()> {
+        if !self.created {
+            std::fs::create_dir(&self.staging).map_err(|e| HairError::io(&self.staging, e))?;
+            self.created = true;
+        }
+        let path = self.staging.join(name);
+        std::fs::write(&path, bytes).map_err(|e| HairError::io(&path, e))?;
+        self.written.push(name.to_string());
+        Ok(())
+    }
+
+    /// Move every written file into the target folder (the whole staging folder when the
+    /// target did not exist).
+    pub fn publish(mut self) -> Result<()> {
+        if !self.created {
+            std::fs::create_dir(&self.staging).map_err(|e| HairError::io(&self.staging, e))?;
+            self.created = true;
+        }
+        if self.existed {
+            for n in &self.written {
+                let (from, to) = (self.staging.join(n), self.target.join(n));
+                std::fs::rename(&from, &to).map_err(|e| HairError::io(&to, e))?;
+            }
+            let _ = std::fs::remove_dir(&self.staging);
+        } else {
+            std::fs::rename(&self.staging, &self.target)
+                .map_err(|e| HairError::io(&self.target, e))?;
+        }
+        self.created = false;
+        Ok(())
+    }
+}
+
+impl Drop for StagedFolder {
+    fn drop(&mut self) {
+        if self.created {
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}
+
 #[cfg(unix)]
 fn is_char_device(m: &std::fs::Metadata) -> bool {
     use std::os::unix::fs::FileTypeExt;

@@ -116,7 +116,8 @@ fn empty_truncated_and_garbage() {
     let e = load(&text[..text.len() - 30]);
     assert!(!e.is_empty());
     assert!(load("v 1 2\n").contains("malformed OBJ"));
-    assert!(load(&format!("{}curv 0 1 1 2\n", ok_text())).contains("not supported"));
+    let e = load(&format!("{}curv 0 1 1 2\n", ok_text()));
+    assert!(e.contains("free-form curve") && e.contains("line "), "{e}");
     assert!(load(&ok_text().replace("f 1/1 2/2 3/3 4/4", "f 1 2 3 4")).contains("no vt"));
     assert!(
         load(&ok_text().replace("f 1/1 2/2 3/3 4/4", "f 1/1 2/2 3/3 99/4")).contains("malformed")

@@ -418,3 +418,113 @@ fn obj_files_real_exporters_write_are_accepted() {
         "'frobnicate'",
     );
 }
+
+/// Every file a run reads is an input, also those it finds on its own, and no two outputs of
+/// a run may be the same file: refused before any work, nothing changed.
+#[test]
+fn inputs_found_beside_meshes_and_colliding_outputs_are_not_overwritten() {
+    let (dir, obj, _) = workspace();
+    let style = dir.path().join("m.toml");
+    let before = std::fs::read(&style).unwrap();
+    // export reads the style beside the mesh.
+    let o = run(
+        env!("CARGO_BIN_EXE_export"),
+        &["--mesh", s(&obj), "-o", s(&style)],
+    );
+    assert_fails(&o, "m.toml");
+    // render reads the files a scene names (and the style beside its mesh).
+    let scene = dir.path().join("s.toml");
+    std::fs::write(&scene, "[[character]]\nmesh = \"m.obj\"\n").unwrap();
+    assert_fails(&render(&["--scene", s(&scene), "-o", s(&style)]), "m.toml");
+    assert_fails(&render(&["--scene", s(&scene), "-o", s(&obj)]), "m.obj");
+    assert_eq!(std::fs::read(&style).unwrap(), before);
+    // fit: the picture may not be the mesh or its style (the check comes before any work).
+    let tfx = root().join("hairmeshes/sintel_hair.tfx");
+    let out = dir.path().join("out.obj");
+    for picture in ["out.obj", "out.toml"] {
+        let p = dir.path().join(picture);
+        let o = run(
+            env!("CARGO_BIN_EXE_fit"),
+            &[s(&tfx), "-o", s(&out), "--report", "--picture", s(&p)],
+        );
+        assert_fails(&o, "--picture");
+        assert!(!out.exists() && !p.exists());
+    }
+}
+
+/// Every tool parses its arguments: `--help` and `--version` answer and create nothing; a
+/// folder that does not exist is refused.
+#[test]
+fn every_tool_answers_help_and_version() {
+    let dir = tempfile::tempdir().unwrap();
+    for bin in [
+        env!("CARGO_BIN_EXE_bake"),
+        env!("CARGO_BIN_EXE_render"),
+        env!("CARGO_BIN_EXE_crowd"),
+        env!("CARGO_BIN_EXE_bench"),
+        env!("CARGO_BIN_EXE_export"),
+        env!("CARGO_BIN_EXE_fit"),
+        env!("CARGO_BIN_EXE_make-hairmeshes"),
+    ] {
+        for flag in ["--help", "--version"] {
+            let o = Command::new(bin)
+                .arg(flag)
+                .current_dir(dir.path())
+                .output()
+                .unwrap();
+            assert!(o.status.success(), "{bin} {flag}");
+            assert!(!o.stdout.is_empty(), "{bin} {flag}: nothing printed");
+        }
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "files created"
+    );
+    let missing = dir.path().join("missing");
+    let o = run(env!("CARGO_BIN_EXE_make-hairmeshes"), &[s(&missing)]);
+    assert_fails(&o, "missing");
+    assert!(!missing.exists());
+}
+
+/// crowd checks every frame's path before the first frame, and its flags before any work.
+#[test]
+fn crowd_outputs_are_checked_before_the_first_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("frames");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::create_dir(out.join("frame_00001.png")).unwrap();
+    let crowd = |extra: &[&str]| {
+        let mut args = vec!["--headless", "--frames", "2", "--size", "16x16"];
+        args.extend_from_slice(extra);
+        run(env!("CARGO_BIN_EXE_crowd"), &args)
+    };
+    assert_fails(
+        &crowd(&["--count", "1", "--out", s(&out)]),
+        "frame_00001.png",
+    );
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        1,
+        "a frame was written"
+    );
+    let new = dir.path().join("new");
+    assert_fails(&crowd(&["--out", s(&new), "--count", "5000"]), "--count");
+    let soft_msaa = [
+        "--count",
+        "1",
+        "--out",
+        s(&new),
+        "--draw",
+        "soft",
+        "--msaa",
+        "4",
+    ];
+    assert_fails(&crowd(&soft_msaa), "--msaa 4");
+    assert!(!new.exists());
+    let deep = dir.path().join("no/such/folder");
+    assert_fails(
+        &crowd(&["--count", "1", "--out", s(&deep)]),
+        "does not exist",
+    );
+}

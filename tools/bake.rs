@@ -135,14 +135,14 @@ fn run(args: Args) -> Result<()> {
         total,
         total as f64 / 1024.0
     )?;
-    // Written only after the bake succeeded and the report could be printed.
-    output.write(&bytes)?;
+    // The last line comes before the file: a stdout that fails leaves no output behind.
     outln!(
-        "  wrote {} ({} bytes with bundle table and header) in {:.2} s",
+        "  writing {} ({} bytes with bundle table and header), baked in {:.2} s",
         args.output.display(),
         bytes.len(),
         start.elapsed().as_secs_f32()
     )?;
+    output.write(&bytes)?;
     Ok(())
 }
 

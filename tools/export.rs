@@ -70,8 +70,9 @@ fn run(args: Args) -> Result<()> {
         baked.texture_bytes() as f64 / 1024.0,
         bytes.len() as f64 / baked.texture_bytes().max(1) as f64
     )?;
+    // The last line comes before the file: a stdout that fails leaves no output behind.
+    outln!("writing {}", args.output.display())?;
     out.write(&bytes)?;
-    outln!("wrote {}", args.output.display())?;
     Ok(())
 }
 

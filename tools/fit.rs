@@ -128,17 +128,20 @@ fn run(args: Args) -> Result<()> {
     if args.report {
         png = report(&args, &model, &fitted, &baked)?;
     }
+    // The last lines come before the files: a stdout that fails leaves no output behind.
+    if let Some(out) = &picture {
+        outln!("writing {}", out.path().display())?;
+    }
+    outln!(
+        "writing {} and {}",
+        args.output.display(),
+        toml_path.display()
+    )?;
     obj_out.write(&obj)?;
     toml_out.write(toml.as_bytes())?;
     if let (Some(out), Some(bytes)) = (picture, png) {
         out.write(&bytes)?;
-        outln!("wrote {}", out.path().display())?;
     }
-    outln!(
-        "wrote {} and {}",
-        args.output.display(),
-        toml_path.display()
-    )?;
     Ok(())
 }
 

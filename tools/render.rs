@@ -336,6 +336,19 @@ fn run(args: Args) -> Result<()> {
             .device(args.device.clone()),
     )?);
     let msaa = args.msaa.or(inputs.look.msaa).unwrap_or(1);
+    let transparency = args
+        .transparency
+        .or(inputs.look.transparency_mode())
+        .unwrap_or_default();
+    if args.draw.uses_software()
+        && let Some(why) = hairmesh::render::software_raster_conflict(
+            path.unwrap_or(RenderPath::Compute),
+            msaa,
+            transparency,
+        )
+    {
+        anyhow::bail!("--draw with --msaa {msaa} / --transparency / --path: {why}");
+    }
     let supported = hairmesh::render::supported_msaa(&ctx);
     if !supported.contains(&msaa) {
         let list: Vec<String> = supported.iter().map(|c| c.to_string()).collect();
@@ -382,10 +395,7 @@ fn run(args: Args) -> Result<()> {
             .shadows
             .or(inputs.look.shadow_mode())
             .unwrap_or_default(),
-        transparency: args
-            .transparency
-            .or(inputs.look.transparency_mode())
-            .unwrap_or_default(),
+        transparency,
         lod_appearance: args
             .lod_appearance
             .or(inputs.look.lod_appearance)
@@ -446,8 +456,9 @@ fn run(args: Args) -> Result<()> {
     let png =
         hairmesh::fsutil::encode_png(&args.output.display().to_string(), width, height, rgba)?;
     print_report(&ctx, &args, inputs.characters.len(), &out, wall)?;
+    // The last line comes before the file: a stdout that fails leaves no output behind.
+    outln!("writing {}", args.output.display())?;
     output.write(&png)?;
-    outln!("wrote {}", args.output.display())?;
     Ok(())
 }
 

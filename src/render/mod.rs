@@ -22,7 +22,8 @@ pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use frame::{FRAMES_IN_FLIGHT, FrameReport};
 pub use renderer::{
-    FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc, supported_msaa,
+    FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc,
+    software_raster_conflict, supported_msaa,
 };
 pub use shadow::ShadowMode;
 pub use shared::FrameStats;

@@ -155,6 +155,31 @@ fn check_size(width: u32, height: u32) -> GpuResult<()> {
     Ok(())
 }
 
+/// Why the software rasterizer cannot draw with `path`, `msaa` samples and `transparency`
+/// (`None`: it can); tools check this before any work to name their flags.
+pub fn software_raster_conflict(
+    path: RenderPath,
+    msaa: u32,
+    transparency: Transparency,
+) -> Option<String> {
+    if !matches!(path, RenderPath::Mesh | RenderPath::Compute) {
+        return Some(
+            "the software rasterizer draws generated strands: use the mesh or compute path".into(),
+        );
+    }
+    if msaa > 1 {
+        return Some(
+            "the software rasterizer antialiases strands analytically and reads single-sample depth: use it without MSAA".into(),
+        );
+    }
+    if matches!(transparency, Transparency::DepthPeeling { .. }) {
+        return Some(
+            "the software rasterizer composites through the k-buffer: use it with opaque or oit transparency, not depth peeling".into(),
+        );
+    }
+    None
+}
+
 /// Sample counts `ctx`'s device supports for the renderer's colour and depth targets.
 pub fn supported_msaa(ctx: &Context) -> Vec<u32> {
     (0..7)
@@ -853,21 +878,8 @@ impl Renderer {
                 self.ctx.info.name
             ));
         }
-        if !matches!(path, RenderPath::Mesh | RenderPath::Compute) {
-            return refuse(
-                "the software rasterizer draws generated strands: use the mesh or compute path"
-                    .into(),
-            );
-        }
-        if self.desc.msaa > 1 {
-            return refuse(
-                "the software rasterizer antialiases strands analytically and reads single-sample depth: use it without MSAA".into(),
-            );
-        }
-        if matches!(transparency, Transparency::DepthPeeling { .. }) {
-            return refuse(
-                "the software rasterizer composites through the k-buffer: use it with opaque or oit transparency, not depth peeling".into(),
-            );
+        if let Some(why) = software_raster_conflict(path, self.desc.msaa, transparency) {
+            return refuse(why);
         }
         Ok(budget)
     }

@@ -20,7 +20,7 @@ use glam::Vec3;
 use hairmesh::animate::{CharacterMotion, Collider, CrowdAnimation, Wind};
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::characters::preset::{self, Preset, SPACING};
-use hairmesh::fsutil::OutputPath;
+use hairmesh::fsutil::{RunFiles, StagedFolder};
 use hairmesh::render::{
     Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
 };
@@ -361,9 +361,21 @@ fn run(args: Args) -> Result<()> {
         return window::run(args, scene);
     }
     let (width, height) = parse_size(&args.size)?;
-    if args.out.exists() && !args.out.is_dir() {
-        bail!("--out {}: not a folder", args.out.display());
+    if args.draw.uses_software()
+        && let Some(why) = hairmesh::render::software_raster_conflict(
+            RenderPath::Compute,
+            args.msaa,
+            args.transparency,
+        )
+    {
+        bail!("--draw with --msaa {} / --transparency: {why}", args.msaa);
     }
+    // Every output of the run is checked before the first frame, and they appear only when
+    // the whole run succeeded.
+    let frame_name = |f: u32| format!("frame_{f:05}.png");
+    let mut names: Vec<String> = (0..args.frames).map(frame_name).collect();
+    names.push("stats.csv".into());
+    let mut out = StagedFolder::check(&args.out, &names, &mut RunFiles::new(), "--out")?;
     let generate_s = scene.generate_s;
     let characters = &scene.characters;
     let ctx = Arc::new(Context::new(
@@ -373,10 +385,7 @@ fn run(args: Args) -> Result<()> {
     )?);
     let mut renderer = scene.renderer(&ctx, &args, width, height)?;
     let mut animation = scene.animation(&mut renderer, &args)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("--out {}: cannot create the folder", args.out.display()))?;
     let csv_path = args.out.join("stats.csv");
-    let csv_out = OutputPath::check(&csv_path, &[])?;
     let mut csv = String::from(
         "frame,gpu_ms,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
     );
@@ -470,12 +479,14 @@ fn run(args: Args) -> Result<()> {
             animation.stats.simulated
         )?;
         let rgba = report.rgba.context("no image read back")?;
-        let path = args.out.join(format!("frame_{f:05}.png"));
+        let path = args.out.join(frame_name(f));
         let png = hairmesh::fsutil::encode_png(&path.display().to_string(), width, height, rgba)?;
-        OutputPath::check(&path, &[])?.write(&png)?;
+        out.write(&frame_name(f), &png)?;
     }
-    csv_out.write(csv.as_bytes())?;
+    out.write("stats.csv", csv.as_bytes())?;
+    // The last line before the files appear: a stdout that fails here leaves nothing behind.
     outln!("wrote {} frames and {}", args.frames, csv_path.display())?;
+    out.publish()?;
     Ok(())
 }
 
