@@ -31,17 +31,24 @@ pub enum Reader {
     Hair,
     /// `StrandModel::from_tfx` (TressFX strand files) and `fit` of small accepted models.
     Tfx,
+    /// `obj_io::parse_triangles` (`fit --head`), and a small `fit` on every accepted head.
+    Head,
+    /// `SceneDesc::parse` of a scene naming the sample files, then `load_mesh` of every
+    /// character it names (each file it names is read through the input policy).
+    SceneFiles,
 }
 
 impl Reader {
     /// Every reader.
-    pub const ALL: [Reader; 6] = [
+    pub const ALL: [Reader; 8] = [
         Reader::Obj,
         Reader::Style,
         Reader::Scene,
         Reader::Hmb,
         Reader::Hair,
         Reader::Tfx,
+        Reader::Head,
+        Reader::SceneFiles,
     ];
 }
 
@@ -77,6 +84,14 @@ const SCENE_SEED: &str = "size = [320, 240]\n[camera]\neye = [0.0, 0.1, 0.6]\n\
     [[character]]\nmesh = \"a.obj\"\ntranslation = [0.1, 0.0, 0.0]\nrotation_y_degrees = 30.0\n\
     scale = 1.5\nstrands_per_bundle = 64\nverts_log2 = 5\n[[character]]\nmesh = \"b.hmb\"\n\
     style = \"b.toml\"\n";
+
+/// A scene naming files in `hairmeshes/` (resolved against [`SAMPLE_DIR`]).
+const SCENE_FILES_SEED: &str = "[[character]]\nmesh = \"small_patch.obj\"\n\
+    translation = [0.1, 0.0, 0.0]\n[[character]]\nmesh = \"triangle_tuft.obj\"\n\
+    style = \"small_patch.toml\"\nscale = 2.0\n";
+
+/// Where [`SCENE_FILES_SEED`]'s names resolve.
+const SAMPLE_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/hairmeshes");
 
 const HOSTILE_NUMBERS: [&str; 16] = [
     "0",
@@ -407,6 +422,29 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
             Ok(_) => true,
             Err(_) => false,
         },
+        Reader::Head => match crate::model::obj_io::parse_triangles("fuzz.obj", input) {
+            Ok(head) if head.len() <= 4096 => {
+                let model = crate::model::strands::StrandModel::from_tfx("seed", &tfx_seed())
+                    .expect("the TressFX seed parses");
+                let opts = crate::fit::FitOptions {
+                    bundles: 4,
+                    layers: None,
+                };
+                crate::fit::fit(&model, Some(&head), &opts).is_ok()
+            }
+            Ok(_) => true,
+            Err(_) => false,
+        },
+        Reader::SceneFiles => std::str::from_utf8(input).ok().is_some_and(|t| {
+            let base = Path::new(SAMPLE_DIR);
+            match crate::render::scene::SceneDesc::parse("fuzz.toml", t, base) {
+                Ok(scene) => scene
+                    .characters
+                    .iter()
+                    .all(|c| crate::render::scene::load_mesh(&c.mesh, c.style.as_deref()).is_ok()),
+                Err(_) => false,
+            }
+        }),
     }));
     result.map_err(|p| {
         p.downcast_ref::<&str>()
@@ -439,6 +477,11 @@ pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
                 mutate_hair(&mut rng, &seed)
             }
             Reader::Tfx => mutate_tfx(&mut rng, &tfx_seed()),
+            Reader::Head => {
+                let seed = *pick(&mut rng, &OBJ_SEEDS);
+                mutate_text(&mut rng, seed)
+            }
+            Reader::SceneFiles => mutate_text(&mut rng, SCENE_FILES_SEED),
         };
         let start = Instant::now();
         let outcome = run_one(reader, &input);

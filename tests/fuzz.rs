@@ -97,3 +97,13 @@ fn fuzz_hair_reader() {
 fn fuzz_tfx_reader() {
     check(Reader::Tfx);
 }
+
+#[test]
+fn fuzz_fit_head_reader() {
+    check(Reader::Head);
+}
+
+#[test]
+fn fuzz_scene_files_reader() {
+    check(Reader::SceneFiles);
+}
