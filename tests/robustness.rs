@@ -528,3 +528,41 @@ fn crowd_outputs_are_checked_before_the_first_frame() {
         "does not exist",
     );
 }
+
+/// What one tool writes, the next reads: `fit` refuses a model whose hair mesh `bake` could
+/// not read back (coordinates past the OBJ limit), naming the input, and writes nothing.
+#[test]
+fn fit_refuses_what_bake_would_refuse() {
+    let (dir, obj, _) = workspace();
+    let hair = dir.path().join("few.hair");
+    let o = run(
+        env!("CARGO_BIN_EXE_export"),
+        &[
+            "--mesh",
+            s(&obj),
+            "--strands-per-bundle",
+            "1",
+            "-o",
+            s(&hair),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Scale every point by 1e8 (header: hairs, points, arrays at bytes 4..16; segments first).
+    let mut b = std::fs::read(&hair).unwrap();
+    let word = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap()) as usize;
+    let (hairs, points, arrays) = (word(4), word(8), word(12));
+    let start = 128 + if arrays & 1 != 0 { 2 * hairs } else { 0 };
+    for k in 0..3 * points {
+        let at = start + 4 * k;
+        let v = f32::from_le_bytes(b[at..at + 4].try_into().unwrap()) * 1e8;
+        b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    let huge = dir.path().join("huge.hair");
+    std::fs::write(&huge, &b).unwrap();
+    let out = dir.path().join("huge.obj");
+    assert_fails(
+        &run(env!("CARGO_BIN_EXE_fit"), &[s(&huge), "-o", s(&out)]),
+        "huge.hair",
+    );
+    assert!(!out.exists());
+}

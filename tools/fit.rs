@@ -90,6 +90,16 @@ fn run(args: Args) -> Result<()> {
         layers: args.layers.map(|l| l as usize),
     };
     let fitted = fit(&model, head.as_deref(), &opts)?;
+    // What fit writes, bake must read: OBJ coordinates are limited (obj_io::MAX_COORDINATE).
+    let (lo, hi) = hairmesh::model::hair_mesh::bounds(fitted.mesh.layers.iter().flatten().copied());
+    let reach = lo.abs().max(hi.abs()).max_element();
+    let limit = hairmesh::model::obj_io::MAX_COORDINATE;
+    if reach > limit {
+        bail!(
+            "{}: the fitted hair mesh reaches {reach:e}, beyond the {limit:e} an OBJ hair mesh may hold (bake refuses it); scale the model down",
+            args.strands.display()
+        );
+    }
     let baked = bake(
         &fitted.mesh,
         &fitted.style,
