@@ -342,7 +342,11 @@ fn run(args: Args) -> Result<()> {
         .unwrap_or_default();
     if args.draw.uses_software()
         && let Some(why) = hairmesh::render::software_raster_conflict(
-            path.unwrap_or(RenderPath::Compute),
+            match args.path.as_deref() {
+                Some("static") => RenderPath::Static,
+                Some("lhs") => RenderPath::Lhs,
+                _ => path.unwrap_or(RenderPath::Compute),
+            },
             msaa,
             transparency,
         )
