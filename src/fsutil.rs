@@ -97,10 +97,7 @@ impl OutputPath {
                 if path.file_name().is_none() {
                     return refuse("is not a file path");
                 }
-                let parent = match path.parent() {
-                    Some(p) if !p.as_os_str().is_empty() => p,
-                    _ => Path::new("."),
-                };
+                let parent = parent_folder(path);
                 if !std::fs::metadata(parent).is_ok_and(|m| m.is_dir()) {
                     return refuse(&format!("folder {} does not exist", parent.display()));
                 }
@@ -164,14 +161,18 @@ pub struct RunFiles {
     outputs: Vec<(PathBuf, PathBuf)>,
 }
 
+/// The folder `path` lies in (`.` for a bare file name).
+fn parent_folder(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
 /// `path` made absolute with its folder resolved (links included), for comparing outputs that
 /// do not exist yet; unchanged where its folder cannot be resolved.
 fn resolved(path: &Path) -> PathBuf {
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    match (std::fs::canonicalize(parent), path.file_name()) {
+    match (std::fs::canonicalize(parent_folder(path)), path.file_name()) {
         (Ok(dir), Some(name)) => dir.join(name),
         _ => path.to_path_buf(),
     }
@@ -251,10 +252,7 @@ impl StagedFolder {
         let leaf = target
             .file_name()
             .ok_or_else(|| HairError::invalid(&name, "not a folder path"))?;
-        let parent = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
+        let parent = parent_folder(target);
         if !existed && !parent.is_dir() {
             return Err(HairError::invalid(
                 name,
@@ -284,23 +282,26 @@ impl StagedFolder {
 
     /// Write file `name` (one of the checked names) into the staging folder.
     pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<()> {
-        if !self.created {
-            std::fs::create_dir(&self.staging).map_err(|e| HairError::io(&self.staging, e))?;
-            self.created = true;
-        }
+        self.ensure_staging()?;
         let path = self.staging.join(name);
         std::fs::write(&path, bytes).map_err(|e| HairError::io(&path, e))?;
         self.written.push(name.to_string());
         Ok(())
     }
 
-    /// Move every written file into the target folder (the whole staging folder when the
-    /// target did not exist).
-    pub fn publish(mut self) -> Result<()> {
+    /// Create the staging folder on first use.
+    fn ensure_staging(&mut self) -> Result<()> {
         if !self.created {
             std::fs::create_dir(&self.staging).map_err(|e| HairError::io(&self.staging, e))?;
             self.created = true;
         }
+        Ok(())
+    }
+
+    /// Move every written file into the target folder (the whole staging folder when the
+    /// target did not exist).
+    pub fn publish(mut self) -> Result<()> {
+        self.ensure_staging()?;
         if self.existed {
             for n in &self.written {
                 let (from, to) = (self.staging.join(n), self.target.join(n));
@@ -338,10 +339,7 @@ fn is_char_device(_: &std::fs::Metadata) -> bool {
 /// Write `bytes` to `path` atomically: a temporary file in the same folder, synced, then renamed.
 /// Tools go through [`OutputPath`], which decides when this is the right way to write.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
+    let dir = parent_folder(path);
     let file_name = path
         .file_name()
         .ok_or_else(|| HairError::invalid(path.display().to_string(), "not a file path"))?;

@@ -353,20 +353,14 @@ fn run(args: Args) -> Result<()> {
     {
         anyhow::bail!("--draw with --msaa {msaa} / --transparency / --path: {why}");
     }
-    let supported = hairmesh::render::supported_msaa(&ctx);
-    if !supported.contains(&msaa) {
-        let list: Vec<String> = supported.iter().map(|c| c.to_string()).collect();
+    hairmesh::render::check_msaa(&ctx, msaa).map_err(|why| {
         let flag = if args.msaa.is_some() {
             "--msaa"
         } else {
             "the scene's [look] msaa"
         };
-        anyhow::bail!(
-            "{flag} {msaa}: {} supports {} samples per pixel",
-            ctx.info.name,
-            list.join(", ")
-        );
-    }
+        anyhow::anyhow!("{flag} {msaa}: {why}")
+    })?;
     let mut renderer = Renderer::new(
         &ctx,
         &RendererDesc::default()

@@ -131,12 +131,17 @@ impl HumanHead {
     /// [`Self::radial_gap`] to the head without its ears: what hair lying between two columns
     /// over an ear must clear (it passes beside the ear, not over its far side).
     pub fn cranium_gap(&self, p: Vec3) -> f32 {
+        self.gap_to(&self.cranium, p)
+    }
+
+    /// Signed radial distance of `p` outside the surface of radial map `map`.
+    fn gap_to(&self, map: &[f32], p: Vec3) -> f32 {
         let r = p - self.centre;
         let l = r.length();
         if l < 1e-9 {
-            return -sample_map(&self.cranium, Vec3::Y);
+            return -sample_map(map, Vec3::Y);
         }
-        l - sample_map(&self.cranium, r / l)
+        l - sample_map(map, r / l)
     }
 
     /// Head surface point at polar angle `theta`, azimuth `phi` about the centre.
@@ -147,12 +152,7 @@ impl HumanHead {
 
     /// Signed radial distance of `p` outside the head (negative inside), metres.
     pub fn radial_gap(&self, p: Vec3) -> f32 {
-        let r = p - self.centre;
-        let l = r.length();
-        if l < 1e-9 {
-            return -self.radius(Vec3::Y);
-        }
-        l - self.radius(r / l)
+        self.gap_to(&self.radius, p)
     }
 
     /// `p` moved radially to at least `margin` outside the head (unchanged if already there).

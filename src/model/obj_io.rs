@@ -120,9 +120,9 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
     let mut continued = false;
     for (n, line) in text.lines().enumerate() {
         let line_no = n + 1;
-        let body = line.split('#').next().unwrap_or("");
+        let (body, continues) = statement_body(line);
         // A line after one ending in a backslash continues that statement.
-        let was_continued = std::mem::replace(&mut continued, body.trim_end().ends_with('\\'));
+        let was_continued = std::mem::replace(&mut continued, continues);
         if was_continued {
             continue;
         }
@@ -200,6 +200,12 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
     Ok(idx)
 }
 
+/// A line without its comment, and whether it continues on the next line (ends in `\\`).
+fn statement_body(line: &str) -> (&str, bool) {
+    let body = line.split('#').next().unwrap_or("");
+    (body, body.trim_end().ends_with('\\'))
+}
+
 /// `text` as obj-rs should see it: ignored statements (and their continuation lines) blanked,
 /// a group line reduced to its first name (obj-rs refuses `g a b`; layer groups name one),
 /// line numbers kept.
@@ -207,8 +213,7 @@ fn for_obj_rs(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut dropping = false;
     for line in text.lines() {
-        let body = line.split('#').next().unwrap_or("");
-        let continues = body.trim_end().ends_with('\\');
+        let (body, continues) = statement_body(line);
         if dropping {
             dropping = continues;
             out.push('\n');

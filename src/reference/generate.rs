@@ -109,11 +109,13 @@ pub struct HairTextures {
     v_dir: SampledTexture,
 }
 
-fn unorm(x: u16) -> f32 {
+/// A UNORM16 texel value as the GPU decodes it.
+pub(crate) fn unorm(x: u16) -> f32 {
     x as f32 / 65535.0
 }
 
-fn snorm(x: i16) -> f32 {
+/// A SNORM16 texel value as the GPU decodes it.
+pub(crate) fn snorm(x: i16) -> f32 {
     (x as f32 / 32767.0).max(-1.0)
 }
 

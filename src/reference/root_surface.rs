@@ -16,6 +16,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::bake::{BakedHairMesh, BundleDesc};
+use crate::reference::generate::{snorm, unorm};
 
 /// Phong tessellation's shape factor `alpha`. On a sphere, a cell of angular half-diagonal
 /// `t` bulges `alpha r sin^2(t) cos(t)` at its middle where the sphere is `r (1 - cos t)` above
@@ -30,14 +31,6 @@ pub struct RootCell {
     pub corners: [Vec3; 4],
     /// Unit normals of the root layer at the corners, or zero.
     pub normals: [Vec3; 4],
-}
-
-fn unorm(x: u16) -> f32 {
-    x as f32 / 65535.0
-}
-
-fn snorm(x: i16) -> f32 {
-    (x as f32 / 32767.0).max(-1.0)
 }
 
 /// Bilinear weights of `local` in texel order.

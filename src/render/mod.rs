@@ -22,7 +22,7 @@ pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use frame::{FRAMES_IN_FLIGHT, FrameReport};
 pub use renderer::{
-    FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc,
+    FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc, check_msaa,
     software_raster_conflict, supported_msaa,
 };
 pub use shadow::ShadowMode;

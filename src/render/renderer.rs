@@ -188,6 +188,21 @@ pub fn supported_msaa(ctx: &Context) -> Vec<u32> {
         .collect()
 }
 
+/// `samples` per pixel on `ctx`'s device, or why not (naming the device and what it offers);
+/// tools prefix the flag that set it.
+pub fn check_msaa(ctx: &Context, samples: u32) -> Result<(), String> {
+    let supported = supported_msaa(ctx);
+    if supported.contains(&samples) {
+        return Ok(());
+    }
+    let list: Vec<String> = supported.iter().map(|c| c.to_string()).collect();
+    Err(format!(
+        "{} supports {} samples per pixel for colour and depth",
+        ctx.info.name,
+        list.join(", ")
+    ))
+}
+
 impl Renderer {
     /// Create pipelines, targets and frame slots; checks the device limits the settings need.
     pub fn new(ctx: &Arc<Context>, desc: &RendererDesc) -> GpuResult<Self> {
@@ -228,16 +243,8 @@ impl Renderer {
         set_layouts[SET_FRAME as usize] = frame_layout.clone();
         set_layouts[SET_TEXTURES as usize] = crowd.texture_layout().clone();
         let layout = PipelineLayout::new(ctx, &set_layouts)?;
-        let supported = supported_msaa(ctx);
-        if !supported.contains(&desc.msaa) {
-            let counts: Vec<String> = supported.iter().map(|c| c.to_string()).collect();
-            return Err(GpuError::Unsupported(format!(
-                "{}: {}x MSAA is not supported for colour and depth (supported: {})",
-                ctx.info.name,
-                desc.msaa,
-                counts.join(", ")
-            )));
-        }
+        check_msaa(ctx, desc.msaa)
+            .map_err(|why| GpuError::Unsupported(format!("{}x MSAA: {why}", desc.msaa)))?;
         let passes = FramePasses::new(ctx, &layout, desc.task_bundles, desc.msaa)?;
         if desc.path == Some(RenderPath::Mesh) && !passes.has_mesh_path() {
             return Err(GpuError::Unsupported(format!(

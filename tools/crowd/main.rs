@@ -134,20 +134,6 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
 }
 
 /// The camera of frame `f`: orbiting the crowd's centre at eye height, far enough to see it.
-/// `--msaa samples` on `ctx`'s device, or an error naming the flag and what the device offers.
-pub fn check_msaa(ctx: &Context, samples: u32) -> Result<()> {
-    let supported = hairmesh::render::supported_msaa(ctx);
-    if !supported.contains(&samples) {
-        let list: Vec<String> = supported.iter().map(|c| c.to_string()).collect();
-        anyhow::bail!(
-            "--msaa {samples}: {} supports {} samples per pixel",
-            ctx.info.name,
-            list.join(", ")
-        );
-    }
-    Ok(())
-}
-
 pub fn orbit_camera(preset: Preset, count: u32, f: u32) -> Camera {
     let side = (count as f32).sqrt().ceil();
     let centre = Vec3::new(0.0, preset.focus_height(), (side - 1.0) * 0.5 * SPACING);
@@ -220,7 +206,8 @@ impl Scene {
             "mesh" => RenderPath::Mesh,
             _ => RenderPath::Compute,
         });
-        check_msaa(ctx, args.msaa)?;
+        hairmesh::render::check_msaa(ctx, args.msaa)
+            .map_err(|why| anyhow::anyhow!("--msaa {}: {why}", args.msaa))?;
         let mut renderer = Renderer::new(
             ctx,
             &RendererDesc::default()
