@@ -416,6 +416,7 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
                 let opts = crate::fit::FitOptions {
                     bundles: 4,
                     layers: None,
+                    ..Default::default()
                 };
                 crate::fit::fit(&m, None, &opts).is_ok()
             }
@@ -429,6 +430,7 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
                 let opts = crate::fit::FitOptions {
                     bundles: 4,
                     layers: None,
+                    ..Default::default()
                 };
                 crate::fit::fit(&model, Some(&head), &opts).is_ok()
             }
@@ -438,10 +440,10 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
         Reader::SceneFiles => std::str::from_utf8(input).ok().is_some_and(|t| {
             let base = Path::new(SAMPLE_DIR);
             match crate::render::scene::SceneDesc::parse("fuzz.toml", t, base) {
-                Ok(scene) => scene
-                    .characters
-                    .iter()
-                    .all(|c| crate::render::scene::load_mesh(&c.mesh, c.style.as_deref()).is_ok()),
+                Ok(scene) => scene.characters.iter().all(|c| {
+                    crate::render::scene::load_mesh(&c.mesh, c.style.as_deref(), Default::default())
+                        .is_ok()
+                }),
                 Err(_) => false,
             }
         }),

@@ -7,6 +7,7 @@
 
 pub mod animate;
 pub mod bake;
+pub mod budget;
 pub mod characters;
 pub mod error;
 pub mod fit;

@@ -24,7 +24,7 @@ fn export_round_trips_the_reference_strands() {
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let hair = HairFile::load(&out).unwrap();
-        let (baked, style) = load_mesh(&mesh, None).unwrap();
+        let (baked, style) = load_mesh(&mesh, None, Default::default()).unwrap();
         let set = CpuGenerator::new(&baked, style).generate(16, 4);
         assert_eq!(hair.hair_count as usize, set.strand_count());
         assert_eq!(hair.default_segments, 16);

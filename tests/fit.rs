@@ -41,6 +41,7 @@ fn round_trip(name: &str, per: u32) -> (Fidelity, usize, usize) {
     let opts = FitOptions {
         bundles: baked.bundles.len(),
         layers: None,
+        ..Default::default()
     };
     let fitted = fit(&model, None, &opts).unwrap();
     let st = &fitted.style;
@@ -114,6 +115,7 @@ fn sintel_fits_bakes_and_renders() {
         &FitOptions {
             bundles: 20,
             layers: Some(6),
+            ..Default::default()
         },
     )
     .unwrap();
@@ -214,5 +216,35 @@ fn bad_strand_files_give_one_line() {
             !out.exists() && !out.with_extension("toml").exists(),
             "{name}"
         );
+    }
+}
+
+/// Fewer strands than bundles asked for, long against their root patch (20 strands, 4 cm of
+/// scalp, 60 cm of hair, like a sparse `.hair` sample): one bundle per strand, none degenerate.
+/// Cells used to shrink to 1e-4 of the chart, making root faces the degenerate-face test
+/// could not tell from a point.
+#[test]
+fn a_model_with_fewer_strands_than_bundles_fits() {
+    let strands: Vec<Vec<Vec3>> = (0..20)
+        .map(|k| {
+            let (a, b) = ((k % 5) as f32 * 0.01, (k / 5) as f32 * 0.01);
+            let root = Vec3::new(a, 1.0 + 0.002 * ((k * 7) % 3) as f32, b);
+            (0..24)
+                .map(|j| root + Vec3::new(0.01 * j as f32, -0.026 * j as f32, 0.0))
+                .collect()
+        })
+        .collect();
+    let model = StrandModel {
+        name: "sparse.hair".into(),
+        strands,
+        file_bytes: 0,
+    };
+    for bundles in [64, 65536] {
+        let opts = FitOptions {
+            bundles,
+            ..Default::default()
+        };
+        let fitted = fit(&model, None, &opts).unwrap_or_else(|e| panic!("{bundles}: {e}"));
+        assert_eq!(fitted.mesh.faces.len(), 20, "{bundles} bundles asked for");
     }
 }

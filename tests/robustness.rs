@@ -566,3 +566,167 @@ fn fit_refuses_what_bake_would_refuse() {
     );
     assert!(!out.exists());
 }
+
+/// A flat `n x n` grid OBJ with uv: a scalp (`layers` 1) or a hair mesh of `layers` groups
+/// `layer0..`, each 1 cm above the last.
+fn grid_obj(path: &Path, n: usize, layers: usize) {
+    use std::fmt::Write as _;
+    let mut t = String::new();
+    for l in 0..layers {
+        for j in 0..n {
+            for i in 0..n {
+                writeln!(
+                    t,
+                    "v {} {} {}",
+                    i as f32 * 0.01,
+                    l as f32 * 0.01,
+                    j as f32 * 0.01
+                )
+                .unwrap();
+            }
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            writeln!(
+                t,
+                "vt {} {}",
+                i as f32 / (n - 1) as f32,
+                j as f32 / (n - 1) as f32
+            )
+            .unwrap();
+        }
+    }
+    for l in 0..layers {
+        if layers > 1 {
+            writeln!(t, "g layer{l}").unwrap();
+        }
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = j * n + i + 1;
+                let c = [a, a + n, a + n + 1, a + 1];
+                let v = c.map(|k| k + l * n * n);
+                let [(v0, t0), (v1, t1), (v2, t2), (v3, t3)] = [0, 1, 2, 3].map(|k| (v[k], c[k]));
+                writeln!(t, "f {v0}/{t0} {v1}/{t1} {v2}/{t2} {v3}/{t3}").unwrap();
+            }
+        }
+    }
+    std::fs::write(path, t).unwrap();
+}
+
+#[test]
+fn work_past_the_memory_budget_is_refused_before_it_starts() {
+    let (dir, _, _) = workspace();
+    let scalp = dir.path().join("scalp.obj");
+    grid_obj(&scalp, 100, 1);
+    let out = dir.path().join("big.hmb");
+    // 10,000 scalp vertices x 128 layers: about 0.3 GiB, over a 256 MiB budget.
+    let o = bake(&[
+        s(&scalp),
+        "--extrude",
+        "128",
+        "--memory-budget-mib",
+        "256",
+        "-o",
+        s(&out),
+    ]);
+    assert_fails(&o, "--extrude 128");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--memory-budget-mib") && err.contains("256.0 MiB"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // The same scalp with few layers fits the same budget.
+    let o = bake(&[
+        s(&scalp),
+        "--extrude",
+        "4",
+        "--memory-budget-mib",
+        "256",
+        "-o",
+        s(&out),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // A hair mesh OBJ (no --extrude) is estimated by the bake itself, after the layout.
+    let tight = dir.path().join("tight.hmb");
+    let mesh = dir.path().join("mesh.obj");
+    grid_obj(&mesh, 60, 64);
+    assert_fails(
+        &bake(&[s(&mesh), "--memory-budget-mib", "100", "-o", s(&tight)]),
+        "--memory-budget-mib",
+    );
+    assert!(!tight.exists());
+    // fit, render and crowd: each refuses naming the flag that sizes the work. 100K strands
+    // (51 MiB .hair) into 65,536 bundles: about 0.75 GiB estimated (252 MB measured).
+    let hair = dir.path().join("many.hair");
+    let o = run(
+        env!("CARGO_BIN_EXE_export"),
+        &[
+            "--mesh",
+            s(&root().join("hairmeshes/small_patch.obj")),
+            "--strands-per-bundle",
+            "4096",
+            "-o",
+            s(&hair),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let fit_out = dir.path().join("fit.obj");
+    assert_fails(
+        &run(
+            env!("CARGO_BIN_EXE_fit"),
+            &[
+                s(&hair),
+                "--bundles",
+                "65536",
+                "--memory-budget-mib",
+                "256",
+                "-o",
+                s(&fit_out),
+            ],
+        ),
+        "lower --bundles",
+    );
+    assert!(!fit_out.exists() && !fit_out.with_extension("toml").exists());
+    let png = dir.path().join("x.png");
+    assert_fails(
+        &render(&[
+            "--mesh",
+            s(&out),
+            "--size",
+            "8192x8192",
+            "--memory-budget-mib",
+            "500",
+            "-o",
+            s(&png),
+        ]),
+        "smaller --size",
+    );
+    assert!(!png.exists());
+    let frames = dir.path().join("frames");
+    assert_fails(
+        &run(
+            env!("CARGO_BIN_EXE_crowd"),
+            &[
+                "--headless",
+                "--count",
+                "4096",
+                "--size",
+                "8192x8192",
+                "--memory-budget-mib",
+                "1000",
+                "--out",
+                s(&frames),
+            ],
+        ),
+        "lower --count or --size",
+    );
+    assert!(!frames.exists());
+    for bin in [env!("CARGO_BIN_EXE_bake"), env!("CARGO_BIN_EXE_crowd")] {
+        assert_fails(
+            &run(bin, &["--memory-budget-mib", "0"]),
+            "--memory-budget-mib",
+        );
+    }
+}

@@ -11,6 +11,7 @@ use anyhow::{Result, bail};
 use clap::Parser;
 use hairmesh::bake::baked_file;
 use hairmesh::bake::{BakeOptions, texels_per_face};
+use hairmesh::budget::{self, MemoryBudget};
 use hairmesh::fsutil::OutputPath;
 use hairmesh::model::obj_io::{load_hair_mesh_obj, load_scalp};
 use hairmesh::{ExtrudeDesc, HairStyle, extrude, outln};
@@ -39,6 +40,9 @@ struct Args {
     /// One 2x2 block per face instead of shared-vertex charts.
     #[arg(long)]
     no_charts: bool,
+    /// Host memory the bake may use, MiB: larger work is refused before it starts.
+    #[arg(long, value_name = "MIB", default_value = "4096", value_parser = budget::parse_budget_flag)]
+    memory_budget_mib: MemoryBudget,
 }
 
 fn run(args: Args) -> Result<()> {
@@ -66,6 +70,16 @@ fn run(args: Args) -> Result<()> {
         Some(layers) => {
             let layers = layers as usize;
             let scalp = load_scalp(&args.input)?;
+            // The extrusion and its bake are estimated before either allocates; the root
+            // slice holds at least one texel per scalp vertex.
+            let n = scalp.positions.len() as u64;
+            let estimate = hairmesh::bake::memory_estimate(n, layers as u64, n);
+            args.memory_budget_mib.check(
+                &args.input.display().to_string(),
+                &format!("--extrude {layers} of {n} scalp vertices"),
+                &estimate,
+                "lower --extrude",
+            )?;
             extrude(
                 args.input.display().to_string(),
                 &scalp.positions,
@@ -87,6 +101,7 @@ fn run(args: Args) -> Result<()> {
         BakeOptions {
             motion_margin: 0.0,
             charts: !args.no_charts,
+            memory_budget: args.memory_budget_mib,
         },
         |done, total| {
             if big {

@@ -220,7 +220,7 @@ fn bench_lod(
     let picture = picture
         .map(|p| OutputPath::check(&p, &[mesh.as_path()]))
         .transpose()?;
-    let (baked, style) = load_mesh(&mesh, None)?;
+    let (baked, style) = load_mesh(&mesh, None, Default::default())?;
     let ctx = Arc::new(Context::new(&ContextDesc::default().device(device))?);
     let mut renderer = Renderer::new(&ctx, &RendererDesc::default().size(width, height))?;
     renderer.add_character(
@@ -449,7 +449,7 @@ fn bench_crowd(
         .transpose()?;
     let meshes = CROWD_MESHES
         .iter()
-        .map(|m| load_mesh(std::path::Path::new(m), None))
+        .map(|m| load_mesh(std::path::Path::new(m), None, Default::default()))
         .collect::<Result<Vec<_>, _>>()?;
     let params = StrandParams {
         strands_per_bundle: n,

@@ -43,7 +43,7 @@ fn run(args: Args) -> Result<()> {
     let out = RunFiles::new()
         .inputs(inputs.iter().map(PathBuf::as_path))
         .output(&args.output, "-o")?;
-    let (baked, style) = load_mesh(&args.mesh, args.style.as_deref())?;
+    let (baked, style) = load_mesh(&args.mesh, args.style.as_deref(), Default::default())?;
     // Refuse absurd counts before generating anything.
     let strands: u64 = baked
         .bundles

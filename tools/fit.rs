@@ -12,6 +12,7 @@ use std::sync::Arc;
 use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::Vec3;
+use hairmesh::budget::{self, MemoryBudget, VEC_HEADER};
 use hairmesh::fit::metric::compare;
 use hairmesh::fit::picture::{StrandLook, draw_strands};
 use hairmesh::fit::{FitOptions, fit};
@@ -53,6 +54,9 @@ struct Args {
     /// Choose the GPU by name substring (--report).
     #[arg(long)]
     device: Option<String>,
+    /// Host memory the fit may use, MiB: larger work is refused before it starts.
+    #[arg(long, value_name = "MIB", default_value = "4096", value_parser = budget::parse_budget_flag)]
+    memory_budget_mib: MemoryBudget,
 }
 
 fn run(args: Args) -> Result<()> {
@@ -88,7 +92,32 @@ fn run(args: Args) -> Result<()> {
     let opts = FitOptions {
         bundles: args.bundles as usize,
         layers: args.layers.map(|l| l as usize),
+        memory_budget: args.memory_budget_mib,
     };
+    if args.report {
+        // The report adds about as many generated strands (33 points of position, tangent and
+        // width each) and the metric's copies of both sets.
+        let s = model.strands.len() as u64;
+        let estimate = hairmesh::fit::memory_estimate(
+            s,
+            model.point_count() as u64,
+            model.file_bytes,
+            opts.bundles as u64,
+            opts.layers.unwrap_or(16) as u64,
+        )
+        .with("generated strands", s, VEC_HEADER + 33 * 32)
+        .with(
+            "metric samples",
+            s.saturating_add(model.point_count() as u64),
+            32,
+        );
+        args.memory_budget_mib.check(
+            &args.strands.display().to_string(),
+            &format!("--report on {s} strands"),
+            &estimate,
+            "drop --report",
+        )?;
+    }
     let fitted = fit(&model, head.as_deref(), &opts)?;
     // What fit writes, bake must read: OBJ coordinates are limited (obj_io::MAX_COORDINATE).
     let (lo, hi) = hairmesh::model::hair_mesh::bounds(fitted.mesh.layers.iter().flatten().copied());

@@ -5,13 +5,16 @@
 //! render --scene scene.toml -o out.png
 //! ```
 
-use std::path::PathBuf;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::{Mat4, Vec3};
+use hairmesh::budget::{self, Estimate, MemoryBudget};
 use hairmesh::fsutil::RunFiles;
 use hairmesh::outln;
 use hairmesh::render::scene::{SceneDesc, load_mesh};
@@ -46,6 +49,9 @@ struct Args {
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720")]
     size: String,
+    /// Host memory the run may use, MiB: meshes and images past it are refused before loading.
+    #[arg(long, value_name = "MIB", default_value = "4096", value_parser = budget::parse_budget_flag)]
+    memory_budget_mib: MemoryBudget,
     /// Strands per average bundle (1..=4096).
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
     strands_per_bundle: u32,
@@ -117,6 +123,43 @@ fn parse_vec3(flag: &str, s: &str) -> Result<Vec3> {
     hairmesh::render::scene::parse_vec3(s).map_err(|e| anyhow::anyhow!("{flag}: {e}"))
 }
 
+/// Host memory of a `w x h` frame: the read-back, the image and its PNG.
+fn image_estimate(w: u32, h: u32) -> Estimate {
+    Estimate::new().with("frame read-back, image and PNG", w as u64 * h as u64, 12)
+}
+
+/// Host memory of loading `meshes` (distinct files): a baked file is read, decoded and staged
+/// for upload (three times its size); an OBJ is parsed (about four times its size) and its
+/// bake is checked by `bake` itself.
+fn mesh_estimate(meshes: &[&Path]) -> Estimate {
+    let bytes = |p: &Path| std::fs::metadata(p).map_or(0, |m| m.len());
+    meshes.iter().fold(Estimate::new(), |e, p| {
+        e.with("mesh files, read and decoded", bytes(p), 4)
+    })
+}
+
+fn check_memory(args: &Args, source: &Path, estimate: &Estimate) -> Result<()> {
+    args.memory_budget_mib.check(
+        &source.display().to_string(),
+        "the run",
+        estimate,
+        "use fewer or smaller meshes, or a smaller --size",
+    )?;
+    Ok(())
+}
+
+/// The scene's image and every distinct mesh it names, before any is loaded.
+fn check_scene_memory(args: &Args, path: &Path, scene: &SceneDesc, size: (u32, u32)) -> Result<()> {
+    let mut meshes: Vec<&Path> = scene.characters.iter().map(|c| c.mesh.as_path()).collect();
+    meshes.sort();
+    meshes.dedup();
+    check_memory(
+        args,
+        path,
+        &image_estimate(size.0, size.1).and(mesh_estimate(&meshes)),
+    )
+}
+
 fn parse_size(s: &str) -> Result<(u32, u32)> {
     hairmesh::render::scene::parse_size(s).map_err(anyhow::Error::msg)
 }
@@ -136,7 +179,8 @@ fn lod_settings(args: &Args) -> Result<LodSettings> {
 
 /// One character to render.
 struct Character {
-    baked: hairmesh::BakedHairMesh,
+    /// Shared by every character of the scene that names the same mesh and style.
+    baked: Rc<hairmesh::BakedHairMesh>,
     style: hairmesh::HairStyle,
     params: StrandParams,
     model: Mat4,
@@ -179,12 +223,24 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
             inputs.light = Vec3::from(l.direction);
         }
         inputs.look = scene.look.clone();
+        check_scene_memory(args, scene_path, &scene, inputs.size)?;
+        // A mesh named by many characters is loaded once.
+        let mut loaded = HashMap::new();
         for c in &scene.characters {
             inputs.files.extend(hairmesh::render::scene::mesh_inputs(
                 &c.mesh,
                 c.style.as_deref(),
             ));
-            let (baked, style) = load_mesh(&c.mesh, c.style.as_deref())?;
+            let key = (c.mesh.clone(), c.style.clone());
+            let (baked, style) = match loaded.get(&key) {
+                Some(hit) => Clone::clone(hit),
+                None => {
+                    let (b, s) = load_mesh(&c.mesh, c.style.as_deref(), args.memory_budget_mib)?;
+                    let hit = (Rc::new(b), s);
+                    loaded.insert(key, hit.clone());
+                    hit
+                }
+            };
             inputs.characters.push(Character {
                 baked,
                 style,
@@ -203,9 +259,15 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
             mesh,
             args.style.as_deref(),
         ));
-        let (baked, style) = load_mesh(mesh, args.style.as_deref())?;
+        let (w, h) = inputs.size;
+        check_memory(
+            args,
+            mesh,
+            &image_estimate(w, h).and(mesh_estimate(&[mesh.as_path()])),
+        )?;
+        let (baked, style) = load_mesh(mesh, args.style.as_deref(), args.memory_budget_mib)?;
         inputs.characters.push(Character {
-            baked,
+            baked: Rc::new(baked),
             style,
             params: StrandParams {
                 strands_per_bundle: args.strands_per_bundle,

@@ -36,19 +36,26 @@ const HEADER: usize = 24;
 
 /// Serialise a bake to bytes.
 pub fn to_bytes(baked: &BakedHairMesh) -> Vec<u8> {
-    let mut payload = Vec::new();
-    payload.extend_from_slice(bytemuck::bytes_of(&baked.info));
-    payload.extend_from_slice(bytemuck::bytes_of(&baked.style));
-    payload.extend_from_slice(bytemuck::cast_slice(&baked.bundles));
-    for t in baked.textures() {
-        payload.extend_from_slice(t.bytes);
-    }
-    let mut out = Vec::with_capacity(HEADER + payload.len());
+    // One buffer of the exact size (the bake's memory estimate counts one copy of the textures).
+    let textures = baked.textures();
+    let payload_len = size_of::<MeshInfo>()
+        + size_of::<HairStyle>()
+        + std::mem::size_of_val(baked.bundles.as_slice())
+        + textures.iter().map(|t| t.bytes.len()).sum::<usize>();
+    let mut out = Vec::with_capacity(HEADER + payload_len);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
-    out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
-    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    out.extend_from_slice(&payload);
+    out.extend_from_slice(&0u32.to_le_bytes());
+    out.extend_from_slice(&(payload_len as u64).to_le_bytes());
+    out.extend_from_slice(bytemuck::bytes_of(&baked.info));
+    out.extend_from_slice(bytemuck::bytes_of(&baked.style));
+    out.extend_from_slice(bytemuck::cast_slice(&baked.bundles));
+    for t in textures {
+        out.extend_from_slice(t.bytes);
+    }
+    debug_assert_eq!(out.len(), HEADER + payload_len);
+    let crc = crc32fast::hash(&out[HEADER..]);
+    out[12..16].copy_from_slice(&crc.to_le_bytes());
     out
 }
 

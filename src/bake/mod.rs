@@ -25,6 +25,7 @@ use glam::Vec3;
 
 use crate::bake::curve::column_control_points;
 use crate::bake::layout::{EMPTY_TEXEL, RootLayout, layout_root_slice};
+use crate::budget::{Estimate, MemoryBudget, VEC_HEADER};
 use crate::error::{HairError, Result};
 use crate::model::hair_mesh::{HairMesh, bounds};
 use crate::model::style::HairStyle;
@@ -175,6 +176,8 @@ pub struct BakeOptions {
     /// Grow the position decode box by this much on every side (object units), so that an
     /// animated mesh ([`deform`]) stays inside it; 0 for static hair.
     pub motion_margin: f32,
+    /// Host memory the bake may use ([`memory_estimate`] is checked against it first).
+    pub memory_budget: MemoryBudget,
 }
 
 impl Default for BakeOptions {
@@ -182,6 +185,7 @@ impl Default for BakeOptions {
         BakeOptions {
             charts: true,
             motion_margin: 0.0,
+            memory_budget: MemoryBudget::default(),
         }
     }
 }
@@ -210,6 +214,26 @@ fn safe_extent(e: Vec3) -> Vec3 {
     Vec3::select(e.cmpgt(Vec3::splat(1e-12)), e, Vec3::ONE)
 }
 
+/// Peak host memory of baking a hair mesh of `vertices` per layer and `layers` layers into a
+/// root slice of `slice` texels: the mesh itself, the control points of every column, the five
+/// textures and one copy of them (the `.hmb` image or the upload), the styling directions.
+pub fn memory_estimate(vertices: u64, layers: u64, slice: u64) -> Estimate {
+    let depth = SLICES_PER_SEGMENT as u64 * layers.saturating_sub(1) + 1;
+    let textures = Estimate::new()
+        .with("hair mesh texture", slice.saturating_mul(depth), 8)
+        .with("uv and w textures", slice, 4 + 2 * layers)
+        .with("u and v textures", slice.saturating_mul(layers), 16);
+    let copy = textures.total();
+    textures
+        .with("hair mesh layers", vertices.saturating_mul(layers), 16)
+        .with("column control points", vertices, VEC_HEADER + 12 * depth)
+        .with("styling directions", vertices.saturating_mul(layers), 24)
+        // About four 24-byte corner terms per vertex, in rows and then packed.
+        .with("styling basis", vertices, VEC_HEADER + 12 * 24)
+        .with("root layout", slice, 4)
+        .with("the textures' file image", copy, 1)
+}
+
 /// Bake `mesh` with `style` into the five textures; `progress(done, total)` is called per layer.
 pub fn bake(
     mesh: &HairMesh,
@@ -235,6 +259,13 @@ pub fn bake(
         ));
     }
     let n = mesh.vertices_per_layer();
+    let estimate = memory_estimate(n as u64, layers as u64, layout.texels.len() as u64);
+    options.memory_budget.check(
+        &mesh.name,
+        &format!("baking {n} vertices x {layers} layers"),
+        &estimate,
+        "use fewer layers or a smaller mesh",
+    )?;
     let total_steps = n + layers;
 
     // Control points of every vertex column along r*.

@@ -37,6 +37,7 @@ pub mod picture;
 
 use glam::{Vec2, Vec3};
 
+use crate::budget::{Estimate, MemoryBudget, VEC_HEADER};
 use crate::error::{HairError, Result};
 use crate::model::hair_mesh::{Face, HairMesh, MAX_LAYERS};
 use crate::model::strands::{StrandModel, point_at_length, polyline_length};
@@ -49,6 +50,35 @@ pub struct FitOptions {
     pub bundles: usize,
     /// Layers including the scalp (`None`: from the strands' curvature).
     pub layers: Option<usize>,
+    /// Host memory the fit may use ([`memory_estimate`] is checked against it first).
+    pub memory_budget: MemoryBudget,
+}
+
+/// Peak host memory of fitting `strands` strands of `points` points in all into `bundles`
+/// bundles of at most `layers` layers: the strands and the file they came from, about 256 bytes
+/// of working set per strand (roots, chart positions, cells, lengths and the neighbour lists:
+/// each strand is a neighbour of the corners within 1.5 cells), curvature samples per point, and
+/// the hair mesh (at most two corners per bundle) with its bake.
+pub fn memory_estimate(
+    strands: u64,
+    points: u64,
+    file_bytes: u64,
+    bundles: u64,
+    layers: u64,
+) -> Estimate {
+    let corners = bundles.min(strands).saturating_mul(2);
+    Estimate::new()
+        .with("the strand file", file_bytes, 1)
+        .with("the strands", points, 12)
+        .with("strand lists", strands, VEC_HEADER)
+        .with("per-strand working set", strands, 256)
+        .with("curvature samples", points, 16)
+        .with("hair mesh corners", corners, 256)
+        .and(crate::bake::memory_estimate(
+            corners,
+            layers,
+            corners.saturating_add(corners / 2),
+        ))
 }
 
 impl Default for FitOptions {
@@ -56,6 +86,7 @@ impl Default for FitOptions {
         FitOptions {
             bundles: 64,
             layers: None,
+            memory_budget: MemoryBudget::default(),
         }
     }
 }
@@ -260,6 +291,32 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
         return Err(bad(format!("{} bundles: 1..=65536", opts.bundles)));
     }
     let strands = &model.strands;
+    // Step 3's layer count comes first: the memory estimate needs it.
+    let layers = match opts.layers {
+        Some(l) => l,
+        None => {
+            let t = median(strands.iter().map(|s| turning(s)).collect());
+            (t / 30f32.to_radians()).round() as usize + 3
+        }
+    }
+    .clamp(2, MAX_LAYERS.min(16));
+    let estimate = memory_estimate(
+        strands.len() as u64,
+        model.point_count() as u64,
+        model.file_bytes,
+        opts.bundles as u64,
+        layers as u64,
+    );
+    opts.memory_budget.check(
+        &model.name,
+        &format!(
+            "fitting {} strands into {} bundles",
+            strands.len(),
+            opts.bundles
+        ),
+        &estimate,
+        "lower --bundles or --layers",
+    )?;
     let roots: Vec<Vec3> = strands.iter().map(|s| s[0]).collect();
     let dirs: Vec<Vec3> = strands
         .iter()
@@ -274,7 +331,11 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
     let extent = (hi - lo).max_element().max(1e-6);
     // Step 2: the cell size whose occupied cells come closest to the target.
     let target = opts.bundles.min(strands.len());
-    let (mut a, mut b) = ((extent * 1e-4).ln(), (extent * 1.01).ln());
+    // Cells no smaller than 1/1024 of the chart (65,536 bundles need 1/256 when they fill it):
+    // with fewer strands than bundles asked for, every strand already has its own cell well
+    // before that, and smaller cells only make root faces too small to be told from a point
+    // (the hair mesh's degenerate-face test).
+    let (mut a, mut b) = ((extent / 1024.0).ln(), (extent * 1.01).ln());
     for _ in 0..40 {
         let mid = 0.5 * (a + b);
         if occupied(&x, lo, mid.exp()) > target {
@@ -341,14 +402,6 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
     };
     // Step 3: layers.
     let lengths: Vec<f32> = strands.iter().map(|s| polyline_length(s)).collect();
-    let layers = match opts.layers {
-        Some(l) => l,
-        None => {
-            let t = median(strands.iter().map(|s| turning(s)).collect());
-            (t / 30f32.to_radians()).round() as usize + 3
-        }
-    }
-    .clamp(2, MAX_LAYERS.min(16));
     let ratios: Vec<f32> = neighbours
         .iter()
         .filter(|n| n.len() >= 4)

@@ -30,6 +30,7 @@ use glam::{Mat4, Quat, Vec3};
 use serde::Deserialize;
 
 use crate::bake::baked_file;
+use crate::budget::MemoryBudget;
 use crate::error::{HairError, Result};
 use crate::model::obj_io::load_hair_mesh_obj;
 use crate::model::style::HairStyle;
@@ -309,9 +310,14 @@ pub fn mesh_inputs(mesh: &Path, style: Option<&Path>) -> Vec<PathBuf> {
     files
 }
 
-/// Load a mesh (`.obj` is baked on load, anything else is read as a baked file) and its style:
-/// `style` if given, else the `.toml` beside an OBJ, else the style stored in the bake.
-pub fn load_mesh(mesh: &Path, style: Option<&Path>) -> Result<(BakedHairMesh, HairStyle)> {
+/// Load a mesh (`.obj` is baked on load, within `budget`; anything else is read as a baked
+/// file) and its style: `style` if given, else the `.toml` beside an OBJ, else the style stored
+/// in the bake.
+pub fn load_mesh(
+    mesh: &Path,
+    style: Option<&Path>,
+    budget: MemoryBudget,
+) -> Result<(BakedHairMesh, HairStyle)> {
     let is_obj = mesh
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
@@ -321,7 +327,11 @@ pub fn load_mesh(mesh: &Path, style: Option<&Path>) -> Result<(BakedHairMesh, Ha
             Some(p) => HairStyle::load(&p)?,
             None => HairStyle::default(),
         };
-        bake(&m, &s, BakeOptions::default(), |_, _| {})?
+        let options = BakeOptions {
+            memory_budget: budget,
+            ..Default::default()
+        };
+        bake(&m, &s, options, |_, _| {})?
     } else {
         baked_file::load(mesh)?
     };

@@ -284,7 +284,11 @@ impl Context {
                 Err(e) => {
                     // SAFETY: nothing was created on the device yet.
                     unsafe { device.destroy_device(None) };
-                    return Err(GpuError::from(e));
+                    return Err(GpuError::Alloc {
+                        name: "the allocator".into(),
+                        size: 0,
+                        error: e,
+                    });
                 }
             };
             let info = device::query_info(&instance, physical, name, &features);
@@ -362,6 +366,11 @@ impl Context {
                     location,
                     linear,
                     allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
+                })
+                .map_err(|error| GpuError::Alloc {
+                    name: name.to_string(),
+                    size: requirements.size,
+                    error,
                 })?;
         // SAFETY: the memory handle is only passed to `bind`, while the allocation is alive.
         let memory = unsafe { allocation.memory() };

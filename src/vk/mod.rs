@@ -44,9 +44,16 @@ pub enum GpuError {
     /// No usable device or a missing feature.
     #[error("{0}")]
     Unsupported(String),
-    /// Memory allocation failed.
-    #[error("GPU memory: {0}")]
-    Alloc(#[from] gpu_allocator::AllocationError),
+    /// Memory allocation failed; names the resource and its size.
+    #[error("GPU memory for {name} ({size} bytes): {error}")]
+    Alloc {
+        /// The resource being allocated.
+        name: String,
+        /// Bytes asked for.
+        size: u64,
+        /// What the allocator said.
+        error: gpu_allocator::AllocationError,
+    },
     /// A shader failed to compile; the message names file and line.
     #[error("shader {0}")]
     Shader(String),

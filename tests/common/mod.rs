@@ -96,7 +96,12 @@ pub fn assert_no_validation_errors(ctx: &Context) {
 }
 
 pub fn sample(name: &str) -> (BakedHairMesh, HairStyle) {
-    load_mesh(&root().join("hairmeshes").join(name), None).unwrap()
+    load_mesh(
+        &root().join("hairmeshes").join(name),
+        None,
+        Default::default(),
+    )
+    .unwrap()
 }
 
 /// Camera framing the mesh from a fixed 3/4 back view.

@@ -181,7 +181,7 @@ pub fn bench_paper(
         )?;
         outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
         for path in MODELS {
-            let (baked, style) = load_mesh(std::path::Path::new(path), None)?;
+            let (baked, style) = load_mesh(std::path::Path::new(path), None, Default::default())?;
             let (per_bundle, strands) =
                 strands_per_bundle_for(&baked, &style, scale.strands as u64);
             let params = StrandParams {
@@ -254,7 +254,7 @@ pub fn bench_paper(
         outln!("|---|---|---|---|---|")?;
         let meshes: Vec<_> = super::CROWD_MESHES
             .iter()
-            .map(|m| load_mesh(std::path::Path::new(m), None))
+            .map(|m| load_mesh(std::path::Path::new(m), None, Default::default()))
             .collect::<Result<_, _>>()?;
         let side = (scale.crowd as f32).sqrt().ceil() as usize;
         let mut r = Renderer::new(
@@ -294,7 +294,7 @@ pub fn bench_paper(
         outln!("\n(c) head_long at near / mid / far (compute path), LoD on vs off")?;
         outln!("| distance | LoD on ms | LoD off ms | speedup |")?;
         outln!("|---|---|---|---|")?;
-        let (baked, style) = load_mesh(std::path::Path::new(MODELS[0]), None)?;
+        let (baked, style) = load_mesh(std::path::Path::new(MODELS[0]), None, Default::default())?;
         let mut r = Renderer::new(
             &ctx,
             &RendererDesc::default().size(w, h).vertex_pool_bytes(pool),

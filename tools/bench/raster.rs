@@ -71,7 +71,11 @@ fn time(
 }
 
 fn head_scenes(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Vec<Scene>> {
-    let (baked, style) = load_mesh(std::path::Path::new("hairmeshes/head_long.obj"), None)?;
+    let (baked, style) = load_mesh(
+        std::path::Path::new("hairmeshes/head_long.obj"),
+        None,
+        Default::default(),
+    )?;
     let at = super::dolly(&baked);
     let head = |strands_per_bundle: u32| -> Result<Renderer> {
         let mut r = Renderer::new(ctx, &desc(a))?;
@@ -108,7 +112,7 @@ fn head_scenes(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Vec<Scene>> {
 fn crowd_scene(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Scene> {
     let meshes = super::CROWD_MESHES
         .iter()
-        .map(|m| load_mesh(std::path::Path::new(m), None))
+        .map(|m| load_mesh(std::path::Path::new(m), None, Default::default()))
         .collect::<Result<Vec<_>, _>>()?;
     let mut r = Renderer::new(ctx, &desc(a))?;
     let side = (a.crowd as f32).sqrt().ceil() as usize;

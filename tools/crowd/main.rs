@@ -52,6 +52,9 @@ pub struct Args {
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "960x540")]
     size: String,
+    /// Host memory the run may use, MiB: a crowd, image or run past it is refused first.
+    #[arg(long, value_name = "MIB", default_value = "4096", value_parser = hairmesh::budget::parse_budget_flag)]
+    memory_budget_mib: hairmesh::budget::MemoryBudget,
     /// Output folder for frame PNGs and stats.csv (headless).
     #[arg(long, default_value = "crowd_frames")]
     out: PathBuf,
@@ -342,7 +345,26 @@ fn bake_options(c: &preset::CrowdCharacter, animated: bool) -> BakeOptions {
     }
 }
 
+/// Host memory of a run, from its flags: each character's hair mesh, textures and simulation
+/// state (measured at about 175 KiB), a frame's read-back, image and PNG, and a stats row per
+/// frame.
+fn check_memory(args: &Args) -> Result<()> {
+    let (w, h) = parse_size(&args.size)?;
+    let estimate = hairmesh::budget::Estimate::new()
+        .with("characters", args.count as u64, 256 << 10)
+        .with("frame read-back, image and PNG", w as u64 * h as u64, 12)
+        .with("stats rows", args.frames as u64, 256);
+    args.memory_budget_mib.check(
+        &format!("--count {} --size {}", args.count, args.size),
+        "the crowd",
+        &estimate,
+        "lower --count or --size",
+    )?;
+    Ok(())
+}
+
 fn run(args: Args) -> Result<()> {
+    check_memory(&args)?;
     let scene = Scene::build(&args)?;
     if !args.headless {
         return window::run(args, scene);
