@@ -339,6 +339,12 @@ fn is_char_device(_: &std::fs::Metadata) -> bool {
 /// Write `bytes` to `path` atomically: a temporary file in the same folder, synced, then renamed.
 /// Tools go through [`OutputPath`], which decides when this is the right way to write.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = stage(path, bytes)?;
+    publish_staged(&tmp, path)
+}
+
+/// Write `bytes` to a hidden temporary file beside `path` (synced), to be renamed onto it.
+fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
     let dir = parent_folder(path);
     let file_name = path
         .file_name()
@@ -351,12 +357,53 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
+        f.sync_all()
     })();
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
         return Err(HairError::io(path, e));
+    }
+    Ok(tmp)
+}
+
+fn publish_staged(tmp: &Path, path: &Path) -> Result<()> {
+    std::fs::rename(tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(tmp);
+        HairError::io(path, e)
+    })
+}
+
+/// Write several outputs of one run all or none: every file is staged (written and synced
+/// beside its path) before the first is renamed into place, so a full disk or a failing
+/// write leaves no output of the run behind. Devices (`/dev/null`) are written last.
+pub fn write_together(outputs: &[(&OutputPath, &[u8])]) -> Result<()> {
+    let mut staged: Vec<(PathBuf, &Path)> = Vec::new();
+    for (out, bytes) in outputs {
+        if matches!(out.kind, OutputKind::Atomic) {
+            match stage(&out.path, bytes) {
+                Ok(tmp) => staged.push((tmp, &out.path)),
+                Err(e) => {
+                    for (tmp, _) in &staged {
+                        let _ = std::fs::remove_file(tmp);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+    }
+    let mut renamed = staged.into_iter();
+    while let Some((tmp, path)) = renamed.next() {
+        if let Err(e) = publish_staged(&tmp, path) {
+            for (tmp, _) in renamed {
+                let _ = std::fs::remove_file(&tmp);
+            }
+            return Err(e);
+        }
+    }
+    for (out, bytes) in outputs {
+        if !matches!(out.kind, OutputKind::Atomic) {
+            out.write(bytes)?;
+        }
     }
     Ok(())
 }
@@ -387,4 +434,32 @@ macro_rules! outln {
 pub fn exit_with_error(tool: &str, error: &dyn std::fmt::Display, code: i32) -> ! {
     let _ = writeln!(std::io::stderr(), "{tool}: {error:#}");
     std::process::exit(code)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_written_together_appear_all_or_none() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, sub) = (dir.path().join("a.obj"), dir.path().join("sub"));
+        std::fs::create_dir(&sub).unwrap();
+        let b = sub.join("b.toml");
+        let (oa, ob) = (
+            OutputPath::check(&a, &[]).unwrap(),
+            OutputPath::check(&b, &[]).unwrap(),
+        );
+        // The second output's folder disappears before the write: the first is not written.
+        std::fs::remove_dir(&sub).unwrap();
+        let err = write_together(&[(&oa, b"1"), (&ob, b"2")]).unwrap_err();
+        assert!(err.to_string().contains("b.toml"), "{err}");
+        assert!(!a.exists());
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "temporary files left: {left:?}");
+        std::fs::create_dir(&sub).unwrap();
+        write_together(&[(&oa, b"1"), (&ob, b"2")]).unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), b"1");
+        assert_eq!(std::fs::read(&b).unwrap(), b"2");
+    }
 }

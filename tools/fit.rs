@@ -176,11 +176,11 @@ fn run(args: Args) -> Result<()> {
         args.output.display(),
         toml_path.display()
     )?;
-    obj_out.write(&obj)?;
-    toml_out.write(toml.as_bytes())?;
-    if let (Some(out), Some(bytes)) = (picture, png) {
-        out.write(&bytes)?;
+    let mut outputs = vec![(&obj_out, obj.as_slice()), (&toml_out, toml.as_bytes())];
+    if let (Some(out), Some(bytes)) = (&picture, &png) {
+        outputs.push((out, bytes.as_slice()));
     }
+    hairmesh::fsutil::write_together(&outputs)?;
     Ok(())
 }
 

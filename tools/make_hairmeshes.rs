@@ -296,8 +296,7 @@ fn run() -> Result<()> {
     for (_, _, line) in &files {
         hairmesh::outln!("{line}")?;
     }
-    for (path, bytes, _) in &files {
-        path.write(bytes)?;
-    }
+    let outputs: Vec<_> = files.iter().map(|(p, b, _)| (p, b.as_slice())).collect();
+    hairmesh::fsutil::write_together(&outputs)?;
     Ok(())
 }

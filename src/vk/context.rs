@@ -358,20 +358,20 @@ impl Context {
         linear: bool,
         bind: impl FnOnce(vk::DeviceMemory, u64) -> Result<(), vk::Result>,
     ) -> GpuResult<gpu_allocator::vulkan::Allocation> {
-        let allocation =
-            self.allocator()
-                .allocate(&gpu_allocator::vulkan::AllocationCreateDesc {
-                    name,
-                    requirements,
-                    location,
-                    linear,
-                    allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
-                })
-                .map_err(|error| GpuError::Alloc {
-                    name: name.to_string(),
-                    size: requirements.size,
-                    error,
-                })?;
+        let allocation = self
+            .allocator()
+            .allocate(&gpu_allocator::vulkan::AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear,
+                allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(|error| GpuError::Alloc {
+                name: name.to_string(),
+                size: requirements.size,
+                error,
+            })?;
         // SAFETY: the memory handle is only passed to `bind`, while the allocation is alive.
         let memory = unsafe { allocation.memory() };
         if let Err(result) = bind(memory, allocation.offset()) {
