@@ -84,7 +84,13 @@ void main() {
         vec3 q[4];
         cubic_to_quadratics(b, q);
         for (uint i = 0u; i < 4u; i++) {
-            position_texels[(4u * k + i) * slice + t] = pack_position(q[i]);
+            uvec2 texel = pack_position(q[i]);
+            if (k == 0u && i == 0u) {
+                // The root slice's alpha: the root thinning, carried in the root layer's w
+                // (as the bake's encode_columns).
+                texel.y |= unorm16(positions[v].w) << 16;
+            }
+            position_texels[(4u * k + i) * slice + t] = texel;
         }
     } else {
         position_texels[4u * k * slice + t] = pack_position(vertex(k, v));

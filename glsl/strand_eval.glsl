@@ -110,6 +110,14 @@ vec3 root_point(vec2 coord) {
     return decode_position(texture(TEX_POSITION, vec3(coord, 0.5 / depth)).xyz);
 }
 
+// Root thinning at coord: the cube of the root slice's alpha (src/reference/generate.rs:
+// root_thinning).
+float root_thinning(vec2 coord) {
+    float depth = float(POSITION_DEPTH(mesh.layers));
+    float a = texture(TEX_POSITION, vec3(coord, 0.5 / depth)).a;
+    return a * a * a;
+}
+
 // Styling frame (eq. 4) and w at parameter r.
 void styling_frame(vec2 coord, float r, out vec3 fu, out vec3 fv, out vec3 fw, out float w) {
     float z = (r + 0.5) / float(mesh.layers);
@@ -157,6 +165,7 @@ struct StrandInfo {
     vec2 local;         // local cell coordinate of the root
     uint key;           // per-strand random key
     float span;         // curve parameter at the tip
+    bool kept;          // false: thinned out at a hairline, every vertex at the root
 };
 
 // Strand `strand` of crowd bundle `g` (its character bound with bind_character).
@@ -171,12 +180,13 @@ StrandInfo strand_info(uint g, uint strand) {
     si.centre_coord = root_coord(b, centre);
     float length_factor = 1.0 - style.length_variation * strand_rand(si.key, 0u);
     si.span = float(mesh.layers - 1u) * length_factor;
+    si.kept = strand_rand(si.key, STRAND_RAND_THINNING) >= root_thinning(si.coord);
     return si;
 }
 
 // Position of vertex k of `segments` (k = 0 is the root: one lookup, no styling).
 vec3 strand_vertex(StrandInfo si, uint k, uint segments) {
-    if (k == 0u) {
+    if (k == 0u || !si.kept) {
         return root_point(si.coord) + root_bulge(root_cell(si.origin), si.local);
     }
     float s = float(k) / float(segments);

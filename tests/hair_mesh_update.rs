@@ -37,6 +37,11 @@ fn gpu_rebuild_equals_the_cpu_twin() {
     for name in ["head_long", "triangle_tuft"] {
         let dir = root().join("hairmeshes");
         let mesh = load_hair_mesh_obj(&dir.join(format!("{name}.obj"))).unwrap();
+        // Some root thinning, which the rebuild must keep in the root slice's alpha.
+        let thinning = (0..mesh.vertices_per_layer())
+            .map(|i| (i % 3) as f32 * 0.4)
+            .collect();
+        let mesh = mesh.with_root_thinning(thinning).unwrap();
         let style = HairStyle::load(&dir.join(format!("{name}.toml"))).unwrap();
         let options = BakeOptions {
             motion_margin: 0.2,
@@ -76,6 +81,7 @@ fn gpu_rebuild_equals_the_cpu_twin() {
             let cpu = basis.rebuild(pose);
             if pose_name == "rest" {
                 assert!(cpu.position == baked.position && cpu.u_dir == baked.u_dir);
+                assert!(cpu.position.iter().any(|t| t[3] > 0), "root thinning baked");
             }
             let cases = [
                 (

@@ -104,8 +104,18 @@ impl StylingBasis {
 
 /// Hair mesh texture texels of columns: for each root-slice texel holding a vertex, its
 /// column's control points quantised into the box `lo .. lo + extent` (UNORM16); empty texels
-/// stay zero. `ctrl[i]` are column `i`'s `4 (L - 1) + 1` control points.
-pub fn encode_columns(texels: &[u32], ctrl: &[Vec<Vec3>], lo: Vec3, extent: Vec3) -> Vec<[u16; 4]> {
+/// stay zero. `ctrl[i]` are column `i`'s `4 (L - 1) + 1` control points. The root slice's alpha
+/// holds the cube root of each column's root thinning (`HairMesh::root_thinning`): generators
+/// cube the interpolated alpha, so that over a root face the thinning gathers toward the vertices
+/// that have it (a hairline's fall-off over its last centimetre or two, not the whole bundle);
+/// the other slices' alpha is 0.
+pub fn encode_columns(
+    texels: &[u32],
+    ctrl: &[Vec<Vec3>],
+    thinning: &[f32],
+    lo: Vec3,
+    extent: Vec3,
+) -> Vec<[u16; 4]> {
     let slice = texels.len();
     let depth = ctrl.first().map_or(0, Vec::len);
     let mut position = vec![[0u16; 4]; slice * depth];
@@ -115,7 +125,12 @@ pub fn encode_columns(texels: &[u32], ctrl: &[Vec<Vec3>], lo: Vec3, extent: Vec3
         }
         for (z, p) in ctrl[vert as usize].iter().enumerate() {
             let q = (*p - lo) / extent;
-            position[z * slice + t] = [to_unorm16(q.x), to_unorm16(q.y), to_unorm16(q.z), 0];
+            let alpha = if z == 0 {
+                to_unorm16(thinning[vert as usize].cbrt())
+            } else {
+                0
+            };
+            position[z * slice + t] = [to_unorm16(q.x), to_unorm16(q.y), to_unorm16(q.z), alpha];
         }
     }
     position
@@ -154,6 +169,8 @@ pub struct DeformBasis {
     pub styling: StylingBasis,
     /// Vertices per layer.
     pub vertices: u32,
+    /// Root thinning per vertex column (kept through every pose).
+    pub root_thinning: Vec<f32>,
 }
 
 /// The rebuilt textures of one pose.
@@ -185,6 +202,7 @@ impl DeformBasis {
             texel_vertex: layout.texels,
             styling: StylingBasis::new(mesh),
             vertices: mesh.vertices_per_layer() as u32,
+            root_thinning: mesh.root_thinning.clone(),
         })
     }
 
@@ -211,7 +229,7 @@ impl DeformBasis {
             .collect();
         let [u_dir, v_dir] = encode_directions(&self.texel_vertex, &dirs);
         DeformedTextures {
-            position: encode_columns(&self.texel_vertex, &ctrl, lo, extent),
+            position: encode_columns(&self.texel_vertex, &ctrl, &self.root_thinning, lo, extent),
             u_dir,
             v_dir,
         }

@@ -296,7 +296,7 @@ pub fn bake(
         .max(1e-12);
 
     let slice = layout.texels.len();
-    let position = deform::encode_columns(&layout.texels, &ctrl, lo, extent);
+    let position = deform::encode_columns(&layout.texels, &ctrl, &mesh.root_thinning, lo, extent);
     let mut uv = vec![[0u16; 2]; slice];
     let mut w = vec![0u16; slice * layers];
     for (t, &vert) in layout.texels.iter().enumerate() {

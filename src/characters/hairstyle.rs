@@ -20,6 +20,7 @@ use glam::{Vec2, Vec3};
 use super::human::direction;
 use super::person::{PersonShape, PlacedHead};
 use crate::animate::Collider;
+use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::error::Result;
 use crate::model::hair_mesh::{ExtrudeDesc, Face, HairMesh, extrude};
 use crate::model::style::HairStyle;
@@ -114,6 +115,24 @@ pub struct Hairstyle {
     pub mesh: HairMesh,
     /// Its style.
     pub style: HairStyle,
+}
+
+/// Root area of the bundle a crowd's strands-per-bundle count is meant for, m²: the grown
+/// families' 5x5 grid on an average scalp (22-25 cm² per bundle).
+pub const REFERENCE_BUNDLE_AREA: f32 = 24e-4;
+
+impl Hairstyle {
+    /// Strands per bundle for a crowd that asks for `asked` per reference bundle
+    /// ([`REFERENCE_BUNDLE_AREA`]): a coarser hair mesh gets proportionally more, so that no
+    /// style is sparser than the reference (the fitted Sintel hair's 20 bundles hold 40 cm²
+    /// each, and at the same count per bundle showed scalp between its strands); a finer one
+    /// keeps `asked`. At most [`MAX_STRANDS_PER_BUNDLE`].
+    pub fn strands_per_bundle(&self, asked: u32) -> u32 {
+        let areas = self.mesh.bundle_areas();
+        let mean = areas.iter().sum::<f32>() / areas.len().max(1) as f32;
+        let scale = (mean / REFERENCE_BUNDLE_AREA).max(1.0);
+        ((asked as f32 * scale).round() as u32).clamp(1, MAX_STRANDS_PER_BUNDLE as u32)
+    }
 }
 
 /// Uniform in `[lo, hi)`.
@@ -854,7 +873,23 @@ fn grown(
         lift_bundle_interiors(&mut layers, &faces, &head, margin, MAX_TOTAL_RAISE);
     }
     let uv = roots.iter().map(|r| r.uv).collect();
-    HairMesh::new(name, layers, None, uv, faces)
+    let thinning = match cut.region {
+        Region::Full(_) => roots.iter().map(|r| hairline_thinning(r.edge)).collect(),
+        // A mohawk's strip is shaved sharp at its sides.
+        Region::Strip => vec![0.0; roots.len()],
+    };
+    HairMesh::new(name, layers, None, uv, faces)?.with_root_thinning(thinning)
+}
+
+/// Share of strands thinned out on the hairline itself (the root grid's border): real hair
+/// thins over the last centimetre or two instead of stopping at a line, and the thinning is
+/// interpolated over the outer bundles like every root attribute.
+pub const HAIRLINE_THINNING: f32 = 0.35;
+
+/// Root thinning of a grid vertex `edge` of the way from the region's middle to its hairline:
+/// none inside 0.8 (the grid's inner rings), rising to [`HAIRLINE_THINNING`] on the hairline.
+fn hairline_thinning(edge: f32) -> f32 {
+    HAIRLINE_THINNING * ((edge - 0.8) / 0.2).clamp(0.0, 1.0).powi(2)
 }
 
 /// Polar angle (canonical, from the crown) below which [`lift_bundle_interiors`] looks: the
@@ -1035,6 +1070,9 @@ fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hai
         margin,
         MAX_TOTAL_RAISE_FITTED,
     );
+    // No hairline thinning: the fit's border follows the Sintel guide strands, whose roots
+    // already thin out there (20 bundles are too coarse to thin them further without showing
+    // scalp from above: 97.0% covered with the border thinned, 98.9% without).
     let mesh = HairMesh::new(
         format!("Fitted #{seed}"),
         layers,

@@ -89,11 +89,15 @@ pub mod prop_mesh {
 pub const FUR_MAX_VERTS_LOG2: u32 = 3;
 
 impl CrowdCharacter {
-    /// The strand settings this character uses when the crowd asks for `crowd`: fur (balls,
-    /// teapots) caps the vertex level at [`FUR_MAX_VERTS_LOG2`].
+    /// The strand settings this character uses when the crowd asks for `crowd`: people get at
+    /// least the reference density ([`Hairstyle::strands_per_bundle`](super::hairstyle::Hairstyle::strands_per_bundle)),
+    /// fur (balls, teapots) caps the vertex level at [`FUR_MAX_VERTS_LOG2`].
     pub fn strand_params(&self, crowd: StrandParams) -> StrandParams {
         match self.body {
-            Body::Person(_) => crowd,
+            Body::Person(_) => StrandParams {
+                strands_per_bundle: self.hair.strands_per_bundle(crowd.strands_per_bundle),
+                ..crowd
+            },
             Body::Ball | Body::Teapot => StrandParams {
                 verts_log2: crowd.verts_log2.min(FUR_MAX_VERTS_LOG2),
                 ..crowd

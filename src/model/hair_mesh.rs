@@ -41,6 +41,11 @@ pub struct HairMesh {
     pub uv: Vec<Vec2>,
     /// Root faces (bundles).
     pub faces: Vec<Face>,
+    /// Per root vertex, the share of strands thinned out there, 0 (all kept, the default)
+    /// ..= 1: interpolated over each root face like `uv`, it makes density fall off across a
+    /// hairline instead of stopping at a polygon edge (baked into the hair mesh texture's
+    /// root-slice alpha).
+    pub root_thinning: Vec<f32>,
 }
 
 /// Relative tolerance below which a face or uv triangle counts as degenerate.
@@ -75,15 +80,24 @@ impl HairMesh {
             Some(w) => w,
             None => path_length_w(&layers),
         };
+        let root_thinning = vec![0.0; uv.len()];
         let mesh = HairMesh {
             name,
             layers,
             w,
             uv,
             faces,
+            root_thinning,
         };
         mesh.validate()?;
         Ok(mesh)
+    }
+
+    /// The mesh with `thinning` per root vertex (see [`HairMesh::root_thinning`]).
+    pub fn with_root_thinning(mut self, thinning: Vec<f32>) -> Result<Self> {
+        self.root_thinning = thinning;
+        self.validate()?;
+        Ok(self)
     }
 
     fn err(&self, what: impl Into<String>) -> HairError {
@@ -100,6 +114,22 @@ impl HairMesh {
             return Err(self.err(format!(
                 "a hair mesh needs 2..={MAX_LAYERS} layers (at least 2 layers), found {}",
                 self.layers.len()
+            )));
+        }
+        if self.root_thinning.len() != n {
+            return Err(self.err(format!(
+                "root thinning has {} values for {n} root vertices",
+                self.root_thinning.len()
+            )));
+        }
+        if let Some(i) = self
+            .root_thinning
+            .iter()
+            .position(|t| !(0.0..=1.0).contains(t))
+        {
+            return Err(self.err(format!(
+                "root vertex {i}: thinning {} must be in [0, 1]",
+                self.root_thinning[i]
             )));
         }
         if self.w.len() != self.layers.len() {
@@ -518,6 +548,28 @@ mod tests {
             total, 7,
             "a fan split covers the n-gon with n-2 triangles' worth"
         );
+    }
+
+    #[test]
+    fn root_thinning_is_checked() {
+        let m = HairMesh::new(
+            "t",
+            vec![square(0.0), square(1.0)],
+            None,
+            vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y],
+            vec![Face::Quad([0, 1, 2, 3])],
+        )
+        .unwrap();
+        assert_eq!(m.root_thinning, vec![0.0; 4]);
+        for (bad, what) in [
+            (vec![0.0; 3], "3 values for 4"),
+            (vec![0.0, 0.5, f32::NAN, 0.0], "root vertex 2"),
+            (vec![0.0, 1.5, 0.0, 0.0], "root vertex 1"),
+        ] {
+            let err = m.clone().with_root_thinning(bad).unwrap_err().to_string();
+            assert!(err.contains(what), "{err}");
+        }
+        assert!(m.with_root_thinning(vec![1.0, 0.0, 0.25, 0.0]).is_ok());
     }
 
     #[test]

@@ -133,7 +133,7 @@ impl HairTextures {
             info,
             bundles: baked.bundles.clone(),
             position: SampledTexture::new([wd, ht, info.position_depth()], &baked.position, |t| {
-                (o + e * Vec3::new(unorm(t[0]), unorm(t[1]), unorm(t[2]))).extend(0.0)
+                (o + e * Vec3::new(unorm(t[0]), unorm(t[1]), unorm(t[2]))).extend(unorm(t[3]))
             }),
             uv: SampledTexture::new([wd, ht, 1], &baked.uv, |t| {
                 Vec4::new(uo0 + ue0 * unorm(t[0]), uo1 + ue1 * unorm(t[1]), 0.0, 0.0)
@@ -184,6 +184,16 @@ impl HairTextures {
             .truncate()
     }
 
+    /// Root thinning at `fp`: the cube of the root slice's alpha, bilinear like every root
+    /// lookup (the bake stores cube roots: `bake::deform::encode_columns`).
+    pub fn root_thinning(&self, fp: &Footprint) -> f32 {
+        let a = self
+            .position
+            .sample_3d(fp, 0.5 / self.position.depth() as f32)
+            .w;
+        a * a * a
+    }
+
     /// Styling frame `(u, v, w)` at curve parameter `r` (eq. 4 for `w`), and the `w` coordinate.
     pub fn frame(&self, fp: &Footprint, r: f32) -> ([Vec3; 3], f32) {
         // u-, v- and w-textures share their size: one depth axis for all three fetches.
@@ -220,6 +230,10 @@ impl HairTextures {
 pub fn strand_key(seed: u32, bundle: u32, strand: u32) -> u32 {
     hash_u32(hash_u32(bundle ^ hash_u32(seed)).wrapping_add(strand))
 }
+
+/// [`strand_rand`] slot deciding whether a strand is thinned out: it is where the value is
+/// below the root thinning at its root (`HairMesh::root_thinning`).
+pub const STRAND_RAND_THINNING: u32 = 3;
 
 /// Random value `slot` of a strand in `[0, 1)` (GLSL: `strand_rand`).
 pub fn strand_rand(key: u32, slot: u32) -> f32 {
@@ -396,6 +410,15 @@ impl CpuGenerator {
         let span = (self.tex.info.layers - 1) as f32 * length;
         pos[0] = self.tex.root_point(&fp) + bulge;
         width[0] = strand_width(style, 0.0);
+        if strand_rand(key, STRAND_RAND_THINNING) < self.tex.root_thinning(&fp) {
+            // Thinned out: every vertex at the root, a strip of no area (GLSL: StrandInfo.kept).
+            for k in 1..=segments as usize {
+                pos[k] = pos[0];
+                width[k] = strand_width(style, k as f32 / segments as f32);
+            }
+            crate::bake::curve::strand_tangents(pos, tan);
+            return;
+        }
         for k in 1..=segments as usize {
             let s = k as f32 / segments as f32;
             let r = s * span;

@@ -152,7 +152,19 @@ impl DeformState {
                 "hair mesh pose: position {i} is not finite"
             )));
         }
-        self.pending = Some(positions.iter().map(|p| p.extend(0.0).to_array()).collect());
+        // The root layer's w carries the root thinning into the root slice's alpha (as its cube
+        // root, like the bake's encode_columns).
+        let thinning = &self.basis.root_thinning;
+        self.pending = Some(
+            positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    p.extend(thinning.get(i).map_or(0.0, |t| t.cbrt()))
+                        .to_array()
+                })
+                .collect(),
+        );
         self.pose_bounds = Some(crate::model::hair_mesh::bounds(positions.iter().copied()));
         Ok(())
     }

@@ -687,7 +687,7 @@ pub fn glsl_header() -> String {
          // Shaders are compiled with this text; this copy is for reading.\n\
          #ifndef SHARED_GLSL\n#define SHARED_GLSL\n"
     );
-    let consts: [(&str, u32); 21] = [
+    let consts: [(&str, u32); 22] = [
         ("STRAND_GROUP_SIZE", STRAND_GROUP_SIZE),
         ("MAX_VERTS_LOG2", MAX_VERTS_LOG2),
         ("MAX_SEGMENTS", MAX_SEGMENTS),
@@ -709,6 +709,10 @@ pub fn glsl_header() -> String {
         ("SOFT_BIN_GROUP", SOFT_BIN_GROUP),
         ("LOD_SOFT", LOD_SOFT),
         ("MAX_OIT_BUDGET", super::transparency::MAX_OIT_BUDGET),
+        (
+            "STRAND_RAND_THINNING",
+            crate::reference::generate::STRAND_RAND_THINNING,
+        ),
     ];
     for (name, v) in consts {
         // Set numbers and local sizes must be int constants in layout qualifiers.

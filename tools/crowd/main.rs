@@ -76,7 +76,8 @@ pub struct Args {
     /// Seed of the hairstyles and placement.
     #[arg(long, default_value_t = 1)]
     seed: u32,
-    /// Strands per average bundle (people's hair meshes have 25-64 bundles).
+    /// Strands per bundle of 24 cm² of scalp (people with coarser hair meshes get
+    /// proportionally more per bundle, so every head has at least that density).
     #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u32).range(1..=4096))]
     strands_per_bundle: u32,
     /// Vertices per strand are 2^e + 1 (e in 0..=6).
