@@ -132,7 +132,10 @@ fn run(args: Args) -> Result<()> {
     let baked = bake(
         &fitted.mesh,
         &fitted.style,
-        BakeOptions::default(),
+        BakeOptions {
+            memory_budget: args.memory_budget_mib,
+            ..Default::default()
+        },
         |_, _| {},
     )
     .context("the fitted hair mesh does not bake")?;
