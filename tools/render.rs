@@ -114,6 +114,10 @@ struct Args {
     /// Enable Vulkan validation layers.
     #[arg(long)]
     validation: bool,
+    /// Print the frame graph of the (last) frame: every pass in order with the resources it
+    /// reads and writes and the barriers the graph derived.
+    #[arg(long)]
+    print_frame: bool,
     /// Output PNG.
     #[arg(short, long)]
     output: PathBuf,
@@ -477,6 +481,7 @@ fn run(args: Args) -> Result<()> {
         &FrameOptions {
             read_image: true,
             raster: args.draw,
+            describe_frame: args.print_frame,
             ..Default::default()
         },
     )?;
@@ -500,11 +505,15 @@ fn run(args: Args) -> Result<()> {
             &FrameOptions {
                 path: Some(second),
                 read_image: true,
+                describe_frame: args.print_frame,
                 ..Default::default()
             },
         )?;
     }
     let wall = start.elapsed().as_secs_f64();
+    if let Some(graph) = &out.frame_graph {
+        outln!("frame graph:\n{graph}")?;
+    }
     // Nothing is written unless the frame succeeded and validation reported nothing.
     if ctx.validation_errors() > 0 {
         bail!(

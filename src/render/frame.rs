@@ -1,17 +1,32 @@
-//! What each of the frames in flight owns: command buffer, fence, per-frame uniform data and
-//! character records, timestamp and mesh queries (reset every frame), statistics and image
-//! readback, its descriptor set 0, and the resources retired with it.
+//! A frame, from settings to submission: what each of the frames in flight owns (command
+//! buffer, fence, per-frame uniform data and character records, timestamp and mesh queries,
+//! statistics and image readback, its descriptor set 0, the resources retired with it), and
+//! the orchestration of one frame: check the settings, size the buffers, write the frame
+//! blocks, build the frame graph from the passes, run it, submit.
 
 use std::any::Any;
 use std::sync::Arc;
 
 use ash::vk;
 
+use std::time::Instant;
+
 use super::RenderPath;
-use super::shared::{CharacterRecord, FrameBlock, FrameStats, GenerateArgs};
+use super::camera::View;
+use super::graph::FrameGraph;
+use super::passes::output::{FrameOutputs, add_outputs};
+use super::passes::props::PropDraw;
+use super::passes::{FrameInputs, FrameRes, FrameSources, PassSets};
+use super::renderer::{PresentTarget, Renderer};
+use super::settings::{FrameOptions, FrameTicket};
+use super::shadow::{LightView, ShadowMode};
+use super::shared::{CharacterRecord, FrameBlock, FrameStats, GenerateArgs, PropInstance};
+use super::soft::StrandRaster;
+use super::transparency::Transparency;
+use super::workspace::FrameBuffers;
 use crate::vk::{
     Buffer, BufferDesc, CommandBuffer, Context, DescriptorSet, DescriptorSetLayout, Fence,
-    GpuResult, MeshPrimitivesQuery, Profiler,
+    GpuError, GpuResult, MeshPrimitivesQuery, Profiler,
 };
 
 /// Frames the CPU may record ahead of the GPU.
@@ -46,6 +61,9 @@ pub struct FrameReport {
     pub record_ms: f64,
     /// RGBA8 pixels (sRGB), top row first, when requested.
     pub rgba: Option<Vec<u8>>,
+    /// The frame graph's passes, uses and barriers, when
+    /// [`super::FrameOptions::describe_frame`] was set.
+    pub frame_graph: Option<String>,
 }
 
 impl FrameReport {
@@ -62,6 +80,8 @@ pub(crate) struct Pending {
     pub height: u32,
     pub record_ms: f64,
     pub read_image: bool,
+    /// The frame graph's description, when asked for.
+    pub frame_graph: Option<String>,
 }
 
 /// One frame in flight.
@@ -149,5 +169,394 @@ pub(crate) fn records_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
             vk::BufferUsageFlags::STORAGE_BUFFER,
         )
         .host_visible(),
+    )
+}
+
+/// What one frame draws (beyond the options the caller gave).
+pub(super) struct FrameWork<'a> {
+    path: RenderPath,
+    bundles: u32,
+    props: &'a [PropDraw],
+    /// Shadow mode, when shadows are on and there is hair to shadow.
+    shadows: Option<ShadowMode>,
+    /// How strands are composited.
+    transparency: super::Transparency,
+    /// How strands are rasterized.
+    raster: StrandRaster,
+    /// k-buffer nodes per pixel (OIT budget, or the software rasterizer's K).
+    kbuffer_budget: u32,
+    /// Character slots whose hair mesh pose changed (rebuilt this frame).
+    pose_updates: Vec<usize>,
+}
+
+impl Renderer {
+    /// [`Renderer::render_frame`], then blit the image onto `present.image` (scaled to its
+    /// size) after `present.wait`, signalling `present.signal` for presentation.
+    pub fn render_frame_to(
+        &mut self,
+        view: &View,
+        opts: &FrameOptions,
+        mut present: Option<PresentTarget>,
+    ) -> GpuResult<FrameTicket> {
+        let (path, kbuffer_budget) = self.check_frame(view, opts)?;
+        let raster = opts.raster;
+        let i = self.next;
+        self.retire_slot(i)?;
+        self.size_buffers(i, view.transparency, raster, kbuffer_budget)?;
+        self.prepare_workspace(i, path)?;
+        let pose_updates = self.crowd.write_pending_poses(i)?;
+        let (block, light_block) = self.frame_blocks(view, raster, kbuffer_budget);
+        let prop_draws = self.write_slot(i, &block, light_block.as_ref(), opts.read_image)?;
+        let start = Instant::now();
+        let work = FrameWork {
+            path,
+            bundles: self.crowd.bundle_count(),
+            props: &prop_draws,
+            shadows: light_block.map(|_| view.shadows),
+            transparency: view.transparency,
+            raster,
+            kbuffer_budget,
+            pose_updates,
+        };
+        let frame_graph = self.record(i, work, opts, present.as_mut())?;
+        let record_ms = start.elapsed().as_secs_f64() * 1e3;
+        let (width, height) = self.targets.size();
+        let pending = Pending {
+            frame: self.frame_number,
+            path,
+            width,
+            height,
+            record_ms,
+            read_image: opts.read_image,
+            frame_graph,
+        };
+        self.submit(i, pending, present.as_ref())?;
+        self.after_submit(path, raster);
+        self.next = (i + 1) % FRAMES_IN_FLIGHT;
+        Ok(FrameTicket(self.frame_number - 1))
+    }
+
+    /// Refuse a frame this renderer cannot draw (path state, 32-bit counters, settings);
+    /// returns its path and k-buffer budget.
+    fn check_frame(&self, view: &View, opts: &FrameOptions) -> GpuResult<(RenderPath, u32)> {
+        view.validate().map_err(GpuError::Unsupported)?;
+        let path = opts.path.unwrap_or(self.default_path());
+        if path == RenderPath::Static && self.static_version != Some(self.crowd.version()) {
+            return Err(GpuError::Unsupported(
+                "the static path draws the strands of the last compute-path frame: render one first, and again after the characters change".into(),
+            ));
+        }
+        let structure = Some(self.crowd.structure_version());
+        if path == RenderPath::Lhs
+            && (self.lhs.as_ref().map(|l| l.0) != structure || self.args_structure != structure)
+        {
+            return Err(GpuError::Unsupported(
+                "the LHS path needs strands stored by capture_lhs for the current characters, and a compute-path frame since the last mesh-path one".into(),
+            ));
+        }
+        // Prefix sums and statistics are 32-bit: refuse a crowd that could wrap them (LoD
+        // usually needs far less, but a frame without LoD must not produce garbage).
+        let worst = self.crowd.max_draw_vertices();
+        if worst > u32::MAX as u64 {
+            return Err(GpuError::Unsupported(format!(
+                "the crowd needs up to {worst} strand draw vertices at full detail, more than 32-bit frame counters hold; lower strands per bundle or vertex level"
+            )));
+        }
+        let settings = super::settings::FrameSettings {
+            path,
+            raster: opts.raster,
+            transparency: view.transparency,
+            msaa: self.desc.msaa,
+        };
+        let budget = settings
+            .validate(&self.caps())
+            .map_err(GpuError::Unsupported)?;
+        Ok((path, budget))
+    }
+
+    /// Size the transparency and software rasterizer buffers for this frame; replaced ones
+    /// are retired with slot `i`.
+    fn size_buffers(
+        &mut self,
+        i: usize,
+        transparency: Transparency,
+        raster: StrandRaster,
+        kbuffer_budget: u32,
+    ) -> GpuResult<()> {
+        let (width, height) = self.targets.size();
+        // The software rasterizer composites through the k-buffer, in opaque frames too.
+        let buffers_for = match (raster.uses_software(), transparency) {
+            (true, Transparency::Opaque) => Transparency::KBuffer {
+                budget: kbuffer_budget,
+            },
+            (_, t) => t,
+        };
+        self.passes.prepare_transparency(buffers_for)?;
+        for old in self.transparency.ensure(buffers_for, width, height)? {
+            self.frames[i].retired.push(Retired::Resource(old));
+        }
+        if raster.uses_software() {
+            for old in self.soft.ensure(self.soft_budget, width, height)? {
+                self.frames[i].retired.push(Retired::Resource(old));
+            }
+        }
+        Ok(())
+    }
+
+    /// The camera's frame block and, with shadows and hair in view, the light's.
+    fn frame_blocks(
+        &self,
+        view: &View,
+        raster: StrandRaster,
+        kbuffer_budget: u32,
+    ) -> (FrameBlock, Option<FrameBlock>) {
+        let (width, height) = self.targets.size();
+        let bundles = self.crowd.bundle_count();
+        let slots = self.crowd.slot_count();
+        let mut block = view.frame_block(width, height, bundles, slots, self.vertex_budget());
+        block.transparency = view.transparency.frame_fields(self.desc.msaa);
+        if raster.uses_software() {
+            block.transparency[1] = kbuffer_budget;
+            let opacity = match view.transparency {
+                Transparency::Opaque => 1.0,
+                _ => super::transparency::STRAND_OPACITY,
+            };
+            let split = self.desc.auto_split_pixels;
+            super::soft::frame_fields(&mut block, raster, self.soft_budget, opacity, split);
+        }
+        let light = self.light_view(view, &block);
+        if let Some(l) = &light {
+            (block.light_view_proj, block.shadow, block.shadow_params) =
+                l.shadow_fields(view.shadows);
+        }
+        let light_block = light.map(|l| l.frame_block(&block, &view.lod));
+        (block, light_block)
+    }
+
+    /// Write slot `i`'s frame blocks, records and prop instances (and size its image
+    /// readback); returns this frame's prop draws.
+    fn write_slot(
+        &mut self,
+        i: usize,
+        block: &FrameBlock,
+        light_block: Option<&FrameBlock>,
+        read_image: bool,
+    ) -> GpuResult<Vec<PropDraw>> {
+        let records = self.crowd.records();
+        let crowd = &self.crowd;
+        let (prop_instances, prop_draws) = self.props.frame_lists(|id| crowd.drawn_model(id));
+        let (width, height) = self.targets.size();
+        let slot = &mut self.frames[i];
+        slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;
+        if let Some(lb) = light_block {
+            slot.light_ubo.write(0, bytemuck::bytes_of(lb))?;
+        }
+        slot.records.write(0, bytemuck::cast_slice(&records))?;
+        slot.prop_instances
+            .write(0, bytemuck::cast_slice(&prop_instances))?;
+        let image_bytes = width as u64 * height as u64 * 4;
+        let stale = slot
+            .image_readback
+            .as_ref()
+            .is_none_or(|b| b.size != image_bytes);
+        if read_image && stale {
+            slot.image_readback = Some(image_readback(&self.ctx, image_bytes)?);
+        }
+        Ok(prop_draws)
+    }
+
+    /// Record frame slot `i`: build the frame graph (hair mesh updates, LHS skinning, the
+    /// frame's passes, overlay, readbacks, presentation) and run it. Returns the graph's
+    /// description when `opts` asks for it.
+    fn record(
+        &mut self,
+        i: usize,
+        work: FrameWork,
+        opts: &FrameOptions,
+        present: Option<&mut PresentTarget>,
+    ) -> GpuResult<Option<String>> {
+        let FrameSlot {
+            cmd,
+            profiler,
+            mesh_query,
+            set,
+            light_set,
+            stats_readback,
+            image_readback,
+            ..
+        } = &mut self.frames[i];
+        let mut rec = cmd.begin()?;
+        profiler.reset(&mut rec);
+        if let Some(q) = mesh_query.as_mut() {
+            q.reset(&mut rec);
+        }
+        let jobs = self.crowd.update_jobs(i, &work.pose_updates);
+        let size = self.targets.size();
+        let mut g = FrameGraph::new(opts.describe_frame);
+        if let Some((pass, resource)) = &self.desc.omit_use {
+            g.omit_use(pass, resource);
+        }
+        let sources = FrameSources {
+            work: &self.work,
+            targets: &mut self.targets,
+            shadow: &mut self.shadow,
+            transparency: &mut self.transparency,
+            soft: &self.soft,
+        };
+        let r = FrameRes::import(&mut g, sources);
+        self.passes.add_updates(&mut g, &r, &jobs);
+        if work.path == RenderPath::Lhs
+            && let Some((_, lhs)) = self.lhs.as_mut()
+        {
+            self.passes.add_lhs_skin(&mut g, &r, lhs, i)?;
+        }
+        let textures = self.crowd.texture_set();
+        let bg = self.background;
+        let inputs = FrameInputs {
+            sets: PassSets {
+                frame: set,
+                textures,
+            },
+            light_sets: PassSets {
+                frame: light_set,
+                textures,
+            },
+            bundles: work.bundles,
+            path: work.path,
+            clear: opts.clear.then_some([bg[0], bg[1], bg[2], 1.0]),
+            props: work.props,
+            shadow: work.shadows,
+            transparency: work.transparency,
+            raster: work.raster,
+            kbuffer_budget: work.kbuffer_budget,
+            size,
+            mesh_query: mesh_query.as_mut(),
+        };
+        self.passes.add(&mut g, &r, inputs)?;
+        let (overlay, image) = match present {
+            Some(p) => (p.overlay.as_mut().map(|o| &mut **o), Some(p.image)),
+            None => (None, None),
+        };
+        let outputs = FrameOutputs {
+            overlay,
+            stats_readback,
+            image_readback: image_readback.as_ref().filter(|_| opts.read_image),
+            present: image,
+        };
+        add_outputs(&mut g, &r, outputs);
+        let description = g.run(&mut rec, profiler)?;
+        drop(rec);
+        cmd.end()?;
+        Ok(description)
+    }
+
+    /// Submit slot `i` (after `present.wait`, signalling `present.signal`).
+    fn submit(
+        &mut self,
+        i: usize,
+        pending: Pending,
+        present: Option<&PresentTarget>,
+    ) -> GpuResult<()> {
+        let slot = &mut self.frames[i];
+        slot.fence.reset()?;
+        let (wait, signal) = match present {
+            Some(p) => (Some(p.wait), Some(p.signal)),
+            None => (None, None),
+        };
+        if let Err(e) = self.ctx.submit_with(&slot.cmd, &slot.fence, wait, signal) {
+            // Keep the slot usable: a fence that will never be signalled would hang the next wait.
+            slot.fence = crate::vk::Fence::new(&self.ctx, true)?;
+            return Err(e);
+        }
+        slot.pending = Some(pending);
+        self.frame_number += 1;
+        Ok(())
+    }
+
+    /// The pool and draw arguments now hold this frame's strands (compute path), or the mesh
+    /// path has overwritten the arguments.
+    fn after_submit(&mut self, path: RenderPath, raster: StrandRaster) {
+        match path {
+            // Software bundles leave no strands in the pool.
+            RenderPath::Compute if !raster.uses_software() => {
+                self.static_version = Some(self.crowd.version());
+                self.args_structure = Some(self.crowd.structure_version());
+            }
+            RenderPath::Compute | RenderPath::Mesh => {
+                self.static_version = None;
+                self.args_structure = None;
+            }
+            RenderPath::Static | RenderPath::Lhs => {}
+        }
+    }
+
+    /// Grow the working buffers for the crowd's bundles and allocate the vertex pool when the
+    /// compute path first needs it. Replaced buffers are retired with frame slot `i`.
+    pub(super) fn prepare_workspace(&mut self, i: usize, path: RenderPath) -> GpuResult<()> {
+        if let Some(old) = self.crowd.update_bundle_table()? {
+            self.frames[i]
+                .retired
+                .push(Retired::Resource(Box::new(old)));
+        }
+        if let Some(old) = self.work.grow(self.crowd.bundle_count())? {
+            self.frames[i]
+                .retired
+                .push(Retired::Resource(Box::new(old)));
+        }
+        if path.pulls_vertices() {
+            self.work.ensure_pool(self.desc.vertex_pool_bytes)?;
+        }
+        let slots = self.crowd.slot_count();
+        let slot = &mut self.frames[i];
+        if slot.records.size < slots as u64 * size_of::<super::shared::CharacterRecord>() as u64 {
+            slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
+        }
+        let instances = (self.props.instances.len() + self.props.attached.len()) as u32;
+        if slot.prop_instances.size < instances as u64 * size_of::<PropInstance>() as u64 {
+            slot.prop_instances = prop_instance_buffer(&self.ctx, instances.next_power_of_two())?;
+        }
+        let slot = &self.frames[i];
+        for (set, ubo) in [
+            (&slot.set, &slot.frame_ubo),
+            (&slot.light_set, &slot.light_ubo),
+        ] {
+            self.work.write_set(
+                set,
+                FrameBuffers {
+                    frame_ubo: ubo,
+                    records: &slot.records,
+                    prop_instances: &slot.prop_instances,
+                    bundle_table: self.crowd.bundle_table(),
+                    prop_vertices: self.props.vertices.as_ref(),
+                    shadow: &self.shadow,
+                    transparency: &self.transparency,
+                    soft: &self.soft,
+                },
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The light's view for `view`: fitted around the visible characters whose hair is in the
+    /// camera's frustum. `None` when shadows are off or no hair is in view.
+    fn light_view(&self, view: &View, block: &super::shared::FrameBlock) -> Option<LightView> {
+        if view.shadows == ShadowMode::Off {
+            return None;
+        }
+        let bounds: Vec<_> = self
+            .crowd
+            .hair_bounds()
+            .into_iter()
+            .filter(|(lo, hi)| super::camera::box_in_frustum(&block.planes, *lo, *hi))
+            .collect();
+        LightView::fit(&bounds, view.light_dir, self.shadow.resolution())
+    }
+}
+
+/// A host-readable buffer for the frame's image.
+pub(super) fn image_readback(ctx: &Arc<Context>, bytes: u64) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new("image readback", bytes, vk::BufferUsageFlags::TRANSFER_DST).readback(),
     )
 }

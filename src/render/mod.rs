@@ -5,9 +5,12 @@
 
 pub mod camera;
 pub mod crowd;
+pub mod debug;
 pub mod deform;
 pub mod frame;
+pub mod graph;
 pub mod passes;
+pub mod prop_table;
 pub mod renderer;
 pub mod scene;
 pub mod settings;
@@ -22,8 +25,8 @@ pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use frame::{FRAMES_IN_FLIGHT, FrameReport};
 pub use renderer::{
-    FrameOptions, FrameTicket, PresentTarget, RenderPath, Renderer, RendererDesc, check_msaa,
-    software_raster_conflict, supported_msaa,
+    DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,
+    RendererDesc, check_msaa, software_raster_conflict, supported_msaa,
 };
 pub use shadow::ShadowMode;
 pub use shared::FrameStats;

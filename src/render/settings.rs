@@ -52,6 +52,10 @@ pub struct RendererDesc {
     /// `StrandRaster::Auto`: bundles whose strands are drawn at most this many pixels wide
     /// go to the software rasterizer (finite, > 0).
     pub auto_split_pixels: f32,
+    /// Leave one declared use out of the frame graph: `(pass, resource)` names as printed by
+    /// `render --print-frame`. A deliberate bug for the test that shows synchronization
+    /// validation catches a missing declaration; `None` in every real use.
+    pub omit_use: Option<(String, String)>,
 }
 
 impl Default for RendererDesc {
@@ -67,6 +71,7 @@ impl Default for RendererDesc {
             shadow_resolution: super::shadow::DEFAULT_SHADOW_RESOLUTION,
             soft_budget: None,
             auto_split_pixels: super::soft::AUTO_SPLIT_PIXELS,
+            omit_use: None,
         }
     }
 }
@@ -125,6 +130,9 @@ pub struct FrameOptions {
     pub clear: bool,
     /// Read the colour target back into the report.
     pub read_image: bool,
+    /// Keep a printable account of the frame graph (passes, uses, derived barriers) in the
+    /// frame's report (`render --print-frame`).
+    pub describe_frame: bool,
     /// Hardware strips, the software rasterizer, or a split per bundle (mesh and compute
     /// paths).
     pub raster: super::soft::StrandRaster,
@@ -136,6 +144,7 @@ impl Default for FrameOptions {
             path: None,
             clear: true,
             read_image: false,
+            describe_frame: false,
             raster: super::soft::StrandRaster::Hardware,
         }
     }
@@ -144,3 +153,133 @@ impl Default for FrameOptions {
 /// A submitted frame, to [`Renderer::wait`] for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FrameTicket(pub u64);
+
+/// What a device (and renderer) offers, for [`FrameSettings::validate`].
+#[derive(Clone, Debug)]
+pub struct DeviceCaps {
+    /// Device name (for messages).
+    pub name: String,
+    /// VK_EXT_mesh_shader usable for the mesh path.
+    pub mesh_path: bool,
+    /// 64-bit shared and buffer atomics (the software rasterizer and k-buffer OIT).
+    pub int64_atomics: bool,
+}
+
+/// The settings of one frame that constrain each other: generation path, strand raster,
+/// transparency and MSAA. Every compatibility rule is in [`FrameSettings::validate`]; the
+/// tools call it rather than restating the rules.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSettings {
+    /// Generation path.
+    pub path: RenderPath,
+    /// How strands are rasterized.
+    pub raster: super::soft::StrandRaster,
+    /// How strands are composited.
+    pub transparency: super::Transparency,
+    /// Samples per pixel of the renderer's targets.
+    pub msaa: u32,
+}
+
+impl FrameSettings {
+    /// Why these settings cannot be drawn on a device with `caps`, or the frame's k-buffer
+    /// budget (the OIT budget, or the software rasterizer's K in opaque frames).
+    pub fn validate(&self, caps: &DeviceCaps) -> Result<u32, String> {
+        use super::Transparency;
+        self.raster.validate()?;
+        self.transparency.validate()?;
+        if self.path == RenderPath::Mesh && !caps.mesh_path {
+            return Err(format!(
+                "{}: no usable VK_EXT_mesh_shader for the mesh path",
+                caps.name
+            ));
+        }
+        match self.transparency {
+            Transparency::KBuffer { .. } if !caps.int64_atomics => {
+                return Err(format!(
+                    "{}: k-buffer OIT needs shaderInt64 and shaderBufferInt64Atomics",
+                    caps.name
+                ));
+            }
+            Transparency::DepthPeeling { .. } if self.msaa > 1 => {
+                return Err(
+                    "depth peeling is the single-sample reference: use it without MSAA".into(),
+                );
+            }
+            _ => {}
+        }
+        let budget = match self.transparency {
+            Transparency::KBuffer { budget } => budget,
+            _ => self.raster.k(),
+        };
+        if !self.raster.uses_software() {
+            return Ok(budget);
+        }
+        if !caps.int64_atomics {
+            return Err(format!(
+                "{}: the software rasterizer needs shaderInt64 and 64-bit buffer and shared atomics",
+                caps.name
+            ));
+        }
+        match software_raster_conflict(self.path, self.msaa, self.transparency) {
+            Some(why) => Err(why),
+            None => Ok(budget),
+        }
+    }
+}
+
+/// Why the software rasterizer cannot draw with `path`, `msaa` samples and `transparency`
+/// (`None`: it can); tools check this before any work to name their flags.
+pub fn software_raster_conflict(
+    path: RenderPath,
+    msaa: u32,
+    transparency: super::Transparency,
+) -> Option<String> {
+    if !matches!(path, RenderPath::Mesh | RenderPath::Compute) {
+        return Some(
+            "the software rasterizer draws generated strands: use the mesh or compute path".into(),
+        );
+    }
+    if msaa > 1 {
+        return Some(
+            "the software rasterizer antialiases strands analytically and reads single-sample depth: use it without MSAA".into(),
+        );
+    }
+    if matches!(transparency, super::Transparency::DepthPeeling { .. }) {
+        return Some(
+            "the software rasterizer composites through the k-buffer: use it with opaque or oit transparency, not depth peeling".into(),
+        );
+    }
+    None
+}
+
+/// Sample counts `ctx`'s device supports for the renderer's colour and depth targets.
+pub fn supported_msaa(ctx: &crate::vk::Context) -> Vec<u32> {
+    (0..7)
+        .map(|b| 1u32 << b)
+        .filter(|c| ctx.info.attachment_sample_counts & c != 0)
+        .collect()
+}
+
+/// `samples` per pixel on `ctx`'s device, or why not (naming the device and what it offers);
+/// tools prefix the flag that set it.
+pub fn check_msaa(ctx: &crate::vk::Context, samples: u32) -> Result<(), String> {
+    let supported = supported_msaa(ctx);
+    if supported.contains(&samples) {
+        return Ok(());
+    }
+    let list: Vec<String> = supported.iter().map(|c| c.to_string()).collect();
+    Err(format!(
+        "{} supports {} samples per pixel for colour and depth",
+        ctx.info.name,
+        list.join(", ")
+    ))
+}
+
+pub(super) fn check_size(width: u32, height: u32) -> crate::vk::GpuResult<()> {
+    if width == 0 || height == 0 || width > 8192 || height > 8192 {
+        return Err(crate::vk::GpuError::Unsupported(format!(
+            "bad target size {width}x{height}: 1..=8192 per side"
+        )));
+    }
+    Ok(())
+}

@@ -24,8 +24,8 @@ pub struct RenderTargets {
     pub color_access: Access,
     /// Last use of the depth target.
     pub depth_access: Access,
-    /// Last use of the output image ([`RenderTargets::output`]).
-    pub output_access: Access,
+    /// Last use of the MSAA resolve image.
+    pub resolved_access: Access,
 }
 
 impl RenderTargets {
@@ -64,7 +64,7 @@ impl RenderTargets {
             },
             color_access: Access::Nothing,
             depth_access: Access::Nothing,
-            output_access: Access::Nothing,
+            resolved_access: Access::Nothing,
         })
     }
 
@@ -77,21 +77,13 @@ impl RenderTargets {
     pub fn output(&self) -> &Image {
         self.resolved.as_ref().unwrap_or(&self.color)
     }
-
-    /// Record a new use of the output image (also of the colour target when they are one).
-    pub fn set_output_access(&mut self, access: Access) {
-        self.output_access = access;
-        if self.resolved.is_none() {
-            self.color_access = access;
-        }
-    }
 }
 
 /// Format of the deep opacity layers (one layer per channel, summed with additive blending).
 pub const SHADOW_LAYERS_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
-/// The light's maps (square, shared by the frames in flight; each frame's barriers order its
-/// use after the previous frame's reads): hair depth, prop depth and deep opacity layers.
+/// The light's maps (square, shared by the frames in flight; the frame graph orders each
+/// frame's use after the previous frame's reads): hair depth, prop depth and deep opacity layers.
 pub struct ShadowMaps {
     /// Depth of the hair nearest the light.
     pub hair_depth: Image,

@@ -41,6 +41,20 @@ pub struct FrameBuffers<'a> {
     pub soft: &'a super::soft::SoftBuffers,
 }
 
+/// The working buffers as the frame graph imports them.
+pub struct WorkBuffers<'a> {
+    /// `GenerateArgs`.
+    pub args: &'a Buffer,
+    /// The vertex pool (or its placeholder).
+    pub pool: &'a Buffer,
+    /// Bundle LoDs.
+    pub lods: &'a Buffer,
+    /// Bundle offsets.
+    pub offsets: &'a Buffer,
+    /// Scan scratch.
+    pub scan: &'a Buffer,
+}
+
 /// The working buffers.
 pub struct Workspace {
     ctx: Arc<Context>,
@@ -141,6 +155,18 @@ impl Workspace {
             )?);
         }
         Ok(())
+    }
+
+    /// The buffers the frame graph imports (the placeholder stands in for a pool not yet
+    /// allocated).
+    pub fn buffers(&self) -> WorkBuffers<'_> {
+        WorkBuffers {
+            args: &self.args,
+            pool: self.pool.as_ref().unwrap_or(&self.placeholder),
+            lods: &self.lods,
+            offsets: &self.offsets,
+            scan: &self.scan,
+        }
     }
 
     /// Point every binding of a frame's set 0 at its buffer.

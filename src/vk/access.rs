@@ -11,10 +11,14 @@ pub enum Access {
     Nothing,
     /// Read as indirect dispatch/draw arguments.
     IndirectRead,
+    /// Storage/uniform read in compute shaders (written by an earlier use).
+    ComputeRead,
     /// Storage read/write in compute shaders.
     ComputeReadWrite,
     /// Storage read in vertex shaders.
     VertexRead,
+    /// Storage read in task shaders.
+    TaskRead,
     /// Storage read/write in task shaders.
     TaskReadWrite,
     /// Storage read in mesh shaders.
@@ -56,6 +60,18 @@ impl Access {
             Access::IndirectRead => (
                 S::DRAW_INDIRECT,
                 A::INDIRECT_COMMAND_READ,
+                L::UNDEFINED,
+                false,
+            ),
+            Access::ComputeRead => (
+                S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
+                L::GENERAL,
+                false,
+            ),
+            Access::TaskRead => (
+                S::TASK_SHADER_EXT,
+                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
                 L::UNDEFINED,
                 false,
             ),
@@ -140,6 +156,48 @@ impl Access {
             layout,
             writes,
         }
+    }
+}
+
+impl Access {
+    /// Every use, in declaration order (for tables and conservative first uses).
+    pub const ALL: [Access; 18] = [
+        Access::Nothing,
+        Access::IndirectRead,
+        Access::ComputeRead,
+        Access::ComputeReadWrite,
+        Access::VertexRead,
+        Access::TaskRead,
+        Access::TaskReadWrite,
+        Access::MeshRead,
+        Access::MeshReadWrite,
+        Access::FragmentRead,
+        Access::FragmentReadWrite,
+        Access::SampledRead,
+        Access::ColorAttachment,
+        Access::DepthAttachment,
+        Access::TransferRead,
+        Access::TransferWrite,
+        Access::HostRead,
+        Access::Present,
+    ];
+
+    /// Whether this use writes (so later uses must wait for it and see its writes).
+    pub fn writes(self) -> bool {
+        self.info().writes
+    }
+
+    /// The image layout this use needs (`UNDEFINED`: any, buffers only).
+    pub fn layout(self) -> vk::ImageLayout {
+        self.info().layout
+    }
+
+    /// Whether this use runs in a task or mesh shader.
+    pub fn is_mesh_stage(self) -> bool {
+        matches!(
+            self,
+            Access::TaskRead | Access::TaskReadWrite | Access::MeshRead | Access::MeshReadWrite
+        )
     }
 }
 

@@ -123,6 +123,29 @@ pub struct Attachment<'a> {
     pub resolve: Option<&'a Image>,
 }
 
+/// An image a barrier transitions.
+#[derive(Clone, Copy)]
+pub enum BarrierImage<'a> {
+    /// One of ours.
+    Image(&'a Image),
+    /// A swapchain image.
+    Swapchain(&'a SwapchainImage),
+}
+
+/// One image's dependency in a [`CommandRecorder::pipeline_barrier`].
+pub struct ImageBarrier<'a> {
+    /// The image.
+    pub image: BarrierImage<'a>,
+    /// The uses to wait for (their stages; their writes are made available).
+    pub prev: Vec<Access>,
+    /// The use whose layout the image is in now (ignored with `discard`).
+    pub from: Access,
+    /// The next use (its layout is the new one).
+    pub next: Access,
+    /// The old contents are not needed: transition from `UNDEFINED`.
+    pub discard: bool,
+}
+
 /// A rendering attachment for `a` in `layout`: stored, cleared to `a.clear` (depth from its
 /// first component) or loaded, resolved into `a.resolve` where given.
 fn attachment_info<'a>(a: &Attachment, layout: vk::ImageLayout) -> vk::RenderingAttachmentInfo<'a> {
@@ -362,55 +385,95 @@ impl CommandRecorder<'_> {
         }
     }
 
-    /// Global memory barrier between buffer uses `prev` and `next`.
+    /// A global memory dependency between buffer uses, for one-off submissions outside a
+    /// frame (uploads, readbacks of tests).
     pub fn barrier(&mut self, prev: &[Access], next: &[Access]) {
-        let (ss, sa, ds, da) = masks(prev, next);
-        let b = [vk::MemoryBarrier2::default()
-            .src_stage_mask(ss)
-            .src_access_mask(sa)
-            .dst_stage_mask(ds)
-            .dst_access_mask(da)];
-        let dep = vk::DependencyInfo::default().memory_barriers(&b);
-        // SAFETY: recording outside a rendering instance.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.raw, &dep) };
+        self.pipeline_barrier(Some((prev, next)), &[]);
     }
 
-    /// Image barrier with layout transition from use `prev` to use `next`.
+    /// An image dependency and layout transition from use `prev` to `next`, for one-off
+    /// submissions outside a frame (uploads, texture readbacks).
     pub fn image_barrier(&mut self, image: &Image, prev: Access, next: Access) {
-        let (ss, sa, ds, da) = masks(&[prev], &[next]);
-        let b = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(ss)
-            .src_access_mask(sa)
-            .dst_stage_mask(ds)
-            .dst_access_mask(da)
-            .old_layout(prev.info().layout)
-            .new_layout(next.info().layout)
-            .image(image.raw())
-            .subresource_range(image.full_range())];
-        let dep = vk::DependencyInfo::default().image_memory_barriers(&b);
-        // SAFETY: recording outside a rendering instance.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.raw, &dep) };
+        let b = ImageBarrier {
+            image: BarrierImage::Image(image),
+            prev: vec![prev],
+            from: prev,
+            next,
+            discard: false,
+        };
+        self.pipeline_barrier(None, &[b]);
     }
 
-    /// Layout transition of a swapchain image from use `prev` to use `next`.
-    pub fn swapchain_barrier(&mut self, image: &SwapchainImage, prev: Access, next: Access) {
-        let (ss, sa, ds, da) = masks(&[prev], &[next]);
-        let b = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(ss | vk::PipelineStageFlags2::TRANSFER)
-            .src_access_mask(sa)
-            .dst_stage_mask(ds | vk::PipelineStageFlags2::TRANSFER)
-            .dst_access_mask(da)
-            .old_layout(prev.info().layout)
-            .new_layout(next.info().layout)
-            .image(image.raw)
-            .subresource_range(
-                vk::ImageSubresourceRange::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .level_count(1)
-                    .layer_count(1),
-            )];
-        let dep = vk::DependencyInfo::default().image_memory_barriers(&b);
-        // SAFETY: recording outside a rendering instance.
+    /// One pipeline barrier: a global memory dependency from buffer uses `memory.0` to
+    /// `memory.1` (when given) and the image dependencies and layout transitions of `images`.
+    /// Task and mesh uses are dropped on devices without mesh shaders (they never ran there).
+    /// The frame graph derives these from declared uses; nothing else should need them.
+    pub fn pipeline_barrier(
+        &mut self,
+        memory: Option<(&[Access], &[Access])>,
+        images: &[ImageBarrier],
+    ) {
+        let mesh = self.ctx.info.mesh_shader;
+        let keep = |list: &[Access]| -> Vec<Access> {
+            list.iter()
+                .copied()
+                .filter(|a| mesh || !a.is_mesh_stage())
+                .collect()
+        };
+        let mut globals = Vec::new();
+        if let Some((prev, next)) = memory {
+            let (ss, sa, ds, da) = masks(&keep(prev), &keep(next));
+            globals.push(
+                vk::MemoryBarrier2::default()
+                    .src_stage_mask(ss)
+                    .src_access_mask(sa)
+                    .dst_stage_mask(ds)
+                    .dst_access_mask(da),
+            );
+        }
+        let transitions: Vec<vk::ImageMemoryBarrier2> = images
+            .iter()
+            .map(|b| {
+                let (ss, sa, ds, da) = masks(&keep(&b.prev), &[b.next]);
+                let (raw, range) = match b.image {
+                    BarrierImage::Image(i) => (i.raw(), i.full_range()),
+                    BarrierImage::Swapchain(s) => (
+                        s.raw,
+                        vk::ImageSubresourceRange::default()
+                            .aspect_mask(vk::ImageAspectFlags::COLOR)
+                            .level_count(1)
+                            .layer_count(1),
+                    ),
+                };
+                // Presentation and acquisition order through semaphores; the transfer stage
+                // keeps the masks valid for the swapchain's transitions.
+                let extra = match b.image {
+                    BarrierImage::Swapchain(_) => vk::PipelineStageFlags2::TRANSFER,
+                    BarrierImage::Image(_) => vk::PipelineStageFlags2::NONE,
+                };
+                let old = if b.discard {
+                    vk::ImageLayout::UNDEFINED
+                } else {
+                    b.from.layout()
+                };
+                vk::ImageMemoryBarrier2::default()
+                    .src_stage_mask(ss | extra)
+                    .src_access_mask(sa)
+                    .dst_stage_mask(ds | extra)
+                    .dst_access_mask(da)
+                    .old_layout(old)
+                    .new_layout(b.next.layout())
+                    .image(raw)
+                    .subresource_range(range)
+            })
+            .collect();
+        if globals.is_empty() && transitions.is_empty() {
+            return;
+        }
+        let dep = vk::DependencyInfo::default()
+            .memory_barriers(&globals)
+            .image_memory_barriers(&transitions);
+        // SAFETY: recording outside a rendering instance; the images are live.
         unsafe { self.ctx.device.cmd_pipeline_barrier2(self.raw, &dep) };
     }
 

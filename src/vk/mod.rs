@@ -17,7 +17,7 @@ pub mod ui;
 
 pub use access::Access;
 pub use buffer::{Buffer, BufferDesc};
-pub use command::{Attachment, CommandBuffer, CommandRecorder};
+pub use command::{Attachment, BarrierImage, CommandBuffer, CommandRecorder, ImageBarrier};
 pub use context::{Context, ContextDesc, DeviceInfo, MemoryReport, WindowHandles};
 pub use descriptor::{BindingDesc, DescriptorKind, DescriptorSet, DescriptorSetLayout};
 pub use image::{Image, ImageDesc, Sampler};

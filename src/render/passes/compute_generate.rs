@@ -1,17 +1,15 @@
 //! Compute path generation for the whole crowd: cull (one invocation per bundle), a
 //! multi-level exclusive scan over all bundles, finalize (totals, vertex-pool budget, indirect
 //! arguments), generate (strand workgroups into the vertex pool).
-//! Reads: frame block, character records, bundle table, root samples, textures.
-//! Writes: bundle LoDs, bundle offsets, scan scratch, `GenerateArgs`, the vertex pool.
+//! What each step reads and writes is declared where it is added to the frame graph.
 
 use std::sync::Arc;
 
-use super::{PassSets, dispatch_2d, shader_options};
+use super::{FrameRes, PassSets, dispatch_2d, shader_options};
+use crate::render::graph::FrameGraph;
 use crate::render::shared::{CULL_GROUP_SIZE, GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
 use crate::vk::shader::compile;
-use crate::vk::{
-    Access, Buffer, CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout, Profiler,
-};
+use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One level of the scan: `count` elements at `input` (level 0: the bundles), block sums at
 /// `sums` in the scratch buffer.
@@ -98,79 +96,101 @@ impl ComputeGenerate {
         })
     }
 
-    /// Record generation of every visible strand of the `bundles` bundles, seen from the view
-    /// of `sets`' frame block, into the vertex pool. `args` must have been cleared before
-    /// (statistics accumulate).
-    pub fn record(
-        &self,
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
-        sets: PassSets,
+    /// Add generation of every visible strand of the `bundles` bundles, seen from the view
+    /// of `sets`' frame block, into the vertex pool: cull, the scan levels, finalize and the
+    /// strand workgroups, each a pass. `args` must have been cleared before (statistics
+    /// accumulate).
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        sets: PassSets<'a>,
         bundles: u32,
-        args: &Buffer,
         view: GenerateView,
     ) {
         let scopes = view.scopes();
-        let rw = [Access::ComputeReadWrite];
-        // Earlier draws (this frame's light passes, earlier frames) read the pool and the
-        // offsets: finish them first.
-        rec.barrier(
-            &[
-                Access::VertexRead,
-                Access::IndirectRead,
-                Access::TransferWrite,
-            ],
-            &rw,
-        );
-        profiler.begin(rec, scopes[0]);
-        rec.bind(&self.cull, &sets.both());
-        let (x, y) = dispatch_2d(bundles.div_ceil(CULL_GROUP_SIZE));
-        rec.dispatch(x, y, 1);
-        profiler.end(rec);
-        rec.barrier(&rw, &rw);
-
-        profiler.begin(rec, scopes[1]);
+        let rw = Access::ComputeReadWrite;
+        let inputs = [r.constants, r.textures];
+        g.begin_scope(scopes[0]);
+        g.pass("cull")
+            .read_all(&inputs, Access::ComputeRead)
+            .write(r.lods, rw)
+            .write(r.args, rw)
+            .record(move |rec| {
+                rec.bind(&self.cull, &sets.both());
+                let (x, y) = dispatch_2d(bundles.div_ceil(CULL_GROUP_SIZE));
+                rec.dispatch(x, y, 1);
+                Ok(())
+            });
+        g.end_scope();
+        g.begin_scope(scopes[1]);
         let (levels, _) = scan_plan(bundles);
-        for (i, l) in levels.iter().enumerate() {
-            rec.bind(&self.scan, &sets.both());
-            rec.push_constants(&self.scan, &[l.count, l.input, l.sums, (i > 0) as u32]);
-            let (x, y) = dispatch_2d(l.count.div_ceil(SCAN_BLOCK));
-            rec.dispatch(x, y, 1);
-            rec.barrier(&rw, &rw);
+        for (i, l) in levels.iter().copied().enumerate() {
+            g.pass("scan")
+                .read(r.lods, Access::ComputeRead)
+                .write(r.offsets, rw)
+                .write(r.scan, rw)
+                .record(move |rec| {
+                    rec.bind(&self.scan, &sets.both());
+                    rec.push_constants(&self.scan, &[l.count, l.input, l.sums, (i > 0) as u32]);
+                    let (x, y) = dispatch_2d(l.count.div_ceil(SCAN_BLOCK));
+                    rec.dispatch(x, y, 1);
+                    Ok(())
+                });
         }
-        for (i, l) in levels.iter().enumerate().rev() {
+        for (i, l) in levels.iter().copied().enumerate().rev() {
             if l.count <= SCAN_BLOCK {
                 continue; // one block: its scanned block sum is 0
             }
-            rec.bind(&self.scan_add, &sets.both());
-            rec.push_constants(&self.scan_add, &[l.count, l.input, l.sums, (i > 0) as u32]);
-            let (x, y) = dispatch_2d(l.count.div_ceil(SCAN_THREADS));
-            rec.dispatch(x, y, 1);
-            rec.barrier(&rw, &rw);
+            g.pass("scan add")
+                .write(r.offsets, rw)
+                .write(r.scan, rw)
+                .record(move |rec| {
+                    rec.bind(&self.scan_add, &sets.both());
+                    rec.push_constants(&self.scan_add, &[l.count, l.input, l.sums, (i > 0) as u32]);
+                    let (x, y) = dispatch_2d(l.count.div_ceil(SCAN_THREADS));
+                    rec.dispatch(x, y, 1);
+                    Ok(())
+                });
         }
         let total = levels.last().map_or(0, |l| l.sums);
-        rec.bind(&self.finalize, &sets.both());
-        rec.push_constants(&self.finalize, &[total, 0u32, 0, 0]);
-        rec.dispatch(1, 1, 1);
-        profiler.end(rec);
-        rec.barrier(&rw, &[Access::ComputeReadWrite, Access::IndirectRead]);
-
-        profiler.begin(rec, scopes[2]);
+        g.pass("finalize")
+            .read(r.constants, Access::ComputeRead)
+            .read(r.offsets, Access::ComputeRead)
+            .read(r.scan, Access::ComputeRead)
+            .write(r.args, rw)
+            .record(move |rec| {
+                rec.bind(&self.finalize, &sets.both());
+                rec.push_constants(&self.finalize, &[total, 0u32, 0, 0]);
+                rec.dispatch(1, 1, 1);
+                Ok(())
+            });
+        g.end_scope();
+        g.begin_scope(scopes[2]);
         let generate = match view {
             GenerateView::Camera => &self.generate_camera,
             GenerateView::Light => &self.generate_light,
         };
-        rec.bind(generate, &sets.both());
-        rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);
-        profiler.end(rec);
-        rec.barrier(
-            &rw,
-            &[
-                Access::VertexRead,
-                Access::IndirectRead,
-                Access::TransferRead,
-            ],
-        );
+        let args = r.args_buffer;
+        let mut p = g
+            .pass("generate")
+            .read_all(&inputs, Access::ComputeRead)
+            .read_all(&[r.lods, r.offsets], Access::ComputeRead)
+            .read(r.args, Access::IndirectRead)
+            .write(r.args, rw)
+            .discard(r.pool, rw);
+        if view == GenerateView::Camera {
+            // Software bundles are shaded here (shadow lookups included).
+            p = p
+                .write(r.soft_segments, rw)
+                .read_all(&r.shadow, Access::SampledRead);
+        }
+        p.record(move |rec| {
+            rec.bind(generate, &sets.both());
+            rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);
+            Ok(())
+        });
+        g.end_scope();
     }
 }
 

@@ -5,11 +5,11 @@
 
 use std::sync::Arc;
 
-use super::dispatch_2d;
+use super::{FrameRes, dispatch_2d};
+use crate::render::graph::{FrameGraph, ImageState, Res};
 use crate::render::shared::DeformBinding;
 use crate::vk::{
-    Access, Buffer, CommandRecorder, Context, DescriptorSet, DescriptorSetLayout, GpuResult, Image,
-    Pipeline, Profiler,
+    Access, Buffer, Context, DescriptorSet, DescriptorSetLayout, GpuResult, Image, Pipeline,
 };
 
 /// One character's update this frame.
@@ -50,27 +50,69 @@ impl HairMeshUpdate {
         &self.set_layout
     }
 
-    /// Record the updates (outside rendering).
-    pub fn record(&self, rec: &mut CommandRecorder, profiler: &mut Profiler, jobs: &[UpdateJob]) {
+    /// Add the updates: the rebuild of every job's packed texels, their copies into the
+    /// textures, and the hand-back of the textures to sampling.
+    pub fn add<'a>(&'a self, g: &mut FrameGraph<'a>, r: &FrameRes, jobs: &'a [UpdateJob<'a>]) {
         if jobs.is_empty() {
             return;
         }
-        profiler.begin(rec, "hair mesh update");
-        // The output buffers were last read by the previous update's copies.
-        rec.barrier(&[Access::TransferRead], &[Access::ComputeReadWrite]);
-        for job in jobs {
-            rec.bind(&self.pipeline, &[job.set]);
-            let (x, y) = dispatch_2d(job.groups);
-            rec.dispatch(x, y, 1);
+        let outputs: Vec<Vec<Res>> = jobs
+            .iter()
+            .map(|j| {
+                j.outputs
+                    .iter()
+                    .map(|b| g.import_buffer("update texels", b))
+                    .collect()
+            })
+            .collect();
+        let images: Vec<Vec<Res>> = jobs
+            .iter()
+            .map(|j| {
+                j.images
+                    .iter()
+                    .map(|i| {
+                        g.import_image(
+                            "character texture",
+                            i,
+                            ImageState::Fixed(Access::SampledRead),
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        g.begin_scope("hair mesh update");
+        let mut p = g
+            .pass("hair mesh update")
+            .read(r.constants, Access::ComputeRead);
+        for o in outputs.iter().flatten() {
+            p = p.discard(*o, Access::ComputeReadWrite);
         }
-        rec.barrier(&[Access::ComputeReadWrite], &[Access::TransferRead]);
-        for job in jobs {
-            for (buffer, image) in job.outputs.iter().zip(job.images) {
-                rec.image_barrier(image, Access::SampledRead, Access::TransferWrite);
-                rec.copy_buffer_to_image(buffer, image);
-                rec.image_barrier(image, Access::TransferWrite, Access::SampledRead);
+        p.record(move |rec| {
+            for job in jobs {
+                rec.bind(&self.pipeline, &[job.set]);
+                let (x, y) = dispatch_2d(job.groups);
+                rec.dispatch(x, y, 1);
             }
+            Ok(())
+        });
+        let mut p = g.pass("texture upload");
+        for (o, i) in outputs.iter().flatten().zip(images.iter().flatten()) {
+            p = p
+                .read(*o, Access::TransferRead)
+                .discard(*i, Access::TransferWrite);
         }
-        profiler.end(rec);
+        p.record(move |rec| {
+            for job in jobs {
+                for (buffer, image) in job.outputs.iter().zip(job.images) {
+                    rec.copy_buffer_to_image(buffer, image);
+                }
+            }
+            Ok(())
+        });
+        let all: Vec<Res> = images.into_iter().flatten().collect();
+        g.pass("textures sampled")
+            .read_all(&all, Access::SampledRead)
+            .done();
+        g.end_scope();
     }
 }

@@ -7,13 +7,14 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::dispatch_2d;
+use super::{FrameRes, dispatch_2d};
 use crate::reference::lhs::LhsModel;
 use crate::render::frame::FRAMES_IN_FLIGHT;
+use crate::render::graph::FrameGraph;
 use crate::render::shared::{HairVertex, LhsBinding, LhsWeights};
 use crate::vk::{
-    Access, Buffer, BufferDesc, CommandRecorder, Context, DescriptorSet, DescriptorSetLayout,
-    GpuError, GpuResult, Pipeline, Profiler,
+    Access, Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult,
+    Pipeline,
 };
 
 /// Invocations of one skinning workgroup.
@@ -135,36 +136,35 @@ impl LhsSkin {
         })
     }
 
-    /// Skin into the pool for frame slot `slot` (outside rendering; before the strands are
-    /// drawn).
-    pub fn record(
-        &self,
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
-        state: &mut LhsState,
+    /// Add the skinning into the pool for frame slot `slot` (before the strands are drawn);
+    /// the guides' deltas set since the last frame are written for that slot first.
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes,
+        state: &'a mut LhsState,
         slot: usize,
     ) -> GpuResult<()> {
         if let Some(d) = state.pending.take() {
             state.deltas[slot].0.write(0, bytemuck::cast_slice(&d))?;
         }
+        let state = &*state;
         let m = &state.model;
         let strands = m.weights.len() as u32;
         let verts = m.verts_per_strand as u32;
-        profiler.begin(rec, "lhs skin");
-        // The previous frame drew (and shadowed) the pool.
-        rec.barrier(
-            &[Access::VertexRead, Access::TransferRead],
-            &[Access::ComputeReadWrite],
-        );
-        rec.bind(&self.pipeline, &[&state.deltas[slot].1]);
-        rec.push_constants(
-            &self.pipeline,
-            &[strands, verts, m.guides.len() as u32, 0u32],
-        );
-        let (x, y) = dispatch_2d((strands * verts).div_ceil(GROUP));
-        rec.dispatch(x, y, 1);
-        rec.barrier(&[Access::ComputeReadWrite], &[Access::VertexRead]);
-        profiler.end(rec);
+        let guides = m.guides.len() as u32;
+        g.begin_scope("lhs skin");
+        g.pass("lhs skin")
+            .read(r.constants, Access::ComputeRead)
+            .write(r.pool, Access::ComputeReadWrite)
+            .record(move |rec| {
+                rec.bind(&self.pipeline, &[&state.deltas[slot].1]);
+                rec.push_constants(&self.pipeline, &[strands, verts, guides, 0u32]);
+                let (x, y) = dispatch_2d((strands * verts).div_ceil(GROUP));
+                rec.dispatch(x, y, 1);
+                Ok(())
+            });
+        g.end_scope();
         Ok(())
     }
 }

@@ -1,9 +1,10 @@
-//! One file per pass. Each pass owns its pipelines and records itself with `record`, naming
-//! what it reads and writes.
+//! One file per pass. Each pass owns its pipelines and adds itself to the frame graph with
+//! `add`, declaring what it reads and writes; the graph derives the barriers.
 
 pub mod compute_generate;
 pub mod hair_mesh_update;
 pub mod lhs_skin;
+pub mod output;
 pub mod props;
 pub mod scalp;
 pub mod shadow;
@@ -14,11 +15,15 @@ pub mod transparency;
 use std::sync::Arc;
 
 use super::RenderPath;
+use super::graph::{FrameGraph, Res};
 use super::shared::GenerateArgs;
-use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets};
+use super::soft::SoftBuffers;
+use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets, ShadowMaps};
+use super::transparency::TransparencyBuffers;
+use super::workspace::Workspace;
 use crate::vk::{
-    Access, Attachment, Buffer, CommandRecorder, Context, DescriptorSet, GpuResult,
-    MeshPrimitivesQuery, PipelineLayout, Profiler,
+    Access, Attachment, Buffer, Context, DescriptorSet, GpuResult, Image, MeshPrimitivesQuery,
+    PipelineLayout,
     shader::{ShaderOptions, compile},
 };
 use compute_generate::{ComputeGenerate, GenerateView};
@@ -173,51 +178,223 @@ pub fn dispatch_2d(groups: u32) -> (u32, u32) {
     (groups.min(row), groups.div_ceil(row))
 }
 
-/// What one frame's passes read and write.
+/// The frame's resources in the graph, and the objects the passes' commands name.
+pub struct FrameRes<'a> {
+    /// Host-written inputs: frame block, character records, bundle table, props.
+    pub constants: Res,
+    /// The characters' textures and the shading table (sampled).
+    pub textures: Res,
+    /// `GenerateArgs`: indirect arguments and statistics.
+    pub args: Res,
+    /// The compute path's vertex pool (a placeholder before its first use).
+    pub pool: Res,
+    /// Per-bundle LoD records.
+    pub lods: Res,
+    /// Per-bundle prefix sums.
+    pub offsets: Res,
+    /// Scan block sums.
+    pub scan: Res,
+    /// Colour target.
+    pub color: Res,
+    /// Depth target.
+    pub depth: Res,
+    /// The MSAA resolve of the colour target.
+    pub resolved: Option<Res>,
+    /// The single-sample image of the frame (`resolved` or `color`).
+    pub output: Res,
+    /// Shadow maps: hair depth, prop depth, opacity layers.
+    pub shadow: [Res; 3],
+    /// K-buffer nodes.
+    pub oit_nodes: Res,
+    /// K-buffer tails.
+    pub oit_tail: Res,
+    /// Depth peeling: previous layer and opaque depth.
+    pub peel_depth: Res,
+    /// Depth peeling: accumulated colour.
+    pub peel_accum: Res,
+    /// Depth peeling: the layers' depth attachment.
+    pub peel_image: Option<Res>,
+    /// Software rasterizer: segments.
+    pub soft_segments: Res,
+    /// Software rasterizer: tile table.
+    pub soft_tiles: Res,
+    /// Software rasterizer: tile entries.
+    pub soft_entries: Res,
+    /// Software rasterizer: the opaque depth copy.
+    pub soft_depth: Res,
+    /// The `args` buffer (indirect commands name it).
+    pub args_buffer: &'a Buffer,
+    /// The transparent modes' buffers (fills and copies name them).
+    pub transparency: TransparencyRefs<'a>,
+    /// The software rasterizer's buffers.
+    pub soft: &'a SoftBuffers,
+    /// The images attachments and copies name.
+    pub images: FrameImages<'a>,
+}
+
+/// The transparent modes' buffers that passes' commands name.
+#[derive(Clone, Copy)]
+pub struct TransparencyRefs<'a> {
+    /// K-buffer nodes.
+    pub nodes: &'a Buffer,
+    /// K-buffer tails.
+    pub tail: &'a Buffer,
+    /// Depth peeling: previous layer and opaque depth.
+    pub peel_depth: &'a Buffer,
+    /// Depth peeling: accumulated colour.
+    pub peel_accum: &'a Buffer,
+}
+
+/// The images of a frame that passes' commands name.
+#[derive(Clone, Copy)]
+pub struct FrameImages<'a> {
+    /// Colour target.
+    pub color: &'a Image,
+    /// Depth target.
+    pub depth: &'a Image,
+    /// MSAA resolve.
+    pub resolved: Option<&'a Image>,
+    /// The single-sample output.
+    pub output: &'a Image,
+    /// Shadow maps: hair depth, prop depth, opacity layers.
+    pub shadow: [&'a Image; 3],
+    /// Depth peeling's layer depth.
+    pub peel: Option<&'a Image>,
+}
+
+/// What a frame imports into its graph.
+pub struct FrameSources<'a> {
+    /// Working buffers (args, pool, LoDs, offsets, scan).
+    pub work: &'a Workspace,
+    /// Colour and depth targets (their last uses are tracked).
+    pub targets: &'a mut RenderTargets,
+    /// Shadow maps.
+    pub shadow: &'a mut ShadowMaps,
+    /// Transparency buffers.
+    pub transparency: &'a mut TransparencyBuffers,
+    /// Software rasterizer buffers.
+    pub soft: &'a SoftBuffers,
+}
+
+impl<'a> FrameRes<'a> {
+    /// Import every resource of the frame into `g`.
+    pub fn import(g: &mut FrameGraph<'a>, src: FrameSources<'a>) -> Self {
+        use crate::render::graph::ImageState::Tracked;
+        let w = src.work.buffers();
+        let RenderTargets {
+            color,
+            depth,
+            resolved,
+            color_access,
+            depth_access,
+            resolved_access,
+        } = src.targets;
+        let ShadowMaps {
+            hair_depth,
+            prop_depth,
+            layers,
+            access,
+            ..
+        } = src.shadow;
+        let [a0, a1, a2] = access;
+        let TransparencyBuffers {
+            nodes,
+            tail,
+            peel_depth,
+            peel_accum,
+            peel_image,
+            peel_access,
+            ..
+        } = src.transparency;
+        let (nodes, tail, peel_depth, peel_accum) = (&*nodes, &*tail, &*peel_depth, &*peel_accum);
+        let color_res = g.import_image("color", color, Tracked(color_access));
+        let resolved_res = resolved
+            .as_ref()
+            .map(|r| g.import_image("color resolved", r, Tracked(resolved_access)));
+        let (color, resolved) = (&*color, resolved.as_ref());
+        let soft = src.soft;
+        FrameRes {
+            constants: g.host_input("frame constants"),
+            textures: g.host_input("textures"),
+            args: g.import_buffer("args", w.args),
+            pool: g.import_buffer("vertex pool", w.pool),
+            lods: g.import_buffer("bundle lods", w.lods),
+            offsets: g.import_buffer("bundle offsets", w.offsets),
+            scan: g.import_buffer("scan scratch", w.scan),
+            color: color_res,
+            depth: g.import_image("depth", depth, Tracked(depth_access)),
+            resolved: resolved_res,
+            output: resolved_res.unwrap_or(color_res),
+            shadow: [
+                g.import_image("shadow hair depth", hair_depth, Tracked(a0)),
+                g.import_image("shadow prop depth", prop_depth, Tracked(a1)),
+                g.import_image("shadow layers", layers, Tracked(a2)),
+            ],
+            oit_nodes: g.import_buffer("oit nodes", &*nodes),
+            oit_tail: g.import_buffer("oit tail", &*tail),
+            peel_depth: g.import_buffer("peel depth", &*peel_depth),
+            peel_accum: g.import_buffer("peel accumulation", &*peel_accum),
+            peel_image: peel_image
+                .as_ref()
+                .map(|i| g.import_image("peel layer depth", i, Tracked(peel_access))),
+            soft_segments: g.import_buffer("soft segments", &soft.segments),
+            soft_tiles: g.import_buffer("soft tiles", &soft.tiles),
+            soft_entries: g.import_buffer("soft entries", &soft.entries),
+            soft_depth: g.import_buffer("soft depth", &soft.depth),
+            args_buffer: w.args,
+            transparency: TransparencyRefs {
+                nodes,
+                tail,
+                peel_depth,
+                peel_accum,
+            },
+            soft,
+            images: FrameImages {
+                color,
+                depth: &*depth,
+                resolved,
+                output: resolved.unwrap_or(color),
+                shadow: [&*hair_depth, &*prop_depth, &*layers],
+                peel: peel_image.as_ref(),
+            },
+        }
+    }
+}
+
+/// What one frame's passes draw.
 pub struct FrameInputs<'a> {
-    /// Descriptor sets.
+    /// Camera descriptor sets.
     pub sets: PassSets<'a>,
+    /// The light's sets (its frame block), for the shadow passes.
+    pub light_sets: PassSets<'a>,
     /// Bundles of all characters.
     pub bundles: u32,
     /// Generation path.
     pub path: RenderPath,
-    /// `GenerateArgs` (cleared here, then written by generation).
-    pub args: &'a Buffer,
-    /// Colour and depth targets.
-    pub targets: &'a mut RenderTargets,
     /// Clear colour, or `None` to draw over the previous contents.
     pub clear: Option<[f32; 4]>,
     /// Props to draw (bodies, ground).
     pub props: &'a [PropDraw],
-    /// The light's passes.
-    pub shadow: ShadowInputs<'a>,
+    /// Shadow mode of this frame; `None` when off (or nothing to shadow).
+    pub shadow: Option<super::shadow::ShadowMode>,
     /// How the strands are composited.
     pub transparency: super::Transparency,
-    /// The transparent modes' per-pixel buffers (sized for this frame's mode).
-    pub transparency_buffers: &'a mut super::transparency::TransparencyBuffers,
     /// How strands are rasterized.
     pub raster: super::soft::StrandRaster,
-    /// The software rasterizer's buffers (sized for this frame when it is used).
-    pub soft_buffers: &'a super::soft::SoftBuffers,
     /// k-buffer nodes per pixel of this frame (the OIT budget, or the software
     /// rasterizer's K in opaque frames).
     pub kbuffer_budget: u32,
+    /// Target size.
+    pub size: (u32, u32),
+    /// The mesh path's primitive query (wraps the strand draw).
+    pub mesh_query: Option<&'a mut MeshPrimitivesQuery>,
 }
 
-/// What the light's passes need.
-pub struct ShadowInputs<'a> {
-    /// Shadow mode of this frame; `None` when off (or nothing to shadow).
-    pub mode: Option<super::shadow::ShadowMode>,
-    /// Set 0 with the light's frame block, and the texture set.
-    pub light_sets: PassSets<'a>,
-    /// The maps.
-    pub maps: &'a mut super::targets::ShadowMaps,
-}
-
-/// The passes of a frame, in order: statistics reset; with shadows, the light's generation
-/// (compute path) and passes, then a second reset; generation (compute path); the opaque pass
-/// (props, scalps, and opaque strands; the mesh path generates inside it); with transparency,
-/// the transparent strand passes and their resolve.
+/// The pipelines of every pass of a frame; [`FramePasses::add`] adds them to the frame graph
+/// in order: statistics reset; with shadows, the light's generation (compute path) and passes,
+/// then a second reset; generation (compute path); the opaque pass (props, scalps, and opaque
+/// strands; the mesh path generates inside it); with transparency, the transparent strand
+/// passes; the software rasterizer; the resolve.
 pub struct FramePasses {
     generate: ComputeGenerate,
     shadow: ShadowPass,
@@ -228,26 +405,22 @@ pub struct FramePasses {
     /// The software rasterizer, on devices with 64-bit shared and buffer atomics.
     soft: Option<soft_raster::SoftRasterPass>,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
-    /// The LHS baseline's skinning pass.
-    pub lhs_skin: lhs_skin::LhsSkin,
+    lhs_skin: lhs_skin::LhsSkin,
 }
 
-/// Zero `args` (indirect arguments and statistics) after earlier generation used it.
-pub(crate) fn clear_args(rec: &mut CommandRecorder, args: &Buffer) {
-    rec.barrier(
-        &[
-            Access::ComputeReadWrite,
-            Access::TaskReadWrite,
-            Access::IndirectRead,
-            Access::TransferRead,
-        ],
-        &[Access::TransferWrite],
-    );
-    rec.fill_buffer(args, 0, size_of::<GenerateArgs>() as u64, 0);
-    rec.barrier(
-        &[Access::TransferWrite],
-        &[Access::ComputeReadWrite, Access::TaskReadWrite],
-    );
+/// Add the pass that zeroes `args` (indirect arguments and statistics).
+pub(crate) fn add_clear_args<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
+    let args = r.args_buffer;
+    g.pass("clear args")
+        .discard(r.args, Access::TransferWrite)
+        .record(move |rec| {
+            rec.fill_buffer(args, 0, size_of::<GenerateArgs>() as u64, 0);
+            Ok(())
+        });
+}
+
+fn no_soft() -> crate::vk::GpuError {
+    crate::vk::GpuError::Unsupported("no software rasterizer on this device".into())
 }
 
 impl FramePasses {
@@ -286,14 +459,30 @@ impl FramePasses {
         self.hair_mesh_update.set_layout()
     }
 
-    /// Record this frame's hair mesh texture rebuilds (before [`Self::record`]).
-    pub fn record_updates(
-        &self,
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
-        jobs: &[hair_mesh_update::UpdateJob],
+    /// The LHS baseline's skinning pass.
+    pub fn lhs_skin(&self) -> &lhs_skin::LhsSkin {
+        &self.lhs_skin
+    }
+
+    /// Add this frame's hair mesh texture rebuilds (before [`Self::add`]).
+    pub fn add_updates<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes,
+        jobs: &'a [hair_mesh_update::UpdateJob<'a>],
     ) {
-        self.hair_mesh_update.record(rec, profiler, jobs);
+        self.hair_mesh_update.add(g, r, jobs);
+    }
+
+    /// Add the LHS baseline's skinning for frame slot `slot` (before [`Self::add`]).
+    pub fn add_lhs_skin<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes,
+        state: &'a mut lhs_skin::LhsState,
+        slot: usize,
+    ) -> GpuResult<()> {
+        self.lhs_skin.add(g, r, state, slot)
     }
 
     /// Check and compile what `mode` needs, before a frame uses it.
@@ -311,220 +500,196 @@ impl FramePasses {
         self.soft.is_some()
     }
 
-    /// The software rasterizer alone over `targets` (cleared to black first): `segments`
-    /// segments already in the soft buffers, nothing in front (the soft depth is filled with
-    /// 1), composited through a k-buffer of `budget` nodes (`Renderer::rasterize_segments`).
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_soft_only(
-        &self,
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
-        sets: PassSets,
-        args: &Buffer,
-        soft_buffers: &super::soft::SoftBuffers,
-        transparency_buffers: &super::transparency::TransparencyBuffers,
-        targets: &mut RenderTargets,
+    /// The software rasterizer alone over the targets (cleared to black first): `segments`
+    /// segments already uploaded to the soft buffers, nothing in front (the soft depth is
+    /// filled with 1), composited through a k-buffer of `budget` nodes
+    /// (`debug::rasterize_segments`).
+    pub fn add_soft_only<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        sets: PassSets<'a>,
         (segments, budget): (u32, u32),
     ) -> GpuResult<()> {
-        let pass = self.soft.as_ref().ok_or_else(|| {
-            crate::vk::GpuError::Unsupported("no software rasterizer on this device".into())
-        })?;
-        let (w, h) = targets.size();
-        clear_args(rec, args);
-        rec.barrier(&[Access::ComputeReadWrite], &[Access::TransferWrite]);
-        let offset = GenerateArgs::SEGMENTS_DEMANDED_OFFSET;
-        rec.fill_buffer(args, offset, 4, segments);
-        rec.fill_buffer(
-            &soft_buffers.depth,
-            0,
-            w as u64 * h as u64 * 4,
-            1.0f32.to_bits(),
-        );
-        rec.image_barrier(&targets.color, Access::Nothing, Access::ColorAttachment);
-        rec.image_barrier(&targets.depth, Access::Nothing, Access::DepthAttachment);
-        rec.begin_rendering(
-            Attachment {
-                image: &targets.color,
-                clear: Some([0.0, 0.0, 0.0, 1.0]),
-                resolve: None,
-            },
-            Attachment {
-                image: &targets.depth,
-                clear: Some([1.0; 4]),
-                resolve: None,
-            },
-        );
-        rec.end_rendering();
-        targets.color_access = Access::ColorAttachment;
-        targets.depth_access = Access::DepthAttachment;
-        TransparencyPass::clear_kbuffer(rec, transparency_buffers, budget, w as u64 * h as u64);
-        let draw = soft_raster::SoftDraw {
-            sets,
-            args,
-            buffers: soft_buffers,
-            targets: None,
-            size: (w, h),
-        };
-        pass.record(rec, profiler, draw);
-        self.transparency
-            .record_resolve(rec, profiler, false, sets, targets)?;
-        targets.set_output_access(Access::ColorAttachment);
-        Ok(())
+        let pass = self.soft.as_ref().ok_or_else(no_soft)?;
+        let (w, h) = (r.images.color.desc.extent[0], r.images.color.desc.extent[1]);
+        add_clear_args(g, r);
+        let (args, soft) = (r.args_buffer, r.soft);
+        g.pass("soft inputs")
+            .write(r.args, Access::TransferWrite)
+            .discard(r.soft_depth, Access::TransferWrite)
+            .record(move |rec| {
+                rec.fill_buffer(args, GenerateArgs::SEGMENTS_DEMANDED_OFFSET, 4, segments);
+                let pixels = w as u64 * h as u64;
+                rec.fill_buffer(&soft.depth, 0, pixels * 4, 1.0f32.to_bits());
+                Ok(())
+            });
+        let (color, depth) = (r.images.color, r.images.depth);
+        g.pass("clear targets")
+            .discard(r.color, Access::ColorAttachment)
+            .discard(r.depth, Access::DepthAttachment)
+            .record(move |rec| {
+                rec.begin_rendering(
+                    Attachment {
+                        image: color,
+                        clear: Some([0.0, 0.0, 0.0, 1.0]),
+                        resolve: None,
+                    },
+                    Attachment {
+                        image: depth,
+                        clear: Some([1.0; 4]),
+                        resolve: None,
+                    },
+                );
+                rec.end_rendering();
+                Ok(())
+            });
+        TransparencyPass::add_kbuffer_clear(g, r, budget, w as u64 * h as u64);
+        pass.add(g, r, sets, (w, h), false);
+        self.transparency.add_resolve(g, r, false, sets)
     }
 
-    /// Record the frame's passes. Leaves the targets as colour / depth attachments and
-    /// `args` written by the last generating stage.
-    pub fn record(
-        &self,
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
-        mesh_query: Option<&mut MeshPrimitivesQuery>,
-        inp: FrameInputs,
+    /// Add the frame's passes to `g`.
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        mut inp: FrameInputs<'a>,
     ) -> GpuResult<()> {
         // Statistics accumulate from zero every frame; the static path keeps the last compute
         // frame's draw arguments (and statistics).
         let keep_args = matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
         if !keep_args {
-            clear_args(rec, inp.args);
+            add_clear_args(g, r);
         }
         let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
-        let shadow = inp.shadow;
-        match shadow.mode {
-            Some(mode) => {
-                if compute {
-                    let sets = shadow.light_sets;
-                    self.generate.record(
-                        rec,
-                        profiler,
-                        sets,
-                        inp.bundles,
-                        inp.args,
-                        GenerateView::Light,
-                    );
-                }
-                let draw = ShadowDraw {
-                    mode,
-                    sets: shadow.light_sets,
-                    bundles: inp.bundles,
-                    path: inp.path,
-                    args: inp.args,
-                    props: inp.props,
-                };
-                self.shadow.record(rec, profiler, shadow.maps, draw)?;
-                // The camera's statistics start from zero again.
-                if !keep_args {
-                    clear_args(rec, inp.args);
-                }
+        if let Some(mode) = inp.shadow {
+            if compute {
+                let view = GenerateView::Light;
+                self.generate.add(g, r, inp.light_sets, inp.bundles, view);
             }
-            None => ShadowPass::keep_readable(rec, shadow.maps),
+            let draw = ShadowDraw {
+                mode,
+                sets: inp.light_sets,
+                bundles: inp.bundles,
+                path: inp.path,
+                props: inp.props,
+            };
+            self.shadow.add(g, r, draw);
+            // The camera's statistics start from zero again.
+            if !keep_args {
+                add_clear_args(g, r);
+            }
         }
         if compute {
-            self.generate.record(
-                rec,
-                profiler,
-                inp.sets,
-                inp.bundles,
-                inp.args,
-                GenerateView::Camera,
-            );
+            let view = GenerateView::Camera;
+            self.generate.add(g, r, inp.sets, inp.bundles, view);
         }
-        let targets = inp.targets;
-        let (color_from, depth_from) = match inp.clear {
-            Some(_) => (Access::Nothing, Access::Nothing),
-            None => (targets.color_access, targets.depth_access),
-        };
-        rec.image_barrier(&targets.color, color_from, Access::ColorAttachment);
-        rec.image_barrier(&targets.depth, depth_from, Access::DepthAttachment);
-        if let Some(r) = &targets.resolved {
-            // The resolve overwrites every pixel: earlier contents are not needed.
-            rec.image_barrier(r, Access::Nothing, Access::ColorAttachment);
-        }
-        let mesh = inp.path == RenderPath::Mesh;
         let transparent = inp.bundles > 0 && inp.transparency != super::Transparency::Opaque;
         let soft = inp.bundles > 0 && inp.raster.uses_software();
-        profiler.begin(rec, if mesh { "mesh draw" } else { "draw" });
-        rec.begin_rendering(
-            Attachment {
-                image: &targets.color,
-                clear: inp.clear,
-                // With transparency or software strands the resolve pass ends the frame's
-                // colour.
-                resolve: targets.resolved.as_ref().filter(|_| !transparent && !soft),
-            },
-            Attachment {
-                image: &targets.depth,
-                clear: inp.clear.map(|_| [1.0; 4]),
-                resolve: None,
-            },
-        );
-        let mut result = Ok(());
-        self.props.record(rec, inp.sets, inp.props);
-        let mut query = mesh_query;
-        if inp.bundles > 0 {
-            self.scalp.record(rec, inp.sets, inp.bundles);
-            if transparent {
-                // Drawn by the transparent passes below.
-            } else if mesh {
-                if let Some(q) = query.as_deref_mut() {
-                    q.begin(rec);
-                }
-                result = self.strands.record_mesh(rec, inp.sets, inp.bundles);
-                if let Some(q) = query.as_deref_mut() {
-                    q.end(rec);
-                }
-            } else {
-                self.strands.record_pulled(rec, inp.sets, inp.args);
-            }
-        }
-        rec.end_rendering();
-        profiler.end(rec);
-        targets.color_access = Access::ColorAttachment;
-        targets.depth_access = Access::DepthAttachment;
-        result?;
+        let query = inp.mesh_query.take();
+        let query = self.add_opaque(g, r, &inp, !transparent && !soft, query);
         if transparent {
             let draw = TransparentDraw {
                 mode: inp.transparency,
                 sets: inp.sets,
                 bundles: inp.bundles,
                 path: inp.path,
-                args: inp.args,
-                targets: &mut *targets,
-                buffers: inp.transparency_buffers,
+                size: inp.size,
                 mesh_query: query,
             };
-            self.transparency.record_layers(rec, profiler, draw)?;
+            self.transparency.add_layers(g, r, draw)?;
         } else if soft {
-            let (w, h) = targets.size();
-            TransparencyPass::clear_kbuffer(
-                rec,
-                inp.transparency_buffers,
-                inp.kbuffer_budget,
-                w as u64 * h as u64,
-            );
+            let pixels = inp.size.0 as u64 * inp.size.1 as u64;
+            TransparencyPass::add_kbuffer_clear(g, r, inp.kbuffer_budget, pixels);
         }
         if soft {
-            let pass = self.soft.as_ref().ok_or_else(|| {
-                crate::vk::GpuError::Unsupported("no software rasterizer on this device".into())
-            })?;
-            let size = targets.size();
-            if mesh {
-                pass.record_mesh_segments(rec, profiler, inp.sets, inp.bundles, size)?;
+            let pass = self.soft.as_ref().ok_or_else(no_soft)?;
+            if inp.path == RenderPath::Mesh {
+                pass.add_mesh_segments(g, r, inp.sets, inp.bundles, inp.size);
             }
-            let draw = soft_raster::SoftDraw {
-                sets: inp.sets,
-                args: inp.args,
-                buffers: inp.soft_buffers,
-                targets: Some(&mut *targets),
-                size,
-            };
-            pass.record(rec, profiler, draw);
+            pass.add(g, r, inp.sets, inp.size, true);
         }
         if transparent || soft {
             let peel = matches!(inp.transparency, super::Transparency::DepthPeeling { .. });
-            self.transparency
-                .record_resolve(rec, profiler, peel, inp.sets, targets)?;
+            self.transparency.add_resolve(g, r, peel, inp.sets)?;
         }
-        targets.set_output_access(Access::ColorAttachment);
         Ok(())
+    }
+
+    /// The opaque pass: props, scalps and (unless drawn later) the strands; `resolve`: the
+    /// colour's MSAA resolve ends here. Returns the mesh query when this pass did not use it.
+    fn add_opaque<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        inp: &FrameInputs<'a>,
+        resolve: bool,
+        query: Option<&'a mut MeshPrimitivesQuery>,
+    ) -> Option<&'a mut MeshPrimitivesQuery> {
+        let clear = inp.clear;
+        let mesh = inp.path == RenderPath::Mesh;
+        g.begin_scope(if mesh { "mesh draw" } else { "draw" });
+        let mut p = g.pass("opaque");
+        p = match clear {
+            Some(_) => p
+                .discard(r.color, Access::ColorAttachment)
+                .discard(r.depth, Access::DepthAttachment),
+            None => p
+                .write(r.color, Access::ColorAttachment)
+                .write(r.depth, Access::DepthAttachment),
+        };
+        let resolve_into = r.images.resolved.filter(|_| resolve);
+        if let (Some(res), true) = (r.resolved, resolve) {
+            p = p.discard(res, Access::ColorAttachment);
+        }
+        p = p
+            .read(r.constants, Access::VertexRead)
+            .read(r.textures, Access::VertexRead)
+            .read_all(&r.shadow, Access::SampledRead);
+        let strands = inp.bundles > 0 && resolve;
+        if strands {
+            p = strands::strand_uses(p, r, inp.path, true);
+        }
+        let (mut query, rest) = match strands && mesh {
+            true => (query, None),
+            false => (None, query),
+        };
+        let (sets, bundles, props, args) = (inp.sets, inp.bundles, inp.props, r.args_buffer);
+        let (color, depth) = (r.images.color, r.images.depth);
+        p.record(move |rec| {
+            rec.begin_rendering(
+                Attachment {
+                    image: color,
+                    clear,
+                    resolve: resolve_into,
+                },
+                Attachment {
+                    image: depth,
+                    clear: clear.map(|_| [1.0; 4]),
+                    resolve: None,
+                },
+            );
+            self.props.record(rec, sets, props);
+            let mut result = Ok(());
+            if bundles > 0 {
+                self.scalp.record(rec, sets, bundles);
+            }
+            if strands && mesh {
+                if let Some(q) = query.as_deref_mut() {
+                    q.begin(rec);
+                }
+                result = self.strands.record_mesh(rec, sets, bundles);
+                if let Some(q) = query {
+                    q.end(rec);
+                }
+            } else if strands {
+                self.strands.record_pulled(rec, sets, args);
+            }
+            rec.end_rendering();
+            result
+        });
+        g.end_scope();
+        rest
     }
 }

@@ -2,35 +2,16 @@
 //! appended the segments) and any hardware strand passes of the frame: the opaque depth is
 //! copied out, the segments are binned into tiles (count, scan, scatter) and each tile is
 //! rasterized into the frame's k-buffer, which the transparency resolve then composites.
-//! Reads: frame block, `GenerateArgs` (segment count), the segments, the depth target.
-//! Writes: the tile table and entries, the soft depth copy, the k-buffer nodes and tail,
-//! `GenerateArgs` (binning dispatch, statistics).
+//! What each step reads and writes is declared where it is added to the frame graph.
 
 use std::sync::Arc;
 
-use super::{PassSets, dispatch_2d, shader_options};
+use super::{FrameRes, PassSets, dispatch_2d, shader_options};
+use crate::render::graph::FrameGraph;
 use crate::render::shared::GenerateArgs;
-use crate::render::soft::{SoftBuffers, tile_grid};
-use crate::render::targets::RenderTargets;
+use crate::render::soft::tile_grid;
 use crate::vk::shader::compile;
-use crate::vk::{
-    Access, Buffer, CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout, Profiler,
-};
-
-/// What one frame's software raster reads and writes.
-pub struct SoftDraw<'a> {
-    /// Camera sets (the frame block carries the budgets and the tile grid).
-    pub sets: PassSets<'a>,
-    /// `GenerateArgs`: segments appended, binning dispatch, statistics.
-    pub args: &'a Buffer,
-    /// The soft buffers (segments, tiles, entries, depth copy).
-    pub buffers: &'a SoftBuffers,
-    /// Depth target after the opaque pass (single sample); `None`: the depth copy was
-    /// filled by the caller.
-    pub targets: Option<&'a mut RenderTargets>,
-    /// Target size.
-    pub size: (u32, u32),
-}
+use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// The pipelines of the software rasterizer.
 pub struct SoftRasterPass {
@@ -92,91 +73,123 @@ impl SoftRasterPass {
         })
     }
 
-    /// Mesh path: build the software bundles of `bundles` bundles in task and mesh shaders and
-    /// append their segments (compute generation appends them in `generate.comp`).
-    pub fn record_mesh_segments(
-        &self,
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
-        sets: PassSets,
+    /// Mesh path: add the pass that builds the software bundles of `bundles` bundles in task
+    /// and mesh shaders and appends their segments (compute generation appends them in
+    /// `generate.comp`).
+    pub fn add_mesh_segments<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        sets: PassSets<'a>,
         bundles: u32,
         size: (u32, u32),
-    ) -> GpuResult<()> {
-        let p = self.mesh_segments.as_ref().ok_or_else(|| {
-            crate::vk::GpuError::Unsupported("no usable VK_EXT_mesh_shader".into())
-        })?;
-        profiler.begin(rec, "soft segments");
-        rec.barrier(
-            &[Access::TransferWrite, Access::ComputeReadWrite],
-            &[Access::TaskReadWrite, Access::MeshReadWrite],
-        );
-        rec.begin_rendering_empty(size.0, size.1);
-        rec.bind(p, &sets.both());
-        let (x, y) = dispatch_2d(bundles.div_ceil(self.task_bundles));
-        let result = rec.draw_mesh_tasks(x, y, 1);
-        rec.end_rendering();
-        profiler.end(rec);
-        result
+    ) {
+        let task_bundles = self.task_bundles;
+        let pipeline = self.mesh_segments.as_ref();
+        g.begin_scope("soft segments");
+        g.pass("soft segments (mesh)")
+            .read_all(&[r.constants, r.textures], Access::TaskRead)
+            .read(r.textures, Access::MeshRead)
+            .write(r.args, Access::TaskReadWrite)
+            .write(r.args, Access::MeshReadWrite)
+            .write(r.soft_segments, Access::MeshReadWrite)
+            .read_all(&r.shadow, Access::SampledRead)
+            .record(move |rec| {
+                let p = pipeline.ok_or_else(|| {
+                    crate::vk::GpuError::Unsupported("no usable VK_EXT_mesh_shader".into())
+                })?;
+                rec.begin_rendering_empty(size.0, size.1);
+                rec.bind(p, &sets.both());
+                let (x, y) = dispatch_2d(bundles.div_ceil(task_bundles));
+                let result = rec.draw_mesh_tasks(x, y, 1);
+                rec.end_rendering();
+                result
+            });
+        g.end_scope();
     }
 
-    /// Record the binning and raster of the segments generation appended this frame. The
+    /// Add the binning and raster of the segments generation appended this frame. The
     /// k-buffer must be cleared (or hold this frame's hardware fragments) before.
-    pub fn record(&self, rec: &mut CommandRecorder, profiler: &mut Profiler, draw: SoftDraw) {
-        let b = draw.buffers;
-        let (tx, ty) = tile_grid(draw.size.0, draw.size.1);
-        let rw = [Access::ComputeReadWrite];
-        profiler.begin(rec, "soft bin");
-        rec.barrier(
-            &[
-                Access::ComputeReadWrite,
-                Access::TransferRead,
-                Access::IndirectRead,
-            ],
-            &[Access::TransferWrite],
-        );
-        if let Some(t) = draw.targets {
-            rec.image_barrier(&t.depth, t.depth_access, Access::TransferRead);
-            rec.copy_image_to_buffer_at(&t.depth, &b.depth, 0);
-            t.depth_access = Access::TransferRead;
+    /// `copy_depth`: copy the opaque depth target into the soft depth first (otherwise the
+    /// caller filled it).
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        sets: PassSets<'a>,
+        size: (u32, u32),
+        copy_depth: bool,
+    ) {
+        let (tx, ty) = tile_grid(size.0, size.1);
+        let rw = Access::ComputeReadWrite;
+        let (args, soft) = (r.args_buffer, r.soft);
+        g.begin_scope("soft bin");
+        if copy_depth {
+            let depth = r.images.depth;
+            g.pass("soft depth copy")
+                .read(r.depth, Access::TransferRead)
+                .discard(r.soft_depth, Access::TransferWrite)
+                .record(move |rec| {
+                    rec.copy_image_to_buffer_at(depth, &soft.depth, 0);
+                    Ok(())
+                });
         }
-        rec.fill_buffer(&b.tiles, 0, tx as u64 * ty as u64 * 16, 0);
-        // Segments come from compute generation or from the mesh shaders of the draw passes.
-        rec.barrier(
-            &[
-                Access::TransferWrite,
-                Access::ComputeReadWrite,
-                Access::MeshReadWrite,
-                Access::TaskReadWrite,
-            ],
-            &rw,
-        );
-        rec.bind(&self.bin_args, &draw.sets.both());
-        rec.dispatch(1, 1, 1);
-        rec.barrier(&rw, &[Access::ComputeReadWrite, Access::IndirectRead]);
-        rec.bind(&self.count, &draw.sets.both());
-        rec.dispatch_indirect(draw.args, GenerateArgs::SOFT_DISPATCH_OFFSET);
-        rec.barrier(&rw, &rw);
-        rec.bind(&self.scan, &draw.sets.both());
-        rec.dispatch(1, 1, 1);
-        // The scan writes `GenerateArgs` statistics beside the scatter's indirect arguments.
-        rec.barrier(&rw, &[Access::ComputeReadWrite, Access::IndirectRead]);
-        rec.bind(&self.scatter, &draw.sets.both());
-        rec.dispatch_indirect(draw.args, GenerateArgs::SOFT_DISPATCH_OFFSET);
-        profiler.end(rec);
-        // The k-buffer may hold this frame's hardware transparent fragments.
-        rec.barrier(&[Access::ComputeReadWrite, Access::FragmentReadWrite], &rw);
-        profiler.begin(rec, "soft raster");
-        rec.bind(&self.raster, &draw.sets.both());
-        rec.dispatch(tx, ty, 1);
-        profiler.end(rec);
-        rec.barrier(
-            &rw,
-            &[
-                Access::FragmentReadWrite,
-                Access::ComputeReadWrite,
-                Access::TransferRead,
-                Access::IndirectRead,
-            ],
-        );
+        g.pass("soft tiles clear")
+            .discard(r.soft_tiles, Access::TransferWrite)
+            .record(move |rec| {
+                rec.fill_buffer(&soft.tiles, 0, tx as u64 * ty as u64 * 16, 0);
+                Ok(())
+            });
+        g.pass("soft bin args")
+            .read(r.constants, Access::ComputeRead)
+            .write(r.args, rw)
+            .record(move |rec| {
+                rec.bind(&self.bin_args, &sets.both());
+                rec.dispatch(1, 1, 1);
+                Ok(())
+            });
+        let bin = |g: &mut FrameGraph<'a>, name, pipeline: &'a Pipeline, scatter: bool| {
+            let mut p = g
+                .pass(name)
+                .read(r.constants, Access::ComputeRead)
+                .read(r.soft_segments, Access::ComputeRead)
+                .read(r.args, Access::IndirectRead)
+                .write(r.args, rw)
+                .write(r.soft_tiles, rw);
+            if scatter {
+                p = p.discard(r.soft_entries, rw);
+            }
+            p.record(move |rec| {
+                rec.bind(pipeline, &sets.both());
+                rec.dispatch_indirect(args, GenerateArgs::SOFT_DISPATCH_OFFSET);
+                Ok(())
+            });
+        };
+        bin(g, "soft bin count", &self.count, false);
+        g.pass("soft tile scan")
+            .read(r.constants, Access::ComputeRead)
+            .write(r.soft_tiles, rw)
+            .write(r.args, rw)
+            .record(move |rec| {
+                rec.bind(&self.scan, &sets.both());
+                rec.dispatch(1, 1, 1);
+                Ok(())
+            });
+        bin(g, "soft bin scatter", &self.scatter, true);
+        g.end_scope();
+        g.begin_scope("soft raster");
+        g.pass("soft raster")
+            .read(r.constants, Access::ComputeRead)
+            .read_all(&[r.soft_segments, r.soft_tiles], Access::ComputeRead)
+            .read_all(&[r.soft_entries, r.soft_depth], Access::ComputeRead)
+            .write(r.args, rw)
+            .write(r.oit_nodes, rw)
+            .write(r.oit_tail, rw)
+            .record(move |rec| {
+                rec.bind(&self.raster, &sets.both());
+                rec.dispatch(tx, ty, 1);
+                Ok(())
+            });
+        g.end_scope();
     }
 }

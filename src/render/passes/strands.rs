@@ -1,17 +1,19 @@
 //! Strand strips: the compute path's vertex-pulling draw (one indirect draw for the crowd) and
 //! the mesh path's task + mesh pipeline (one task dispatch for the crowd, `TASK_BUNDLES`
-//! bundles per task workgroup). Reads: frame block, records, bundles, LoDs and offsets,
-//! the vertex pool (compute) or the textures (mesh). Writes: colour, depth, and on the mesh
-//! path the frame statistics.
+//! bundles per task workgroup). [`strand_uses`] declares what a strand draw reads and
+//! writes on each path.
 
 use std::sync::Arc;
 
 use ash::vk;
 
-use super::{DrawTarget, PassSets, dispatch_2d, shader_options};
+use super::{DrawTarget, FrameRes, PassSets, dispatch_2d, shader_options};
+use crate::render::RenderPath;
+use crate::render::graph::PassBuilder;
 use crate::render::shared::{
     DISPATCH_ROW, GenerateArgs, MAX_SEGMENTS, STRAND_GROUP_SIZE, TASK_PAYLOAD_BUNDLES, TaskPayload,
 };
+use crate::vk::Access;
 use crate::vk::shader::compile;
 use crate::vk::{Buffer, CommandRecorder, Context, GpuError, GpuResult, Pipeline, PipelineLayout};
 
@@ -139,5 +141,31 @@ impl StrandDraw {
         rec.bind(p, &sets.both());
         let (x, y) = dispatch_2d(bundles.div_ceil(self.task_bundles));
         rec.draw_mesh_tasks(x, y, 1)
+    }
+}
+
+/// Declare what drawing the strands as `path` does reads and writes (beside the pass's
+/// targets): the pulled paths read the vertex pool, LoDs and offsets and the draw arguments;
+/// the mesh path's task shaders read the textures and add to the statistics. `shaded`: the
+/// fragment shaders light the strands (shadow maps, shading table).
+pub fn strand_uses<'g, 'a>(
+    p: PassBuilder<'g, 'a>,
+    r: &FrameRes,
+    path: RenderPath,
+    shaded: bool,
+) -> PassBuilder<'g, 'a> {
+    let p = if path.pulls_vertices() {
+        p.read(r.constants, Access::VertexRead)
+            .read_all(&[r.pool, r.lods, r.offsets], Access::VertexRead)
+            .read(r.args, Access::IndirectRead)
+    } else {
+        p.read_all(&[r.constants, r.textures], Access::TaskRead)
+            .read(r.textures, Access::MeshRead)
+            .write(r.args, Access::TaskReadWrite)
+    };
+    if shaded {
+        p.read_all(&r.shadow, Access::SampledRead)
+    } else {
+        p
     }
 }

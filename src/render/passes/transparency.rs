@@ -1,7 +1,6 @@
 //! Transparent strands (`render::transparency`): the k-buffer insert and its resolve, or depth
-//! peeling and its resolve, after the opaque pass. Reads: frame block, crowd tables, the
-//! vertex pool (compute) or textures (mesh), the opaque depth. Writes: the per-pixel buffers
-//! (`TransparencyBuffers`), then the colour target (and its MSAA resolve).
+//! peeling and its resolve, after the opaque pass; what each pass reads and writes is
+//! declared where it is added to the frame graph.
 //!
 //! Pipelines are compiled the first time a frame uses their mode.
 
@@ -9,15 +8,15 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::strands::StrandDraw;
-use super::{DrawTarget, PassSets, TargetFormats, clear_args, shader_options};
+use super::strands::{StrandDraw, strand_uses};
+use super::{DrawTarget, FrameRes, PassSets, TargetFormats, shader_options};
 use crate::render::RenderPath;
-use crate::render::targets::RenderTargets;
-use crate::render::transparency::{Transparency, TransparencyBuffers};
+use crate::render::graph::FrameGraph;
+use crate::render::transparency::Transparency;
 use crate::vk::shader::compile;
 use crate::vk::{
-    Access, Attachment, BlendMode, Buffer, CommandRecorder, Context, DepthMode, GpuError,
-    GpuResult, MeshPrimitivesQuery, Pipeline, PipelineLayout, Profiler,
+    Access, Attachment, BlendMode, Context, DepthMode, GpuError, GpuResult, MeshPrimitivesQuery,
+    Pipeline, PipelineLayout,
 };
 
 /// What the transparent passes of one frame draw.
@@ -30,12 +29,8 @@ pub struct TransparentDraw<'a> {
     pub bundles: u32,
     /// Generation path (compute: the vertex pool is already generated).
     pub path: RenderPath,
-    /// `GenerateArgs` (the compute path's draw arguments; the mesh path's statistics).
-    pub args: &'a Buffer,
-    /// Colour and depth after the opaque pass.
-    pub targets: &'a mut RenderTargets,
-    /// Per-pixel buffers, sized for this mode and size.
-    pub buffers: &'a mut TransparencyBuffers,
+    /// Target size.
+    pub size: (u32, u32),
     /// Mesh-primitive query of the frame (wraps the k-buffer insert).
     pub mesh_query: Option<&'a mut MeshPrimitivesQuery>,
 }
@@ -137,88 +132,86 @@ impl TransparencyPass {
         Pipeline::graphics(&self.ctx, &self.layout, &desc)
     }
 
-    /// Empty the k-buffer of `budget` nodes per pixel for `pixels` pixels (before the
-    /// k-buffer insert or the software rasterizer).
-    pub fn clear_kbuffer(
-        rec: &mut CommandRecorder,
-        buffers: &TransparencyBuffers,
+    /// Add the pass that empties the k-buffer of `budget` nodes per pixel for `pixels`
+    /// pixels (before the k-buffer insert or the software rasterizer).
+    pub fn add_kbuffer_clear<'a>(
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
         budget: u32,
         pixels: u64,
     ) {
-        rec.barrier(
-            &[Access::FragmentReadWrite, Access::ComputeReadWrite],
-            &[Access::TransferWrite],
-        );
-        rec.fill_buffer(&buffers.nodes, 0, pixels * budget as u64 * 8, u32::MAX);
-        rec.fill_buffer(&buffers.tail, 0, pixels * 16, 0);
-        rec.barrier(
-            &[Access::TransferWrite],
-            &[Access::FragmentReadWrite, Access::ComputeReadWrite],
-        );
+        let b = r.transparency;
+        g.pass("k-buffer clear")
+            .discard(r.oit_nodes, Access::TransferWrite)
+            .discard(r.oit_tail, Access::TransferWrite)
+            .record(move |rec| {
+                rec.fill_buffer(&b.nodes, 0, pixels * budget as u64 * 8, u32::MAX);
+                rec.fill_buffer(&b.tail, 0, pixels * 16, 0);
+                Ok(())
+            });
     }
 
-    /// Record the transparent strand passes of `draw.mode` (prepared with [`Self::prepare`]):
-    /// the k-buffer clear and insert, or the peeled layers; [`Self::record_resolve`]
-    /// composites them.
-    pub fn record_layers(
-        &self,
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
-        mut draw: TransparentDraw,
+    /// Add the transparent strand passes of `draw.mode` (prepared with [`Self::prepare`]):
+    /// the k-buffer clear and insert, or the peeled layers; [`Self::add_resolve`] composites
+    /// them.
+    pub fn add_layers<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        draw: TransparentDraw<'a>,
     ) -> GpuResult<()> {
         let unprepared = || GpuError::Unsupported("transparency pipelines not prepared".into());
-        let (w, h) = draw.targets.size();
+        let (w, h) = draw.size;
         let pixels = w as u64 * h as u64;
         match draw.mode {
             Transparency::Opaque => Ok(()),
             Transparency::KBuffer { budget } => {
                 let p = self.kbuffer.as_ref().ok_or_else(unprepared)?;
-                Self::clear_kbuffer(rec, draw.buffers, budget, pixels);
-                let t = &*draw.targets;
-                rec.image_barrier(&t.depth, t.depth_access, Access::DepthAttachment);
-                profiler.begin(rec, "oit insert");
-                rec.begin_rendering_depth(Attachment {
-                    image: &t.depth,
-                    clear: None,
-                    resolve: None,
+                Self::add_kbuffer_clear(g, r, budget, pixels);
+                g.begin_scope("oit insert");
+                let pass = g
+                    .pass("oit insert")
+                    .write(r.depth, Access::DepthAttachment)
+                    .write(r.oit_nodes, Access::FragmentReadWrite)
+                    .write(r.oit_tail, Access::FragmentReadWrite);
+                let (sets, bundles, path, args) =
+                    (draw.sets, draw.bundles, draw.path, r.args_buffer);
+                let depth = r.images.depth;
+                let mut query = draw.mesh_query.filter(|_| path == RenderPath::Mesh);
+                strand_uses(pass, r, path, true).record(move |rec| {
+                    rec.begin_rendering_depth(Attachment {
+                        image: depth,
+                        clear: None,
+                        resolve: None,
+                    });
+                    if let Some(q) = query.as_deref_mut() {
+                        q.begin(rec);
+                    }
+                    let result = p.insert.record(rec, sets, bundles, path, args);
+                    if let Some(q) = query {
+                        q.end(rec);
+                    }
+                    rec.end_rendering();
+                    result
                 });
-                let mut query = draw.mesh_query;
-                if let Some(q) = query
-                    .as_deref_mut()
-                    .filter(|_| draw.path == RenderPath::Mesh)
-                {
-                    q.begin(rec);
-                }
-                let result = p
-                    .insert
-                    .record(rec, draw.sets, draw.bundles, draw.path, draw.args);
-                if let Some(q) = query.filter(|_| draw.path == RenderPath::Mesh) {
-                    q.end(rec);
-                }
-                rec.end_rendering();
-                profiler.end(rec);
-                result?;
-                draw.targets.depth_access = Access::DepthAttachment;
+                g.end_scope();
                 Ok(())
             }
             Transparency::DepthPeeling { layers } => {
                 let p = self.peel.as_ref().ok_or_else(unprepared)?;
-                Self::record_peeling(rec, profiler, p, &mut draw, layers, pixels)?;
-                draw.targets.depth_access = Access::TransferRead;
-                Ok(())
+                Self::add_peeling(g, r, p, &draw, layers, pixels)
             }
         }
     }
 
-    /// Composite the k-buffer (`peel` false) or the peeling accumulation over the colour
-    /// target (and its MSAA resolve), leaving them as colour attachments.
-    pub fn record_resolve(
-        &self,
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
+    /// Add the pass that composites the k-buffer (`peel` false) or the peeling accumulation
+    /// over the colour target (and its MSAA resolve).
+    pub fn add_resolve<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
         peel: bool,
-        sets: PassSets,
-        targets: &RenderTargets,
+        sets: PassSets<'a>,
     ) -> GpuResult<()> {
         let unprepared = || GpuError::Unsupported("transparency pipelines not prepared".into());
         let resolve = if peel {
@@ -226,92 +219,99 @@ impl TransparencyPass {
         } else {
             &self.kbuffer.as_ref().ok_or_else(unprepared)?.resolve
         };
-        rec.barrier(
-            &[Access::FragmentReadWrite, Access::ComputeReadWrite],
-            &[Access::FragmentReadWrite],
-        );
-        let t = targets;
-        rec.image_barrier(&t.color, Access::ColorAttachment, Access::ColorAttachment);
-        profiler.begin(rec, "transparency resolve");
-        rec.begin_rendering_color(Attachment {
-            image: &t.color,
-            clear: None,
-            resolve: t.resolved.as_ref(),
+        g.begin_scope("transparency resolve");
+        let mut pass = g
+            .pass("transparency resolve")
+            .read(r.constants, Access::FragmentRead)
+            .write(r.color, Access::ColorAttachment);
+        pass = if peel {
+            pass.read(r.peel_accum, Access::FragmentRead)
+        } else {
+            pass.read_all(&[r.oit_nodes, r.oit_tail], Access::FragmentRead)
+        };
+        if let Some(resolved) = r.resolved {
+            // The resolve overwrites every pixel.
+            pass = pass.discard(resolved, Access::ColorAttachment);
+        }
+        let (color, resolved) = (r.images.color, r.images.resolved);
+        pass.record(move |rec| {
+            rec.begin_rendering_color(Attachment {
+                image: color,
+                clear: None,
+                resolve: resolved,
+            });
+            rec.bind(resolve, &sets.both());
+            rec.draw(3);
+            rec.end_rendering();
+            Ok(())
         });
-        rec.bind(resolve, &sets.both());
-        rec.draw(3);
-        rec.end_rendering();
-        profiler.end(rec);
+        g.end_scope();
         Ok(())
     }
 
     /// `layers` depth-peeling layers, each composited under the ones before into the
     /// accumulation buffer.
-    fn record_peeling(
-        rec: &mut CommandRecorder,
-        profiler: &mut Profiler,
-        p: &PeelPipelines,
-        draw: &mut TransparentDraw,
+    fn add_peeling<'a>(
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        p: &'a PeelPipelines,
+        draw: &TransparentDraw<'a>,
         layers: u32,
         pixels: u64,
     ) -> GpuResult<()> {
-        let t = &*draw.targets;
-        let TransparencyBuffers {
-            peel_image,
-            peel_access,
-            peel_depth,
-            peel_accum,
-            ..
-        } = &mut *draw.buffers;
-        let image = peel_image
-            .as_ref()
-            .ok_or_else(|| GpuError::Unsupported("peel depth image not allocated".into()))?;
+        let missing = || GpuError::Unsupported("peel depth image not allocated".into());
+        let (image, image_res) = r.images.peel.zip(r.peel_image).ok_or_else(missing)?;
+        let (b, depth) = (r.transparency, r.images.depth);
+        g.begin_scope("peel layers");
         // Previous layer: depth 0 (nothing peeled); opaque depth in the second half.
-        rec.image_barrier(&t.depth, t.depth_access, Access::TransferRead);
-        rec.barrier(&[Access::FragmentReadWrite], &[Access::TransferWrite]);
-        rec.fill_buffer(peel_depth, 0, pixels * 4, 0);
-        rec.copy_image_to_buffer_at(&t.depth, peel_depth, pixels * 4);
-        rec.fill_buffer(peel_accum, 0, pixels * 16, 0);
-        rec.barrier(&[Access::TransferWrite], &[Access::FragmentReadWrite]);
-        let mesh = draw.path == RenderPath::Mesh;
-        let att = |clear| Attachment {
-            image,
-            clear,
-            resolve: None,
-        };
-        profiler.begin(rec, "peel layers");
-        let mut result = Ok(());
-        for layer in 0..layers {
-            let from = if layer == 0 {
-                *peel_access
-            } else {
-                Access::TransferRead
-            };
-            rec.image_barrier(image, from, Access::DepthAttachment);
+        g.pass("peel setup")
+            .read(r.depth, Access::TransferRead)
+            .discard(r.peel_depth, Access::TransferWrite)
+            .discard(r.peel_accum, Access::TransferWrite)
+            .record(move |rec| {
+                rec.fill_buffer(&b.peel_depth, 0, pixels * 4, 0);
+                rec.copy_image_to_buffer_at(depth, &b.peel_depth, pixels * 4);
+                rec.fill_buffer(&b.peel_accum, 0, pixels * 16, 0);
+                Ok(())
+            });
+        let (sets, bundles, path, args) = (draw.sets, draw.bundles, draw.path, r.args_buffer);
+        let mesh = path == RenderPath::Mesh;
+        for _ in 0..layers {
             for (i, strands) in [&p.depth, &p.color].into_iter().enumerate() {
-                if i == 1 {
-                    rec.image_barrier(image, Access::DepthAttachment, Access::DepthAttachment);
-                }
                 if mesh {
                     // The task shader counts statistics again: keep one pass's worth.
-                    clear_args(rec, draw.args);
+                    super::add_clear_args(g, r);
                 }
-                rec.begin_rendering_depth(att(if i == 0 { Some([1.0; 4]) } else { None }));
-                result =
-                    result.and(strands.record(rec, draw.sets, draw.bundles, draw.path, draw.args));
-                rec.end_rendering();
+                let pass = if i == 0 {
+                    g.pass("peel depth")
+                        .discard(image_res, Access::DepthAttachment)
+                } else {
+                    g.pass("peel colour")
+                        .write(image_res, Access::DepthAttachment)
+                        .write(r.peel_accum, Access::FragmentReadWrite)
+                };
+                let pass = pass.read(r.peel_depth, Access::FragmentRead);
+                strand_uses(pass, r, path, i == 1).record(move |rec| {
+                    rec.begin_rendering_depth(Attachment {
+                        image,
+                        clear: (i == 0).then_some([1.0; 4]),
+                        resolve: None,
+                    });
+                    let result = strands.record(rec, sets, bundles, path, args);
+                    rec.end_rendering();
+                    result
+                });
             }
             // This layer's depth becomes the next layer's "previous".
-            rec.barrier(
-                &[Access::FragmentReadWrite],
-                &[Access::FragmentReadWrite, Access::TransferWrite],
-            );
-            rec.image_barrier(image, Access::DepthAttachment, Access::TransferRead);
-            rec.copy_image_to_buffer_at(image, peel_depth, 0);
-            rec.barrier(&[Access::TransferWrite], &[Access::FragmentReadWrite]);
+            g.pass("peel copy")
+                .read(image_res, Access::TransferRead)
+                .write(r.peel_depth, Access::TransferWrite)
+                .record(move |rec| {
+                    rec.copy_image_to_buffer_at(image, &b.peel_depth, 0);
+                    Ok(())
+                });
         }
-        profiler.end(rec);
-        *peel_access = Access::TransferRead;
-        result
+        g.end_scope();
+        Ok(())
     }
 }

@@ -1,0 +1,198 @@
+//! Hooks for tests and tools that look inside the renderer: the software rasterizer alone
+//! over given segments, the vertex pool and a character's texture read back. Each waits for
+//! the frames in flight and runs its own small frame graph.
+
+use ash::vk;
+
+use super::crowd::CharacterId;
+use super::graph::{FrameGraph, ImageState};
+use super::passes::{FrameRes, FrameSources, PassSets};
+use super::renderer::Renderer;
+use super::settings::{FrameSettings, RenderPath};
+use super::shared::{FrameBlock, HairVertex, SoftSegment, TextureBinding};
+use super::soft::StrandRaster;
+use super::transparency::Transparency;
+use crate::vk::{Access, Buffer, BufferDesc, GpuError, GpuResult};
+
+fn readback(ctx: &std::sync::Arc<crate::vk::Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(name, bytes, vk::BufferUsageFlags::TRANSFER_DST).readback(),
+    )
+}
+
+impl Renderer {
+    /// Draw `segments` (screen space and shaded, as generation appends them) with the
+    /// software rasterizer alone, over a black image with nothing in front, keeping `k`
+    /// fragments per pixel sorted, each with opacity `opacity` times its coverage; returns
+    /// the image (RGBA8, sRGB). Waits for the frames in flight. For tests and tools that
+    /// check the rasterizer apart from generation (single-sample targets only).
+    pub fn rasterize_segments(
+        &mut self,
+        segments: &[SoftSegment],
+        k: u32,
+        opacity: f32,
+    ) -> GpuResult<Vec<u8>> {
+        let raster = StrandRaster::Software { k };
+        let kbuffer = Transparency::KBuffer { budget: k };
+        let settings = FrameSettings {
+            path: RenderPath::Compute,
+            raster,
+            transparency: kbuffer,
+            msaa: self.desc.msaa,
+        };
+        settings
+            .validate(&self.caps())
+            .map_err(GpuError::Unsupported)?;
+        if segments.is_empty() || segments.len() as u64 > self.soft_budget.segments as u64 {
+            return Err(GpuError::Unsupported(format!(
+                "rasterize_segments: 1..={} segments",
+                self.soft_budget.segments
+            )));
+        }
+        if !(0.0..=1.0).contains(&opacity) {
+            return Err(GpuError::Unsupported(format!(
+                "rasterize_segments: opacity {opacity} outside 0..=1"
+            )));
+        }
+        self.finish()?;
+        let i = self.next;
+        let (width, height) = self.targets.size();
+        self.passes.prepare_transparency(kbuffer)?;
+        // Nothing is in flight: replaced buffers can go now.
+        drop(self.transparency.ensure(kbuffer, width, height)?);
+        drop(self.soft.ensure(self.soft_budget, width, height)?);
+        self.prepare_workspace(i, RenderPath::Mesh)?;
+        let mut block: FrameBlock = bytemuck::Zeroable::zeroed();
+        block.viewport = [
+            width as f32,
+            height as f32,
+            1.0 / width as f32,
+            1.0 / height as f32,
+        ];
+        block.transparency = kbuffer.frame_fields(1);
+        let split = self.desc.auto_split_pixels;
+        super::soft::frame_fields(&mut block, raster, self.soft_budget, opacity, split);
+        self.frames[i]
+            .frame_ubo
+            .write(0, bytemuck::bytes_of(&block))?;
+        let upload = Buffer::with_data(
+            &self.ctx,
+            "soft segments upload",
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            bytemuck::cast_slice(segments),
+        )?;
+        let mut image = readback(
+            &self.ctx,
+            "image readback",
+            width as u64 * height as u64 * 4,
+        )?;
+        let counts = (segments.len() as u32, k);
+        self.run_debug_graph(i, &upload, &image, counts)?;
+        image.read()
+    }
+
+    /// The graph of [`Self::rasterize_segments`]: upload, the soft passes, readback.
+    fn run_debug_graph(
+        &mut self,
+        i: usize,
+        upload: &Buffer,
+        image: &Buffer,
+        counts: (u32, u32),
+    ) -> GpuResult<()> {
+        let ctx = self.ctx.clone();
+        let slot = &mut self.frames[i];
+        let sets = PassSets {
+            frame: &slot.set,
+            textures: self.crowd.texture_set(),
+        };
+        let profiler = &mut slot.profiler;
+        let sources = FrameSources {
+            work: &self.work,
+            targets: &mut self.targets,
+            shadow: &mut self.shadow,
+            transparency: &mut self.transparency,
+            soft: &self.soft,
+        };
+        let passes = &self.passes;
+        let result = ctx.submit_and_wait(|rec| {
+            profiler.reset(rec);
+            let mut g = FrameGraph::new(false);
+            let r = FrameRes::import(&mut g, sources);
+            let upload_res = g.host_input("segments upload");
+            let segments = &r.soft.segments;
+            g.pass("upload segments")
+                .read(upload_res, Access::TransferRead)
+                .discard(r.soft_segments, Access::TransferWrite)
+                .record(move |rec| {
+                    rec.copy_buffer(upload, 0, segments, 0, upload.size);
+                    Ok(())
+                });
+            passes.add_soft_only(&mut g, &r, sets, counts)?;
+            let out = g.import_buffer("image readback", image);
+            let output = r.images.output;
+            g.pass("image readback")
+                .read(r.output, Access::TransferRead)
+                .discard(out, Access::TransferWrite)
+                .record(move |rec| {
+                    rec.copy_image_to_buffer(output, image);
+                    Ok(())
+                });
+            g.pass("host reads").read(out, Access::HostRead).done();
+            g.run(rec, profiler).map(|_| ())
+        });
+        result?
+    }
+
+    /// The first `count` vertices of the compute path's pool, as the last frame wrote them
+    /// (waits for every frame in flight).
+    pub fn read_vertices(&mut self, count: u32) -> GpuResult<Vec<HairVertex>> {
+        self.finish()?;
+        let Some(pool) = &self.work.pool else {
+            return Ok(Vec::new());
+        };
+        let bytes = (count as u64 * size_of::<HairVertex>() as u64).min(pool.size);
+        if bytes == 0 {
+            return Ok(Vec::new());
+        }
+        let mut out = readback(&self.ctx, "vertex readback", bytes)?;
+        self.ctx.submit_and_wait(|rec| {
+            let mut g = FrameGraph::new(false);
+            let src = g.import_buffer("vertex pool", pool);
+            let dst = g.import_buffer("vertex readback", &out);
+            g.pass("copy vertices")
+                .read(src, Access::TransferRead)
+                .discard(dst, Access::TransferWrite)
+                .record(|rec| {
+                    rec.copy_buffer(pool, 0, &out, 0, bytes);
+                    Ok(())
+                });
+            g.pass("host reads").read(dst, Access::HostRead).done();
+            g.run_untimed(rec).map(|_| ())
+        })??;
+        Ok(bytemuck::pod_collect_to_vec(&out.read()?))
+    }
+
+    /// Read back character `id`'s texture `binding` (tightly packed texels, as in the bake).
+    /// Waits for every frame in flight; for tests and tools.
+    pub fn read_texture(&mut self, id: CharacterId, binding: TextureBinding) -> GpuResult<Vec<u8>> {
+        self.finish()?;
+        let image = self.crowd.texture(id, binding)?;
+        let mut out = readback(&self.ctx, "texture readback", image.byte_size())?;
+        self.ctx.submit_and_wait(|rec| {
+            let mut g = FrameGraph::new(false);
+            let src = g.import_image("texture", image, ImageState::Fixed(Access::SampledRead));
+            let dst = g.import_buffer("texture readback", &out);
+            g.pass("copy texture")
+                .read(src, Access::TransferRead)
+                .discard(dst, Access::TransferWrite)
+                .record(|rec| {
+                    rec.copy_image_to_buffer(image, &out);
+                    Ok(())
+                });
+            g.pass("host reads").read(dst, Access::HostRead).done();
+            g.run_untimed(rec).map(|_| ())
+        })??;
+        out.read()
+    }
+}

@@ -1,0 +1,664 @@
+//! The frame graph: every pass of a frame is added with the resources it reads and writes
+//! and how ([`Access`] uses); the graph runs the passes in the order they were added and
+//! derives every barrier and image layout transition from consecutive uses. Passes record
+//! commands only; they never order themselves against each other.
+//!
+//! Resources are imported: buffers (their earlier uses, in earlier frames, are unknown, so
+//! the first use waits for anything), images whose last use the owner keeps
+//! ([`ImageState::Tracked`], written back when the frame is recorded) or that must be left
+//! in one use ([`ImageState::Fixed`]: character textures stay sampled), swapchain images, and
+//! host-written inputs that need no GPU ordering (declared so the frame can be printed).
+//!
+//! Hazards, per resource: a read waits for the last writes unless it has already been made
+//! visible to that use; a write waits for the last writes and every read since; an image
+//! whose layout changes is transitioned (the transition counts as a write).
+
+use std::fmt::Write as _;
+
+use crate::vk::{
+    Access, BarrierImage, Buffer, CommandRecorder, GpuResult, Image, ImageBarrier, Profiler,
+    SwapchainImage,
+};
+
+/// A resource of the frame graph.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Res(usize);
+
+/// How an imported image's state is known.
+pub enum ImageState<'a> {
+    /// Its last use, kept by the owner across frames; the graph writes the frame's last use
+    /// back when the frame is recorded.
+    Tracked(&'a mut Access),
+    /// Always in this use between frames (the graph returns it there at the end).
+    Fixed(Access),
+}
+
+enum Object<'a> {
+    /// Buffers are ordered with global memory dependencies: the object is not needed.
+    Buffer,
+    Image(&'a Image),
+    Swapchain(&'a SwapchainImage),
+    /// Written by the host before the submission (visible to every use): never ordered.
+    Host,
+}
+
+/// A small set of [`Access`] uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Uses(u32);
+
+impl Uses {
+    fn of(a: Access) -> Self {
+        Uses(1 << a as u32)
+    }
+    fn contains(self, a: Access) -> bool {
+        self.0 & (1 << a as u32) != 0
+    }
+    fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+    fn list(self) -> Vec<Access> {
+        Access::ALL
+            .iter()
+            .copied()
+            .filter(|a| self.contains(*a))
+            .collect()
+    }
+    /// Every use that writes, and every use that only reads.
+    fn everything() -> Self {
+        Uses(Access::ALL.iter().fold(0, |m, a| m | (1 << *a as u32)))
+    }
+}
+
+impl std::ops::BitOr for Uses {
+    type Output = Uses;
+    fn bitor(self, o: Uses) -> Uses {
+        Uses(self.0 | o.0)
+    }
+}
+
+/// What the graph knows of a resource while it runs.
+struct Tracker {
+    /// Uses the next access must wait for as writes (writes, and layout transitions).
+    writes: Uses,
+    /// Reads since those writes that have been made visible (no barrier needed again).
+    visible: Uses,
+    /// Reads since the last write (a write must wait for them).
+    reads: Uses,
+    /// The last use of an image (its layout).
+    last: Access,
+}
+
+struct Resource<'a> {
+    name: &'static str,
+    object: Object<'a>,
+    tracked: Option<&'a mut Access>,
+    fixed: Option<Access>,
+    tracker: Tracker,
+}
+
+/// One declared use of a resource by a pass.
+#[derive(Clone, Copy, Debug)]
+struct Use {
+    res: Res,
+    access: Access,
+    /// Written without reading the old contents (images transition from `UNDEFINED`).
+    discard: bool,
+}
+
+type Record<'a> = Box<dyn FnOnce(&mut CommandRecorder) -> GpuResult<()> + 'a>;
+
+enum Node<'a> {
+    Pass {
+        name: &'static str,
+        uses: Vec<Use>,
+        record: Option<Record<'a>>,
+    },
+    BeginScope(&'static str),
+    EndScope,
+}
+
+/// One frame's passes and resources; see the module documentation.
+pub struct FrameGraph<'a> {
+    resources: Vec<Resource<'a>>,
+    nodes: Vec<Node<'a>>,
+    /// A `(pass, resource)` use to leave out (tests: show that sync validation catches it).
+    omit: Option<(&'a str, &'a str)>,
+    describe: bool,
+}
+
+/// A pass being declared: its uses, then its commands.
+pub struct PassBuilder<'g, 'a> {
+    graph: &'g mut FrameGraph<'a>,
+    name: &'static str,
+    uses: Vec<Use>,
+}
+
+impl<'a> PassBuilder<'_, 'a> {
+    fn add(mut self, res: Res, access: Access, discard: bool) -> Self {
+        let omitted = self
+            .graph
+            .omit
+            .is_some_and(|(p, r)| p == self.name && r == self.graph.resources[res.0].name);
+        if !omitted {
+            self.uses.push(Use {
+                res,
+                access,
+                discard,
+            });
+        }
+        self
+    }
+
+    /// The pass reads `res` as `access` (a use that does not write).
+    pub fn read(self, res: Res, access: Access) -> Self {
+        debug_assert!(
+            !access.writes(),
+            "{access:?} writes: declare it with write()"
+        );
+        self.add(res, access, false)
+    }
+
+    /// The pass writes (and may read) `res` as `access`.
+    pub fn write(self, res: Res, access: Access) -> Self {
+        self.add(res, access, false)
+    }
+
+    /// The pass overwrites `res` as `access` without reading what was there (an image is
+    /// transitioned from `UNDEFINED`).
+    pub fn discard(self, res: Res, access: Access) -> Self {
+        self.add(res, access, true)
+    }
+
+    /// [`Self::read`] of every resource in `list`.
+    pub fn read_all(self, list: &[Res], access: Access) -> Self {
+        list.iter().fold(self, |p, r| p.read(*r, access))
+    }
+
+    /// Add the pass with the commands `record` writes (after the graph's barriers).
+    pub fn record(self, record: impl FnOnce(&mut CommandRecorder) -> GpuResult<()> + 'a) {
+        self.graph.nodes.push(Node::Pass {
+            name: self.name,
+            uses: self.uses,
+            record: Some(Box::new(record)),
+        });
+    }
+
+    /// Add the pass with no commands of its own: only its uses (a hand-over, such as the
+    /// host reading back or the presentation engine taking the image).
+    pub fn done(self) {
+        self.graph.nodes.push(Node::Pass {
+            name: self.name,
+            uses: self.uses,
+            record: None,
+        });
+    }
+}
+
+impl<'a> FrameGraph<'a> {
+    /// An empty frame; `describe`: keep a printable account of passes, uses and barriers.
+    pub fn new(describe: bool) -> Self {
+        FrameGraph {
+            resources: Vec::new(),
+            nodes: Vec::new(),
+            omit: None,
+            describe,
+        }
+    }
+
+    /// Leave out pass `pass`'s declared use of `resource` (a deliberate bug, for the test
+    /// that shows synchronization validation catches a missing declaration).
+    pub fn omit_use(&mut self, pass: &'a str, resource: &'a str) {
+        self.omit = Some((pass, resource));
+    }
+
+    fn push(
+        &mut self,
+        name: &'static str,
+        object: Object<'a>,
+        state: Option<ImageState<'a>>,
+    ) -> Res {
+        let (last, tracked, fixed) = match state {
+            Some(ImageState::Tracked(a)) => (*a, Some(a), None),
+            Some(ImageState::Fixed(a)) => (a, None, Some(a)),
+            None => (Access::Nothing, None, None),
+        };
+        let tracker = match object {
+            // Earlier frames' uses are unknown: the first use waits for any of them.
+            Object::Buffer => Tracker {
+                writes: Uses::everything(),
+                visible: Uses::default(),
+                reads: Uses::everything(),
+                last,
+            },
+            _ => Tracker {
+                writes: Uses::of(last),
+                visible: Uses::default(),
+                reads: Uses::of(last),
+                last,
+            },
+        };
+        self.resources.push(Resource {
+            name,
+            object,
+            tracked,
+            fixed,
+            tracker,
+        });
+        Res(self.resources.len() - 1)
+    }
+
+    /// A buffer the GPU may have used in earlier frames.
+    pub fn import_buffer(&mut self, name: &'static str, _buffer: &'a Buffer) -> Res {
+        self.push(name, Object::Buffer, None)
+    }
+
+    /// An image and what is known of its state.
+    pub fn import_image(
+        &mut self,
+        name: &'static str,
+        image: &'a Image,
+        state: ImageState<'a>,
+    ) -> Res {
+        self.push(name, Object::Image(image), Some(state))
+    }
+
+    /// A swapchain image just acquired; the frame must end with it in [`Access::Present`].
+    pub fn import_swapchain(&mut self, name: &'static str, image: &'a SwapchainImage) -> Res {
+        self.push(
+            name,
+            Object::Swapchain(image),
+            Some(ImageState::Fixed(Access::Nothing)),
+        )
+    }
+
+    /// Inputs the host wrote before the submission (frame block, tables, uploaded
+    /// textures): declared for the frame's description, never ordered.
+    pub fn host_input(&mut self, name: &'static str) -> Res {
+        self.push(name, Object::Host, None)
+    }
+
+    /// Declare the next pass.
+    pub fn pass<'g>(&'g mut self, name: &'static str) -> PassBuilder<'g, 'a> {
+        PassBuilder {
+            graph: self,
+            name,
+            uses: Vec::new(),
+        }
+    }
+
+    /// Time the passes added until [`Self::end_scope`] as `name` (the frame report's pass
+    /// timings).
+    pub fn begin_scope(&mut self, name: &'static str) {
+        self.nodes.push(Node::BeginScope(name));
+    }
+
+    /// End the scope begun last.
+    pub fn end_scope(&mut self) {
+        self.nodes.push(Node::EndScope);
+    }
+
+    /// Number of passes added so far.
+    pub fn pass_count(&self) -> usize {
+        self.nodes
+            .iter()
+            .filter(|n| matches!(n, Node::Pass { .. }))
+            .count()
+    }
+
+    /// Record every pass in order with the barriers its uses need; returns the frame's
+    /// description when asked for. Tracked images get their last use written back.
+    pub fn run(
+        self,
+        rec: &mut CommandRecorder,
+        profiler: &mut Profiler,
+    ) -> GpuResult<Option<String>> {
+        self.run_with(rec, Some(profiler))
+    }
+
+    /// [`Self::run`] without timing the scopes (one-off submissions).
+    pub fn run_untimed(self, rec: &mut CommandRecorder) -> GpuResult<Option<String>> {
+        self.run_with(rec, None)
+    }
+
+    fn run_with(
+        mut self,
+        rec: &mut CommandRecorder,
+        mut profiler: Option<&mut Profiler>,
+    ) -> GpuResult<Option<String>> {
+        let mut text = String::new();
+        let nodes = std::mem::take(&mut self.nodes);
+        let mut count = 0;
+        for node in nodes {
+            match node {
+                Node::BeginScope(name) => {
+                    if let Some(p) = profiler.as_deref_mut() {
+                        p.begin(rec, name);
+                    }
+                }
+                Node::EndScope => {
+                    if let Some(p) = profiler.as_deref_mut() {
+                        p.end(rec);
+                    }
+                }
+                Node::Pass { name, uses, record } => {
+                    count += 1;
+                    let plan = self.plan(&uses);
+                    if self.describe {
+                        self.describe_pass(&mut text, count, name, &uses, &plan);
+                    }
+                    plan.record(rec, &self.resources);
+                    if let Some(record) = record {
+                        record(rec)?;
+                    }
+                }
+            }
+        }
+        self.finish(rec, &mut text, count);
+        for r in &mut self.resources {
+            if let Some(t) = r.tracked.as_deref_mut() {
+                *t = r.tracker.last;
+            }
+        }
+        Ok(self.describe.then_some(text))
+    }
+
+    /// Return fixed-state images to their use.
+    fn finish(&mut self, rec: &mut CommandRecorder, text: &mut String, count: usize) {
+        let back: Vec<Use> = self
+            .resources
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| {
+                let fixed = r.fixed?;
+                let keep = fixed == r.tracker.last || matches!(r.object, Object::Swapchain(_));
+                (!keep).then_some(Use {
+                    res: Res(i),
+                    access: fixed,
+                    discard: false,
+                })
+            })
+            .collect();
+        if back.is_empty() {
+            return;
+        }
+        let plan = self.plan(&back);
+        if self.describe {
+            self.describe_pass(text, count + 1, "(return fixed images)", &back, &plan);
+        }
+        plan.record(rec, &self.resources);
+    }
+
+    /// The barriers before a pass with `uses`, updating the trackers.
+    fn plan(&mut self, uses: &[Use]) -> Plan {
+        let mut plan = Plan::default();
+        // Uses of one resource by one pass are taken together.
+        let mut order: Vec<Res> = Vec::new();
+        for u in uses {
+            if !order.contains(&u.res) {
+                order.push(u.res);
+            }
+        }
+        for res in order {
+            let mine: Vec<&Use> = uses.iter().filter(|u| u.res == res).collect();
+            let r = &mut self.resources[res.0];
+            match r.object {
+                Object::Host => {}
+                Object::Buffer => plan_buffer(&mut plan, res, &mut r.tracker, &mine),
+                Object::Image(_) | Object::Swapchain(_) => {
+                    plan_image(&mut plan, res, &mut r.tracker, mine[0])
+                }
+            }
+        }
+        plan
+    }
+
+    fn describe_pass(&self, text: &mut String, n: usize, name: &str, uses: &[Use], plan: &Plan) {
+        let _ = writeln!(text, "{n:>3}. {name}");
+        let list = |reads: bool| -> Vec<String> {
+            uses.iter()
+                .filter(|u| u.access.writes() != reads)
+                .map(|u| {
+                    let d = if u.discard { ", discard" } else { "" };
+                    format!("{} ({:?}{d})", self.resources[u.res.0].name, u.access)
+                })
+                .collect()
+        };
+        for (label, items) in [("reads", list(true)), ("writes", list(false))] {
+            if !items.is_empty() {
+                let _ = writeln!(text, "       {label}: {}", items.join(", "));
+            }
+        }
+        for (res, prev, next) in &plan.buffer_log {
+            let _ = writeln!(
+                text,
+                "       barrier: {} {} -> {:?}",
+                self.resources[res.0].name,
+                names(prev),
+                next
+            );
+        }
+        for b in &plan.images {
+            let old = if b.discard {
+                "UNDEFINED".to_string()
+            } else {
+                format!("{:?}", b.from.layout())
+            };
+            let _ = writeln!(
+                text,
+                "       barrier: {} {} -> {:?} (layout {old} -> {:?})",
+                self.resources[b.res.0].name,
+                names(&b.prev),
+                b.next,
+                b.next.layout()
+            );
+        }
+    }
+}
+
+fn names(list: &[Access]) -> String {
+    let v: Vec<String> = list.iter().map(|a| format!("{a:?}")).collect();
+    format!("[{}]", v.join("|"))
+}
+
+/// One image's planned dependency.
+struct PlannedImage {
+    res: Res,
+    prev: Vec<Access>,
+    from: Access,
+    next: Access,
+    discard: bool,
+}
+
+/// The barriers before one pass: one global memory dependency for all buffers, and the
+/// image dependencies.
+#[derive(Default)]
+struct Plan {
+    memory_prev: Uses,
+    memory_next: Uses,
+    buffer_log: Vec<(Res, Vec<Access>, Access)>,
+    images: Vec<PlannedImage>,
+}
+
+impl Plan {
+    fn record(&self, rec: &mut CommandRecorder, resources: &[Resource]) {
+        let prev = self.memory_prev.list();
+        let next = self.memory_next.list();
+        let memory = (!next.is_empty()).then_some((&prev[..], &next[..]));
+        let images: Vec<ImageBarrier> = self
+            .images
+            .iter()
+            .filter_map(|p| {
+                let image = match resources[p.res.0].object {
+                    Object::Image(i) => BarrierImage::Image(i),
+                    Object::Swapchain(s) => BarrierImage::Swapchain(s),
+                    _ => return None,
+                };
+                Some(ImageBarrier {
+                    image,
+                    prev: p.prev.clone(),
+                    from: p.from,
+                    next: p.next,
+                    discard: p.discard,
+                })
+            })
+            .collect();
+        if memory.is_some() || !images.is_empty() {
+            rec.pipeline_barrier(memory, &images);
+        }
+    }
+}
+
+/// A buffer's dependency before a pass using it as `mine`.
+fn plan_buffer(plan: &mut Plan, res: Res, t: &mut Tracker, mine: &[&Use]) {
+    let writes = mine.iter().any(|u| u.access.writes());
+    let mut wait = Uses::default();
+    let mut next = Uses::default();
+    if writes {
+        wait = t.writes | t.reads;
+        for u in mine {
+            next = next | Uses::of(u.access);
+        }
+        t.writes = Uses(
+            mine.iter()
+                .filter(|u| u.access.writes())
+                .fold(0, |m, u| m | (1 << u.access as u32)),
+        );
+        // Reads in the same pass as the write are ordered by the pass itself; later reads
+        // still need the write made visible to them.
+        t.reads = Uses(
+            mine.iter()
+                .filter(|u| !u.access.writes())
+                .fold(0, |m, u| m | (1 << u.access as u32)),
+        );
+        t.visible = Uses::default();
+    } else {
+        for u in mine {
+            if !t.visible.contains(u.access) && !t.writes.is_empty() {
+                wait = wait | t.writes;
+                next = next | Uses::of(u.access);
+            }
+            t.visible = t.visible | Uses::of(u.access);
+            t.reads = t.reads | Uses::of(u.access);
+        }
+    }
+    if !next.is_empty() && !wait.is_empty() {
+        plan.memory_prev = plan.memory_prev | wait;
+        plan.memory_next = plan.memory_next | next;
+        for a in next.list() {
+            plan.buffer_log.push((res, wait.list(), a));
+        }
+    }
+}
+
+/// An image's dependency (and layout transition) before a pass using it as `u`.
+fn plan_image(plan: &mut Plan, res: Res, t: &mut Tracker, u: &Use) {
+    let a = u.access;
+    let layout_change = u.discard || t.last.layout() != a.layout();
+    let write = a.writes();
+    let stale = !t.writes.is_empty() && !t.visible.contains(a);
+    if write || layout_change || stale {
+        let wait = if write || layout_change {
+            t.writes | t.reads
+        } else {
+            t.writes
+        };
+        plan.images.push(PlannedImage {
+            res,
+            prev: wait.list(),
+            from: t.last,
+            next: a,
+            discard: u.discard,
+        });
+    }
+    if write || layout_change {
+        // A transition is a write ordered before `a`.
+        t.writes = Uses::of(a);
+        t.visible = Uses::of(a);
+        t.reads = Uses::of(a);
+    } else {
+        t.visible = t.visible | Uses::of(a);
+        t.reads = t.reads | Uses::of(a);
+    }
+    t.last = a;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tracker() -> Tracker {
+        Tracker {
+            writes: Uses::default(),
+            visible: Uses::default(),
+            reads: Uses::default(),
+            last: Access::Nothing,
+        }
+    }
+
+    fn use_(access: Access) -> Use {
+        Use {
+            res: Res(0),
+            access,
+            discard: false,
+        }
+    }
+
+    #[test]
+    fn buffer_hazards() {
+        let mut t = tracker();
+        let mut p = Plan::default();
+        // Nothing written yet: a read needs nothing.
+        plan_buffer(&mut p, Res(0), &mut t, &[&use_(Access::ComputeRead)]);
+        assert!(p.memory_next.is_empty());
+        // A write waits for the read (WAR).
+        let mut p = Plan::default();
+        plan_buffer(&mut p, Res(0), &mut t, &[&use_(Access::ComputeReadWrite)]);
+        assert!(p.memory_prev.contains(Access::ComputeRead));
+        // A read waits for the write; the same read again does not.
+        let mut p = Plan::default();
+        plan_buffer(&mut p, Res(0), &mut t, &[&use_(Access::IndirectRead)]);
+        assert!(p.memory_prev.contains(Access::ComputeReadWrite));
+        assert!(p.memory_next.contains(Access::IndirectRead));
+        let mut p = Plan::default();
+        plan_buffer(&mut p, Res(0), &mut t, &[&use_(Access::IndirectRead)]);
+        assert!(p.memory_next.is_empty());
+        // Another stage's read still waits.
+        let mut p = Plan::default();
+        plan_buffer(&mut p, Res(0), &mut t, &[&use_(Access::VertexRead)]);
+        assert!(p.memory_next.contains(Access::VertexRead));
+        // A write waits for every read since the last write.
+        let mut p = Plan::default();
+        plan_buffer(&mut p, Res(0), &mut t, &[&use_(Access::TransferWrite)]);
+        for a in [
+            Access::ComputeReadWrite,
+            Access::IndirectRead,
+            Access::VertexRead,
+        ] {
+            assert!(p.memory_prev.contains(a), "{a:?}");
+        }
+    }
+
+    #[test]
+    fn image_transitions() {
+        let mut t = tracker();
+        let mut p = Plan::default();
+        plan_image(&mut p, Res(0), &mut t, &use_(Access::ColorAttachment));
+        assert_eq!(p.images.len(), 1);
+        assert_eq!(p.images[0].from, Access::Nothing);
+        // Sampled twice from different stages after one transition: the first read needs
+        // the transition, the same read again nothing.
+        let mut p = Plan::default();
+        plan_image(&mut p, Res(0), &mut t, &use_(Access::SampledRead));
+        assert_eq!(p.images[0].from, Access::ColorAttachment);
+        let mut p = Plan::default();
+        plan_image(&mut p, Res(0), &mut t, &use_(Access::SampledRead));
+        assert!(p.images.is_empty());
+        // A discarding write transitions from UNDEFINED and waits for the reads.
+        let mut p = Plan::default();
+        let mut u = use_(Access::TransferWrite);
+        u.discard = true;
+        plan_image(&mut p, Res(0), &mut t, &u);
+        assert!(p.images[0].discard);
+        assert_eq!(p.images[0].prev, vec![Access::SampledRead]);
+    }
+}
