@@ -393,8 +393,8 @@ impl Renderer {
         let jobs = self.crowd.update_jobs(i, &work.pose_updates);
         let size = self.targets.size();
         let mut g = FrameGraph::new(opts.describe_frame);
-        if let Some((pass, resource)) = &self.desc.omit_use {
-            g.omit_use(pass, resource);
+        if let Some((pass, resource, access)) = &self.desc.omit_use {
+            g.omit_use(pass, resource, *access);
         }
         let sources = FrameSources {
             work: &self.work,

@@ -121,8 +121,8 @@ enum Node<'a> {
 pub struct FrameGraph<'a> {
     resources: Vec<Resource<'a>>,
     nodes: Vec<Node<'a>>,
-    /// A `(pass, resource)` use to leave out (tests: show that sync validation catches it).
-    omit: Option<(&'a str, &'a str)>,
+    /// A `(pass, resource, use)` to leave out (tests: show that sync validation catches it).
+    omit: Option<(&'a str, &'a str, Option<Access>)>,
     describe: bool,
 }
 
@@ -135,10 +135,9 @@ pub struct PassBuilder<'g, 'a> {
 
 impl<'a> PassBuilder<'_, 'a> {
     fn add(mut self, res: Res, access: Access, discard: bool) -> Self {
-        let omitted = self
-            .graph
-            .omit
-            .is_some_and(|(p, r)| p == self.name && r == self.graph.resources[res.0].name);
+        let omitted = self.graph.omit.is_some_and(|(p, r, a)| {
+            p == self.name && r == self.graph.resources[res.0].name && a.is_none_or(|a| a == access)
+        });
         if !omitted {
             self.uses.push(Use {
                 res,
@@ -205,10 +204,11 @@ impl<'a> FrameGraph<'a> {
         }
     }
 
-    /// Leave out pass `pass`'s declared use of `resource` (a deliberate bug, for the test
-    /// that shows synchronization validation catches a missing declaration).
-    pub fn omit_use(&mut self, pass: &'a str, resource: &'a str) {
-        self.omit = Some((pass, resource));
+    /// Leave out pass `pass`'s declared use `access` of `resource` (`None`: every use; a
+    /// deliberate bug, for the test that shows synchronization validation catches a missing
+    /// declaration).
+    pub fn omit_use(&mut self, pass: &'a str, resource: &'a str, access: Option<Access>) {
+        self.omit = Some((pass, resource, access));
     }
 
     fn push(

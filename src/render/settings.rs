@@ -52,10 +52,11 @@ pub struct RendererDesc {
     /// `StrandRaster::Auto`: bundles whose strands are drawn at most this many pixels wide
     /// go to the software rasterizer (finite, > 0).
     pub auto_split_pixels: f32,
-    /// Leave one declared use out of the frame graph: `(pass, resource)` names as printed by
-    /// `render --print-frame`. A deliberate bug for the test that shows synchronization
-    /// validation catches a missing declaration; `None` in every real use.
-    pub omit_use: Option<(String, String)>,
+    /// Leave one declared use out of the frame graph: pass and resource names as printed by
+    /// `render --print-frame`, and the use (`None`: every use of it by that pass). A
+    /// deliberate bug for the test that shows synchronization validation catches a missing
+    /// declaration; `None` in every real use.
+    pub omit_use: Option<(String, String, Option<crate::vk::Access>)>,
 }
 
 impl Default for RendererDesc {

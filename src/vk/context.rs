@@ -32,6 +32,10 @@ pub struct ContextDesc {
     pub window: Option<WindowHandles>,
     /// Enable `VK_LAYER_KHRONOS_validation`; validation errors are counted and printed.
     pub validation: bool,
+    /// With `validation`: also enable synchronization validation (hazards between commands
+    /// that no barrier orders are reported as errors). Slow: for the test that covers every
+    /// pass combination.
+    pub sync_validation: bool,
     /// Pick the device whose name contains this string (case-insensitive).
     pub device: Option<String>,
 }
@@ -40,6 +44,13 @@ impl ContextDesc {
     /// Validation on (tests, debug builds).
     pub fn validation(mut self, on: bool) -> Self {
         self.validation = on;
+        self
+    }
+
+    /// Validation with synchronization validation.
+    pub fn sync_validation(mut self, on: bool) -> Self {
+        self.validation |= on;
+        self.sync_validation = on;
         self
     }
 
@@ -179,6 +190,13 @@ impl Context {
             layers.push(VALIDATION_LAYER.as_ptr());
         }
         let mut extensions = vec![debug_utils::NAME.as_ptr()];
+        let sync = desc.validation && desc.sync_validation;
+        if sync {
+            extensions.push(ash::ext::validation_features::NAME.as_ptr());
+        }
+        let enabled = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled);
         if let Some(w) = &desc.window {
             let needed = ash_window::enumerate_required_extensions(w.display)
                 .ctx("window surface extensions")?;
@@ -206,6 +224,9 @@ impl Context {
             .enabled_extension_names(&extensions);
         if desc.validation {
             info = info.push_next(&mut messenger_info);
+        }
+        if sync {
+            info = info.push_next(&mut features);
         }
         // SAFETY: all pointers in `info` live until the call returns.
         let instance = unsafe { entry.create_instance(&info, None) }.ctx("create instance")?;
