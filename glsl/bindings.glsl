@@ -63,7 +63,7 @@ void bind_character(uint c) {
 // bundle_lods[].y: vertex level e in the low byte, LOD_SOFT when the software rasterizer
 // draws the bundle.
 uint lod_segments(uint y) {
-    return 1u << (y & 255u);
+    return 1u << (y & LOD_LEVEL_MASK);
 }
 
 bool lod_is_soft(uint y) {

@@ -22,8 +22,8 @@ uvec4 encode_lod(BundleLod r) {
 // when the bundle's strands are drawn at most frame.soft_params.x pixels wide at its nearest
 // point `d` (the LoD-thickened width, or the cluster footprint of lod_appearance.glsl).
 bool soft_raster(float d, float width, float thickness, float cap) {
-    if (frame.soft.x != 2u) {
-        return frame.soft.x == 1u;
+    if (frame.soft.x != RASTER_AUTO) {
+        return frame.soft.x == RASTER_SOFTWARE;
     }
     float pixel = frame.light_dir.w > 0.0 ? 2.0 * max(d, 1e-6) / (frame.camera_pos.w * frame.light_dir.w)
                                           : frame.lod_ortho.x / frame.camera_pos.w;

@@ -8,7 +8,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared.glsl"
 #include "curve.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = DEFORM_GROUP_SIZE) in;
 
 layout(set = 0, binding = DEFORM_PARAMS, std430) readonly buffer Params { DeformParams params; };
 layout(set = 0, binding = DEFORM_POSITIONS, std430) readonly buffer Positions { vec4 positions[]; };

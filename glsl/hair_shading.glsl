@@ -14,9 +14,8 @@
 #endif
 layout(set = SHADING_LUT_SET, binding = SHADING_LUT_BINDING) uniform sampler2D marschner_lut;
 
-#define HAIR_ETA 1.55
-#define KAJIYA_KAY_EXPONENT 80.0
-#define MARSCHNER_ENERGY_SCALE 0.9
+// HAIR_ETA, KAJIYA_KAY_EXPONENT and MARSCHNER_ENERGY_SCALE come from shared.glsl (their
+// Rust twins in src/shade/mod.rs).
 
 // (diffuse, specular) of Kajiya-Kay.
 vec2 kajiya_kay(vec3 t, vec3 l, vec3 v) {

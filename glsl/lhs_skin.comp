@@ -5,7 +5,7 @@
 // vertex; push constants: x strands, y vertices per strand.
 #extension GL_GOOGLE_include_directive : require
 #include "shared.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = LHS_GROUP_SIZE) in;
 
 layout(set = 0, binding = LHS_REST, std430) readonly buffer Rest { HairVertex lhs_rest[]; };
 layout(set = 0, binding = LHS_WEIGHTS, std430) readonly buffer Weights { LhsWeights lhs_weights[]; };

@@ -22,7 +22,7 @@ float deep_opacity(vec4 layers, float dz) {
 // the light (world units) against self-shadowing of opaque surfaces.
 float light_transmittance(vec3 p, float offset) {
     uint mode = frame.shadow.x;
-    if (mode == 0u) {
+    if (mode == SHADOW_OFF) {
         return 1.0;
     }
     vec4 c = frame.light_view_proj * vec4(p, 1.0);
@@ -49,7 +49,7 @@ float light_transmittance(vec3 p, float offset) {
             }
             float dz = max(z - texelFetch(shadow_hair_depth, t, 0).r * range, 0.0);
             float opacity;
-            if (mode == 1u) {
+            if (mode == SHADOW_DEEP_OPACITY) {
                 opacity = deep_opacity(texelFetch(shadow_layers, t, 0), dz);
             } else {
                 // One strand per layer thickness in front of the point (calibrated against

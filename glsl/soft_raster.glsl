@@ -101,7 +101,7 @@ float chord_in_pixel(SegmentFrame f, float v, vec2 pmin) {
 
 // Strands drawn at most this wide (pixels) take the line-sampled coverage below. CPU twin:
 // THIN_WIDTH.
-#define SOFT_THIN_WIDTH 2.0
+// SOFT_THIN_WIDTH: shared.glsl (render::soft::THIN_WIDTH).
 
 // The exact area for thick strands: the square in the segment's frame, clipped by the four
 // sides of the rectangle (Sutherland-Hodgman), then the shoelace formula. Its arrays land in

@@ -4,15 +4,17 @@
 // budget (frame.soft.w) are dropped from the tiles at the end of the order and counted.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
-layout(local_size_x = 256) in;
+// One workgroup, dispatched alone: its width has no Rust twin.
+#define TILE_SCAN_THREADS 256
+layout(local_size_x = TILE_SCAN_THREADS) in;
 #include "soft_raster.glsl"
 
-shared uint s_sum[256];
+shared uint s_sum[TILE_SCAN_THREADS];
 
 void main() {
     uint t = gl_LocalInvocationID.x;
     uint tiles = tiles_per_row() * tile_rows();
-    uint run = (tiles + 255u) / 256u;
+    uint run = (tiles + TILE_SCAN_THREADS - 1u) / uint(TILE_SCAN_THREADS);
     uint first = min(t * run, tiles);
     uint last = min(first + run, tiles);
     uint mine = 0u;
@@ -22,7 +24,7 @@ void main() {
     s_sum[t] = mine;
     barrier();
     // Hillis-Steele inclusive scan over the 256 run totals.
-    for (uint step = 1u; step < 256u; step <<= 1u) {
+    for (uint step = 1u; step < uint(TILE_SCAN_THREADS); step <<= 1u) {
         uint add = t >= step ? s_sum[t - step] : 0u;
         barrier();
         s_sum[t] += add;

@@ -23,10 +23,10 @@ vec3 strand_radiance(vec3 tangent, float s_param, vec3 pos, vec3 base, uint char
     float lit = light_transmittance(pos, 0.0);
     float root_shadow = mix(0.55, 1.0, smoothstep(0.0, 0.3, s_param));
     vec3 c;
-    if (frame.shading.x == 1u) {
+    if (frame.shading.x == SHADING_KAJIYA_KAY) {
         vec2 kk = kajiya_kay(t, l, e);
         c = (base * (AMBIENT + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
-    } else if (frame.shading.x == 2u) {
+    } else if (frame.shading.x == SHADING_MARSCHNER) {
         HairStyle s = characters[character].style;
         vec3 sc = marschner(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees));
         float cos_i = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));

@@ -46,6 +46,10 @@ pub const SOFT_BIN_GROUP: u32 = 256;
 /// `bundle_lods[].y` bit: the bundle is drawn by the software rasterizer (the low byte is the
 /// vertex level e).
 pub const LOD_SOFT: u32 = 256;
+/// `GpuBundleLod::y` (`bundle_lods[].y`): the vertex level `e` is the low byte.
+pub const LOD_LEVEL_MASK: u32 = 255;
+/// Invocations of one LHS skinning workgroup (`lhs_skin.comp`).
+pub const LHS_GROUP_SIZE: u32 = 64;
 
 /// Descriptor set 0: per-frame data and the crowd's tables.
 pub const SET_FRAME: u32 = 0;
@@ -677,7 +681,99 @@ pub fn std430_layout(
     (offsets, offset.next_multiple_of(align_max), align_max)
 }
 
-/// The GLSL include `shared.glsl`: constants, binding numbers and shared structs.
+/// Integer constants shared with GLSL. Those used in layout qualifiers (set numbers, local
+/// sizes, mesh output limits) are written as `int`, the rest as `uint`.
+fn int_constants() -> Vec<(&'static str, u32, bool)> {
+    use crate::render::shadow::ShadowMode;
+    use crate::shade::ShadingModel;
+    let layout = |n, v| (n, v, true);
+    let uint = |n, v| (n, v, false);
+    vec![
+        layout("STRAND_GROUP_SIZE", STRAND_GROUP_SIZE),
+        uint("MAX_VERTS_LOG2", MAX_VERTS_LOG2),
+        uint("MAX_SEGMENTS", MAX_SEGMENTS),
+        // The mesh shader's outputs: two vertices per strand vertex, two triangles per
+        // segment.
+        layout("MESH_MAX_VERTICES", 2 * (MAX_SEGMENTS + 1)),
+        layout("MESH_MAX_PRIMITIVES", 2 * MAX_SEGMENTS),
+        uint("MAX_STRANDS_PER_BUNDLE", MAX_STRANDS_PER_BUNDLE as u32),
+        uint("SLICES_PER_SEGMENT", SLICES_PER_SEGMENT),
+        uint("BUNDLE_TRIANGLE", crate::bake::BUNDLE_TRIANGLE),
+        layout("TASK_PAYLOAD_BUNDLES", TASK_PAYLOAD_BUNDLES),
+        layout("CULL_GROUP_SIZE", CULL_GROUP_SIZE),
+        layout("SCAN_THREADS", SCAN_THREADS),
+        uint("SCAN_BLOCK", SCAN_BLOCK),
+        uint("DISPATCH_ROW", DISPATCH_ROW),
+        layout(
+            "DEFORM_GROUP_SIZE",
+            crate::render::deform::DEFORM_GROUP_SIZE,
+        ),
+        layout("LHS_GROUP_SIZE", LHS_GROUP_SIZE),
+        uint("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
+        uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
+        uint("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
+        layout("SET_FRAME", SET_FRAME),
+        layout("SET_TEXTURES", SET_TEXTURES),
+        uint("SOFT_TILE", SOFT_TILE),
+        uint("SOFT_MAX_K", SOFT_MAX_K),
+        layout("SOFT_BIN_GROUP", SOFT_BIN_GROUP),
+        uint("LOD_SOFT", LOD_SOFT),
+        uint("LOD_LEVEL_MASK", LOD_LEVEL_MASK),
+        uint("MAX_OIT_BUDGET", super::transparency::MAX_OIT_BUDGET),
+        uint(
+            "STRAND_RAND_THINNING",
+            crate::reference::generate::STRAND_RAND_THINNING,
+        ),
+        uint("EMPTY_TEXEL", crate::bake::layout::EMPTY_TEXEL),
+        // Enum numbers the frame block carries.
+        uint("SHADING_PLACEHOLDER", ShadingModel::Placeholder as u32),
+        uint("SHADING_KAJIYA_KAY", ShadingModel::KajiyaKay as u32),
+        uint("SHADING_MARSCHNER", ShadingModel::Marschner as u32),
+        uint("SHADOW_OFF", ShadowMode::Off as u32),
+        uint("SHADOW_DEEP_OPACITY", ShadowMode::DeepOpacity as u32),
+        uint("SHADOW_APPROXIMATE", ShadowMode::Approximate as u32),
+        uint(
+            "RASTER_HARDWARE",
+            super::soft::StrandRaster::Hardware.mode(),
+        ),
+        uint(
+            "RASTER_SOFTWARE",
+            super::soft::StrandRaster::Software { k: 1 }.mode(),
+        ),
+        uint(
+            "RASTER_AUTO",
+            super::soft::StrandRaster::Auto { k: 1 }.mode(),
+        ),
+        uint("TRANSPARENCY_OPAQUE", super::Transparency::Opaque.mode()),
+        uint(
+            "TRANSPARENCY_KBUFFER",
+            super::Transparency::KBuffer { budget: 1 }.mode(),
+        ),
+        uint(
+            "TRANSPARENCY_PEELING",
+            super::Transparency::DepthPeeling { layers: 1 }.mode(),
+        ),
+    ]
+}
+
+/// Float constants shared with GLSL.
+fn float_constants() -> Vec<(&'static str, f32)> {
+    vec![
+        ("STRAND_OPACITY", super::transparency::STRAND_OPACITY),
+        ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
+        (
+            "ROOT_PHONG_SHAPE",
+            crate::reference::root_surface::ROOT_PHONG_SHAPE,
+        ),
+        ("HAIR_ETA", crate::shade::HAIR_ETA),
+        ("KAJIYA_KAY_EXPONENT", crate::shade::KAJIYA_KAY_EXPONENT),
+        ("MARSCHNER_ENERGY_SCALE", crate::shade::ENERGY_SCALE),
+        ("SOFT_THIN_WIDTH", super::soft::THIN_WIDTH),
+    ]
+}
+
+/// The GLSL include `shared.glsl`: constants, enum numbers, binding numbers and shared
+/// structs.
 pub fn glsl_header() -> String {
     use std::fmt::Write;
     let mut out = String::new();
@@ -687,75 +783,21 @@ pub fn glsl_header() -> String {
          // Shaders are compiled with this text; this copy is for reading.\n\
          #ifndef SHARED_GLSL\n#define SHARED_GLSL\n"
     );
-    let consts: [(&str, u32); 22] = [
-        ("STRAND_GROUP_SIZE", STRAND_GROUP_SIZE),
-        ("MAX_VERTS_LOG2", MAX_VERTS_LOG2),
-        ("MAX_SEGMENTS", MAX_SEGMENTS),
-        ("MAX_STRANDS_PER_BUNDLE", MAX_STRANDS_PER_BUNDLE as u32),
-        ("SLICES_PER_SEGMENT", SLICES_PER_SEGMENT),
-        ("BUNDLE_TRIANGLE", crate::bake::BUNDLE_TRIANGLE),
-        ("TASK_PAYLOAD_BUNDLES", TASK_PAYLOAD_BUNDLES),
-        ("CULL_GROUP_SIZE", CULL_GROUP_SIZE),
-        ("SCAN_THREADS", SCAN_THREADS),
-        ("SCAN_BLOCK", SCAN_BLOCK),
-        ("DISPATCH_ROW", DISPATCH_ROW),
-        ("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
-        ("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
-        ("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
-        ("SET_FRAME", SET_FRAME),
-        ("SET_TEXTURES", SET_TEXTURES),
-        ("SOFT_TILE", SOFT_TILE),
-        ("SOFT_MAX_K", SOFT_MAX_K),
-        ("SOFT_BIN_GROUP", SOFT_BIN_GROUP),
-        ("LOD_SOFT", LOD_SOFT),
-        ("MAX_OIT_BUDGET", super::transparency::MAX_OIT_BUDGET),
-        (
-            "STRAND_RAND_THINNING",
-            crate::reference::generate::STRAND_RAND_THINNING,
-        ),
-    ];
-    for (name, v) in consts {
-        // Set numbers and local sizes must be int constants in layout qualifiers.
-        let suffix = if name.starts_with("SET_")
-            || name.ends_with("_GROUP_SIZE")
-            || name == "SCAN_THREADS"
-            || name == "TASK_PAYLOAD_BUNDLES"
-            || name == "SOFT_BIN_GROUP"
-        {
-            ""
-        } else {
-            "u"
-        };
+    for (name, v, layout) in int_constants() {
+        let suffix = if layout { "" } else { "u" };
         let _ = writeln!(out, "#define {name} {v}{suffix}");
     }
-    let float_consts = [
-        ("STRAND_OPACITY", super::transparency::STRAND_OPACITY),
-        ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
-        (
-            "ROOT_PHONG_SHAPE",
-            crate::reference::root_surface::ROOT_PHONG_SHAPE,
-        ),
-    ];
-    for (name, v) in float_consts {
+    for (name, v) in float_constants() {
         let _ = writeln!(out, "#define {name} {v:?}");
     }
-    for (b, name) in FrameBinding::ALL {
-        let _ = writeln!(out, "#define {name} {}", b as u32);
+    let bindings = FrameBinding::ALL.iter().map(|(b, n)| (*b as u32, *n));
+    let bindings = bindings
+        .chain(TextureBinding::ALL.iter().map(|(b, n)| (*b as u32, *n)))
+        .chain(DeformBinding::ALL.iter().map(|(b, n)| (*b as u32, *n)))
+        .chain(LhsBinding::ALL.iter().map(|(b, n)| (*b as u32, *n)));
+    for (b, name) in bindings {
+        let _ = writeln!(out, "#define {name} {b}");
     }
-    for (b, name) in TextureBinding::ALL {
-        let _ = writeln!(out, "#define {name} {}", b as u32);
-    }
-    for (b, name) in DeformBinding::ALL {
-        let _ = writeln!(out, "#define {name} {}", b as u32);
-    }
-    for (b, name) in LhsBinding::ALL {
-        let _ = writeln!(out, "#define {name} {}", b as u32);
-    }
-    let _ = writeln!(
-        out,
-        "#define EMPTY_TEXEL {}u",
-        crate::bake::layout::EMPTY_TEXEL
-    );
     let _ = writeln!(
         out,
         "// Depth of the hair mesh texture: SLICES_PER_SEGMENT (L - 1) + 1 slices.\n\

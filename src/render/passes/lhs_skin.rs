@@ -17,8 +17,7 @@ use crate::vk::{
     Pipeline,
 };
 
-/// Invocations of one skinning workgroup.
-const GROUP: u32 = 64;
+use crate::render::shared::LHS_GROUP_SIZE as GROUP;
 
 /// The stored strands on the GPU and one guide-displacement buffer per frame slot.
 pub struct LhsState {
