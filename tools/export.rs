@@ -59,7 +59,12 @@ fn run(args: Args) -> Result<()> {
     }
     let set = CpuGenerator::new(&baked, style).generate(args.strands_per_bundle, args.verts_log2);
     let info = format!("hairmesh export of {}", args.mesh.display());
-    let hair = HairFile::from_strands(&set, style.color, &info)?;
+    let hair = HairFile::from_strands(
+        &set.positions,
+        &set.widths,
+        set.verts_per_strand,
+        (style.color, &info),
+    )?;
     let bytes = hair.to_bytes();
     outln!(
         "{}: {} strands, {} points; .hair {:.2} MiB, hair mesh textures {:.1} KiB ({:.0}x smaller)",

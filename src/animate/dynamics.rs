@@ -18,6 +18,17 @@ use glam::{Mat4, Vec3};
 
 use crate::model::hair_mesh::HairMesh;
 
+/// A canonical head's push-out: `(p, margin)` -> `p` moved out of it (equal when it is the
+/// same function).
+#[derive(Clone, Copy, Debug)]
+pub struct PushOut(pub fn(Vec3, f32) -> Vec3);
+
+impl PartialEq for PushOut {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::fn_addr_eq(self.0, other.0)
+    }
+}
+
 /// Something hair cannot enter, in the character's frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Collider {
@@ -28,10 +39,13 @@ pub enum Collider {
         /// Radii.
         radii: Vec3,
     },
-    /// The human head ([`crate::characters::human`]) placed by `to_person` (canonical head to
-    /// the character's frame; `to_canonical` its inverse): pushed out radially to `margin`
-    /// canonical metres outside it.
+    /// A head in its canonical frame (the human head of `characters::human`, which passes
+    /// its `push_out`) placed by `to_person` (canonical head to the character's frame;
+    /// `to_canonical` its inverse): points are pushed out to `margin` canonical metres
+    /// outside it.
     Human {
+        /// `(p, margin)` -> `p` moved out of the canonical head.
+        push_out: PushOut,
         /// Canonical head to the character's frame.
         to_person: Mat4,
         /// The inverse.
@@ -51,9 +65,11 @@ pub enum Collider {
 }
 
 impl Collider {
-    /// The human head placed by `to_person`, kept `margin` canonical metres away.
-    pub fn human(to_person: Mat4, margin: f32) -> Collider {
+    /// A canonical head (its `push_out`) placed by `to_person`, kept `margin` canonical
+    /// metres away.
+    pub fn human(push_out: fn(Vec3, f32) -> Vec3, to_person: Mat4, margin: f32) -> Collider {
         Collider::Human {
+            push_out: PushOut(push_out),
             to_person,
             to_canonical: to_person.inverse(),
             margin,
@@ -73,21 +89,19 @@ impl Collider {
                 }
             }
             Collider::Human {
+                push_out,
                 to_person,
                 to_canonical,
                 margin,
-            } => match crate::characters::human::human_head() {
-                Ok(head) => {
-                    let q = to_canonical.transform_point3(p);
-                    let moved = head.push_out(q, margin);
-                    if moved == q {
-                        p
-                    } else {
-                        to_person.transform_point3(moved)
-                    }
+            } => {
+                let q = to_canonical.transform_point3(p);
+                let moved = (push_out.0)(q, margin);
+                if moved == q {
+                    p
+                } else {
+                    to_person.transform_point3(moved)
                 }
-                Err(_) => p,
-            },
+            }
             Collider::Capsule { a, b, radius } => {
                 let ab = b - a;
                 let t = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
@@ -159,8 +173,11 @@ impl Collider {
                 radii: radii * scale,
             },
             Collider::Human {
-                to_person, margin, ..
-            } => Collider::human(*m * to_person, margin),
+                push_out,
+                to_person,
+                margin,
+                ..
+            } => Collider::human(push_out.0, *m * to_person, margin),
             Collider::Capsule { a, b, radius } => Collider::Capsule {
                 a: m.transform_point3(a),
                 b: m.transform_point3(b),

@@ -76,9 +76,7 @@ pub struct BundleDesc {
     pub _pad: [u32; 3],
 }
 
-/// Slices of the hair mesh texture per layer segment: the layer slice and the three
-/// intermediate quadratic-Bezier slices (paper 003 sec. 3.1); depth is `4 (L - 1) + 1`.
-pub const SLICES_PER_SEGMENT: u32 = 4;
+pub use crate::model::hair_mesh::{MAX_TEXTURE_SIDE, SLICES_PER_SEGMENT};
 
 /// `BundleDesc::flags` bit of triangle bundles.
 pub const BUNDLE_TRIANGLE: u32 = 1;
@@ -189,9 +187,6 @@ impl Default for BakeOptions {
         }
     }
 }
-
-/// Largest texture side accepted (Vulkan guarantees 2048 for 3D images).
-pub const MAX_TEXTURE_SIDE: u32 = 2048;
 
 /// Per-vertex styling directions `u`, `v` of one layer (eq. 1-3): the texture-space-area-weighted
 /// average of each corner triangle's linear map of the uv axes, normalised. Shared by every

@@ -295,3 +295,12 @@ mod tests {
         assert_eq!(head.prop_mesh().len(), head.triangles.len() * 3);
     }
 }
+
+/// `p` (canonical frame) pushed radially out of the human head to `margin` metres outside it
+/// (unchanged when outside, or when the head cannot be loaded): the dynamics' head collider.
+pub fn push_out_of_head(p: Vec3, margin: f32) -> Vec3 {
+    match human_head() {
+        Ok(head) => head.push_out(p, margin),
+        Err(_) => p,
+    }
+}

@@ -104,7 +104,11 @@ impl PersonShape {
             })
             .collect();
         // The head last: where the neck capsule and the jaw disagree, the head wins.
-        out.push(Collider::human(self.head_transform()?, 0.005));
+        out.push(Collider::human(
+            super::human::push_out_of_head,
+            self.head_transform()?,
+            0.005,
+        ));
         Ok(out)
     }
 }

@@ -231,38 +231,40 @@ impl HairFile {
         Self::parse(&path.display().to_string(), &bytes)
     }
 
-    /// The strands of the CPU reference generator as a `.hair` model: positions and per-point
-    /// thickness (object units), the style's colour as the default colour.
+    /// Strands of `verts_per_strand` points each (the CPU reference generator's `StrandSet`)
+    /// as a `.hair` model: positions and per-point thickness (object units), `color` as the
+    /// default colour.
     pub fn from_strands(
-        set: &crate::reference::generate::StrandSet,
-        color: [f32; 3],
-        info: &str,
+        positions: &[glam::Vec3],
+        widths: &[f32],
+        verts_per_strand: usize,
+        (color, info): ([f32; 3], &str),
     ) -> Result<Self> {
-        let segments = set.verts_per_strand.saturating_sub(1);
+        let segments = verts_per_strand.saturating_sub(1);
         if segments == 0 || segments > u16::MAX as usize {
             return Err(HairError::invalid(
                 "strands",
                 format!("{segments} segments per strand cannot be written"),
             ));
         }
-        if set.positions.len() as u64 > MAX_POINTS {
+        if positions.len() as u64 > MAX_POINTS {
             return Err(HairError::invalid(
                 "strands",
-                format!("{} points: more than {MAX_POINTS}", set.positions.len()),
+                format!("{} points: more than {MAX_POINTS}", positions.len()),
             ));
         }
         Ok(HairFile {
             segments: None,
             default_segments: segments as u32,
-            points: set.positions.iter().map(|p| p.to_array()).collect(),
-            thickness: Some(set.widths.clone()),
-            default_thickness: set.widths.first().copied().unwrap_or(0.0),
+            points: positions.iter().map(|p| p.to_array()).collect(),
+            thickness: Some(widths.to_vec()),
+            default_thickness: widths.first().copied().unwrap_or(0.0),
             transparency: None,
             default_transparency: 0.0,
             colors: None,
             default_color: color,
             info: info.to_string(),
-            hair_count: set.strand_count() as u32,
+            hair_count: (positions.len() / verts_per_strand) as u32,
         })
     }
 }

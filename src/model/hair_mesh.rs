@@ -9,6 +9,14 @@ use glam::{Vec2, Vec3};
 
 use crate::error::{HairError, Result};
 
+/// Slices of the hair mesh texture per layer segment: the layer slice and the three
+/// intermediate quadratic-Bezier slices (paper 003 sec. 3.1); depth is `4 (L - 1) + 1`. The
+/// bake's layout; here because it bounds the layers a hair mesh may have.
+pub const SLICES_PER_SEGMENT: u32 = 4;
+
+/// Largest texture side accepted (Vulkan guarantees 2048 for 3D images).
+pub const MAX_TEXTURE_SIDE: u32 = 2048;
+
 /// A root face: a bundle of the hair mesh. Higher-degree polygons are split on load.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Face {
@@ -324,9 +332,8 @@ pub fn split_polygon(degree: usize) -> Vec<Vec<usize>> {
 }
 
 /// Most layers of a hair mesh: the hair mesh texture has `4 (L - 1) + 1` slices and a side
-/// holds at most [`MAX_TEXTURE_SIDE`](crate::bake::MAX_TEXTURE_SIDE) texels.
-pub const MAX_LAYERS: usize =
-    (crate::bake::MAX_TEXTURE_SIDE / crate::bake::SLICES_PER_SEGMENT) as usize;
+/// holds at most [`MAX_TEXTURE_SIDE`] texels.
+pub const MAX_LAYERS: usize = (MAX_TEXTURE_SIDE / SLICES_PER_SEGMENT) as usize;
 
 /// How a scalp is extruded into layers by [`extrude`].
 #[derive(Clone, Debug)]

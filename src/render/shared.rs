@@ -28,13 +28,7 @@ pub const SCAN_BLOCK: u32 = 1024;
 pub const DISPATCH_ROW: u32 = 65535;
 /// `CharacterRecord::flags`: the character is drawn this frame.
 pub const CHARACTER_VISIBLE: u32 = 1;
-/// Marschner lookup texture (`shade::lut`): texels over `cos(phi)`.
-pub const MARSCHNER_LUT_PHI: u32 = 256;
-/// Marschner lookup texture: texels over `cos(theta_d)`.
-pub const MARSCHNER_LUT_D: u32 = 64;
-/// Marschner lookup texture: scale of the TRT attenuation channel (its largest value is
-/// 0.185).
-pub const MARSCHNER_LUT_TRT_SCALE: f32 = 5.0;
+pub use crate::shade::lut::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE};
 
 /// Software rasterizer: side of a square screen tile in pixels (one raster workgroup).
 pub const SOFT_TILE: u32 = 16;

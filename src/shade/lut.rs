@@ -9,7 +9,12 @@
 //! holds the factors at `cos(phi) = -1 + 2 i / (PHI - 1)`, `cos(theta_d) = j / (D - 1)`: r the TT
 //! path, g the TT attenuation, b the TRT attenuation times `MARSCHNER_LUT_TRT_SCALE`, a 0.
 
-use crate::render::shared::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE};
+/// Texels over `cos(phi)`.
+pub const MARSCHNER_LUT_PHI: u32 = 256;
+/// Texels over `cos(theta_d)`.
+pub const MARSCHNER_LUT_D: u32 = 64;
+/// Scale of the TRT attenuation channel (its largest value is 0.185).
+pub const MARSCHNER_LUT_TRT_SCALE: f32 = 5.0;
 
 /// `(cos(phi), cos(theta_d))` of texel `(i, j)`.
 pub fn texel_angles(i: u32, j: u32) -> (f32, f32) {
