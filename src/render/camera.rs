@@ -211,7 +211,7 @@ pub struct View {
     /// Shading model of the strands.
     pub shading: crate::shade::ShadingModel,
     /// Shadows from the light (hair on hair, hair and bodies on each other).
-    pub shadows: super::shadow::ShadowMode,
+    pub shadows: super::settings::ShadowMode,
     /// How strands are composited: opaque, k-buffer OIT or depth peeling.
     pub transparency: super::transparency::Transparency,
     /// Seed 000's aggregated appearance for LoD-thickened strands (opacity and multiple

@@ -8,15 +8,14 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec3;
 
-use super::frame::FRAMES_IN_FLIGHT;
 use super::shared::{DeformBinding, DeformParams};
+use super::slots::FRAMES_IN_FLIGHT;
 use crate::bake::deform::DeformBasis;
 use crate::vk::{
     Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult,
 };
 
-/// Invocations of one `hair_mesh_update.comp` workgroup.
-pub const DEFORM_GROUP_SIZE: u32 = 64;
+pub use super::shared::DEFORM_GROUP_SIZE;
 
 /// One animated character's update state.
 pub struct DeformState {

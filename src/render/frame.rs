@@ -1,10 +1,7 @@
-//! A frame, from settings to submission: what each of the frames in flight owns (command
-//! buffer, fence, per-frame uniform data and character records, timestamp and mesh queries,
-//! statistics and image readback, its descriptor set 0, the resources retired with it), and
-//! the orchestration of one frame: check the settings, size the buffers, write the frame
-//! blocks, build the frame graph from the passes, run it, submit.
+//! A frame, from settings to submission: check the settings, size the buffers, write the frame
+//! blocks, build the frame graph from the passes, run it, submit (the frames in flight are
+//! [`super::slots`]).
 
-use std::any::Any;
 use std::sync::Arc;
 
 use ash::vk;
@@ -20,157 +17,14 @@ use super::passes::{FrameInputs, FrameRes, FrameSources, PassSets};
 use super::renderer::{PresentTarget, Renderer};
 use super::settings::{FrameOptions, FrameTicket};
 use super::shadow::{LightView, ShadowMode};
-use super::shared::{CharacterRecord, FrameBlock, FrameStats, GenerateArgs, PropInstance};
+use super::shared::{FrameBlock, PropInstance};
+use super::slots::{
+    FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
+};
 use super::soft::StrandRaster;
 use super::transparency::Transparency;
 use super::workspace::FrameBuffers;
-use crate::vk::{
-    Buffer, BufferDesc, CommandBuffer, Context, DescriptorSet, DescriptorSetLayout, Fence,
-    GpuError, GpuResult, MeshPrimitivesQuery, Profiler,
-};
-
-/// Frames the CPU may record ahead of the GPU.
-pub const FRAMES_IN_FLIGHT: usize = 2;
-
-/// A resource released once the frame it was retired with has completed.
-pub enum Retired {
-    /// Any GPU object (buffer, image, set...): dropped.
-    Resource(Box<dyn Any>),
-    /// A character slot: reusable.
-    CharacterSlot(u32),
-}
-
-/// What a completed frame did.
-#[derive(Clone, Debug)]
-pub struct FrameReport {
-    /// Frame number (from 0, per renderer).
-    pub frame: u64,
-    /// Generation path used.
-    pub path: RenderPath,
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// What the GPU generated.
-    pub stats: FrameStats,
-    /// GPU milliseconds per pass.
-    pub pass_ms: Vec<(&'static str, f64)>,
-    /// Mesh path: `MESH_PRIMITIVES_GENERATED_EXT` where the device supports it.
-    pub mesh_primitives: Option<u64>,
-    /// CPU milliseconds spent recording the frame's commands.
-    pub record_ms: f64,
-    /// RGBA8 pixels (sRGB), top row first, when requested.
-    pub rgba: Option<Vec<u8>>,
-    /// The frame graph's passes, uses and barriers, when
-    /// [`super::FrameOptions::describe_frame`] was set.
-    pub frame_graph: Option<String>,
-}
-
-impl FrameReport {
-    /// Total GPU milliseconds.
-    pub fn gpu_ms(&self) -> f64 {
-        self.pass_ms.iter().map(|p| p.1).sum()
-    }
-}
-
-pub(crate) struct Pending {
-    pub frame: u64,
-    pub path: RenderPath,
-    pub width: u32,
-    pub height: u32,
-    pub record_ms: f64,
-    pub read_image: bool,
-    /// The frame graph's description, when asked for.
-    pub frame_graph: Option<String>,
-}
-
-/// One frame in flight.
-pub(crate) struct FrameSlot {
-    pub cmd: CommandBuffer,
-    pub fence: Fence,
-    pub frame_ubo: Buffer,
-    /// The light's frame block (shadow passes).
-    pub light_ubo: Buffer,
-    pub records: Buffer,
-    pub prop_instances: Buffer,
-    pub stats_readback: Buffer,
-    pub image_readback: Option<Buffer>,
-    pub profiler: Profiler,
-    pub mesh_query: Option<MeshPrimitivesQuery>,
-    pub set: DescriptorSet,
-    /// Set 0 of the shadow passes: as `set`, with `light_ubo` as the frame block.
-    pub light_set: DescriptorSet,
-    pub retired: Vec<Retired>,
-    pub pending: Option<Pending>,
-}
-
-impl FrameSlot {
-    pub fn new(ctx: &Arc<Context>, layout: &Arc<DescriptorSetLayout>) -> GpuResult<Self> {
-        Ok(FrameSlot {
-            cmd: CommandBuffer::new(ctx, "frame")?,
-            fence: Fence::new(ctx, true)?,
-            frame_ubo: frame_block_buffer(ctx, "frame block")?,
-            light_ubo: frame_block_buffer(ctx, "light frame block")?,
-            records: records_buffer(ctx, 1)?,
-            prop_instances: prop_instance_buffer(ctx, 1)?,
-            stats_readback: Buffer::new(
-                ctx,
-                &BufferDesc::new(
-                    "stats readback",
-                    size_of::<GenerateArgs>() as u64,
-                    vk::BufferUsageFlags::TRANSFER_DST,
-                )
-                .readback(),
-            )?,
-            image_readback: None,
-            profiler: Profiler::new(ctx)?,
-            mesh_query: MeshPrimitivesQuery::new(ctx)?,
-            set: DescriptorSet::new(ctx, "frame set", layout)?,
-            light_set: DescriptorSet::new(ctx, "light frame set", layout)?,
-            retired: Vec::new(),
-            pending: None,
-        })
-    }
-}
-
-/// A host-visible uniform buffer for one `FrameBlock`.
-fn frame_block_buffer(ctx: &Arc<Context>, name: &str) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(
-            name,
-            size_of::<FrameBlock>() as u64,
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        )
-        .host_visible(),
-    )
-}
-
-/// A host-visible buffer for `n` prop instances.
-pub(crate) fn prop_instance_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(
-            "prop instances",
-            n.max(1) as u64 * size_of::<super::shared::PropInstance>() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        )
-        .host_visible(),
-    )
-}
-
-/// A host-visible buffer for `n` character records.
-pub(crate) fn records_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(
-            "character records",
-            n.max(1) as u64 * size_of::<CharacterRecord>() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        )
-        .host_visible(),
-    )
-}
+use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
 
 /// What one frame draws (beyond the options the caller gave).
 pub(super) struct FrameWork<'a> {

@@ -16,6 +16,7 @@ pub mod scene;
 pub mod settings;
 pub mod shadow;
 pub mod shared;
+pub mod slots;
 pub mod soft;
 pub mod targets;
 pub mod transparency;
@@ -23,12 +24,12 @@ pub mod workspace;
 
 pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
 pub use crowd::{CharacterId, Crowd, StrandParams};
-pub use frame::{FRAMES_IN_FLIGHT, FrameReport};
 pub use renderer::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,
     RendererDesc, check_msaa, software_raster_conflict, supported_msaa,
 };
 pub use shadow::ShadowMode;
 pub use shared::FrameStats;
+pub use slots::{FRAMES_IN_FLIGHT, FrameReport};
 pub use soft::StrandRaster;
 pub use transparency::Transparency;

@@ -1,15 +1,15 @@
 //! Props (bodies, ground): prop meshes on the GPU, the world's instances and the ones that
 //! move with a character, and this frame's draw lists.
 
+use std::sync::Arc;
+
+use ash::vk;
 use glam::Mat4;
 
 use super::crowd::CharacterId;
-use super::frame::Retired;
 use super::passes::props::PropDraw;
-use super::renderer::Renderer;
 use super::shared::{PropInstance, PropVertex};
-use crate::vk::{Buffer, GpuError, GpuResult};
-use ash::vk;
+use crate::vk::{Buffer, Context, GpuError, GpuResult};
 
 /// Prop meshes on the GPU and the instances placed for the next frames.
 #[derive(Default)]
@@ -58,10 +58,14 @@ impl Props {
     }
 }
 
-impl Renderer {
-    /// Upload the prop meshes (triangle lists); instances refer to them by index. Replaces
-    /// earlier meshes and clears the instances.
-    pub fn set_prop_meshes(&mut self, meshes: &[Vec<PropVertex>]) -> GpuResult<()> {
+impl Props {
+    /// Replace the prop meshes (triangle lists) and clear the instances; returns the old
+    /// vertex buffer (frames in flight may still read it).
+    pub(super) fn set_meshes(
+        &mut self,
+        ctx: &Arc<Context>,
+        meshes: &[Vec<PropVertex>],
+    ) -> GpuResult<Option<Buffer>> {
         let mut all = Vec::new();
         let mut ranges = Vec::new();
         for m in meshes {
@@ -77,72 +81,59 @@ impl Renderer {
             None
         } else {
             Some(Buffer::device_local_with_data(
-                &self.ctx,
+                ctx,
                 "prop vertices",
                 vk::BufferUsageFlags::STORAGE_BUFFER,
                 bytemuck::cast_slice(&all),
             )?)
         };
-        if let Some(old) = std::mem::replace(&mut self.props.vertices, vertices) {
-            self.retire(Retired::Resource(Box::new(old)));
-        }
-        self.props.meshes = ranges;
-        self.props.instances.clear();
-        self.props.attached.clear();
-        Ok(())
+        self.meshes = ranges;
+        self.instances.clear();
+        self.attached.clear();
+        Ok(std::mem::replace(&mut self.vertices, vertices))
     }
+
     /// Refuse instances of meshes that do not exist or with non-finite values.
-    fn check_prop_instances(&self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
-        if let Some((m, _)) = instances
-            .iter()
-            .find(|(m, _)| *m >= self.props.meshes.len())
-        {
+    fn check(&self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
+        if let Some((m, _)) = instances.iter().find(|(m, _)| *m >= self.meshes.len()) {
             return Err(GpuError::Unsupported(format!("no prop mesh {m}")));
         }
-        if instances.iter().any(|(_, i)| {
-            !i.model
+        let finite = |i: &PropInstance| {
+            i.model
                 .iter()
                 .flatten()
                 .chain(&i.color)
                 .all(|x| x.is_finite())
-        }) {
+        };
+        if !instances.iter().all(|(_, i)| finite(i)) {
             return Err(GpuError::Unsupported("prop transform is not finite".into()));
         }
         Ok(())
     }
-    /// Place world props for the next frames: `(mesh index, instance)`.
-    pub fn set_prop_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
-        self.check_prop_instances(instances)?;
-        self.props.instances = instances.to_vec();
+
+    /// Place the world props: `(mesh index, instance)`.
+    pub(super) fn set_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
+        self.check(instances)?;
+        self.instances = instances.to_vec();
         Ok(())
     }
-    /// Give character `id` props that move with it (its head and body): `(mesh index,
-    /// instance in the character's frame)`, drawn every frame at the character's current
-    /// model, and not at all while it is hidden or after it is removed. Replaces its earlier
-    /// props.
-    pub fn set_character_props(
+
+    /// Replace character `id`'s props (instances in its frame).
+    pub(super) fn set_attached(
         &mut self,
         id: CharacterId,
         instances: &[(usize, PropInstance)],
     ) -> GpuResult<()> {
-        if !self.crowd.contains(id) {
-            return Err(GpuError::Unsupported(format!("no character {id:?}")));
-        }
-        self.check_prop_instances(instances)?;
-        self.props.attached.retain(|(c, ..)| *c != id);
-        self.props
-            .attached
+        self.check(instances)?;
+        self.attached.retain(|(c, ..)| *c != id);
+        self.attached
             .extend(instances.iter().map(|(m, i)| (id, *m, *i)));
         Ok(())
     }
-    /// Where character `id`'s props are drawn this frame (world transforms, in the order
-    /// given to [`Self::set_character_props`]); empty while it is hidden.
-    pub fn character_prop_models(&self, id: CharacterId) -> Vec<Mat4> {
-        let Some(model) = self.crowd.drawn_model(id) else {
-            return Vec::new();
-        };
-        self.props
-            .attached
+
+    /// Character `id`'s props placed at `model` (world transforms, in the order given).
+    pub(super) fn attached_models(&self, id: CharacterId, model: Mat4) -> Vec<Mat4> {
+        self.attached
             .iter()
             .filter(|(c, ..)| *c == id)
             .map(|(_, _, i)| model * Mat4::from_cols_array_2d(&i.model))

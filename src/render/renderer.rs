@@ -12,7 +12,6 @@ use glam::Mat4;
 
 use super::camera::View;
 use super::crowd::{CharacterId, Crowd, StrandParams};
-use super::frame::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Retired};
 use super::passes::FramePasses;
 pub use super::passes::output::Overlay;
 use super::prop_table::Props;
@@ -20,7 +19,10 @@ pub use super::settings::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, RenderPath, RendererDesc, check_msaa,
     software_raster_conflict, supported_msaa,
 };
-use super::shared::{FrameBinding, GenerateArgs, HairVertex, SET_FRAME, SET_TEXTURES};
+use super::shared::{
+    FrameBinding, GenerateArgs, HairVertex, PropInstance, SET_FRAME, SET_TEXTURES,
+};
+use super::slots::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Retired};
 use super::soft::{SoftBudget, SoftBuffers};
 use super::targets::{RenderTargets, ShadowMaps};
 use super::transparency::TransparencyBuffers;
@@ -300,6 +302,44 @@ impl Renderer {
             .ok_or_else(|| GpuError::Unsupported("no LHS strands captured".into()))?
             .1
             .set_guides(now)
+    }
+
+    /// Upload the prop meshes (triangle lists); instances refer to them by index. Replaces
+    /// earlier meshes and clears the instances.
+    pub fn set_prop_meshes(&mut self, meshes: &[Vec<super::shared::PropVertex>]) -> GpuResult<()> {
+        if let Some(old) = self.props.set_meshes(&self.ctx, meshes)? {
+            self.retire(Retired::Resource(Box::new(old)));
+        }
+        Ok(())
+    }
+
+    /// Place world props for the next frames: `(mesh index, instance)`.
+    pub fn set_prop_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
+        self.props.set_instances(instances)
+    }
+
+    /// Give character `id` props that move with it (its head and body): `(mesh index,
+    /// instance in the character's frame)`, drawn every frame at the character's current
+    /// model, and not at all while it is hidden or after it is removed. Replaces its earlier
+    /// props.
+    pub fn set_character_props(
+        &mut self,
+        id: CharacterId,
+        instances: &[(usize, PropInstance)],
+    ) -> GpuResult<()> {
+        if !self.crowd.contains(id) {
+            return Err(GpuError::Unsupported(format!("no character {id:?}")));
+        }
+        self.props.set_attached(id, instances)
+    }
+
+    /// Where character `id`'s props are drawn this frame (world transforms, in the order
+    /// given to [`Self::set_character_props`]); empty while it is hidden.
+    pub fn character_prop_models(&self, id: CharacterId) -> Vec<Mat4> {
+        match self.crowd.drawn_model(id) {
+            Some(model) => self.props.attached_models(id, model),
+            None => Vec::new(),
+        }
     }
 
     /// Where character `id` is drawn this frame (`None`: hidden or removed).

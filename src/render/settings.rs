@@ -69,7 +69,7 @@ impl Default for RendererDesc {
             width: 1280,
             height: 720,
             msaa: 1,
-            shadow_resolution: super::shadow::DEFAULT_SHADOW_RESOLUTION,
+            shadow_resolution: DEFAULT_SHADOW_RESOLUTION,
             soft_budget: None,
             auto_split_pixels: super::soft::AUTO_SPLIT_PIXELS,
             omit_use: None,
@@ -283,4 +283,38 @@ pub(super) fn check_size(width: u32, height: u32) -> crate::vk::GpuResult<()> {
         )));
     }
     Ok(())
+}
+
+/// Default shadow map resolution (square).
+pub const DEFAULT_SHADOW_RESOLUTION: u32 = 1024;
+
+/// How hair is shadowed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum ShadowMode {
+    /// No shadows.
+    #[default]
+    Off = super::shared::SHADOW_OFF,
+    /// Deep opacity maps (two light passes).
+    DeepOpacity = super::shared::SHADOW_DEEP_OPACITY,
+    /// Approximate deep shadow maps (one light pass).
+    Approximate = super::shared::SHADOW_APPROXIMATE,
+}
+
+impl ShadowMode {
+    /// Every mode, in menu order.
+    pub const ALL: [ShadowMode; 3] = [
+        ShadowMode::Off,
+        ShadowMode::DeepOpacity,
+        ShadowMode::Approximate,
+    ];
+
+    /// Name used by flags and scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowMode::Off => "off",
+            ShadowMode::DeepOpacity => "deep-opacity",
+            ShadowMode::Approximate => "approximate",
+        }
+    }
 }

@@ -23,39 +23,7 @@ pub const SHADOW_LAYERS: u32 = 4;
 /// Opacity of one strand to the light: fibres pass part of the light (the TT lobe), so one
 /// strand does not block it all.
 pub const STRAND_SHADOW_OPACITY: f32 = 0.5;
-/// Default shadow map resolution (square).
-pub const DEFAULT_SHADOW_RESOLUTION: u32 = 1024;
-
-/// How hair is shadowed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-#[repr(u32)]
-pub enum ShadowMode {
-    /// No shadows.
-    #[default]
-    Off = 0,
-    /// Deep opacity maps (two light passes).
-    DeepOpacity = 1,
-    /// Approximate deep shadow maps (one light pass).
-    Approximate = 2,
-}
-
-impl ShadowMode {
-    /// Every mode, in menu order.
-    pub const ALL: [ShadowMode; 3] = [
-        ShadowMode::Off,
-        ShadowMode::DeepOpacity,
-        ShadowMode::Approximate,
-    ];
-
-    /// Name used by flags and scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            ShadowMode::Off => "off",
-            ShadowMode::DeepOpacity => "deep-opacity",
-            ShadowMode::Approximate => "approximate",
-        }
-    }
-}
+pub use super::settings::{DEFAULT_SHADOW_RESOLUTION, ShadowMode};
 
 impl std::str::FromStr for ShadowMode {
     type Err = String;

@@ -40,6 +40,34 @@ pub const SOFT_BIN_GROUP: u32 = 256;
 /// `bundle_lods[].y` bit: the bundle is drawn by the software rasterizer (the low byte is the
 /// vertex level e).
 pub const LOD_SOFT: u32 = 256;
+/// Invocations of one `hair_mesh_update.comp` workgroup.
+pub const DEFORM_GROUP_SIZE: u32 = 64;
+/// Largest k-buffer budget (nodes per pixel).
+pub const MAX_OIT_BUDGET: u32 = 16;
+/// Opacity of one full-detail strand over the part of a pixel it covers.
+pub const STRAND_OPACITY: f32 = 0.7;
+/// Strands drawn at most this wide (pixels) take the software rasterizer's line-sampled
+/// coverage: much cheaper on GPUs than the exact area; the sum over pixels is still the
+/// strand's area (a pixel may get a little more than 1 and its neighbours as much less).
+pub const SOFT_THIN_WIDTH: f32 = 2.0;
+/// `FrameBlock::soft.x`: hardware strips.
+pub const RASTER_HARDWARE: u32 = 0;
+/// `FrameBlock::soft.x`: the software rasterizer.
+pub const RASTER_SOFTWARE: u32 = 1;
+/// `FrameBlock::soft.x`: software or hardware per bundle.
+pub const RASTER_AUTO: u32 = 2;
+/// `FrameBlock::transparency.x`: opaque strands.
+pub const TRANSPARENCY_OPAQUE: u32 = 0;
+/// `FrameBlock::transparency.x`: k-buffer OIT.
+pub const TRANSPARENCY_KBUFFER: u32 = 1;
+/// `FrameBlock::transparency.x`: depth peeling.
+pub const TRANSPARENCY_PEELING: u32 = 2;
+/// `FrameBlock::shadow.x`: no shadows.
+pub const SHADOW_OFF: u32 = 0;
+/// `FrameBlock::shadow.x`: deep opacity maps.
+pub const SHADOW_DEEP_OPACITY: u32 = 1;
+/// `FrameBlock::shadow.x`: approximate deep shadow maps.
+pub const SHADOW_APPROXIMATE: u32 = 2;
 /// `GpuBundleLod::y` (`bundle_lods[].y`): the vertex level `e` is the low byte.
 pub const LOD_LEVEL_MASK: u32 = 255;
 /// Invocations of one LHS skinning workgroup (`lhs_skin.comp`).
@@ -678,7 +706,6 @@ pub fn std430_layout(
 /// Integer constants shared with GLSL. Those used in layout qualifiers (set numbers, local
 /// sizes, mesh output limits) are written as `int`, the rest as `uint`.
 fn int_constants() -> Vec<(&'static str, u32, bool)> {
-    use crate::render::shadow::ShadowMode;
     use crate::shade::ShadingModel;
     let layout = |n, v| (n, v, true);
     let uint = |n, v| (n, v, false);
@@ -698,10 +725,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         layout("SCAN_THREADS", SCAN_THREADS),
         uint("SCAN_BLOCK", SCAN_BLOCK),
         uint("DISPATCH_ROW", DISPATCH_ROW),
-        layout(
-            "DEFORM_GROUP_SIZE",
-            crate::render::deform::DEFORM_GROUP_SIZE,
-        ),
+        layout("DEFORM_GROUP_SIZE", DEFORM_GROUP_SIZE),
         layout("LHS_GROUP_SIZE", LHS_GROUP_SIZE),
         uint("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
         uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
@@ -713,7 +737,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         layout("SOFT_BIN_GROUP", SOFT_BIN_GROUP),
         uint("LOD_SOFT", LOD_SOFT),
         uint("LOD_LEVEL_MASK", LOD_LEVEL_MASK),
-        uint("MAX_OIT_BUDGET", super::transparency::MAX_OIT_BUDGET),
+        uint("MAX_OIT_BUDGET", MAX_OIT_BUDGET),
         uint(
             "STRAND_RAND_THINNING",
             crate::reference::generate::STRAND_RAND_THINNING,
@@ -723,37 +747,22 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("SHADING_PLACEHOLDER", ShadingModel::Placeholder as u32),
         uint("SHADING_KAJIYA_KAY", ShadingModel::KajiyaKay as u32),
         uint("SHADING_MARSCHNER", ShadingModel::Marschner as u32),
-        uint("SHADOW_OFF", ShadowMode::Off as u32),
-        uint("SHADOW_DEEP_OPACITY", ShadowMode::DeepOpacity as u32),
-        uint("SHADOW_APPROXIMATE", ShadowMode::Approximate as u32),
-        uint(
-            "RASTER_HARDWARE",
-            super::soft::StrandRaster::Hardware.mode(),
-        ),
-        uint(
-            "RASTER_SOFTWARE",
-            super::soft::StrandRaster::Software { k: 1 }.mode(),
-        ),
-        uint(
-            "RASTER_AUTO",
-            super::soft::StrandRaster::Auto { k: 1 }.mode(),
-        ),
-        uint("TRANSPARENCY_OPAQUE", super::Transparency::Opaque.mode()),
-        uint(
-            "TRANSPARENCY_KBUFFER",
-            super::Transparency::KBuffer { budget: 1 }.mode(),
-        ),
-        uint(
-            "TRANSPARENCY_PEELING",
-            super::Transparency::DepthPeeling { layers: 1 }.mode(),
-        ),
+        uint("SHADOW_OFF", SHADOW_OFF),
+        uint("SHADOW_DEEP_OPACITY", SHADOW_DEEP_OPACITY),
+        uint("SHADOW_APPROXIMATE", SHADOW_APPROXIMATE),
+        uint("RASTER_HARDWARE", RASTER_HARDWARE),
+        uint("RASTER_SOFTWARE", RASTER_SOFTWARE),
+        uint("RASTER_AUTO", RASTER_AUTO),
+        uint("TRANSPARENCY_OPAQUE", TRANSPARENCY_OPAQUE),
+        uint("TRANSPARENCY_KBUFFER", TRANSPARENCY_KBUFFER),
+        uint("TRANSPARENCY_PEELING", TRANSPARENCY_PEELING),
     ]
 }
 
 /// Float constants shared with GLSL.
 fn float_constants() -> Vec<(&'static str, f32)> {
     vec![
-        ("STRAND_OPACITY", super::transparency::STRAND_OPACITY),
+        ("STRAND_OPACITY", STRAND_OPACITY),
         ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
         (
             "ROOT_PHONG_SHAPE",
@@ -762,7 +771,7 @@ fn float_constants() -> Vec<(&'static str, f32)> {
         ("HAIR_ETA", crate::shade::HAIR_ETA),
         ("KAJIYA_KAY_EXPONENT", crate::shade::KAJIYA_KAY_EXPONENT),
         ("MARSCHNER_ENERGY_SCALE", crate::shade::ENERGY_SCALE),
-        ("SOFT_THIN_WIDTH", super::soft::THIN_WIDTH),
+        ("SOFT_THIN_WIDTH", SOFT_THIN_WIDTH),
     ]
 }
 

@@ -65,9 +65,9 @@ impl StrandRaster {
     /// Mode number in `FrameBlock::soft.x`.
     pub fn mode(self) -> u32 {
         match self {
-            StrandRaster::Hardware => 0,
-            StrandRaster::Software { .. } => 1,
-            StrandRaster::Auto { .. } => 2,
+            StrandRaster::Hardware => super::shared::RASTER_HARDWARE,
+            StrandRaster::Software { .. } => super::shared::RASTER_SOFTWARE,
+            StrandRaster::Auto { .. } => super::shared::RASTER_AUTO,
         }
     }
 
@@ -307,11 +307,7 @@ fn chord_in_pixel(a: Vec2, d: Vec2, n: Vec2, len: f32, v: f32, pmin: Vec2) -> f3
     (hi - lo).max(0.0)
 }
 
-/// Strands drawn at most this wide (pixels) take the line-sampled coverage
-/// (`SOFT_THIN_WIDTH` of `soft_raster.glsl`): much cheaper on GPUs than the exact area; the
-/// sum over pixels is still the strand's area (a pixel may get a little more than 1 and its
-/// neighbours as much less).
-pub const THIN_WIDTH: f32 = 2.0;
+pub use super::shared::SOFT_THIN_WIDTH as THIN_WIDTH;
 
 /// Share of the unit pixel square with corner `pmin` covered by the rectangle of half-width
 /// `h` around the segment `a -> b`: CPU twin of `pixel_coverage` in `soft_raster.glsl`

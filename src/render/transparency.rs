@@ -20,16 +20,13 @@ use ash::vk;
 
 use crate::vk::{Access, Buffer, BufferDesc, Context, GpuResult, Image, ImageDesc};
 
-/// Largest k-buffer budget (nodes per pixel).
-pub const MAX_OIT_BUDGET: u32 = 16;
+pub use super::shared::{MAX_OIT_BUDGET, STRAND_OPACITY};
 /// Default k-buffer budget.
 pub const DEFAULT_OIT_BUDGET: u32 = 8;
 /// Largest number of peeled layers.
 pub const MAX_PEEL_LAYERS: u32 = 256;
 /// Default number of peeled layers.
 pub const DEFAULT_PEEL_LAYERS: u32 = 32;
-/// Opacity of one full-detail strand over the part of a pixel it covers.
-pub const STRAND_OPACITY: f32 = 0.7;
 
 /// How the strands of a frame are composited.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -53,9 +50,9 @@ impl Transparency {
     /// Mode number in `FrameBlock::transparency.x`.
     pub fn mode(self) -> u32 {
         match self {
-            Transparency::Opaque => 0,
-            Transparency::KBuffer { .. } => 1,
-            Transparency::DepthPeeling { .. } => 2,
+            Transparency::Opaque => super::shared::TRANSPARENCY_OPAQUE,
+            Transparency::KBuffer { .. } => super::shared::TRANSPARENCY_KBUFFER,
+            Transparency::DepthPeeling { .. } => super::shared::TRANSPARENCY_PEELING,
         }
     }
 

@@ -9,8 +9,7 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec2;
 
-use super::passes::compute_generate::scan_plan;
-use super::shared::{FrameBinding, GenerateArgs, MARSCHNER_LUT_D, MARSCHNER_LUT_PHI};
+use super::shared::{FrameBinding, GenerateArgs, MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, SCAN_BLOCK};
 use crate::bake::blue_noise::{quad_samples, triangle_samples};
 use crate::vk::{Buffer, BufferDesc, Context, DescriptorSet, GpuResult, Image, ImageDesc, Sampler};
 
@@ -39,6 +38,39 @@ pub struct FrameBuffers<'a> {
     pub transparency: &'a super::transparency::TransparencyBuffers,
     /// The software rasterizer's buffers.
     pub soft: &'a super::soft::SoftBuffers,
+}
+
+/// One level of the scan: `count` elements at `input` (level 0: the bundles), block sums at
+/// `sums` in the scratch buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ScanLevel {
+    /// Elements scanned.
+    pub count: u32,
+    /// Offset of the elements in the scratch buffer (level > 0).
+    pub input: u32,
+    /// Offset of the block sums in the scratch buffer.
+    pub sums: u32,
+}
+
+/// The levels that scan `bundles` elements (up to one block sum at the top, the grand
+/// total), and the scratch elements they need.
+pub fn scan_plan(bundles: u32) -> (Vec<ScanLevel>, u32) {
+    let mut levels = Vec::new();
+    let (mut count, mut input, mut next) = (bundles.max(1), 0, 0);
+    loop {
+        let blocks = count.div_ceil(SCAN_BLOCK);
+        levels.push(ScanLevel {
+            count,
+            input,
+            sums: next,
+        });
+        input = next;
+        next += blocks;
+        if blocks == 1 {
+            return (levels, next);
+        }
+        count = blocks;
+    }
 }
 
 /// The working buffers as the frame graph imports them.

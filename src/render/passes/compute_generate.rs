@@ -11,38 +11,7 @@ use crate::render::shared::{CULL_GROUP_SIZE, GenerateArgs, SCAN_BLOCK, SCAN_THRE
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 
-/// One level of the scan: `count` elements at `input` (level 0: the bundles), block sums at
-/// `sums` in the scratch buffer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ScanLevel {
-    /// Elements scanned.
-    pub count: u32,
-    /// Offset of the elements in the scratch buffer (level > 0).
-    pub input: u32,
-    /// Offset of the block sums in the scratch buffer.
-    pub sums: u32,
-}
-
-/// The levels that scan `bundles` elements (up to one block sum at the top, the grand
-/// total), and the scratch elements they need.
-pub fn scan_plan(bundles: u32) -> (Vec<ScanLevel>, u32) {
-    let mut levels = Vec::new();
-    let (mut count, mut input, mut next) = (bundles.max(1), 0, 0);
-    loop {
-        let blocks = count.div_ceil(SCAN_BLOCK);
-        levels.push(ScanLevel {
-            count,
-            input,
-            sums: next,
-        });
-        input = next;
-        next += blocks;
-        if blocks == 1 {
-            return (levels, next);
-        }
-        count = blocks;
-    }
-}
+pub use crate::render::workspace::{ScanLevel, scan_plan};
 
 /// Which view a generation serves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

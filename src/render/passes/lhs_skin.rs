@@ -9,9 +9,9 @@ use ash::vk;
 
 use super::{FrameRes, dispatch_2d};
 use crate::reference::lhs::LhsModel;
-use crate::render::frame::FRAMES_IN_FLIGHT;
 use crate::render::graph::FrameGraph;
 use crate::render::shared::{HairVertex, LhsBinding, LhsWeights};
+use crate::render::slots::FRAMES_IN_FLIGHT;
 use crate::vk::{
     Access, Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult,
     Pipeline,
