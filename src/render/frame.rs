@@ -266,26 +266,18 @@ impl Renderer {
         }
         let textures = self.crowd.texture_set();
         let bg = self.background;
-        let inputs = FrameInputs {
-            sets: PassSets {
+        let clear = opts.clear.then_some([bg[0], bg[1], bg[2], 1.0]);
+        let sets = (
+            PassSets {
                 frame: set,
                 textures,
             },
-            light_sets: PassSets {
+            PassSets {
                 frame: light_set,
                 textures,
             },
-            bundles: work.bundles,
-            path: work.path,
-            clear: opts.clear.then_some([bg[0], bg[1], bg[2], 1.0]),
-            props: work.props,
-            shadow: work.shadows,
-            transparency: work.transparency,
-            raster: work.raster,
-            kbuffer_budget: work.kbuffer_budget,
-            size,
-            mesh_query: mesh_query.as_mut(),
-        };
+        );
+        let inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
         self.passes.add(&mut g, &r, inputs)?;
         let (overlay, image) = match present {
             Some(p) => (p.overlay.as_mut().map(|o| &mut **o), Some(p.image)),
@@ -413,4 +405,28 @@ pub(super) fn image_readback(ctx: &Arc<Context>, bytes: u64) -> GpuResult<Buffer
         ctx,
         &BufferDesc::new("image readback", bytes, vk::BufferUsageFlags::TRANSFER_DST).readback(),
     )
+}
+
+/// What the frame's passes draw, from the frame's work and slot.
+fn frame_inputs<'a>(
+    work: &FrameWork<'a>,
+    (sets, light_sets): (PassSets<'a>, PassSets<'a>),
+    clear: Option<[f32; 4]>,
+    size: (u32, u32),
+    mesh_query: Option<&'a mut crate::vk::MeshPrimitivesQuery>,
+) -> FrameInputs<'a> {
+    FrameInputs {
+        sets,
+        light_sets,
+        bundles: work.bundles,
+        path: work.path,
+        clear,
+        props: work.props,
+        shadow: work.shadows,
+        transparency: work.transparency,
+        raster: work.raster,
+        kbuffer_budget: work.kbuffer_budget,
+        size,
+        mesh_query,
+    }
 }

@@ -131,7 +131,7 @@ pub struct FrameOptions {
     pub clear: bool,
     /// Read the colour target back into the report.
     pub read_image: bool,
-    /// Keep a printable account of the frame graph (passes, uses, derived barriers) in the
+    /// Keep a printable account of the frame graph (passes, uses, derived dependencies) in the
     /// frame's report (`render --print-frame`).
     pub describe_frame: bool,
     /// Hardware strips, the software rasterizer, or a split per bundle (mesh and compute

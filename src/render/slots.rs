@@ -47,7 +47,7 @@ pub struct FrameReport {
     pub record_ms: f64,
     /// RGBA8 pixels (sRGB), top row first, when requested.
     pub rgba: Option<Vec<u8>>,
-    /// The frame graph's passes, uses and barriers, when
+    /// The frame graph's passes, uses and derived dependencies, when
     /// [`super::FrameOptions::describe_frame`] was set.
     pub frame_graph: Option<String>,
 }

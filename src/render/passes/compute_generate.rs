@@ -93,6 +93,45 @@ impl ComputeGenerate {
             });
         g.end_scope();
         g.begin_scope(scopes[1]);
+        self.add_scan(g, r, sets, bundles);
+        g.end_scope();
+        g.begin_scope(scopes[2]);
+        let generate = match view {
+            GenerateView::Camera => &self.generate_camera,
+            GenerateView::Light => &self.generate_light,
+        };
+        let args = r.args_buffer;
+        let mut p = g
+            .pass("generate")
+            .read_all(&inputs, Access::ComputeRead)
+            .read_all(&[r.lods, r.offsets], Access::ComputeRead)
+            .read(r.args, Access::IndirectRead)
+            .write(r.args, rw)
+            .discard(r.pool, rw);
+        if view == GenerateView::Camera {
+            // Software bundles are shaded here (shadow lookups included).
+            p = p
+                .write(r.soft_segments, rw)
+                .read_all(&r.shadow, Access::SampledRead);
+        }
+        p.record(move |rec| {
+            rec.bind(generate, &sets.both());
+            rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);
+            Ok(())
+        });
+        g.end_scope();
+    }
+
+    /// The multi-level exclusive scan of the bundles' strand and vertex counts, then
+    /// finalize (totals, vertex-pool budget, indirect arguments).
+    fn add_scan<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        sets: PassSets<'a>,
+        bundles: u32,
+    ) {
+        let rw = Access::ComputeReadWrite;
         let (levels, _) = scan_plan(bundles);
         for (i, l) in levels.iter().copied().enumerate() {
             g.pass("scan")
@@ -134,32 +173,6 @@ impl ComputeGenerate {
                 rec.dispatch(1, 1, 1);
                 Ok(())
             });
-        g.end_scope();
-        g.begin_scope(scopes[2]);
-        let generate = match view {
-            GenerateView::Camera => &self.generate_camera,
-            GenerateView::Light => &self.generate_light,
-        };
-        let args = r.args_buffer;
-        let mut p = g
-            .pass("generate")
-            .read_all(&inputs, Access::ComputeRead)
-            .read_all(&[r.lods, r.offsets], Access::ComputeRead)
-            .read(r.args, Access::IndirectRead)
-            .write(r.args, rw)
-            .discard(r.pool, rw);
-        if view == GenerateView::Camera {
-            // Software bundles are shaded here (shadow lookups included).
-            p = p
-                .write(r.soft_segments, rw)
-                .read_all(&r.shadow, Access::SampledRead);
-        }
-        p.record(move |rec| {
-            rec.bind(generate, &sets.both());
-            rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);
-            Ok(())
-        });
-        g.end_scope();
     }
 }
 

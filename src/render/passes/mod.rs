@@ -1,5 +1,5 @@
 //! One file per pass. Each pass owns its pipelines and adds itself to the frame graph with
-//! `add`, declaring what it reads and writes; the graph derives the barriers.
+//! `add`, declaring what it reads and writes; the graph derives the synchronisation.
 
 pub mod compute_generate;
 pub mod hair_mesh_update;
@@ -293,10 +293,9 @@ impl<'a> FrameRes<'a> {
             hair_depth,
             prop_depth,
             layers,
-            access,
+            access: [a0, a1, a2],
             ..
         } = src.shadow;
-        let [a0, a1, a2] = access;
         let TransparencyBuffers {
             nodes,
             tail,
@@ -312,7 +311,6 @@ impl<'a> FrameRes<'a> {
             .as_ref()
             .map(|r| g.import_image("color resolved", r, Tracked(resolved_access)));
         let (color, resolved) = (&*color, resolved.as_ref());
-        let soft = src.soft;
         FrameRes {
             constants: g.host_input("frame constants"),
             textures: g.host_input("textures"),
@@ -337,10 +335,10 @@ impl<'a> FrameRes<'a> {
             peel_image: peel_image
                 .as_ref()
                 .map(|i| g.import_image("peel layer depth", i, Tracked(peel_access))),
-            soft_segments: g.import_buffer("soft segments", &soft.segments),
-            soft_tiles: g.import_buffer("soft tiles", &soft.tiles),
-            soft_entries: g.import_buffer("soft entries", &soft.entries),
-            soft_depth: g.import_buffer("soft depth", &soft.depth),
+            soft_segments: g.import_buffer("soft segments", &src.soft.segments),
+            soft_tiles: g.import_buffer("soft tiles", &src.soft.tiles),
+            soft_entries: g.import_buffer("soft entries", &src.soft.entries),
+            soft_depth: g.import_buffer("soft depth", &src.soft.depth),
             args_buffer: w.args,
             transparency: TransparencyRefs {
                 nodes,
@@ -348,7 +346,7 @@ impl<'a> FrameRes<'a> {
                 peel_depth,
                 peel_accum,
             },
-            soft,
+            soft: src.soft,
             images: FrameImages {
                 color,
                 depth: &*depth,
