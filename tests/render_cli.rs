@@ -99,3 +99,72 @@ fn bad_inputs_fail_before_the_gpu() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn print_frame_lists_every_pass_of_the_full_look() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("full.png");
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/hairmeshes/head_long.obj");
+    let o = render(&[
+        "--mesh",
+        mesh,
+        "--size",
+        "64x48",
+        "--strands-per-bundle",
+        "8",
+        "--path",
+        "compute",
+        "--shadows",
+        "deep-opacity",
+        "--transparency",
+        "oit",
+        "--draw",
+        "auto",
+        "--validation",
+        "--print-frame",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // Every pass of the frame, in order, each with what it reads and writes.
+    let passes = [
+        "clear args",
+        "cull",
+        "scan",
+        "finalize",
+        "generate",
+        "shadow props",
+        "shadow hair depth",
+        "shadow opacity",
+        "opaque",
+        "k-buffer clear",
+        "oit insert",
+        "soft bin count",
+        "soft bin scatter",
+        "soft raster",
+        "transparency resolve",
+        "image readback",
+        "host reads",
+    ];
+    let mut at = 0;
+    for p in passes {
+        let line = format!(". {p}\n");
+        let found = stdout[at..]
+            .find(&line)
+            .unwrap_or_else(|| panic!("no pass {p} after byte {at}:\n{stdout}"));
+        at += found + line.len();
+    }
+    for needle in [
+        "writes: shadow layers (ColorAttachment, discard)",
+        "reads: shadow hair depth (SampledRead)",
+        "barrier: args [ComputeReadWrite] -> IndirectRead",
+        "(layout DEPTH_ATTACHMENT_OPTIMAL -> SHADER_READ_ONLY_OPTIMAL)",
+    ] {
+        assert!(stdout.contains(needle), "{needle}:\n{stdout}");
+    }
+}

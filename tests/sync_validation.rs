@@ -42,13 +42,8 @@ fn scene(ctx: &Arc<Context>, desc: RendererDesc) -> (Renderer, View) {
         r.add_character(&baked, &style, params(), model).unwrap();
     }
     let view = View {
-        camera: framing(&baked),
-        light_dir: light(),
-        lod: LodSettings::default(),
         shading: ShadingModel::Marschner,
-        shadows: ShadowMode::Off,
-        transparency: Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(framing(&baked))
     };
     (r, view)
 }

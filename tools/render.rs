@@ -66,11 +66,11 @@ struct Args {
     /// with no generation: the raster limit), or lhs (the same strands stored with 1% guides
     /// and skinned by them, the paper's baseline); for static and lhs the report is the
     /// second frame's. Default: mesh where the device supports it.
-    #[arg(long, value_parser = ["mesh", "compute", "static", "lhs"])]
-    path: Option<String>,
+    #[arg(long)]
+    path: Option<RenderPath>,
     /// Level of detail (paper sec. 3.6).
-    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
-    lod: String,
+    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
+    lod: bool,
     /// Alpha of eq. 7 for strand LoD.
     #[arg(long, default_value_t = 0.1)]
     lod_alpha_strands: f32,
@@ -171,7 +171,7 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
 /// Settings from the flags, checked.
 fn lod_settings(args: &Args) -> Result<LodSettings> {
     let lod = LodSettings {
-        enabled: args.lod == "on",
+        enabled: args.lod,
         alpha_strands: args.lod_alpha_strands,
         alpha_verts: args.lod_alpha_verts,
         lambda: args.lod_lambda,
@@ -382,9 +382,9 @@ fn print_report(
 
 fn run(args: Args) -> Result<()> {
     let lod = lod_settings(&args)?;
-    let path = args.path.as_deref().map(|p| match p {
-        "mesh" => RenderPath::Mesh,
-        // The renderer's default path is compute here; the static frame is asked for below.
+    // Static and LHS frames draw what a compute frame generated first (asked for below).
+    let path = args.path.map(|p| match p {
+        RenderPath::Mesh => RenderPath::Mesh,
         _ => RenderPath::Compute,
     });
     // Load and validate every input, and the output path, before touching the GPU.
@@ -406,18 +406,14 @@ fn run(args: Args) -> Result<()> {
         .transparency
         .or(inputs.look.transparency_mode())
         .unwrap_or_default();
-    if args.draw.uses_software()
-        && let Some(why) = hairmesh::render::software_raster_conflict(
-            match args.path.as_deref() {
-                Some("static") => RenderPath::Static,
-                Some("lhs") => RenderPath::Lhs,
-                _ => path.unwrap_or(RenderPath::Compute),
-            },
-            msaa,
-            transparency,
-        )
-    {
-        anyhow::bail!("--draw with --msaa {msaa} / --transparency / --path: {why}");
+    let settings = hairmesh::render::FrameSettings {
+        path: args.path.unwrap_or(RenderPath::Compute),
+        raster: args.draw,
+        transparency,
+        msaa,
+    };
+    if let Err(why) = settings.check_combination() {
+        anyhow::bail!("--draw / --msaa {msaa} / --transparency / --path: {why}");
     }
     hairmesh::render::check_msaa(&ctx, msaa).map_err(|why| {
         let flag = if args.msaa.is_some() {
@@ -465,17 +461,9 @@ fn run(args: Args) -> Result<()> {
             .or(inputs.look.lod_appearance)
             .unwrap_or(true),
     };
-    let second = match args.path.as_deref() {
-        Some("static") => Some(RenderPath::Static),
-        Some("lhs") => Some(RenderPath::Lhs),
-        _ => None,
-    };
-    if second.is_some() && args.draw.uses_software() {
-        bail!(
-            "--draw {} draws generated strands: use it with --path mesh or compute",
-            args.draw
-        );
-    }
+    let second = args
+        .path
+        .filter(|p| matches!(p, RenderPath::Static | RenderPath::Lhs));
     let mut out = renderer.render_one(
         &view,
         &FrameOptions {

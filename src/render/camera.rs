@@ -199,6 +199,9 @@ pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
     })
 }
 
+/// Direction toward the light of [`View::new`] (normalised by the frame).
+pub const DEFAULT_LIGHT_DIR: Vec3 = Vec3::new(0.4, 1.0, 0.6);
+
 /// Everything per-view a frame needs: camera, light, image size and LoD settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
@@ -220,6 +223,21 @@ pub struct View {
 }
 
 impl View {
+    /// `camera` with the defaults: light from above and in front (`DEFAULT_LIGHT_DIR`), LoD
+    /// on, the placeholder look, no shadows, opaque strands, seed 000's LoD appearance on.
+    /// Change fields with struct update syntax: `View { shadows, ..View::new(camera) }`.
+    pub fn new(camera: Camera) -> View {
+        View {
+            camera,
+            light_dir: DEFAULT_LIGHT_DIR,
+            lod: LodSettings::default(),
+            shading: Default::default(),
+            shadows: Default::default(),
+            transparency: Default::default(),
+            lod_appearance: true,
+        }
+    }
+
     /// Check camera, light and LoD settings (finite, in range).
     pub fn validate(&self) -> Result<(), String> {
         let c = &self.camera;

@@ -183,6 +183,11 @@ impl Renderer {
         }
     }
 
+    /// Samples per pixel of the targets.
+    pub fn msaa(&self) -> u32 {
+        self.desc.msaa
+    }
+
     /// The software rasterizer's budgets.
     pub fn soft_budget(&self) -> SoftBudget {
         self.soft_budget

@@ -16,6 +16,39 @@ pub enum RenderPath {
     Lhs,
 }
 
+impl std::str::FromStr for RenderPath {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "mesh" => Ok(RenderPath::Mesh),
+            "compute" => Ok(RenderPath::Compute),
+            "static" => Ok(RenderPath::Static),
+            "lhs" => Ok(RenderPath::Lhs),
+            _ => Err(format!("path {s:?}: mesh, compute, static or lhs")),
+        }
+    }
+}
+
+impl std::fmt::Display for RenderPath {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(match self {
+            RenderPath::Mesh => "mesh",
+            RenderPath::Compute => "compute",
+            RenderPath::Static => "static",
+            RenderPath::Lhs => "lhs",
+        })
+    }
+}
+
+/// A switch flag: `on`/`true` or `off`/`false` (the tools' `--lod`, `--animate`, `--orbit`).
+pub fn parse_switch(s: &str) -> Result<bool, String> {
+    match s {
+        "on" | "true" => Ok(true),
+        "off" | "false" => Ok(false),
+        _ => Err(format!("{s:?}: on or off")),
+    }
+}
+
 impl RenderPath {
     /// Whether strands are drawn from the vertex pool (compute and static paths).
     pub fn pulls_vertices(self) -> bool {
@@ -182,12 +215,27 @@ pub struct FrameSettings {
 }
 
 impl FrameSettings {
+    /// The rules between the settings themselves (any device): tools call this before
+    /// touching the GPU; [`Self::validate`] adds the device's.
+    pub fn check_combination(&self) -> Result<(), String> {
+        self.raster.validate()?;
+        self.transparency.validate()?;
+        if matches!(self.transparency, super::Transparency::DepthPeeling { .. }) && self.msaa > 1 {
+            return Err("depth peeling is the single-sample reference: use it without MSAA".into());
+        }
+        if self.raster.uses_software()
+            && let Some(why) = software_raster_conflict(self.path, self.msaa, self.transparency)
+        {
+            return Err(why);
+        }
+        Ok(())
+    }
+
     /// Why these settings cannot be drawn on a device with `caps`, or the frame's k-buffer
     /// budget (the OIT budget, or the software rasterizer's K in opaque frames).
     pub fn validate(&self, caps: &DeviceCaps) -> Result<u32, String> {
         use super::Transparency;
-        self.raster.validate()?;
-        self.transparency.validate()?;
+        self.check_combination()?;
         if self.path == RenderPath::Mesh && !caps.mesh_path {
             return Err(format!(
                 "{}: no usable VK_EXT_mesh_shader for the mesh path",
@@ -200,11 +248,6 @@ impl FrameSettings {
                     "{}: k-buffer OIT needs shaderInt64 and shaderBufferInt64Atomics",
                     caps.name
                 ));
-            }
-            Transparency::DepthPeeling { .. } if self.msaa > 1 => {
-                return Err(
-                    "depth peeling is the single-sample reference: use it without MSAA".into(),
-                );
             }
             _ => {}
         }
@@ -221,10 +264,7 @@ impl FrameSettings {
                 caps.name
             ));
         }
-        match software_raster_conflict(self.path, self.msaa, self.transparency) {
-            Some(why) => Err(why),
-            None => Ok(budget),
-        }
+        Ok(budget)
     }
 }
 

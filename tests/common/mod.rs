@@ -45,13 +45,12 @@ pub fn renderer(ctx: &Arc<Context>, size: u32) -> Renderer {
 /// Render one frame of everything in `r` and read it back.
 pub fn render(r: &mut Renderer, cam: &Camera, settings: &RenderSettings) -> RenderOutput {
     let view = View {
-        camera: *cam,
-        light_dir: light(),
         lod: settings.lod,
         shading: settings.shading,
         shadows: settings.shadows,
         transparency: settings.transparency,
         lod_appearance: settings.lod_appearance,
+        ..View::new(*cam)
     };
     let report = r
         .render_one(
@@ -152,7 +151,7 @@ pub fn save_failure(name: &str, w: u32, h: u32, rgba: &[u8], err: &nv_flip::Flip
 }
 
 pub fn light() -> Vec3 {
-    Vec3::new(0.4, 1.0, 0.6)
+    hairmesh::render::camera::DEFAULT_LIGHT_DIR
 }
 
 /// Compute path, LoD off: the settings the golden images were made with.

@@ -107,12 +107,12 @@ pub struct Args {
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     lod_appearance: bool,
     /// Level of detail.
-    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
-    lod: String,
+    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
+    lod: bool,
     /// Characters walk, turn and sway, and their hair meshes are simulated (people and furry
     /// balls; teapots move without hair dynamics).
-    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
-    animate: String,
+    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
+    animate: bool,
     /// Wind strength on the hair tips, m/s^2 (0..=100; gusty).
     #[arg(long, default_value_t = 0.0)]
     wind: f32,
@@ -120,11 +120,11 @@ pub struct Args {
     #[arg(long, default_value = "1,0,0.3")]
     wind_dir: String,
     /// Headless: the camera orbits the crowd (off: it stays at frame 0's place).
-    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
-    orbit: String,
+    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
+    orbit: bool,
     /// Generation path (default: mesh where supported).
-    #[arg(long, value_parser = ["mesh", "compute"])]
-    path: Option<String>,
+    #[arg(long, value_parser = parse_generated_path)]
+    path: Option<RenderPath>,
     /// Choose the GPU by name substring.
     #[arg(long)]
     device: Option<String>,
@@ -187,7 +187,7 @@ impl Scene {
             baked.push(hairmesh::bake(
                 &c.hair.mesh,
                 &c.hair.style,
-                bake_options(c, args.animate == "on"),
+                bake_options(c, args.animate),
                 |_, _| {},
             )?);
         }
@@ -206,10 +206,7 @@ impl Scene {
         width: u32,
         height: u32,
     ) -> Result<Renderer> {
-        let path = args.path.as_deref().map(|p| match p {
-            "mesh" => RenderPath::Mesh,
-            _ => RenderPath::Compute,
-        });
+        let path = args.path;
         hairmesh::render::check_msaa(ctx, args.msaa)
             .map_err(|why| anyhow::anyhow!("--msaa {}: {why}", args.msaa))?;
         let mut renderer = Renderer::new(
@@ -247,7 +244,7 @@ impl Scene {
         if !(0.0..=100.0).contains(&args.wind) {
             bail!("--wind {}: must be 0..=100", args.wind);
         }
-        if args.animate != "on" {
+        if !args.animate {
             anim.moving = false;
             anim.simulating = false;
             return Ok(anim);
@@ -364,6 +361,14 @@ fn check_memory(args: &Args) -> Result<()> {
     Ok(())
 }
 
+/// `--path`: the crowd generates its strands (mesh or compute).
+fn parse_generated_path(s: &str) -> Result<RenderPath, String> {
+    match s.parse()? {
+        p @ (RenderPath::Mesh | RenderPath::Compute) => Ok(p),
+        p => Err(format!("{p}: the crowd uses the mesh or compute path")),
+    }
+}
+
 fn run(args: Args) -> Result<()> {
     check_memory(&args)?;
     let scene = Scene::build(&args)?;
@@ -371,14 +376,14 @@ fn run(args: Args) -> Result<()> {
         return window::run(args, scene);
     }
     let (width, height) = parse_size(&args.size)?;
-    if args.draw.uses_software()
-        && let Some(why) = hairmesh::render::software_raster_conflict(
-            RenderPath::Compute,
-            args.msaa,
-            args.transparency,
-        )
-    {
-        bail!("--draw with --msaa {} / --transparency: {why}", args.msaa);
+    let settings = hairmesh::render::FrameSettings {
+        path: args.path.unwrap_or(RenderPath::Compute),
+        raster: args.draw,
+        transparency: args.transparency,
+        msaa: args.msaa,
+    };
+    if let Err(why) = settings.check_combination() {
+        bail!("--draw / --msaa {} / --transparency: {why}", args.msaa);
     }
     // Every output of the run is checked before the first frame, and they appear only when
     // the whole run succeeded.
@@ -407,18 +412,14 @@ fn run(args: Args) -> Result<()> {
         args.preset,
         renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64
     )?;
-    let lod = if args.lod == "on" {
+    let lod = if args.lod {
         LodSettings::default()
     } else {
         LodSettings::off()
     };
     for f in 0..args.frames {
         let camera = match args.view.as_str() {
-            "orbit" => orbit_camera(
-                args.preset,
-                args.count,
-                if args.orbit == "on" { f } else { 0 },
-            ),
+            "orbit" => orbit_camera(args.preset, args.count, if args.orbit { f } else { 0 }),
             "eye" => {
                 let side = (args.count as f32).sqrt().ceil();
                 let depth = (side - 1.0) * SPACING;

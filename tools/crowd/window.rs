@@ -53,6 +53,8 @@ struct Controls {
     paused: bool,
     fly: bool,
     present_mode: PresentMode,
+    /// Show the frame graph (passes, uses, derived dependencies) of the last frame.
+    show_graph: bool,
 }
 
 impl Controls {
@@ -61,7 +63,7 @@ impl Controls {
         ctx: &egui::Context,
         total: usize,
         (mesh_ok, soft_ok): (bool, bool),
-        stats: &str,
+        (stats, graph): (&str, &str),
     ) {
         egui::Window::new("crowd")
             .default_width(260.0)
@@ -183,6 +185,12 @@ impl Controls {
                 });
                 ui.separator();
                 ui.label(stats);
+                ui.checkbox(&mut self.show_graph, "frame graph");
+                if self.show_graph {
+                    egui::ScrollArea::vertical()
+                        .max_height(320.0)
+                        .show(ui, |ui| ui.monospace(graph));
+                }
             });
     }
 }
@@ -285,6 +293,8 @@ struct Running {
     cursor: (f64, f64),
     last_ticket: Option<FrameTicket>,
     last_report: Option<FrameReport>,
+    /// The panel shows the frame graph (frames then keep its description).
+    show_graph: bool,
     fps_window: (Instant, u64),
     fps: f64,
     /// Swapchain (re)creations and frames skipped for a zero-size window.
@@ -383,7 +393,7 @@ impl App {
             egui_state,
             pending_free: Vec::new(),
             visible: self.scene.character_count(),
-            lod: if self.args.lod == "on" {
+            lod: if self.args.lod {
                 LodSettings::default()
             } else {
                 LodSettings::off()
@@ -442,6 +452,7 @@ impl App {
             cursor: (0.0, 0.0),
             last_ticket: None,
             last_report: None,
+            show_graph: false,
             fps_window: (Instant::now(), 0),
             fps: 0.0,
             recreations: 0,
@@ -545,6 +556,7 @@ impl Running {
             &FrameOptions {
                 path: Some(self.path),
                 raster,
+                describe_frame: self.show_graph,
                 ..Default::default()
             },
             Some(PresentTarget {
@@ -599,10 +611,17 @@ impl Running {
             paused: self.paused,
             fly: self.camera.fly,
             present_mode: self.present_mode,
+            show_graph: self.show_graph,
         };
         let stats = self.stats_text(scene_len);
         let ok = (self.renderer.has_mesh_path(), self.soft_ok());
-        let output = egui_ctx.run_ui(input, |ui| c.show(ui.ctx(), scene_len, ok, &stats));
+        let graph = self
+            .last_report
+            .as_ref()
+            .and_then(|r| r.frame_graph.as_deref())
+            .unwrap_or("(shown from the next frame)");
+        let text = (stats.as_str(), graph);
+        let output = egui_ctx.run_ui(input, |ui| c.show(ui.ctx(), scene_len, ok, text));
         self.panel
             .egui_state
             .handle_platform_output(&self.window, output.platform_output);
@@ -617,19 +636,24 @@ impl Running {
         ))
     }
 
-    /// Whether the software rasterizer can draw this window's frames (device support and
-    /// single-sample targets).
+    /// Whether the software rasterizer can draw this window's frames at all (device support
+    /// and single-sample targets), for the panel.
     fn soft_ok(&self) -> bool {
         self.soft_ok
     }
 
-    /// The raster of the next frame: the chosen one, or hardware strips where the software
-    /// rasterizer cannot composite (depth peeling).
+    /// The raster of the next frame: the chosen one where the settings allow it
+    /// (`FrameSettings::validate` holds the rules), else hardware strips.
     fn frame_raster(&self) -> StrandRaster {
-        match self.transparency {
-            Transparency::DepthPeeling { .. } => StrandRaster::Hardware,
-            _ if !self.soft_ok() => StrandRaster::Hardware,
-            _ => self.raster,
+        let settings = hairmesh::render::FrameSettings {
+            path: self.path,
+            raster: self.raster,
+            transparency: self.transparency,
+            msaa: self.renderer.msaa(),
+        };
+        match settings.validate(&self.renderer.caps()) {
+            Ok(_) => self.raster,
+            Err(_) => StrandRaster::Hardware,
         }
     }
 
@@ -659,6 +683,7 @@ impl Running {
         self.path = c.path;
         self.paused = c.paused || (c.fly && !self.camera.fly);
         self.camera.fly = c.fly;
+        self.show_graph = c.show_graph;
         Ok(())
     }
 
