@@ -400,9 +400,16 @@ impl CrowdRun<'_> {
             };
             let read_image = self.read_image && lod_on;
             let first = renderer.render_one(&view, &FrameOptions { read_image, ..opts })?;
+            let mut walls = Vec::new();
             let reports = (0..self.runs)
-                .map(|_| renderer.render_one(&view, &opts))
+                .map(|_| {
+                    let start = std::time::Instant::now();
+                    let report = renderer.render_one(&view, &opts);
+                    walls.push(start.elapsed().as_secs_f64() * 1e3);
+                    report
+                })
                 .collect::<Result<Vec<_>, _>>()?;
+            let wall = median(walls);
             let passes: Vec<String> = median_passes(&first, &reports)
                 .iter()
                 .map(|(n, ms)| format!("{n} {ms:.1}"))
@@ -411,7 +418,7 @@ impl CrowdRun<'_> {
             let record = median(reports.iter().map(|r| r.record_ms).collect());
             let used = ctx.memory_report().allocated_bytes - before;
             outln!(
-                "| {count} | {label} | {} | {} ({}) | {} | {} | {gpu:.1} | {record:.3} | {:.1} | {per_char:.1} ({tex_per_char:.1}) | {:.0} |",
+                "| {count} | {label} | {} | {} ({}) | {} | {} | {gpu:.1} | {record:.3} | {:.1} | {per_char:.1} ({tex_per_char:.1}) | {:.0} | {wall:.1} |",
                 if lod_on { "on" } else { "off" },
                 first.stats.strands_drawn,
                 first.stats.strands_demanded,
@@ -464,9 +471,9 @@ fn bench_crowd(
         (1u32 << e) + 1
     )?;
     outln!(
-        "| N | path | LoD | strands drawn (demanded) | triangles | GPU ms per pass | GPU ms | CPU record ms | GPU MiB | per-character KiB (textures) | peak RSS MiB |"
+        "| N | path | LoD | strands drawn (demanded) | triangles | GPU ms per pass | GPU ms | CPU record ms | GPU MiB | per-character KiB (textures) | peak RSS MiB | frame wall ms |"
     )?;
-    outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
+    outln!("|---|---|---|---|---|---|---|---|---|---|---|---|")?;
     let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
     let mut configs = Vec::new();
     if hairmesh::render::passes::strands::mesh_path_supported(&ctx) {

@@ -59,15 +59,26 @@ fn time(
     runs: usize,
 ) -> Result<(f64, hairmesh::render::FrameStats, String)> {
     let first = r.render_one(view, &opts)?;
+    let mut walls = Vec::new();
     let reports = (0..runs)
-        .map(|_| r.render_one(view, &opts))
+        .map(|_| {
+            let start = std::time::Instant::now();
+            let report = r.render_one(view, &opts);
+            walls.push(start.elapsed().as_secs_f64() * 1e3);
+            report
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let passes: Vec<String> = super::median_passes(&first, &reports)
         .iter()
         .map(|(n, ms)| format!("{n} {ms:.2}"))
         .collect();
     let ms = super::median(reports.iter().map(|r| r.gpu_ms()).collect());
-    Ok((ms, first.stats, passes.join(", ")))
+    let wall = super::median(walls);
+    Ok((
+        ms,
+        first.stats,
+        format!("{} (frame wall {wall:.1} ms)", passes.join(", ")),
+    ))
 }
 
 fn head_scenes(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Vec<Scene>> {
