@@ -262,6 +262,15 @@ pub fn smooth_prop_mesh(triangles: &[[Vec3; 3]]) -> Vec<PropVertex> {
         .collect()
 }
 
+/// `p` (canonical frame) pushed radially out of the human head to `margin` metres outside it
+/// (unchanged when outside, or when the head cannot be loaded): the dynamics' head collider.
+pub fn push_out_of_head(p: Vec3, margin: f32) -> Vec3 {
+    match human_head() {
+        Ok(head) => head.push_out(p, margin),
+        Err(_) => p,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -293,14 +302,5 @@ mod tests {
             head.radial_gap(head.push_out(head.centre + (p - head.centre) * 0.9, 0.01)) > 0.0099
         );
         assert_eq!(head.prop_mesh().len(), head.triangles.len() * 3);
-    }
-}
-
-/// `p` (canonical frame) pushed radially out of the human head to `margin` metres outside it
-/// (unchanged when outside, or when the head cannot be loaded): the dynamics' head collider.
-pub fn push_out_of_head(p: Vec3, margin: f32) -> Vec3 {
-    match human_head() {
-        Ok(head) => head.push_out(p, margin),
-        Err(_) => p,
     }
 }

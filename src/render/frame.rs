@@ -280,7 +280,7 @@ impl Renderer {
         let inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
         self.passes.add(&mut g, &r, inputs)?;
         let (overlay, image) = match present {
-            Some(p) => (p.overlay.as_mut().map(|o| &mut **o), Some(p.image)),
+            Some(p) => (p.overlay.as_deref_mut(), Some(p.image)),
             None => (None, None),
         };
         let outputs = FrameOutputs {

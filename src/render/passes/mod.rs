@@ -328,10 +328,10 @@ impl<'a> FrameRes<'a> {
                 g.import_image("shadow prop depth", prop_depth, Tracked(a1)),
                 g.import_image("shadow layers", layers, Tracked(a2)),
             ],
-            oit_nodes: g.import_buffer("oit nodes", &*nodes),
-            oit_tail: g.import_buffer("oit tail", &*tail),
-            peel_depth: g.import_buffer("peel depth", &*peel_depth),
-            peel_accum: g.import_buffer("peel accumulation", &*peel_accum),
+            oit_nodes: g.import_buffer("oit nodes", nodes),
+            oit_tail: g.import_buffer("oit tail", tail),
+            peel_depth: g.import_buffer("peel depth", peel_depth),
+            peel_accum: g.import_buffer("peel accumulation", peel_accum),
             peel_image: peel_image
                 .as_ref()
                 .map(|i| g.import_image("peel layer depth", i, Tracked(peel_access))),

@@ -145,8 +145,8 @@ impl TransparencyPass {
             .discard(r.oit_nodes, Access::TransferWrite)
             .discard(r.oit_tail, Access::TransferWrite)
             .record(move |rec| {
-                rec.fill_buffer(&b.nodes, 0, pixels * budget as u64 * 8, u32::MAX);
-                rec.fill_buffer(&b.tail, 0, pixels * 16, 0);
+                rec.fill_buffer(b.nodes, 0, pixels * budget as u64 * 8, u32::MAX);
+                rec.fill_buffer(b.tail, 0, pixels * 16, 0);
                 Ok(())
             });
     }
@@ -269,9 +269,9 @@ impl TransparencyPass {
             .discard(r.peel_depth, Access::TransferWrite)
             .discard(r.peel_accum, Access::TransferWrite)
             .record(move |rec| {
-                rec.fill_buffer(&b.peel_depth, 0, pixels * 4, 0);
-                rec.copy_image_to_buffer_at(depth, &b.peel_depth, pixels * 4);
-                rec.fill_buffer(&b.peel_accum, 0, pixels * 16, 0);
+                rec.fill_buffer(b.peel_depth, 0, pixels * 4, 0);
+                rec.copy_image_to_buffer_at(depth, b.peel_depth, pixels * 4);
+                rec.fill_buffer(b.peel_accum, 0, pixels * 16, 0);
                 Ok(())
             });
         let (sets, bundles, path, args) = (draw.sets, draw.bundles, draw.path, r.args_buffer);
@@ -307,7 +307,7 @@ impl TransparencyPass {
                 .read(image_res, Access::TransferRead)
                 .write(r.peel_depth, Access::TransferWrite)
                 .record(move |rec| {
-                    rec.copy_image_to_buffer_at(image, &b.peel_depth, 0);
+                    rec.copy_image_to_buffer_at(image, b.peel_depth, 0);
                     Ok(())
                 });
         }
