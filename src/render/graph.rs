@@ -63,9 +63,22 @@ impl Uses {
             .filter(|a| self.contains(*a))
             .collect()
     }
-    /// Every use that writes, and every use that only reads.
-    fn everything() -> Self {
-        Uses(Access::ALL.iter().fold(0, |m, a| m | (1 << *a as u32)))
+    /// Every use a buffer can have (attachments, sampling and presentation are image uses):
+    /// what an earlier frame may have done to a buffer.
+    fn any_buffer_use() -> Self {
+        let image_only = [
+            Access::Nothing,
+            Access::SampledRead,
+            Access::ColorAttachment,
+            Access::DepthAttachment,
+            Access::Present,
+        ];
+        Uses(
+            Access::ALL
+                .iter()
+                .filter(|a| !image_only.contains(a))
+                .fold(0, |m, a| m | (1 << *a as u32)),
+        )
     }
 }
 
@@ -225,9 +238,9 @@ impl<'a> FrameGraph<'a> {
         let tracker = match object {
             // Earlier frames' uses are unknown: the first use waits for any of them.
             Object::Buffer => Tracker {
-                writes: Uses::everything(),
+                writes: Uses::any_buffer_use(),
                 visible: Uses::default(),
-                reads: Uses::everything(),
+                reads: Uses::any_buffer_use(),
                 last,
             },
             _ => Tracker {
