@@ -129,15 +129,7 @@ impl Renderer {
                     Ok(())
                 });
             passes.add_soft_only(&mut g, &r, sets, counts)?;
-            let out = g.import_buffer("image readback", image);
-            let output = r.images.output;
-            g.pass("image readback")
-                .read(r.output, Access::TransferRead)
-                .discard(out, Access::TransferWrite)
-                .record(move |rec| {
-                    rec.copy_image_to_buffer(output, image);
-                    Ok(())
-                });
+            let out = super::passes::output::add_image_readback(&mut g, &r, image);
             g.pass("host reads").read(out, Access::HostRead).done();
             g.run(rec, profiler).map(|_| ())
         });

@@ -3,7 +3,7 @@
 //! and the host's reads after the submission completes.
 
 use super::FrameRes;
-use crate::render::graph::FrameGraph;
+use crate::render::graph::{FrameGraph, Res};
 use crate::render::shared::GenerateArgs;
 use crate::vk::{Access, Buffer, CommandRecorder, GpuResult, Image, SwapchainImage};
 
@@ -47,15 +47,7 @@ pub fn add_outputs<'a, 'o: 'a>(
         });
     let mut host = vec![stats];
     if let Some(buffer) = out.image_readback {
-        let readback = g.import_buffer("image readback", buffer);
-        g.pass("image readback")
-            .read(r.output, Access::TransferRead)
-            .discard(readback, Access::TransferWrite)
-            .record(move |rec| {
-                rec.copy_image_to_buffer(output, buffer);
-                Ok(())
-            });
-        host.push(readback);
+        host.push(add_image_readback(g, r, buffer));
     }
     if let Some(image) = out.present {
         let swapchain = g.import_swapchain("swapchain image", image);
@@ -71,4 +63,19 @@ pub fn add_outputs<'a, 'o: 'a>(
     g.pass("host reads")
         .read_all(&host, Access::HostRead)
         .done();
+}
+
+/// Add the copy of the frame's output image into `buffer` (RGBA8); returns the buffer's
+/// resource, which the host reads once the frame completes.
+pub fn add_image_readback<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>, buffer: &'a Buffer) -> Res {
+    let output = r.images.output;
+    let readback = g.import_buffer("image readback", buffer);
+    g.pass("image readback")
+        .read(r.output, Access::TransferRead)
+        .discard(readback, Access::TransferWrite)
+        .record(move |rec| {
+            rec.copy_image_to_buffer(output, buffer);
+            Ok(())
+        });
+    readback
 }
