@@ -6,7 +6,7 @@ use ash::vk;
 
 use super::crowd::CharacterId;
 use super::graph::{FrameGraph, ImageState};
-use super::passes::{FrameRes, FrameSources, PassSets};
+use super::passes::{FrameRes, FrameSources, FrameTransients, PassSets};
 use super::renderer::Renderer;
 use super::settings::{FrameSettings, RenderPath};
 use super::shared::{FrameBlock, HairVertex, SoftSegment, TextureBinding};
@@ -58,11 +58,8 @@ impl Renderer {
         self.finish()?;
         let i = self.next;
         let (width, height) = self.targets.size();
-        self.passes.prepare_transparency(kbuffer)?;
-        // Nothing is in flight: replaced buffers can go now.
-        drop(self.transparency.ensure(kbuffer, width, height)?);
-        drop(self.soft.ensure(self.soft_budget, width, height)?);
         self.prepare_workspace(i, RenderPath::Mesh)?;
+        let transients = self.frame_transients(kbuffer, raster, k)?;
         let mut block: FrameBlock = bytemuck::Zeroable::zeroed();
         block.viewport = [
             width as f32,
@@ -88,7 +85,10 @@ impl Renderer {
             width as u64 * height as u64 * 4,
         )?;
         let counts = (segments.len() as u32, k);
-        self.run_debug_graph(i, &upload, &image, counts)?;
+        let result = self.run_debug_graph(i, (&upload, &image), &transients, counts);
+        // Nothing is in flight any more: replaced objects can go now.
+        drop(self.transients.take_released());
+        result?;
         image.read()
     }
 
@@ -96,8 +96,8 @@ impl Renderer {
     fn run_debug_graph(
         &mut self,
         i: usize,
-        upload: &Buffer,
-        image: &Buffer,
+        (upload, image): (&Buffer, &Buffer),
+        transients: &FrameTransients,
         counts: (u32, u32),
     ) -> GpuResult<()> {
         let ctx = self.ctx.clone();
@@ -111,27 +111,26 @@ impl Renderer {
             work: &self.work,
             targets: &mut self.targets,
             shadow: &mut self.shadow,
-            transparency: &mut self.transparency,
-            soft: &self.soft,
         };
-        let passes = &self.passes;
+        let (passes, pool) = (&self.passes, &mut self.transients);
         let result = ctx.submit_and_wait(|rec| {
             profiler.reset(rec);
             let mut g = FrameGraph::new(false);
-            let r = FrameRes::import(&mut g, sources);
+            let r = FrameRes::new(&mut g, sources, transients);
+            g.bind_transients(sets.frame);
             let upload_res = g.host_input("segments upload");
-            let segments = &r.soft.segments;
+            let segments = r.soft_segments;
             g.pass("upload segments")
                 .read(upload_res, Access::TransferRead)
-                .discard(r.soft_segments, Access::TransferWrite)
-                .record(move |rec| {
-                    rec.copy_buffer(upload, 0, segments, 0, upload.size);
+                .discard(segments, Access::TransferWrite)
+                .record(move |rec, res| {
+                    rec.copy_buffer(upload, 0, res.buffer(segments)?, 0, upload.size);
                     Ok(())
                 });
             passes.add_soft_only(&mut g, &r, sets, counts)?;
             let out = super::passes::output::add_image_readback(&mut g, &r, image);
             g.pass("host reads").read(out, Access::HostRead).done();
-            g.run(rec, profiler).map(|_| ())
+            g.run(rec, profiler, pool).map(|_| ())
         });
         result?
     }
@@ -155,7 +154,7 @@ impl Renderer {
             g.pass("copy vertices")
                 .read(src, Access::TransferRead)
                 .discard(dst, Access::TransferWrite)
-                .record(|rec| {
+                .record(|rec, _| {
                     rec.copy_buffer(pool, 0, &out, 0, bytes);
                     Ok(())
                 });
@@ -178,7 +177,7 @@ impl Renderer {
             g.pass("copy texture")
                 .read(src, Access::TransferRead)
                 .discard(dst, Access::TransferWrite)
-                .record(|rec| {
+                .record(|rec, _| {
                     rec.copy_image_to_buffer(image, &out);
                     Ok(())
                 });

@@ -13,7 +13,7 @@ use super::camera::View;
 use super::graph::FrameGraph;
 use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::PropDraw;
-use super::passes::{FrameInputs, FrameRes, FrameSources, PassSets};
+use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets};
 use super::renderer::{PresentTarget, Renderer};
 use super::settings::{FrameOptions, FrameTicket};
 use super::shadow::{LightView, ShadowMode};
@@ -41,6 +41,8 @@ pub(super) struct FrameWork<'a> {
     kbuffer_budget: u32,
     /// Character slots whose hair mesh pose changed (rebuilt this frame).
     pose_updates: Vec<usize>,
+    /// The transient buffers and images the frame graph creates.
+    transients: FrameTransients,
 }
 
 impl Renderer {
@@ -56,8 +58,8 @@ impl Renderer {
         let raster = opts.raster;
         let i = self.next;
         self.retire_slot(i)?;
-        self.size_buffers(i, view.transparency, raster, kbuffer_budget)?;
         self.prepare_workspace(i, path)?;
+        let transients = self.frame_transients(view.transparency, raster, kbuffer_budget)?;
         let pose_updates = self.crowd.write_pending_poses(i)?;
         let (block, light_block) = self.frame_blocks(view, raster, kbuffer_budget);
         let prop_draws = self.write_slot(i, &block, light_block.as_ref(), opts.read_image)?;
@@ -71,6 +73,7 @@ impl Renderer {
             raster,
             kbuffer_budget,
             pose_updates,
+            transients,
         };
         let frame_graph = self.record(i, work, opts, present.as_mut())?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -128,16 +131,16 @@ impl Renderer {
         Ok((path, budget))
     }
 
-    /// Size the transparency and software rasterizer buffers for this frame; replaced ones
-    /// are retired with slot `i`.
-    fn size_buffers(
+    /// The transient resources of this frame's passes (after [`Self::prepare_workspace`]
+    /// has updated the bundle table), checked against the device before anything is
+    /// recorded; compiles the transparency pipelines it needs.
+    pub(super) fn frame_transients(
         &mut self,
-        i: usize,
         transparency: Transparency,
         raster: StrandRaster,
         kbuffer_budget: u32,
-    ) -> GpuResult<()> {
-        let (width, height) = self.targets.size();
+    ) -> GpuResult<FrameTransients> {
+        let size = self.targets.size();
         // The software rasterizer composites through the k-buffer, in opaque frames too.
         let buffers_for = match (raster.uses_software(), transparency) {
             (true, Transparency::Opaque) => Transparency::KBuffer {
@@ -146,15 +149,18 @@ impl Renderer {
             (_, t) => t,
         };
         self.passes.prepare_transparency(buffers_for)?;
-        for old in self.transparency.ensure(buffers_for, width, height)? {
-            self.frames[i].retired.push(Retired::Resource(old));
-        }
         if raster.uses_software() {
-            for old in self.soft.ensure(self.soft_budget, width, height)? {
-                self.frames[i].retired.push(Retired::Resource(old));
-            }
+            let range = self.ctx.info.max_storage_buffer_range;
+            self.soft_budget
+                .validate(range)
+                .map_err(GpuError::Unsupported)?;
         }
-        Ok(())
+        let soft = raster.uses_software().then_some(self.soft_budget);
+        let t = FrameTransients::new(buffers_for, soft, size);
+        for b in t.buffers() {
+            self.transients.check(b)?;
+        }
+        Ok(t)
     }
 
     /// The camera's frame block and, with shadows and hair in view, the light's.
@@ -237,6 +243,7 @@ impl Renderer {
             light_set,
             stats_readback,
             image_readback,
+            retired,
             ..
         } = &mut self.frames[i];
         let mut rec = cmd.begin()?;
@@ -254,10 +261,10 @@ impl Renderer {
             work: &self.work,
             targets: &mut self.targets,
             shadow: &mut self.shadow,
-            transparency: &mut self.transparency,
-            soft: &self.soft,
         };
-        let r = FrameRes::import(&mut g, sources);
+        let r = FrameRes::new(&mut g, sources, &work.transients);
+        g.bind_transients(set);
+        g.bind_transients(light_set);
         self.passes.add_updates(&mut g, &r, &jobs);
         if work.path == RenderPath::Lhs
             && let Some((_, lhs)) = self.lhs.as_mut()
@@ -290,7 +297,10 @@ impl Renderer {
             present: image,
         };
         add_outputs(&mut g, &r, outputs);
-        let description = g.run(&mut rec, profiler)?;
+        let result = g.run(&mut rec, profiler, &mut self.transients);
+        let released = self.transients.take_released();
+        retired.extend(released.into_iter().map(Retired::Resource));
+        let description = result?;
         drop(rec);
         cmd.end()?;
         Ok(description)
@@ -375,8 +385,6 @@ impl Renderer {
                     bundle_table: self.crowd.bundle_table(),
                     prop_vertices: self.props.vertices.as_ref(),
                     shadow: &self.shadow,
-                    transparency: &self.transparency,
-                    soft: &self.soft,
                 },
             )?;
         }

@@ -12,6 +12,7 @@ use glam::Mat4;
 
 use super::camera::View;
 use super::crowd::{CharacterId, Crowd, StrandParams};
+use super::graph::TransientPool;
 use super::passes::FramePasses;
 pub use super::passes::output::Overlay;
 use super::prop_table::Props;
@@ -23,9 +24,8 @@ use super::shared::{
     FrameBinding, GenerateArgs, HairVertex, PropInstance, SET_FRAME, SET_TEXTURES,
 };
 use super::slots::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Retired};
-use super::soft::{SoftBudget, SoftBuffers};
+use super::soft::SoftBudget;
 use super::targets::{RenderTargets, ShadowMaps};
-use super::transparency::TransparencyBuffers;
 use super::workspace::Workspace;
 use crate::bake::BakedHairMesh;
 use crate::model::style::HairStyle;
@@ -60,10 +60,9 @@ pub struct Renderer {
     pub(super) frame_number: u64,
     pub(super) targets: RenderTargets,
     pub(super) shadow: ShadowMaps,
-    /// Per-pixel buffers of the transparent modes.
-    pub(super) transparency: TransparencyBuffers,
-    /// The software rasterizer's buffers and budgets.
-    pub(super) soft: SoftBuffers,
+    /// The frame graph's transient buffers and images, kept across frames.
+    pub(super) transients: TransientPool,
+    /// The software rasterizer's budgets.
     pub(super) soft_budget: SoftBudget,
     /// The crowd version whose strands the vertex pool holds (the last compute-path frame's),
     /// which static-path frames draw again.
@@ -143,8 +142,7 @@ impl Renderer {
             frame_number: 0,
             targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
             shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
-            transparency: TransparencyBuffers::new(ctx)?,
-            soft: SoftBuffers::new(ctx)?,
+            transients: TransientPool::new(ctx),
             soft_budget,
             static_version: None,
             args_structure: None,

@@ -28,13 +28,10 @@
 //! widened by the LoD thickness, over the pixel size at the bundle's nearest distance) goes
 //! to software, thicker ones stay on hardware strips.
 
-use std::sync::Arc;
-
-use ash::vk;
 use glam::Vec2;
 
-use super::shared::{FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
-use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
+use super::graph::TransientBuffer;
+use super::shared::{FrameBinding, FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
 
 /// Default number of fragments per pixel the software rasterizer keeps sorted.
 pub const DEFAULT_SOFT_K: u32 = 8;
@@ -194,68 +191,27 @@ pub fn frame_fields(
     block.soft_params = [auto_split_pixels, opacity, tx as f32, ty as f32];
 }
 
-/// The software rasterizer's buffers, allocated on first use and grown with the target.
-pub struct SoftBuffers {
-    ctx: Arc<Context>,
-    /// `SoftSegment[]`.
-    pub segments: Buffer,
-    /// Per tile `uvec4`.
-    pub tiles: Buffer,
-    /// Segment indices by tile.
-    pub entries: Buffer,
-    /// The opaque depth, one float per pixel.
-    pub depth: Buffer,
-}
-
-fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(
-            name,
-            bytes,
-            vk::BufferUsageFlags::STORAGE_BUFFER
-                | vk::BufferUsageFlags::TRANSFER_DST
-                | vk::BufferUsageFlags::TRANSFER_SRC,
-        ),
-    )
-}
-
-impl SoftBuffers {
-    /// Placeholders only.
-    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
-        Ok(SoftBuffers {
-            ctx: ctx.clone(),
-            segments: storage(ctx, "soft segments", 32)?,
-            tiles: storage(ctx, "soft tiles", 16)?,
-            entries: storage(ctx, "soft entries", 16)?,
-            depth: storage(ctx, "soft depth", 16)?,
-        })
-    }
-
-    /// Make the buffers large enough for `budget` and a `width x height` target; returns the
-    /// replaced ones (frames in flight may still use them).
-    pub fn ensure(
-        &mut self,
-        budget: SoftBudget,
-        width: u32,
-        height: u32,
-    ) -> GpuResult<Vec<Box<dyn std::any::Any>>> {
-        let range = self.ctx.info.max_storage_buffer_range;
-        budget.validate(range).map_err(GpuError::Unsupported)?;
+impl SoftBudget {
+    /// The software rasterizer's buffers for this budget and a `width x height` target, as
+    /// the frame graph creates them (`None`: not drawn this frame, sized 0): segments, the
+    /// tile table (`uvec4` per tile), segment indices by tile, and the opaque depth (one
+    /// float per pixel).
+    pub fn buffers(budget: Option<Self>, width: u32, height: u32) -> [TransientBuffer; 4] {
         let (tx, ty) = tile_grid(width, height);
-        let need = [
-            budget.segments as u64 * size_of::<SoftSegment>() as u64,
-            tx as u64 * ty as u64 * 16,
-            budget.tile_entries as u64 * 4,
-            width as u64 * height as u64 * 4,
-        ];
-        let slots = [
-            (&mut self.segments, "soft segments", need[0]),
-            (&mut self.tiles, "soft tiles", need[1]),
-            (&mut self.entries, "soft entries", need[2]),
-            (&mut self.depth, "soft depth", need[3]),
-        ];
-        super::transparency::grow_buffers(slots, |name, bytes| storage(&self.ctx, name, bytes))
+        let need = budget.map_or([0; 4], |b| {
+            [
+                b.segments as u64 * size_of::<SoftSegment>() as u64,
+                tx as u64 * ty as u64 * 16,
+                b.tile_entries as u64 * 4,
+                width as u64 * height as u64 * 4,
+            ]
+        });
+        [
+            TransientBuffer::storage("soft segments", need[0], FrameBinding::SoftSegments as u32),
+            TransientBuffer::storage("soft tiles", need[1], FrameBinding::SoftTiles as u32),
+            TransientBuffer::storage("soft entries", need[2], FrameBinding::SoftEntries as u32),
+            TransientBuffer::storage("soft depth", need[3], FrameBinding::SoftDepth as u32),
+        ]
     }
 }
 

@@ -1,5 +1,5 @@
 //! How strands are composited, chosen per frame ([`Transparency`]), and the per-pixel buffers
-//! the transparent modes use ([`TransparencyBuffers`]).
+//! the transparent modes use ([`Transparency::buffers`], created by the frame graph).
 //!
 //! - **Opaque**: strands write depth, as strips at least one pixel wide (MSAA smooths
 //!   their edges).
@@ -14,11 +14,11 @@
 //!   fragment behind the previous layer and compositing it under the layers before; exact up
 //!   to the layer count, and slow (two geometry passes per layer). Single-sample only.
 
-use std::sync::Arc;
-
 use ash::vk;
 
-use crate::vk::{Access, Buffer, BufferDesc, Context, GpuResult, Image, ImageDesc};
+use super::graph::TransientBuffer;
+use super::shared::FrameBinding;
+use crate::vk::ImageDesc;
 
 pub use super::shared::{MAX_OIT_BUDGET, STRAND_OPACITY};
 /// Default k-buffer budget.
@@ -139,111 +139,25 @@ impl std::str::FromStr for Transparency {
     }
 }
 
-/// The per-pixel buffers of the transparent modes, sized for the current target and mode
-/// (grown when a frame needs more, never shrunk; a placeholder where a mode is not used).
-pub struct TransparencyBuffers {
-    ctx: Arc<Context>,
-    /// K-buffer nodes.
-    pub nodes: Buffer,
-    /// K-buffer tail sums.
-    pub tail: Buffer,
-    /// Depth peeling: previous layer and opaque depth.
-    pub peel_depth: Buffer,
-    /// Depth peeling: accumulated colour.
-    pub peel_accum: Buffer,
-    /// Depth peeling: the depth attachment of the layers (single sample, target size).
-    pub peel_image: Option<Image>,
-    /// Last use of `peel_image`.
-    pub peel_access: Access,
-}
-
-fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(
-            name,
-            bytes,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-        ),
-    )
-}
-
-impl TransparencyBuffers {
-    /// Placeholders only.
-    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
-        Ok(TransparencyBuffers {
-            ctx: ctx.clone(),
-            nodes: storage(ctx, "oit nodes", 16)?,
-            tail: storage(ctx, "oit tail", 16)?,
-            peel_depth: storage(ctx, "peel depth", 16)?,
-            peel_accum: storage(ctx, "peel accumulation", 16)?,
-            peel_image: None,
-            peel_access: Access::Nothing,
-        })
-    }
-
-    /// Make every buffer at least as large as `mode` needs for `width x height` targets, and
-    /// the peel depth image that size; returns the replaced resources (frames in flight may
-    /// still use them).
-    pub fn ensure(
-        &mut self,
-        mode: Transparency,
-        width: u32,
-        height: u32,
-    ) -> GpuResult<Vec<Box<dyn std::any::Any>>> {
-        let need = mode.buffer_bytes(width as u64 * height as u64);
-        let limit = self.ctx.info.max_storage_buffer_range;
-        if let Some(too_big) = need.iter().find(|&&b| b > limit) {
-            return Err(crate::vk::GpuError::Unsupported(format!(
-                "transparency {mode} needs a {too_big}-byte buffer at this size, more than the device's maxStorageBufferRange ({limit}); lower the budget or the size"
-            )));
-        }
-        let mut replaced: Vec<Box<dyn std::any::Any>> = Vec::new();
-        let peel = matches!(mode, Transparency::DepthPeeling { .. });
-        let stale = self
-            .peel_image
-            .as_ref()
-            .is_some_and(|i| i.desc.extent[..2] != [width, height]);
-        if peel && (self.peel_image.is_none() || stale) {
-            let image = Image::new(
-                &self.ctx,
-                &ImageDesc::new_2d("peel depth", super::targets::DEPTH_FORMAT, width, height)
-                    .usage(
-                        vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
-                            | vk::ImageUsageFlags::TRANSFER_SRC,
-                    ),
-            )?;
-            if let Some(old) = self.peel_image.replace(image) {
-                replaced.push(Box::new(old));
-            }
-            self.peel_access = Access::Nothing;
-        }
-        let slots = [
-            (&mut self.nodes, "oit nodes", need[0]),
-            (&mut self.tail, "oit tail", need[1]),
-            (&mut self.peel_depth, "peel depth", need[2]),
-            (&mut self.peel_accum, "peel accumulation", need[3]),
-        ];
-        replaced.extend(grow_buffers(slots, |name, bytes| {
-            storage(&self.ctx, name, bytes)
-        })?);
-        Ok(replaced)
+impl Transparency {
+    /// The per-pixel buffers of this mode for `pixels` pixels, as the frame graph creates
+    /// them (sized 0 where the mode does not use them): k-buffer nodes and tail sums, depth
+    /// peeling's previous layer and opaque depth, and its accumulated colour.
+    pub fn buffers(self, pixels: u64) -> [TransientBuffer; 4] {
+        let [nodes, tail, depth, accum] = self.buffer_bytes(pixels);
+        [
+            TransientBuffer::storage("oit nodes", nodes, FrameBinding::OitNodes as u32),
+            TransientBuffer::storage("oit tail", tail, FrameBinding::OitTail as u32),
+            TransientBuffer::storage("peel depth", depth, FrameBinding::PeelDepth as u32),
+            TransientBuffer::storage("peel accumulation", accum, FrameBinding::PeelAccum as u32),
+        ]
     }
 }
 
-/// Replace every `(buffer, name, bytes)` smaller than `bytes` by `make(name, bytes)`; returns
-/// the replaced buffers (frames in flight may still use them).
-pub(crate) fn grow_buffers<'a>(
-    slots: impl IntoIterator<Item = (&'a mut Buffer, &'a str, u64)>,
-    make: impl Fn(&str, u64) -> GpuResult<Buffer>,
-) -> GpuResult<Vec<Box<dyn std::any::Any>>> {
-    let mut replaced: Vec<Box<dyn std::any::Any>> = Vec::new();
-    for (buffer, name, bytes) in slots {
-        if bytes > buffer.size {
-            replaced.push(Box::new(std::mem::replace(buffer, make(name, bytes)?)));
-        }
-    }
-    Ok(replaced)
+/// The depth attachment of depth peeling's layers (single sample, target size).
+pub fn peel_image(width: u32, height: u32) -> ImageDesc {
+    ImageDesc::new_2d("peel depth", super::targets::DEPTH_FORMAT, width, height)
+        .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC)
 }
 
 #[cfg(test)]

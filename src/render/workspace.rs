@@ -2,7 +2,9 @@
 //! sums, scan scratch, indirect arguments + statistics, the compute path's vertex pool, and the
 //! Marschner lookup texture.
 //! Sized by the crowd's bundle count (grown by half again when too small, never shrunk); the
-//! pool is allocated when the compute path is first used.
+//! pool is allocated when the compute path is first used. These persist across frames (the
+//! static and LHS paths draw the last compute frame's strands with its LoDs and offsets), so
+//! they are imported into the frame graph, not created by it.
 
 use std::sync::Arc;
 
@@ -34,10 +36,6 @@ pub struct FrameBuffers<'a> {
     pub prop_vertices: Option<&'a Buffer>,
     /// The light's maps.
     pub shadow: &'a super::targets::ShadowMaps,
-    /// The transparent modes' per-pixel buffers.
-    pub transparency: &'a super::transparency::TransparencyBuffers,
-    /// The software rasterizer's buffers.
-    pub soft: &'a super::soft::SoftBuffers,
 }
 
 /// One level of the scan: `count` elements at `input` (level 0: the bundles), block sums at
@@ -201,7 +199,8 @@ impl Workspace {
         }
     }
 
-    /// Point every binding of a frame's set 0 at its buffer.
+    /// Point every binding of a frame's set 0 at its buffer, except the frame graph's
+    /// transient buffers (it binds them when it runs).
     pub fn write_set(&self, set: &DescriptorSet, frame: FrameBuffers) -> GpuResult<()> {
         let bundles = frame.bundle_table.unwrap_or(&self.placeholder);
         let prop_vertices = frame.prop_vertices.unwrap_or(&self.placeholder);
@@ -219,14 +218,14 @@ impl Workspace {
                 FrameBinding::Vertices => pool,
                 FrameBinding::PropVertices => prop_vertices,
                 FrameBinding::PropInstances => frame.prop_instances,
-                FrameBinding::OitNodes => &frame.transparency.nodes,
-                FrameBinding::OitTail => &frame.transparency.tail,
-                FrameBinding::PeelDepth => &frame.transparency.peel_depth,
-                FrameBinding::PeelAccum => &frame.transparency.peel_accum,
-                FrameBinding::SoftSegments => &frame.soft.segments,
-                FrameBinding::SoftTiles => &frame.soft.tiles,
-                FrameBinding::SoftEntries => &frame.soft.entries,
-                FrameBinding::SoftDepth => &frame.soft.depth,
+                FrameBinding::OitNodes
+                | FrameBinding::OitTail
+                | FrameBinding::PeelDepth
+                | FrameBinding::PeelAccum
+                | FrameBinding::SoftSegments
+                | FrameBinding::SoftTiles
+                | FrameBinding::SoftEntries
+                | FrameBinding::SoftDepth => continue,
                 FrameBinding::ShadowHairDepth
                 | FrameBinding::ShadowPropDepth
                 | FrameBinding::ShadowLayers => {

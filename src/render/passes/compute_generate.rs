@@ -85,7 +85,7 @@ impl ComputeGenerate {
             .read_all(&inputs, Access::ComputeRead)
             .write(r.lods, rw)
             .write(r.args, rw)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.bind(&self.cull, &sets.both());
                 let (x, y) = dispatch_2d(bundles.div_ceil(CULL_GROUP_SIZE));
                 rec.dispatch(x, y, 1);
@@ -114,7 +114,7 @@ impl ComputeGenerate {
                 .write(r.soft_segments, rw)
                 .read_all(&r.shadow, Access::SampledRead);
         }
-        p.record(move |rec| {
+        p.record(move |rec, _| {
             rec.bind(generate, &sets.both());
             rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);
             Ok(())
@@ -138,7 +138,7 @@ impl ComputeGenerate {
                 .read(r.lods, Access::ComputeRead)
                 .write(r.offsets, rw)
                 .write(r.scan, rw)
-                .record(move |rec| {
+                .record(move |rec, _| {
                     rec.bind(&self.scan, &sets.both());
                     rec.push_constants(&self.scan, &[l.count, l.input, l.sums, (i > 0) as u32]);
                     let (x, y) = dispatch_2d(l.count.div_ceil(SCAN_BLOCK));
@@ -153,7 +153,7 @@ impl ComputeGenerate {
             g.pass("scan add")
                 .write(r.offsets, rw)
                 .write(r.scan, rw)
-                .record(move |rec| {
+                .record(move |rec, _| {
                     rec.bind(&self.scan_add, &sets.both());
                     rec.push_constants(&self.scan_add, &[l.count, l.input, l.sums, (i > 0) as u32]);
                     let (x, y) = dispatch_2d(l.count.div_ceil(SCAN_THREADS));
@@ -167,7 +167,7 @@ impl ComputeGenerate {
             .read(r.offsets, Access::ComputeRead)
             .read(r.scan, Access::ComputeRead)
             .write(r.args, rw)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.bind(&self.finalize, &sets.both());
                 rec.push_constants(&self.finalize, &[total, 0u32, 0, 0]);
                 rec.dispatch(1, 1, 1);

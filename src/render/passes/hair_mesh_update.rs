@@ -87,7 +87,7 @@ impl HairMeshUpdate {
         for o in outputs.iter().flatten() {
             p = p.discard(*o, Access::ComputeReadWrite);
         }
-        p.record(move |rec| {
+        p.record(move |rec, _| {
             for job in jobs {
                 rec.bind(&self.pipeline, &[job.set]);
                 let (x, y) = dispatch_2d(job.groups);
@@ -101,7 +101,7 @@ impl HairMeshUpdate {
                 .read(*o, Access::TransferRead)
                 .discard(*i, Access::TransferWrite);
         }
-        p.record(move |rec| {
+        p.record(move |rec, _| {
             for job in jobs {
                 for (buffer, image) in job.outputs.iter().zip(job.images) {
                     rec.copy_buffer_to_image(buffer, image);

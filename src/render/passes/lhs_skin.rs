@@ -156,7 +156,7 @@ impl LhsSkin {
         g.pass("lhs skin")
             .read(r.constants, Access::ComputeRead)
             .write(r.pool, Access::ComputeReadWrite)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.bind(&self.pipeline, &[&state.deltas[slot].1]);
                 rec.push_constants(&self.pipeline, &[strands, verts, guides, 0u32]);
                 let (x, y) = dispatch_2d((strands * verts).div_ceil(GROUP));

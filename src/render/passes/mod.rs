@@ -15,15 +15,16 @@ pub mod transparency;
 use std::sync::Arc;
 
 use super::RenderPath;
+use super::graph::TransientBuffer;
 use super::graph::{FrameGraph, Res};
 use super::shared::GenerateArgs;
-use super::soft::SoftBuffers;
+use super::soft::SoftBudget;
 use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets, ShadowMaps};
-use super::transparency::TransparencyBuffers;
+use super::transparency::Transparency;
 use super::workspace::Workspace;
 use crate::vk::{
-    Access, Attachment, Buffer, Context, DescriptorSet, GpuResult, Image, MeshPrimitivesQuery,
-    PipelineLayout,
+    Access, Attachment, Buffer, Context, DescriptorSet, GpuResult, Image, ImageDesc,
+    MeshPrimitivesQuery, PipelineLayout,
     shader::{ShaderOptions, compile},
 };
 use compute_generate::{ComputeGenerate, GenerateView};
@@ -224,28 +225,11 @@ pub struct FrameRes<'a> {
     pub soft_depth: Res,
     /// The `args` buffer (indirect commands name it).
     pub args_buffer: &'a Buffer,
-    /// The transparent modes' buffers (fills and copies name them).
-    pub transparency: TransparencyRefs<'a>,
-    /// The software rasterizer's buffers.
-    pub soft: &'a SoftBuffers,
-    /// The images attachments and copies name.
+    /// The imported images attachments and copies name.
     pub images: FrameImages<'a>,
 }
 
-/// The transparent modes' buffers that passes' commands name.
-#[derive(Clone, Copy)]
-pub struct TransparencyRefs<'a> {
-    /// K-buffer nodes.
-    pub nodes: &'a Buffer,
-    /// K-buffer tails.
-    pub tail: &'a Buffer,
-    /// Depth peeling: previous layer and opaque depth.
-    pub peel_depth: &'a Buffer,
-    /// Depth peeling: accumulated colour.
-    pub peel_accum: &'a Buffer,
-}
-
-/// The images of a frame that passes' commands name.
+/// The imported images of a frame that passes' commands name.
 #[derive(Clone, Copy)]
 pub struct FrameImages<'a> {
     /// Colour target.
@@ -258,8 +242,6 @@ pub struct FrameImages<'a> {
     pub output: &'a Image,
     /// Shadow maps: hair depth, prop depth, opacity layers.
     pub shadow: [&'a Image; 3],
-    /// Depth peeling's layer depth.
-    pub peel: Option<&'a Image>,
 }
 
 /// What a frame imports into its graph.
@@ -270,15 +252,45 @@ pub struct FrameSources<'a> {
     pub targets: &'a mut RenderTargets,
     /// Shadow maps.
     pub shadow: &'a mut ShadowMaps,
-    /// Transparency buffers.
-    pub transparency: &'a mut TransparencyBuffers,
-    /// Software rasterizer buffers.
-    pub soft: &'a SoftBuffers,
+}
+
+/// The transient resources of a frame, sized for its settings; the frame graph creates them
+/// (every buffer every frame, sized 0 where unused, so set 0's bindings always name one).
+pub struct FrameTransients {
+    /// K-buffer nodes and tails, peel depth and accumulation.
+    pub transparency: [TransientBuffer; 4],
+    /// Software rasterizer segments, tiles, entries, depth.
+    pub soft: [TransientBuffer; 4],
+    /// Depth peeling's layer depth attachment, when peeling.
+    pub peel_image: Option<ImageDesc>,
+}
+
+impl FrameTransients {
+    /// The transients of a frame at `size`, whose per-pixel buffers are
+    /// those of `transparency` (the software rasterizer composites through a k-buffer), with
+    /// the software rasterizer's budget when it draws.
+    pub fn new(
+        transparency: Transparency,
+        soft: Option<SoftBudget>,
+        (width, height): (u32, u32),
+    ) -> Self {
+        let peel = matches!(transparency, Transparency::DepthPeeling { .. });
+        FrameTransients {
+            transparency: transparency.buffers(width as u64 * height as u64),
+            soft: SoftBudget::buffers(soft, width, height),
+            peel_image: peel.then(|| super::transparency::peel_image(width, height)),
+        }
+    }
+
+    /// Every transient buffer.
+    pub fn buffers(&self) -> impl Iterator<Item = &TransientBuffer> {
+        self.transparency.iter().chain(&self.soft)
+    }
 }
 
 impl<'a> FrameRes<'a> {
-    /// Import every resource of the frame into `g`.
-    pub fn import(g: &mut FrameGraph<'a>, src: FrameSources<'a>) -> Self {
+    /// Import the frame's persistent resources into `g` and create its transients.
+    pub fn new(g: &mut FrameGraph<'a>, src: FrameSources<'a>, t: &FrameTransients) -> Self {
         use crate::render::graph::ImageState::Tracked;
         let w = src.work.buffers();
         let RenderTargets {
@@ -296,21 +308,15 @@ impl<'a> FrameRes<'a> {
             access: [a0, a1, a2],
             ..
         } = src.shadow;
-        let TransparencyBuffers {
-            nodes,
-            tail,
-            peel_depth,
-            peel_accum,
-            peel_image,
-            peel_access,
-            ..
-        } = src.transparency;
-        let (nodes, tail, peel_depth, peel_accum) = (&*nodes, &*tail, &*peel_depth, &*peel_accum);
         let color_res = g.import_image("color", color, Tracked(color_access));
         let resolved_res = resolved
             .as_ref()
             .map(|r| g.import_image("color resolved", r, Tracked(resolved_access)));
         let (color, resolved) = (&*color, resolved.as_ref());
+        let [oit_nodes, oit_tail, peel_depth, peel_accum] =
+            t.transparency.map(|d| g.create_buffer(d));
+        let [soft_segments, soft_tiles, soft_entries, soft_depth] =
+            t.soft.map(|d| g.create_buffer(d));
         FrameRes {
             constants: g.host_input("frame constants"),
             textures: g.host_input("textures"),
@@ -328,32 +334,25 @@ impl<'a> FrameRes<'a> {
                 g.import_image("shadow prop depth", prop_depth, Tracked(a1)),
                 g.import_image("shadow layers", layers, Tracked(a2)),
             ],
-            oit_nodes: g.import_buffer("oit nodes", nodes),
-            oit_tail: g.import_buffer("oit tail", tail),
-            peel_depth: g.import_buffer("peel depth", peel_depth),
-            peel_accum: g.import_buffer("peel accumulation", peel_accum),
-            peel_image: peel_image
-                .as_ref()
-                .map(|i| g.import_image("peel layer depth", i, Tracked(peel_access))),
-            soft_segments: g.import_buffer("soft segments", &src.soft.segments),
-            soft_tiles: g.import_buffer("soft tiles", &src.soft.tiles),
-            soft_entries: g.import_buffer("soft entries", &src.soft.entries),
-            soft_depth: g.import_buffer("soft depth", &src.soft.depth),
+            oit_nodes,
+            oit_tail,
+            peel_depth,
+            peel_accum,
+            peel_image: t
+                .peel_image
+                .clone()
+                .map(|d| g.create_image("peel layer depth", d)),
+            soft_segments,
+            soft_tiles,
+            soft_entries,
+            soft_depth,
             args_buffer: w.args,
-            transparency: TransparencyRefs {
-                nodes,
-                tail,
-                peel_depth,
-                peel_accum,
-            },
-            soft: src.soft,
             images: FrameImages {
                 color,
                 depth: &*depth,
                 resolved,
                 output: resolved.unwrap_or(color),
                 shadow: [&*hair_depth, &*prop_depth, &*layers],
-                peel: peel_image.as_ref(),
             },
         }
     }
@@ -411,7 +410,7 @@ pub(crate) fn add_clear_args<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
     let args = r.args_buffer;
     g.pass("clear args")
         .discard(r.args, Access::TransferWrite)
-        .record(move |rec| {
+        .record(move |rec, _| {
             rec.fill_buffer(args, 0, size_of::<GenerateArgs>() as u64, 0);
             Ok(())
         });
@@ -512,21 +511,21 @@ impl FramePasses {
         let pass = self.soft.as_ref().ok_or_else(no_soft)?;
         let (w, h) = (r.images.color.desc.extent[0], r.images.color.desc.extent[1]);
         add_clear_args(g, r);
-        let (args, soft) = (r.args_buffer, r.soft);
+        let (args, soft_depth) = (r.args_buffer, r.soft_depth);
         g.pass("soft inputs")
             .write(r.args, Access::TransferWrite)
             .discard(r.soft_depth, Access::TransferWrite)
-            .record(move |rec| {
+            .record(move |rec, res| {
                 rec.fill_buffer(args, GenerateArgs::SEGMENTS_DEMANDED_OFFSET, 4, segments);
                 let pixels = w as u64 * h as u64;
-                rec.fill_buffer(&soft.depth, 0, pixels * 4, 1.0f32.to_bits());
+                rec.fill_buffer(res.buffer(soft_depth)?, 0, pixels * 4, 1.0f32.to_bits());
                 Ok(())
             });
         let (color, depth) = (r.images.color, r.images.depth);
         g.pass("clear targets")
             .discard(r.color, Access::ColorAttachment)
             .discard(r.depth, Access::DepthAttachment)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.begin_rendering(
                     Attachment {
                         image: color,
@@ -655,7 +654,7 @@ impl FramePasses {
         };
         let (sets, bundles, props, args) = (inp.sets, inp.bundles, inp.props, r.args_buffer);
         let (color, depth) = (r.images.color, r.images.depth);
-        p.record(move |rec| {
+        p.record(move |rec, _| {
             rec.begin_rendering(
                 Attachment {
                     image: color,

@@ -33,7 +33,7 @@ pub fn add_outputs<'a, 'o: 'a>(
     if let Some(overlay) = out.overlay {
         g.pass("overlay")
             .write(r.output, Access::ColorAttachment)
-            .record(move |rec| overlay(rec, output));
+            .record(move |rec, _| overlay(rec, output));
     }
     let stats = g.import_buffer("statistics readback", out.stats_readback);
     let args = r.args_buffer;
@@ -41,7 +41,7 @@ pub fn add_outputs<'a, 'o: 'a>(
     g.pass("statistics readback")
         .read(r.args, Access::TransferRead)
         .discard(stats, Access::TransferWrite)
-        .record(move |rec| {
+        .record(move |rec, _| {
             rec.copy_buffer(args, 0, out.stats_readback, 0, bytes);
             Ok(())
         });
@@ -54,7 +54,7 @@ pub fn add_outputs<'a, 'o: 'a>(
         g.pass("blit to swapchain")
             .read(r.output, Access::TransferRead)
             .discard(swapchain, Access::TransferWrite)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.blit_to_swapchain(output, image);
                 Ok(())
             });
@@ -73,7 +73,7 @@ pub fn add_image_readback<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>, buffer: 
     g.pass("image readback")
         .read(r.output, Access::TransferRead)
         .discard(readback, Access::TransferWrite)
-        .record(move |rec| {
+        .record(move |rec, _| {
             rec.copy_image_to_buffer(output, buffer);
             Ok(())
         });

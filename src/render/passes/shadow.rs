@@ -59,7 +59,7 @@ impl ShadowPass {
         g.pass("shadow props")
             .read(r.constants, Access::VertexRead)
             .discard(prop, Access::DepthAttachment)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.begin_rendering_depth(Attachment {
                     image: prop_image,
                     clear: Some([1.0; 4]),
@@ -73,7 +73,7 @@ impl ShadowPass {
             .pass("shadow hair depth")
             .discard(hair, Access::DepthAttachment);
         let (path, bundles, args) = (d.path, d.bundles, r.args_buffer);
-        strand_uses(p, r, path, false).record(move |rec| {
+        strand_uses(p, r, path, false).record(move |rec, _| {
             rec.begin_rendering_depth(Attachment {
                 image: hair_image,
                 clear: Some([1.0; 4]),
@@ -91,7 +91,7 @@ impl ShadowPass {
                 .pass("shadow opacity")
                 .read(hair, Access::SampledRead)
                 .discard(layers, Access::ColorAttachment);
-            strand_uses(p, r, path, false).record(move |rec| {
+            strand_uses(p, r, path, false).record(move |rec, _| {
                 rec.begin_rendering_color(Attachment {
                     image: layers_image,
                     clear: Some([0.0; 4]),

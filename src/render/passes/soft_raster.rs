@@ -94,7 +94,7 @@ impl SoftRasterPass {
             .write(r.args, Access::MeshReadWrite)
             .write(r.soft_segments, Access::MeshReadWrite)
             .read_all(&r.shadow, Access::SampledRead)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 let p = pipeline.ok_or_else(|| {
                     crate::vk::GpuError::Unsupported("no usable VK_EXT_mesh_shader".into())
                 })?;
@@ -122,28 +122,28 @@ impl SoftRasterPass {
     ) {
         let (tx, ty) = tile_grid(size.0, size.1);
         let rw = Access::ComputeReadWrite;
-        let (args, soft) = (r.args_buffer, r.soft);
+        let (args, soft_depth, soft_tiles) = (r.args_buffer, r.soft_depth, r.soft_tiles);
         g.begin_scope("soft bin");
         if copy_depth {
             let depth = r.images.depth;
             g.pass("soft depth copy")
                 .read(r.depth, Access::TransferRead)
                 .discard(r.soft_depth, Access::TransferWrite)
-                .record(move |rec| {
-                    rec.copy_image_to_buffer_at(depth, &soft.depth, 0);
+                .record(move |rec, res| {
+                    rec.copy_image_to_buffer_at(depth, res.buffer(soft_depth)?, 0);
                     Ok(())
                 });
         }
         g.pass("soft tiles clear")
             .discard(r.soft_tiles, Access::TransferWrite)
-            .record(move |rec| {
-                rec.fill_buffer(&soft.tiles, 0, tx as u64 * ty as u64 * 16, 0);
+            .record(move |rec, res| {
+                rec.fill_buffer(res.buffer(soft_tiles)?, 0, tx as u64 * ty as u64 * 16, 0);
                 Ok(())
             });
         g.pass("soft bin args")
             .read(r.constants, Access::ComputeRead)
             .write(r.args, rw)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.bind(&self.bin_args, &sets.both());
                 rec.dispatch(1, 1, 1);
                 Ok(())
@@ -159,7 +159,7 @@ impl SoftRasterPass {
             if scatter {
                 p = p.discard(r.soft_entries, rw);
             }
-            p.record(move |rec| {
+            p.record(move |rec, _| {
                 rec.bind(pipeline, &sets.both());
                 rec.dispatch_indirect(args, GenerateArgs::SOFT_DISPATCH_OFFSET);
                 Ok(())
@@ -170,7 +170,7 @@ impl SoftRasterPass {
             .read(r.constants, Access::ComputeRead)
             .write(r.soft_tiles, rw)
             .write(r.args, rw)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.bind(&self.scan, &sets.both());
                 rec.dispatch(1, 1, 1);
                 Ok(())
@@ -185,7 +185,7 @@ impl SoftRasterPass {
             .write(r.args, rw)
             .write(r.oit_nodes, rw)
             .write(r.oit_tail, rw)
-            .record(move |rec| {
+            .record(move |rec, _| {
                 rec.bind(&self.raster, &sets.both());
                 rec.dispatch(tx, ty, 1);
                 Ok(())

@@ -140,13 +140,13 @@ impl TransparencyPass {
         budget: u32,
         pixels: u64,
     ) {
-        let b = r.transparency;
+        let (nodes, tail) = (r.oit_nodes, r.oit_tail);
         g.pass("k-buffer clear")
-            .discard(r.oit_nodes, Access::TransferWrite)
-            .discard(r.oit_tail, Access::TransferWrite)
-            .record(move |rec| {
-                rec.fill_buffer(b.nodes, 0, pixels * budget as u64 * 8, u32::MAX);
-                rec.fill_buffer(b.tail, 0, pixels * 16, 0);
+            .discard(nodes, Access::TransferWrite)
+            .discard(tail, Access::TransferWrite)
+            .record(move |rec, res| {
+                rec.fill_buffer(res.buffer(nodes)?, 0, pixels * budget as u64 * 8, u32::MAX);
+                rec.fill_buffer(res.buffer(tail)?, 0, pixels * 16, 0);
                 Ok(())
             });
     }
@@ -178,7 +178,7 @@ impl TransparencyPass {
                     (draw.sets, draw.bundles, draw.path, r.args_buffer);
                 let depth = r.images.depth;
                 let mut query = draw.mesh_query.filter(|_| path == RenderPath::Mesh);
-                strand_uses(pass, r, path, true).record(move |rec| {
+                strand_uses(pass, r, path, true).record(move |rec, _| {
                     rec.begin_rendering_depth(Attachment {
                         image: depth,
                         clear: None,
@@ -234,7 +234,7 @@ impl TransparencyPass {
             pass = pass.discard(resolved, Access::ColorAttachment);
         }
         let (color, resolved) = (r.images.color, r.images.resolved);
-        pass.record(move |rec| {
+        pass.record(move |rec, _| {
             rec.begin_rendering_color(Attachment {
                 image: color,
                 clear: None,
@@ -259,19 +259,20 @@ impl TransparencyPass {
         layers: u32,
         pixels: u64,
     ) -> GpuResult<()> {
-        let missing = || GpuError::Unsupported("peel depth image not allocated".into());
-        let (image, image_res) = r.images.peel.zip(r.peel_image).ok_or_else(missing)?;
-        let (b, depth) = (r.transparency, r.images.depth);
+        let missing = || GpuError::Unsupported("peel depth image not declared".into());
+        let image_res = r.peel_image.ok_or_else(missing)?;
+        let (peel_depth, peel_accum, depth) = (r.peel_depth, r.peel_accum, r.images.depth);
         g.begin_scope("peel layers");
         // Previous layer: depth 0 (nothing peeled); opaque depth in the second half.
         g.pass("peel setup")
             .read(r.depth, Access::TransferRead)
             .discard(r.peel_depth, Access::TransferWrite)
             .discard(r.peel_accum, Access::TransferWrite)
-            .record(move |rec| {
-                rec.fill_buffer(b.peel_depth, 0, pixels * 4, 0);
-                rec.copy_image_to_buffer_at(depth, b.peel_depth, pixels * 4);
-                rec.fill_buffer(b.peel_accum, 0, pixels * 16, 0);
+            .record(move |rec, res| {
+                let prev = res.buffer(peel_depth)?;
+                rec.fill_buffer(prev, 0, pixels * 4, 0);
+                rec.copy_image_to_buffer_at(depth, prev, pixels * 4);
+                rec.fill_buffer(res.buffer(peel_accum)?, 0, pixels * 16, 0);
                 Ok(())
             });
         let (sets, bundles, path, args) = (draw.sets, draw.bundles, draw.path, r.args_buffer);
@@ -291,9 +292,9 @@ impl TransparencyPass {
                         .write(r.peel_accum, Access::FragmentReadWrite)
                 };
                 let pass = pass.read(r.peel_depth, Access::FragmentRead);
-                strand_uses(pass, r, path, i == 1).record(move |rec| {
+                strand_uses(pass, r, path, i == 1).record(move |rec, res| {
                     rec.begin_rendering_depth(Attachment {
-                        image,
+                        image: res.image(image_res)?,
                         clear: (i == 0).then_some([1.0; 4]),
                         resolve: None,
                     });
@@ -306,8 +307,8 @@ impl TransparencyPass {
             g.pass("peel copy")
                 .read(image_res, Access::TransferRead)
                 .write(r.peel_depth, Access::TransferWrite)
-                .record(move |rec| {
-                    rec.copy_image_to_buffer_at(image, b.peel_depth, 0);
+                .record(move |rec, res| {
+                    rec.copy_image_to_buffer_at(res.image(image_res)?, res.buffer(peel_depth)?, 0);
                     Ok(())
                 });
         }

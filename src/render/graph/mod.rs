@@ -9,16 +9,25 @@
 //! in one use ([`ImageState::Fixed`]: character textures stay sampled), swapchain images, and
 //! host-written inputs that need no GPU ordering (declared so the frame can be printed).
 //!
+//! Transient buffers and images are created by the graph from their descriptions
+//! ([`FrameGraph::create_buffer`], [`FrameGraph::create_image`]) when it runs, from a
+//! [`TransientPool`] that reuses them across frames ([`transient`]); their contents do not
+//! outlive the frame, so their first use must write them. Passes name any resource's object
+//! at record time through [`PassResources`].
+//!
 //! Hazards, per resource: a read waits for the last writes unless it has already been made
 //! visible to that use; a write waits for the last writes and every read since; an image
 //! whose layout changes is transitioned (the transition counts as a write).
 
+pub mod transient;
+
 use std::fmt::Write as _;
 
 use crate::vk::{
-    Access, BarrierImage, Buffer, CommandRecorder, GpuResult, Image, ImageBarrier, Profiler,
-    SwapchainImage,
+    Access, BarrierImage, Buffer, CommandRecorder, DescriptorSet, GpuError, GpuResult, Image,
+    ImageBarrier, ImageDesc, Profiler, SwapchainImage,
 };
+pub use transient::{Realized, TransientBuffer, TransientPool};
 
 /// A resource of the frame graph.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,10 +43,13 @@ pub enum ImageState<'a> {
 }
 
 enum Object<'a> {
-    /// Buffers are ordered with global memory dependencies: the object is not needed.
-    Buffer,
+    /// Buffers are ordered with global memory dependencies.
+    Buffer(&'a Buffer),
     Image(&'a Image),
     Swapchain(&'a SwapchainImage),
+    /// Created when the graph runs.
+    TransientBuffer(TransientBuffer),
+    TransientImage(ImageDesc),
     /// Written by the host before the submission (visible to every use): never ordered.
     Host,
 }
@@ -107,6 +119,8 @@ struct Resource<'a> {
     tracked: Option<&'a mut Access>,
     fixed: Option<Access>,
     tracker: Tracker,
+    /// Used by a pass already this frame.
+    touched: bool,
 }
 
 /// One declared use of a resource by a pass.
@@ -118,7 +132,44 @@ struct Use {
     discard: bool,
 }
 
-type Record<'a> = Box<dyn FnOnce(&mut CommandRecorder) -> GpuResult<()> + 'a>;
+type Record<'a> = Box<dyn FnOnce(&mut CommandRecorder, &PassResources) -> GpuResult<()> + 'a>;
+
+/// A resource's object once the graph runs.
+#[derive(Clone, Copy)]
+enum Bound<'r> {
+    None,
+    Buffer(&'r Buffer),
+    Image(&'r Image),
+    Swapchain(&'r SwapchainImage),
+}
+
+/// The objects behind a running graph's resources, for the passes' commands.
+pub struct PassResources<'r> {
+    bound: Vec<Bound<'r>>,
+    names: Vec<&'static str>,
+}
+
+impl PassResources<'_> {
+    /// The buffer behind `res`.
+    pub fn buffer(&self, res: Res) -> GpuResult<&Buffer> {
+        match self.bound[res.0] {
+            Bound::Buffer(b) => Ok(b),
+            _ => Err(self.not(res, "a buffer")),
+        }
+    }
+
+    /// The image behind `res`.
+    pub fn image(&self, res: Res) -> GpuResult<&Image> {
+        match self.bound[res.0] {
+            Bound::Image(i) => Ok(i),
+            _ => Err(self.not(res, "an image")),
+        }
+    }
+
+    fn not(&self, res: Res, what: &str) -> GpuError {
+        GpuError::Unsupported(format!("frame graph: {} is not {what}", self.names[res.0]))
+    }
+}
 
 enum Node<'a> {
     Pass {
@@ -137,6 +188,8 @@ pub struct FrameGraph<'a> {
     /// A `(pass, resource, use)` to leave out (tests: show that sync validation catches it).
     omit: Option<(&'a str, &'a str, Option<Access>)>,
     describe: bool,
+    /// Sets whose bindings the transient buffers are written to.
+    bind_sets: Vec<&'a DescriptorSet>,
 }
 
 /// A pass being declared: its uses, then its commands.
@@ -187,7 +240,10 @@ impl<'a> PassBuilder<'_, 'a> {
     }
 
     /// Add the pass with the commands `record` writes (after the graph's barriers).
-    pub fn record(self, record: impl FnOnce(&mut CommandRecorder) -> GpuResult<()> + 'a) {
+    pub fn record(
+        self,
+        record: impl FnOnce(&mut CommandRecorder, &PassResources) -> GpuResult<()> + 'a,
+    ) {
         self.graph.nodes.push(Node::Pass {
             name: self.name,
             uses: self.uses,
@@ -214,6 +270,7 @@ impl<'a> FrameGraph<'a> {
             nodes: Vec::new(),
             omit: None,
             describe,
+            bind_sets: Vec::new(),
         }
     }
 
@@ -237,7 +294,7 @@ impl<'a> FrameGraph<'a> {
         };
         let tracker = match object {
             // Earlier frames' uses are unknown: the first use waits for any of them.
-            Object::Buffer => Tracker {
+            Object::Buffer(_) | Object::TransientBuffer(_) => Tracker {
                 writes: Uses::any_buffer_use(),
                 visible: Uses::default(),
                 reads: Uses::any_buffer_use(),
@@ -256,13 +313,34 @@ impl<'a> FrameGraph<'a> {
             tracked,
             fixed,
             tracker,
+            touched: false,
         });
         Res(self.resources.len() - 1)
     }
 
     /// A buffer the GPU may have used in earlier frames.
-    pub fn import_buffer(&mut self, name: &'static str, _buffer: &'a Buffer) -> Res {
-        self.push(name, Object::Buffer, None)
+    pub fn import_buffer(&mut self, name: &'static str, buffer: &'a Buffer) -> Res {
+        self.push(name, Object::Buffer(buffer), None)
+    }
+
+    /// A buffer the graph takes from its pool when it runs (see [`transient`]); it is
+    /// reused by earlier frames, so its first use waits for anything, as an imported one.
+    pub fn create_buffer(&mut self, desc: TransientBuffer) -> Res {
+        self.push(desc.name, Object::TransientBuffer(desc), None)
+    }
+
+    /// An image the graph takes from its pool when it runs; its first use must discard.
+    pub fn create_image(&mut self, name: &'static str, desc: ImageDesc) -> Res {
+        let state = Some(ImageState::Fixed(Access::Nothing));
+        let res = self.push(name, Object::TransientImage(desc), state);
+        self.resources[res.0].fixed = None;
+        res
+    }
+
+    /// Write the transient buffers that have bindings into `set` when the graph runs
+    /// (before any pass records).
+    pub fn bind_transients(&mut self, set: &'a DescriptorSet) {
+        self.bind_sets.push(set);
     }
 
     /// An image and what is known of its state.
@@ -318,26 +396,73 @@ impl<'a> FrameGraph<'a> {
             .count()
     }
 
-    /// Record every pass in order with the barriers its uses need; returns the frame's
-    /// description when asked for. Tracked images get their last use written back.
+    /// Record every pass in order with the barriers its uses need, creating the transient
+    /// resources from `pool` first; returns the frame's description when asked for. Tracked
+    /// images get their last use written back. Objects the pool replaced are in
+    /// [`TransientPool::take_released`], whatever the result.
     pub fn run(
         self,
         rec: &mut CommandRecorder,
         profiler: &mut Profiler,
+        pool: &mut TransientPool,
     ) -> GpuResult<Option<String>> {
-        self.run_with(rec, Some(profiler))
+        self.run_with(rec, Some(profiler), Some(pool))
     }
 
-    /// [`Self::run`] without timing the scopes (one-off submissions).
+    /// [`Self::run`] without timing the scopes or a pool (one-off submissions that create
+    /// no transients).
     pub fn run_untimed(self, rec: &mut CommandRecorder) -> GpuResult<Option<String>> {
-        self.run_with(rec, None)
+        self.run_with(rec, None, None)
+    }
+
+    /// Take every transient from `pool`: `(index in the pool, what became of it)` per
+    /// resource (`None` for imports); transient images start from their pooled last use.
+    fn realize(
+        &mut self,
+        mut pool: Option<&mut TransientPool>,
+    ) -> GpuResult<Vec<Option<(usize, Realized)>>> {
+        let mut out = Vec::with_capacity(self.resources.len());
+        for r in &mut self.resources {
+            let taken = match (&r.object, pool.as_deref_mut()) {
+                (Object::TransientBuffer(d), Some(p)) => Some(p.buffer(d)?),
+                (Object::TransientImage(d), Some(p)) => {
+                    let (i, how) = p.image(d)?;
+                    let last = p.image_at(i).1;
+                    r.tracker.writes = Uses::of(last);
+                    r.tracker.reads = Uses::of(last);
+                    r.tracker.last = last;
+                    Some((i, how))
+                }
+                (Object::TransientBuffer(_) | Object::TransientImage(_), None) => {
+                    return Err(GpuError::Unsupported(format!(
+                        "frame graph: {} is transient, but the graph runs without a pool",
+                        r.name
+                    )));
+                }
+                _ => None,
+            };
+            out.push(taken);
+        }
+        Ok(out)
     }
 
     fn run_with(
         mut self,
         rec: &mut CommandRecorder,
         mut profiler: Option<&mut Profiler>,
+        mut pool: Option<&mut TransientPool>,
     ) -> GpuResult<Option<String>> {
+        let realized = self.realize(pool.as_deref_mut())?;
+        let pool_ref = pool.as_deref();
+        if let Some(p) = pool_ref {
+            for set in &self.bind_sets {
+                p.write_bindings(set)?;
+            }
+        }
+        let resources = PassResources {
+            bound: bind(&self.resources, &realized, pool_ref),
+            names: self.resources.iter().map(|r| r.name).collect(),
+        };
         let mut text = String::new();
         let nodes = std::mem::take(&mut self.nodes);
         let mut count = 0;
@@ -355,28 +480,43 @@ impl<'a> FrameGraph<'a> {
                 }
                 Node::Pass { name, uses, record } => {
                     count += 1;
-                    let plan = self.plan(&uses);
+                    let plan = self.plan(name, &uses)?;
                     if self.describe {
                         self.describe_pass(&mut text, count, name, &uses, &plan);
                     }
-                    plan.record(rec, &self.resources);
+                    plan.record(rec, &resources.bound);
                     if let Some(record) = record {
-                        record(rec)?;
+                        record(rec, &resources)?;
                     }
                 }
             }
         }
-        self.finish(rec, &mut text, count);
-        for r in &mut self.resources {
+        self.finish(rec, &mut text, count, &resources.bound)?;
+        drop(resources);
+        if self.describe {
+            self.describe_transients(&mut text, &realized, pool.as_deref());
+        }
+        for (r, taken) in self.resources.iter_mut().zip(&realized) {
             if let Some(t) = r.tracked.as_deref_mut() {
                 *t = r.tracker.last;
+            }
+            if let (Object::TransientImage(_), Some((i, _)), Some(p)) =
+                (&r.object, taken, pool.as_deref_mut())
+            {
+                p.set_image_last(*i, r.tracker.last);
             }
         }
         Ok(self.describe.then_some(text))
     }
 
     /// Return fixed-state images to their use.
-    fn finish(&mut self, rec: &mut CommandRecorder, text: &mut String, count: usize) {
+    fn finish(
+        &mut self,
+        rec: &mut CommandRecorder,
+        text: &mut String,
+        count: usize,
+        bound: &[Bound],
+    ) -> GpuResult<()> {
         let back: Vec<Use> = self
             .resources
             .iter()
@@ -392,17 +532,19 @@ impl<'a> FrameGraph<'a> {
             })
             .collect();
         if back.is_empty() {
-            return;
+            return Ok(());
         }
-        let plan = self.plan(&back);
+        let plan = self.plan("(return fixed images)", &back)?;
         if self.describe {
             self.describe_pass(text, count + 1, "(return fixed images)", &back, &plan);
         }
-        plan.record(rec, &self.resources);
+        plan.record(rec, bound);
+        Ok(())
     }
 
-    /// The barriers before a pass with `uses`, updating the trackers.
-    fn plan(&mut self, uses: &[Use]) -> Plan {
+    /// The barriers before pass `pass` with `uses`, updating the trackers. A transient's
+    /// first use must write it: its contents are an earlier frame's.
+    fn plan(&mut self, pass: &str, uses: &[Use]) -> GpuResult<Plan> {
         let mut plan = Plan::default();
         // Uses of one resource by one pass are taken together.
         let mut order: Vec<Res> = Vec::new();
@@ -414,15 +556,64 @@ impl<'a> FrameGraph<'a> {
         for res in order {
             let mine: Vec<&Use> = uses.iter().filter(|u| u.res == res).collect();
             let r = &mut self.resources[res.0];
+            let transient = matches!(
+                r.object,
+                Object::TransientBuffer(_) | Object::TransientImage(_)
+            );
+            if transient && !r.touched && !mine.iter().any(|u| u.access.writes()) {
+                return Err(GpuError::Unsupported(format!(
+                    "frame graph: pass {pass} reads {}, which no earlier pass of the frame wrote",
+                    r.name
+                )));
+            }
+            r.touched = true;
             match r.object {
                 Object::Host => {}
-                Object::Buffer => plan_buffer(&mut plan, res, &mut r.tracker, &mine),
-                Object::Image(_) | Object::Swapchain(_) => {
+                Object::Buffer(_) | Object::TransientBuffer(_) => {
+                    plan_buffer(&mut plan, res, &mut r.tracker, &mine)
+                }
+                Object::Image(_) | Object::Swapchain(_) | Object::TransientImage(_) => {
                     plan_image(&mut plan, res, &mut r.tracker, mine[0])
                 }
             }
         }
-        plan
+        Ok(plan)
+    }
+
+    /// The transients' sizes and whether they were reused.
+    fn describe_transients(
+        &self,
+        text: &mut String,
+        realized: &[Option<(usize, Realized)>],
+        pool: Option<&TransientPool>,
+    ) {
+        let Some(pool) = pool else { return };
+        let mut lines = Vec::new();
+        for (r, taken) in self.resources.iter().zip(realized) {
+            let Some((i, how)) = taken else { continue };
+            let (bytes, asked) = match &r.object {
+                Object::TransientBuffer(d) => (pool.buffer_at(*i).size, d.bytes),
+                _ => {
+                    let b = pool.image_at(*i).0.byte_size();
+                    (b, b)
+                }
+            };
+            let how = match how {
+                Realized::New => "new".to_string(),
+                Realized::Reused => "reused".to_string(),
+                Realized::Grown(b) => format!("grown from {b}"),
+                Realized::Shrunk(b) => format!("shrunk from {b}"),
+                Realized::Recreated => "recreated".to_string(),
+            };
+            lines.push(format!(
+                "       {}: {bytes} bytes ({asked} needed, {how})",
+                r.name
+            ));
+        }
+        if !lines.is_empty() {
+            let _ = writeln!(text, "transient resources (pool {} bytes):", pool.bytes());
+            let _ = writeln!(text, "{}", lines.join("\n"));
+        }
     }
 
     fn describe_pass(&self, text: &mut String, n: usize, name: &str, uses: &[Use], plan: &Plan) {
@@ -468,6 +659,31 @@ impl<'a> FrameGraph<'a> {
     }
 }
 
+/// The object behind every resource.
+fn bind<'r>(
+    resources: &[Resource<'r>],
+    realized: &[Option<(usize, Realized)>],
+    pool: Option<&'r TransientPool>,
+) -> Vec<Bound<'r>> {
+    let from_pool = |taken: &Option<(usize, Realized)>, image: bool| match (taken, pool) {
+        (Some((i, _)), Some(p)) if image => Bound::Image(p.image_at(*i).0),
+        (Some((i, _)), Some(p)) => Bound::Buffer(p.buffer_at(*i)),
+        _ => Bound::None,
+    };
+    resources
+        .iter()
+        .zip(realized)
+        .map(|(r, taken)| match r.object {
+            Object::Buffer(b) => Bound::Buffer(b),
+            Object::Image(i) => Bound::Image(i),
+            Object::Swapchain(s) => Bound::Swapchain(s),
+            Object::Host => Bound::None,
+            Object::TransientBuffer(_) => from_pool(taken, false),
+            Object::TransientImage(_) => from_pool(taken, true),
+        })
+        .collect()
+}
+
 fn names(list: &[Access]) -> String {
     let v: Vec<String> = list.iter().map(|a| format!("{a:?}")).collect();
     format!("[{}]", v.join("|"))
@@ -493,7 +709,7 @@ struct Plan {
 }
 
 impl Plan {
-    fn record(&self, rec: &mut CommandRecorder, resources: &[Resource]) {
+    fn record(&self, rec: &mut CommandRecorder, bound: &[Bound]) {
         let prev = self.memory_prev.list();
         let next = self.memory_next.list();
         let memory = (!next.is_empty()).then_some((&prev[..], &next[..]));
@@ -501,9 +717,9 @@ impl Plan {
             .images
             .iter()
             .filter_map(|p| {
-                let image = match resources[p.res.0].object {
-                    Object::Image(i) => BarrierImage::Image(i),
-                    Object::Swapchain(s) => BarrierImage::Swapchain(s),
+                let image = match bound[p.res.0] {
+                    Bound::Image(i) => BarrierImage::Image(i),
+                    Bound::Swapchain(s) => BarrierImage::Swapchain(s),
                     _ => return None,
                 };
                 Some(ImageBarrier {
