@@ -48,13 +48,12 @@ fn crowd_view(count: usize) -> View {
     let side = (count as f32).sqrt().ceil() * 0.4;
     let centre = Vec3::new(side * 0.5, 0.0, side * 0.5);
     View {
-        camera: Camera::look_at(centre + Vec3::new(0.3, 1.2, -1.1) * side, centre, 40.0),
         light_dir: light(),
-        lod: LodSettings::default(),
-        shading: hairmesh::shade::ShadingModel::Placeholder,
-        shadows: hairmesh::render::ShadowMode::Off,
-        transparency: hairmesh::render::Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(Camera::look_at(
+            centre + Vec3::new(0.3, 1.2, -1.1) * side,
+            centre,
+            40.0,
+        ))
     }
 }
 

@@ -113,12 +113,10 @@ fn gpu_rebuild_equals_the_cpu_twin() {
 
 fn light_view(baked: &hairmesh::BakedHairMesh) -> hairmesh::render::View {
     hairmesh::render::View {
-        camera: framing(baked),
         light_dir: light(),
         lod: hairmesh::render::LodSettings::default(),
         shading: hairmesh::shade::ShadingModel::Marschner,
         shadows: hairmesh::render::ShadowMode::DeepOpacity,
-        transparency: hairmesh::render::Transparency::Opaque,
-        lod_appearance: true,
+        ..hairmesh::render::View::new(framing(baked))
     }
 }

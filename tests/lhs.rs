@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use hairmesh::render::{
-    FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, ShadowMode, Transparency, View,
+    FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, ShadowMode, View,
 };
 use hairmesh::shade::ShadingModel;
 
@@ -19,13 +19,11 @@ fn lhs_at_rest_equals_the_hair_mesh_and_skins_like_its_twin() {
     let mut r = Renderer::new(&ctx, &RendererDesc::default().size(128, 128)).unwrap();
     let id = upload(&mut r, &baked, &style, 16, 4);
     let view = View {
-        camera: framing(&baked),
         light_dir: light(),
         lod: LodSettings::off(),
         shading: ShadingModel::KajiyaKay,
         shadows: ShadowMode::DeepOpacity,
-        transparency: Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(framing(&baked))
     };
     let frame = |r: &mut Renderer, path| {
         r.render_one(

@@ -80,7 +80,6 @@ fn at_distance(near: &Camera, k: f32) -> Camera {
 
 fn frame(s: &mut Scene, cam: Camera, lod: bool, term: bool, t: Transparency) -> Vec<u8> {
     let view = View {
-        camera: cam,
         light_dir: Vec3::new(0.4, 1.0, 0.6),
         lod: if lod {
             LodSettings::default()
@@ -91,6 +90,7 @@ fn frame(s: &mut Scene, cam: Camera, lod: bool, term: bool, t: Transparency) -> 
         shadows: ShadowMode::DeepOpacity,
         transparency: t,
         lod_appearance: term,
+        ..View::new(cam)
     };
     let opts = FrameOptions {
         path: Some(RenderPath::Compute),

@@ -14,13 +14,10 @@ fn frame(ctx: &std::sync::Arc<hairmesh::vk::Context>, msaa: u32, path: RenderPat
     let mut r = Renderer::new(ctx, &RendererDesc::default().size(128, 128).msaa(msaa)).unwrap();
     upload(&mut r, &baked, &style, 16, 4);
     let view = View {
-        camera: framing(&baked),
         light_dir: light(),
         lod: LodSettings::off(),
         shading: ShadingModel::Marschner,
-        shadows: hairmesh::render::ShadowMode::Off,
-        transparency: hairmesh::render::Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(framing(&baked))
     };
     let opts = FrameOptions {
         path: Some(path),

@@ -25,14 +25,12 @@ fn frame(
     .unwrap();
     upload(&mut r, &baked, &style, 16, 4);
     let view = View {
-        camera: framing(&baked),
         // From the side: half the hair the camera sees lies behind the rest.
         light_dir: glam::Vec3::new(-1.0, 0.5, 0.2),
         lod: LodSettings::off(),
         shading: ShadingModel::KajiyaKay,
         shadows,
-        transparency: hairmesh::render::Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(framing(&baked))
     };
     let opts = FrameOptions {
         path: Some(path),
@@ -100,13 +98,9 @@ fn light_generation_does_not_leak_into_the_camera_pool() {
     .unwrap();
     upload(&mut r, &baked, &style, 16, 4);
     let mut view = View {
-        camera: framing(&baked),
         light_dir: glam::Vec3::new(-1.0, 0.5, 0.2),
-        lod: LodSettings::default(),
         shading: ShadingModel::Marschner,
-        shadows: ShadowMode::Off,
-        transparency: hairmesh::render::Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(framing(&baked))
     };
     // Far enough that LoD drops strands in the camera's view.
     view.camera.eye = view.camera.target + (view.camera.eye - view.camera.target) * 3.0;

@@ -10,8 +10,8 @@ use glam::{Mat4, Vec2, Vec3};
 use hairmesh::render::shared::SoftSegment;
 use hairmesh::render::soft::{SoftBudget, pixel_coverage};
 use hairmesh::render::{
-    FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, StrandRaster,
-    Transparency, View,
+    FrameOptions, RenderPath, Renderer, RendererDesc, StrandParams, StrandRaster, Transparency,
+    View,
 };
 
 const PARAMS: StrandParams = StrandParams {
@@ -107,13 +107,15 @@ fn view_of(r: &Renderer, transparency: Transparency) -> View {
         |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
     );
     View {
-        camera: hairmesh::render::Camera::framing(lo, hi, hairmesh::render::DEFAULT_VIEW_DIR, 40.0),
         light_dir: light(),
-        lod: LodSettings::default(),
         shading: hairmesh::shade::ShadingModel::KajiyaKay,
-        shadows: hairmesh::render::ShadowMode::Off,
         transparency,
-        lod_appearance: true,
+        ..View::new(hairmesh::render::Camera::framing(
+            lo,
+            hi,
+            hairmesh::render::DEFAULT_VIEW_DIR,
+            40.0,
+        ))
     }
 }
 

@@ -18,13 +18,10 @@ fn static_strands_equal_the_generated_ones() {
     let mut r = Renderer::new(&ctx, &RendererDesc::default().size(128, 128)).unwrap();
     let id = upload(&mut r, &baked, &style, 16, 4);
     let mut view = View {
-        camera: framing(&baked),
         light_dir: light(),
         lod: LodSettings::off(),
         shading: ShadingModel::KajiyaKay,
-        shadows: ShadowMode::Off,
-        transparency: Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(framing(&baked))
     };
     let frame = |r: &mut Renderer, view: &View, path| {
         r.render_one(

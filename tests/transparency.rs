@@ -142,13 +142,10 @@ fn kbuffer_with_msaa() {
     let mut r = Renderer::new(&ctx, &RendererDesc::default().size(32, 32).msaa(4)).unwrap();
     upload(&mut r, &baked, &style, 4, 3);
     let view = View {
-        camera: framing(&baked),
         light_dir: light(),
-        lod: LodSettings::default(),
         shading: ShadingModel::KajiyaKay,
-        shadows: ShadowMode::Off,
         transparency: Transparency::DepthPeeling { layers: 4 },
-        lod_appearance: true,
+        ..View::new(framing(&baked))
     };
     let e = r.render_one(&view, &FrameOptions::default()).err().unwrap();
     assert!(e.to_string().contains("without MSAA"), "{e}");
@@ -163,13 +160,10 @@ fn modes_switch_per_frame_and_survive_resize() {
     let mut r = Renderer::new(&ctx, &RendererDesc::default().size(64, 48)).unwrap();
     upload(&mut r, &baked, &style, 8, 3);
     let mut view = View {
-        camera: framing(&baked),
         light_dir: light(),
-        lod: LodSettings::default(),
         shading: ShadingModel::Marschner,
         shadows: ShadowMode::DeepOpacity,
-        transparency: Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(framing(&baked))
     };
     let modes = [
         Transparency::KBuffer { budget: 2 },

@@ -508,17 +508,13 @@ fn bench_crowd(
 /// The benchmarks' view: `camera`, a fixed light, default LoD on or LoD off.
 fn bench_view(camera: Camera, lod_on: bool) -> View {
     View {
-        camera,
         light_dir: Vec3::new(0.4, 1.0, 0.6),
         lod: if lod_on {
             LodSettings::default()
         } else {
             LodSettings::off()
         },
-        shading: hairmesh::shade::ShadingModel::Placeholder,
-        shadows: hairmesh::render::ShadowMode::Off,
-        transparency: hairmesh::render::Transparency::Opaque,
-        lod_appearance: true,
+        ..View::new(camera)
     }
 }
 

@@ -436,7 +436,6 @@ fn run(args: Args) -> Result<()> {
         renderer.add_character(&c.baked, &c.style, c.params, c.model)?;
     }
     let view = View {
-        camera,
         light_dir: match &args.light {
             Some(l) => {
                 let d = parse_vec3("--light", l)?;
@@ -460,6 +459,7 @@ fn run(args: Args) -> Result<()> {
             .lod_appearance
             .or(inputs.look.lod_appearance)
             .unwrap_or(true),
+        ..View::new(camera)
     };
     let second = args
         .path

@@ -103,13 +103,12 @@ pub fn bench_animate(a: AnimateArgs) -> Result<()> {
         renderer.set_model(id, model)?;
         renderer.set_hair_mesh_pose(id, &pose)?;
         let view = View {
-            camera,
             light_dir: Vec3::new(-0.6, 0.8, 0.4),
             lod: LodSettings::off(),
             shading: hairmesh::shade::ShadingModel::Marschner,
             shadows: ShadowMode::DeepOpacity,
             transparency: Transparency::KBuffer { budget: 8 },
-            lod_appearance: true,
+            ..View::new(camera)
         };
         let wants_image = strip.is_some() && (f + 1) % strip_every == 0;
         let report = renderer.render_one(

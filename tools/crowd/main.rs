@@ -434,13 +434,13 @@ fn run(args: Args) -> Result<()> {
         // Headless frames are 1/30 s apart in animation time.
         animation.advance(&mut renderer, 1.0 / 30.0, &camera, height)?;
         let view = View {
-            camera,
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod,
             shading: args.shading,
             shadows: args.shadows,
             transparency: args.transparency,
             lod_appearance: args.lod_appearance,
+            ..View::new(camera)
         };
         let t = Instant::now();
         let report = renderer.render_one(

@@ -534,13 +534,13 @@ impl Running {
         let camera = self.camera.camera();
         self.animation.advance(&mut self.renderer, dt, &camera, h)?;
         let view = View {
-            camera,
             light_dir: Vec3::new(0.4, 1.0, 0.3),
             lod: self.panel.lod,
             shading: self.shading,
             shadows: self.shadows,
             transparency: self.transparency,
             lod_appearance: self.lod_appearance,
+            ..View::new(camera)
         };
         let (primitives, ppp, freed) = self.panel_frame(scene_len)?;
         let raster = self.frame_raster();

@@ -27,7 +27,7 @@ use crate::vk::{
     Access, BarrierImage, Buffer, CommandRecorder, DescriptorSet, GpuError, GpuResult, Image,
     ImageBarrier, ImageDesc, Profiler, SwapchainImage,
 };
-pub use transient::{Realized, TransientBuffer, TransientPool};
+pub use transient::{Realized, SHRINK_AFTER_FRAMES, TransientBuffer, TransientPool};
 
 /// A resource of the frame graph.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -323,8 +323,8 @@ impl<'a> FrameGraph<'a> {
         self.push(name, Object::Buffer(buffer), None)
     }
 
-    /// A buffer the graph takes from its pool when it runs (see [`transient`]); it is
-    /// reused by earlier frames, so its first use waits for anything, as an imported one.
+    /// A buffer the graph takes from its pool when it runs (see [`transient`]); earlier
+    /// frames used the same object, so its first use waits for the uses the pool remembers.
     pub fn create_buffer(&mut self, desc: TransientBuffer) -> Res {
         self.push(desc.name, Object::TransientBuffer(desc), None)
     }
@@ -424,7 +424,13 @@ impl<'a> FrameGraph<'a> {
         let mut out = Vec::with_capacity(self.resources.len());
         for r in &mut self.resources {
             let taken = match (&r.object, pool.as_deref_mut()) {
-                (Object::TransientBuffer(d), Some(p)) => Some(p.buffer(d)?),
+                (Object::TransientBuffer(d), Some(p)) => {
+                    let (i, how) = p.buffer(d)?;
+                    // The last frame's uses of this object, not any use.
+                    let last = Uses(p.buffer_last_uses(i));
+                    (r.tracker.writes, r.tracker.reads) = (last, last);
+                    Some((i, how))
+                }
                 (Object::TransientImage(d), Some(p)) => {
                     let (i, how) = p.image(d)?;
                     let last = p.image_at(i).1;
@@ -500,10 +506,14 @@ impl<'a> FrameGraph<'a> {
             if let Some(t) = r.tracked.as_deref_mut() {
                 *t = r.tracker.last;
             }
-            if let (Object::TransientImage(_), Some((i, _)), Some(p)) =
-                (&r.object, taken, pool.as_deref_mut())
-            {
-                p.set_image_last(*i, r.tracker.last);
+            match (&r.object, taken, pool.as_deref_mut()) {
+                (Object::TransientImage(_), Some((i, _)), Some(p)) => {
+                    p.set_image_last(*i, r.tracker.last)
+                }
+                (Object::TransientBuffer(_), Some((i, _)), Some(p)) => {
+                    p.set_buffer_last_uses(*i, (r.tracker.writes | r.tracker.reads).0)
+                }
+                _ => {}
             }
         }
         Ok(self.describe.then_some(text))

@@ -6,7 +6,8 @@
 //! description changed, and shrinking a buffer that has needed under a quarter of its size
 //! for [`SHRINK_AFTER_FRAMES`] frames. Replaced objects are handed back with
 //! [`TransientPool::take_released`] for the frame's deferred release (frames in flight may
-//! still use them).
+//! still use them). A pooled buffer remembers the uses the last frame made of it, so the next
+//! frame's first use waits for those alone (an imported buffer's first use waits for any).
 
 use std::any::Any;
 use std::sync::Arc;
@@ -71,6 +72,9 @@ struct PooledBuffer {
     buffer: Buffer,
     /// Consecutive frames it needed under a quarter of its size.
     oversized_frames: u32,
+    /// The uses (bits of [`Access`]) the last frame that used it made since its last
+    /// write: what the next frame's first use waits for. 0 for a new buffer.
+    last_uses: u32,
 }
 
 struct PooledImage {
@@ -126,6 +130,7 @@ impl TransientPool {
                 desc: *desc,
                 buffer,
                 oversized_frames: 0,
+                last_uses: 0,
             });
             return Ok((self.buffers.len() - 1, Realized::New));
         };
@@ -154,7 +159,7 @@ impl TransientPool {
         let buffer = self.make_buffer(desc, bytes)?;
         let pooled = &mut self.buffers[i];
         let old = std::mem::replace(&mut pooled.buffer, buffer);
-        (pooled.desc, pooled.oversized_frames) = (*desc, 0);
+        (pooled.desc, pooled.oversized_frames, pooled.last_uses) = (*desc, 0, 0);
         self.released.push(Box::new(old));
         Ok((i, realized))
     }
@@ -190,6 +195,14 @@ impl TransientPool {
 
     pub(super) fn buffer_at(&self, i: usize) -> &Buffer {
         &self.buffers[i].buffer
+    }
+
+    pub(super) fn buffer_last_uses(&self, i: usize) -> u32 {
+        self.buffers[i].last_uses
+    }
+
+    pub(super) fn set_buffer_last_uses(&mut self, i: usize, uses: u32) {
+        self.buffers[i].last_uses = uses;
     }
 
     pub(super) fn image_at(&self, i: usize) -> (&Image, Access) {
