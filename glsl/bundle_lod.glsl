@@ -18,12 +18,13 @@ uvec4 encode_lod(BundleLod r) {
     return uvec4(r.strands, r.e | (r.soft ? LOD_SOFT : 0u), floatBitsToUint(r.gamma), floatBitsToUint(r.thickness));
 }
 
-// Software or hardware raster (frame.soft.x: 0 hardware, 1 software, 2 auto). Auto: software
+// Software or hardware raster (frame.soft.x: RASTER_HARDWARE, RASTER_SOFTWARE, RASTER_AUTO, or
+// RASTER_LIGHT: the light's software shadow passes, every bundle). Auto: software
 // when the bundle's strands are drawn at most frame.soft_params.x pixels wide at its nearest
 // point `d` (the LoD-thickened width, or the cluster footprint of lod_appearance.glsl).
 bool soft_raster(float d, float width, float thickness, float cap) {
     if (frame.soft.x != RASTER_AUTO) {
-        return frame.soft.x == RASTER_SOFTWARE;
+        return frame.soft.x != RASTER_HARDWARE;
     }
     float pixel = frame.light_dir.w > 0.0 ? 2.0 * max(d, 1e-6) / (frame.camera_pos.w * frame.light_dir.w)
                                           : frame.lod_ortho.x / frame.camera_pos.w;

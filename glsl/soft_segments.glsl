@@ -4,7 +4,9 @@
 // same models as the fragment shaders, evaluated at the vertices and interpolated along the
 // segment) and projected; every segment with both ends in the depth range and its footprint
 // on screen is appended to soft_segments[]. The workgroup reserves its segments with one
-// atomic add; those past the budget (frame.soft.z) are counted, not written.
+// atomic add; those past the budget (frame.soft.z) are counted, not written. In the light's
+// view (frame.soft.x == RASTER_LIGHT) nothing is shaded: the shadow passes need depth and
+// coverage only.
 #ifndef SOFT_SEGMENTS_GLSL
 #define SOFT_SEGMENTS_GLSL
 #include "strip.glsl"
@@ -68,7 +70,7 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
         vec3 ndc = c.xyz / max(c.w, 1e-6);
         vec2 screen = (ndc.xy * 0.5 + 0.5) * frame.viewport.xy;
         sv_screen[idx] = vec4(screen, ndc.z, in_range ? drawn / pixel : -1.0);
-        vec3 radiance = strand_radiance(st[idx], s, p, color, character);
+        vec3 radiance = frame.soft.x == RASTER_LIGHT ? vec3(0.0) : strand_radiance(st[idx], s, p, color, character);
         sv_color[idx] = pack_fragment(radiance, width / max(drawn, 1e-20));
     }
     barrier();

@@ -13,8 +13,8 @@ use common::*;
 use glam::{Mat4, Vec3};
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::render::{
-    FrameOptions, FrameSettings, LodSettings, RenderPath, Renderer, RendererDesc, ShadowMode,
-    StrandParams, StrandRaster, Transparency, View,
+    FrameOptions, FrameSettings, LightRaster, LodSettings, RenderPath, Renderer, RendererDesc,
+    ShadowMode, StrandParams, StrandRaster, Transparency, View,
 };
 use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{Access, Context, ContextDesc};
@@ -69,6 +69,7 @@ fn two_frames(ctx: &Context, r: &mut Renderer, view: &View, opts: &FrameOptions,
 fn every_pass_combination_is_free_of_hazards() {
     let ctx = sync_context();
     let mut valid = 0;
+    let mut soft_lights = 0;
     for msaa in [1, 4] {
         let (mut r, base) = scene(&ctx, RendererDesc::default().msaa(msaa));
         for path in [RenderPath::Mesh, RenderPath::Compute] {
@@ -87,16 +88,24 @@ fn every_pass_combination_is_free_of_hazards() {
                         Transparency::KBuffer { budget: 4 },
                         Transparency::DepthPeeling { layers: 2 },
                     ] {
+                        // The light's passes alternate between the hardware and the
+                        // software ones, so each path, shadow mode and draw meets both.
+                        let light_raster = match shadows != ShadowMode::Off && valid % 2 == 1 {
+                            true => LightRaster::Software,
+                            false => LightRaster::Hardware,
+                        };
                         let settings = FrameSettings {
                             path,
                             raster,
                             transparency,
                             msaa,
+                            light_raster,
                         };
                         if settings.validate(&r.caps()).is_err() {
                             continue;
                         }
                         valid += 1;
+                        soft_lights += (light_raster == LightRaster::Software) as u32;
                         let view = View {
                             shadows,
                             transparency,
@@ -105,10 +114,13 @@ fn every_pass_combination_is_free_of_hazards() {
                         let opts = FrameOptions {
                             path: Some(path),
                             raster,
+                            light_raster,
                             read_image: valid % 2 == 0,
                             ..Default::default()
                         };
-                        let what = format!("{path:?} {raster} {shadows:?} {transparency} {msaa}x");
+                        let what = format!(
+                            "{path:?} {raster} {shadows:?} (light {light_raster}) {transparency} {msaa}x"
+                        );
                         two_frames(&ctx, &mut r, &view, &opts, &what);
                     }
                 }
@@ -117,6 +129,10 @@ fn every_pass_combination_is_free_of_hazards() {
     }
     // Per path: 9 hardware + 6 soft + 6 auto single-sample combinations, 6 with 4x MSAA.
     assert_eq!(valid, 2 * (9 + 6 + 6 + 6), "combinations drawn");
+    assert!(
+        soft_lights >= 12,
+        "software light passes drawn {soft_lights} times"
+    );
 }
 
 #[test]

@@ -107,6 +107,16 @@ struct Args {
     /// software, thicker ones to hardware). With the mesh or compute path.
     #[arg(long, default_value = "hw")]
     draw: hairmesh::render::StrandRaster,
+    /// How the light's passes draw the hair with shadows on: hw (hardware strips) or soft
+    /// (the compute software rasterizer: nearest depth by atomic min, deep opacity layers by
+    /// fixed-point sums). soft needs the mesh or compute path.
+    #[arg(long, default_value = "hw")]
+    shadow_draw: hairmesh::render::LightRaster,
+    /// Render this many identical frames and report (and write) the last: later frames give
+    /// steady-state timings (lavapipe compiles shaders during the first). With the mesh or
+    /// compute path.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    repeat: u32,
     /// Size of the compute path's vertex pool in MiB (frames that need more keep whole strands
     /// up to it and report the overflow).
     #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u64).range(1..=4096))]
@@ -411,9 +421,10 @@ fn run(args: Args) -> Result<()> {
         raster: args.draw,
         transparency,
         msaa,
+        light_raster: args.shadow_draw,
     };
     if let Err(why) = settings.check_combination() {
-        anyhow::bail!("--draw / --msaa {msaa} / --transparency / --path: {why}");
+        anyhow::bail!("--draw / --shadow-draw / --msaa {msaa} / --transparency / --path: {why}");
     }
     hairmesh::render::check_msaa(&ctx, msaa).map_err(|why| {
         let flag = if args.msaa.is_some() {
@@ -464,15 +475,18 @@ fn run(args: Args) -> Result<()> {
     let second = args
         .path
         .filter(|p| matches!(p, RenderPath::Static | RenderPath::Lhs));
-    let mut out = renderer.render_one(
-        &view,
-        &FrameOptions {
-            read_image: true,
-            raster: args.draw,
-            describe_frame: args.print_frame,
-            ..Default::default()
-        },
-    )?;
+    let opts = FrameOptions {
+        read_image: true,
+        raster: args.draw,
+        light_raster: args.shadow_draw,
+        describe_frame: args.print_frame,
+        ..Default::default()
+    };
+    let mut out = renderer.render_one(&view, &opts)?;
+    // Later frames report steady-state timings (the first includes shader JIT on lavapipe).
+    for _ in 1..args.repeat {
+        out = renderer.render_one(&view, &opts)?;
+    }
     if let Some(second) = second {
         outln!(
             "generated (compute path): GPU {:.3} ms; then {second:?}:",

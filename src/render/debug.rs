@@ -40,6 +40,7 @@ impl Renderer {
             raster,
             transparency: kbuffer,
             msaa: self.desc.msaa,
+            light_raster: super::settings::LightRaster::Hardware,
         };
         settings
             .validate(&self.caps())
@@ -59,7 +60,7 @@ impl Renderer {
         let i = self.next;
         let (width, height) = self.targets.size();
         self.prepare_workspace(i, RenderPath::Mesh)?;
-        let transients = self.frame_transients(kbuffer, raster, k)?;
+        let transients = self.frame_transients((kbuffer, raster), None, k)?;
         let mut block: FrameBlock = bytemuck::Zeroable::zeroed();
         block.viewport = [
             width as f32,

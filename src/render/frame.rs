@@ -15,7 +15,7 @@ use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::PropDraw;
 use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets};
 use super::renderer::{PresentTarget, Renderer};
-use super::settings::{FrameOptions, FrameTicket};
+use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
 use super::shared::{FrameBlock, PropInstance};
 use super::slots::{
@@ -37,6 +37,8 @@ pub(super) struct FrameWork<'a> {
     transparency: super::Transparency,
     /// How strands are rasterized.
     raster: StrandRaster,
+    /// How the light's passes draw the hair.
+    light_raster: LightRaster,
     /// k-buffer nodes per pixel (OIT budget, or the software rasterizer's K).
     kbuffer_budget: u32,
     /// Character slots whose hair mesh pose changed (rebuilt this frame).
@@ -59,9 +61,16 @@ impl Renderer {
         let i = self.next;
         self.retire_slot(i)?;
         self.prepare_workspace(i, path)?;
-        let transients = self.frame_transients(view.transparency, raster, kbuffer_budget)?;
         let pose_updates = self.crowd.write_pending_poses(i)?;
-        let (block, light_block) = self.frame_blocks(view, raster, kbuffer_budget);
+        let (block, light_block) = self.frame_blocks(view, opts, kbuffer_budget);
+        // Software light passes only where there is a light view this frame.
+        let light_raster = match light_block {
+            Some(_) => opts.light_raster,
+            None => LightRaster::Hardware,
+        };
+        let soft_light = (light_raster == LightRaster::Software).then_some(view.shadows);
+        let transients =
+            self.frame_transients((view.transparency, raster), soft_light, kbuffer_budget)?;
         let prop_draws = self.write_slot(i, &block, light_block.as_ref(), opts.read_image)?;
         let start = Instant::now();
         let work = FrameWork {
@@ -71,6 +80,7 @@ impl Renderer {
             shadows: light_block.map(|_| view.shadows),
             transparency: view.transparency,
             raster,
+            light_raster,
             kbuffer_budget,
             pose_updates,
             transients,
@@ -124,6 +134,7 @@ impl Renderer {
             raster: opts.raster,
             transparency: view.transparency,
             msaa: self.desc.msaa,
+            light_raster: opts.light_raster,
         };
         let budget = settings
             .validate(&self.caps())
@@ -136,8 +147,8 @@ impl Renderer {
     /// recorded; compiles the transparency pipelines it needs.
     pub(super) fn frame_transients(
         &mut self,
-        transparency: Transparency,
-        raster: StrandRaster,
+        (transparency, raster): (Transparency, StrandRaster),
+        soft_light: Option<ShadowMode>,
         kbuffer_budget: u32,
     ) -> GpuResult<FrameTransients> {
         let size = self.targets.size();
@@ -149,14 +160,15 @@ impl Renderer {
             (_, t) => t,
         };
         self.passes.prepare_transparency(buffers_for)?;
-        if raster.uses_software() {
+        if raster.uses_software() || soft_light.is_some() {
             let range = self.ctx.info.max_storage_buffer_range;
             self.soft_budget
                 .validate(range)
                 .map_err(GpuError::Unsupported)?;
         }
         let soft = raster.uses_software().then_some(self.soft_budget);
-        let t = FrameTransients::new(buffers_for, soft, size);
+        let light = soft_light.map(|mode| (self.soft_budget, self.shadow.resolution(), mode));
+        let t = FrameTransients::new(buffers_for, (soft, light), size);
         for b in t.buffers() {
             self.transients.check(b)?;
         }
@@ -167,9 +179,10 @@ impl Renderer {
     fn frame_blocks(
         &self,
         view: &View,
-        raster: StrandRaster,
+        opts: &FrameOptions,
         kbuffer_budget: u32,
     ) -> (FrameBlock, Option<FrameBlock>) {
+        let raster = opts.raster;
         let (width, height) = self.targets.size();
         let bundles = self.crowd.bundle_count();
         let slots = self.crowd.slot_count();
@@ -189,7 +202,8 @@ impl Renderer {
             (block.light_view_proj, block.shadow, block.shadow_params) =
                 l.shadow_fields(view.shadows);
         }
-        let light_block = light.map(|l| l.frame_block(&block, &view.lod));
+        let soft_light = (opts.light_raster == LightRaster::Software).then_some(self.soft_budget);
+        let light_block = light.map(|l| l.frame_block(&block, &view.lod, soft_light));
         (block, light_block)
     }
 
@@ -433,6 +447,7 @@ fn frame_inputs<'a>(
         shadow: work.shadows,
         transparency: work.transparency,
         raster: work.raster,
+        light_raster: work.light_raster,
         kbuffer_budget: work.kbuffer_budget,
         size,
         mesh_query,

@@ -28,7 +28,7 @@ pub use renderer::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,
     RendererDesc, check_msaa, software_raster_conflict, supported_msaa,
 };
-pub use settings::parse_switch;
+pub use settings::{LightRaster, parse_switch};
 pub use shadow::ShadowMode;
 pub use shared::FrameStats;
 pub use slots::{FRAMES_IN_FLIGHT, FrameReport};

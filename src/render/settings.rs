@@ -29,6 +29,37 @@ impl std::str::FromStr for RenderPath {
     }
 }
 
+/// How the light's passes draw the hair into the shadow maps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LightRaster {
+    /// Hardware strips (task/mesh or vertex + fragment shaders, depth and blending units).
+    #[default]
+    Hardware,
+    /// The software rasterizer in compute: the light's segments are binned into tiles; the
+    /// nearest depth per texel by atomic min, deep opacity layers by fixed-point sums.
+    Software,
+}
+
+impl std::str::FromStr for LightRaster {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "hw" => Ok(LightRaster::Hardware),
+            "soft" => Ok(LightRaster::Software),
+            _ => Err(format!("shadow draw {s:?}: hw or soft")),
+        }
+    }
+}
+
+impl std::fmt::Display for LightRaster {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(match self {
+            LightRaster::Hardware => "hw",
+            LightRaster::Software => "soft",
+        })
+    }
+}
+
 impl std::fmt::Display for RenderPath {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
         f.write_str(match self {
@@ -170,6 +201,8 @@ pub struct FrameOptions {
     /// Hardware strips, the software rasterizer, or a split per bundle (mesh and compute
     /// paths).
     pub raster: super::soft::StrandRaster,
+    /// How the light's passes draw the hair (with shadows on).
+    pub light_raster: LightRaster,
 }
 
 impl Default for FrameOptions {
@@ -180,6 +213,7 @@ impl Default for FrameOptions {
             read_image: false,
             describe_frame: false,
             raster: super::soft::StrandRaster::Hardware,
+            light_raster: LightRaster::Hardware,
         }
     }
 }
@@ -212,6 +246,8 @@ pub struct FrameSettings {
     pub transparency: super::Transparency,
     /// Samples per pixel of the renderer's targets.
     pub msaa: u32,
+    /// How the light's passes draw the hair.
+    pub light_raster: LightRaster,
 }
 
 impl FrameSettings {
@@ -227,6 +263,14 @@ impl FrameSettings {
             && let Some(why) = software_raster_conflict(self.path, self.msaa, self.transparency)
         {
             return Err(why);
+        }
+        if self.light_raster == LightRaster::Software
+            && matches!(self.path, RenderPath::Static | RenderPath::Lhs)
+        {
+            return Err(format!(
+                "software shadows draw the light's generated segments: use them with the mesh or compute path, not {}",
+                self.path
+            ));
         }
         Ok(())
     }
@@ -255,7 +299,8 @@ impl FrameSettings {
             Transparency::KBuffer { budget } => budget,
             _ => self.raster.k(),
         };
-        if !self.raster.uses_software() {
+        let soft_light = self.light_raster == LightRaster::Software;
+        if !self.raster.uses_software() && !soft_light {
             return Ok(budget);
         }
         if !caps.int64_atomics {

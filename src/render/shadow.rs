@@ -125,9 +125,24 @@ impl LightView {
 
     /// The light's own frame block: orthographic (`lod.w = 0`, `light_dir.w = 0`), LoD from the
     /// view size, culling against the light's box; otherwise as `camera` (counts, shading,
-    /// shadow settings).
-    pub fn frame_block(&self, camera: &FrameBlock, lod: &LodSettings) -> FrameBlock {
+    /// shadow settings). With `soft` (the software shadow passes' budgets) every bundle goes to
+    /// the software rasterizer as depth and coverage (`RASTER_LIGHT`), binned into the map's
+    /// tiles; otherwise the light's passes draw hardware strips.
+    pub fn frame_block(
+        &self,
+        camera: &FrameBlock,
+        lod: &LodSettings,
+        soft: Option<super::soft::SoftBudget>,
+    ) -> FrameBlock {
         let res = self.resolution as f32;
+        let (tx, ty) = super::soft::tile_grid(self.resolution, self.resolution);
+        let (soft, soft_params) = match soft {
+            Some(b) => (
+                [super::shared::RASTER_LIGHT, 0, b.segments, b.tile_entries],
+                [0.0, 0.0, tx as f32, ty as f32],
+            ),
+            None => ([0; 4], [0.0; 4]),
+        };
         FrameBlock {
             view_proj: self.view_proj.to_cols_array_2d(),
             camera_pos: self.eye.extend(res).to_array(),
@@ -136,9 +151,8 @@ impl LightView {
             planes: frustum_planes(self.view_proj),
             lod: [lod.alpha_strands, lod.alpha_verts, lod.lambda, 0.0],
             lod_ortho: [self.size, 0.0, 0.0, 0.0],
-            // The light's passes draw hardware strips only.
-            soft: [0; 4],
-            soft_params: [0.0; 4],
+            soft,
+            soft_params,
             ..*camera
         }
     }

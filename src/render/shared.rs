@@ -56,6 +56,12 @@ pub const RASTER_HARDWARE: u32 = 0;
 pub const RASTER_SOFTWARE: u32 = 1;
 /// `FrameBlock::soft.x`: software or hardware per bundle.
 pub const RASTER_AUTO: u32 = 2;
+/// `FrameBlock::soft.x` of the light's view: every bundle to the software rasterizer, as
+/// depth and coverage only (no shading).
+pub const RASTER_LIGHT: u32 = 3;
+/// Fixed-point scale of the software shadow pass's opacity sums (`soft_shadow.comp`): opacity
+/// `o` adds `round(o * SHADOW_OPACITY_FIXED)`.
+pub const SHADOW_OPACITY_FIXED: f32 = 4096.0;
 /// `FrameBlock::transparency.x`: opaque strands.
 pub const TRANSPARENCY_OPAQUE: u32 = 0;
 /// `FrameBlock::transparency.x`: k-buffer OIT.
@@ -135,11 +141,17 @@ pub enum FrameBinding {
     /// Software rasterizer: per pixel, the opaque depth (`float`) the strands are tested
     /// against.
     SoftDepth = 22,
+    /// Software shadows: per light texel, the depth of the nearest hair (`float` bits),
+    /// copied into the hair depth map.
+    SoftShadowDepth = 23,
+    /// Software shadows: per light texel, the deep opacity layers (4 halves in a `uvec2`,
+    /// the RGBA16F texel), copied into the layers map.
+    SoftShadowLayers = 24,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 23] = [
+    pub const ALL: [(FrameBinding, &'static str); 25] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -163,6 +175,8 @@ impl FrameBinding {
         (FrameBinding::SoftTiles, "BINDING_SOFT_TILES"),
         (FrameBinding::SoftEntries, "BINDING_SOFT_ENTRIES"),
         (FrameBinding::SoftDepth, "BINDING_SOFT_DEPTH"),
+        (FrameBinding::SoftShadowDepth, "BINDING_SOFT_SHADOW_DEPTH"),
+        (FrameBinding::SoftShadowLayers, "BINDING_SOFT_SHADOW_LAYERS"),
     ];
 
     /// What the binding holds.
@@ -753,6 +767,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("RASTER_HARDWARE", RASTER_HARDWARE),
         uint("RASTER_SOFTWARE", RASTER_SOFTWARE),
         uint("RASTER_AUTO", RASTER_AUTO),
+        uint("RASTER_LIGHT", RASTER_LIGHT),
         uint("TRANSPARENCY_OPAQUE", TRANSPARENCY_OPAQUE),
         uint("TRANSPARENCY_KBUFFER", TRANSPARENCY_KBUFFER),
         uint("TRANSPARENCY_PEELING", TRANSPARENCY_PEELING),
@@ -772,6 +787,7 @@ fn float_constants() -> Vec<(&'static str, f32)> {
         ("KAJIYA_KAY_EXPONENT", crate::shade::KAJIYA_KAY_EXPONENT),
         ("MARSCHNER_ENERGY_SCALE", crate::shade::ENERGY_SCALE),
         ("SOFT_THIN_WIDTH", SOFT_THIN_WIDTH),
+        ("SHADOW_OPACITY_FIXED", SHADOW_OPACITY_FIXED),
     ]
 }
 

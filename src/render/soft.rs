@@ -31,6 +31,7 @@
 use glam::Vec2;
 
 use super::graph::TransientBuffer;
+use super::settings::ShadowMode;
 use super::shared::{FrameBinding, FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
 
 /// Default number of fragments per pixel the software rasterizer keeps sorted.
@@ -135,6 +136,12 @@ pub struct SoftBudget {
 }
 
 impl SoftBudget {
+    /// No budget (no buffers).
+    pub const EMPTY: SoftBudget = SoftBudget {
+        segments: 0,
+        tile_entries: 0,
+    };
+
     /// The largest budgets the device's `maxStorageBufferRange` allows, at most 4M segments
     /// and 16M entries (128 MiB + 64 MiB).
     pub fn for_range(range: u64) -> Self {
@@ -192,20 +199,25 @@ pub fn frame_fields(
 }
 
 impl SoftBudget {
-    /// The software rasterizer's buffers for this budget and a `width x height` target, as
-    /// the frame graph creates them (`None`: not drawn this frame, sized 0): segments, the
-    /// tile table (`uvec4` per tile), segment indices by tile, and the opaque depth (one
-    /// float per pixel).
-    pub fn buffers(budget: Option<Self>, width: u32, height: u32) -> [TransientBuffer; 4] {
-        let (tx, ty) = tile_grid(width, height);
-        let need = budget.map_or([0; 4], |b| {
-            [
-                b.segments as u64 * size_of::<SoftSegment>() as u64,
-                tx as u64 * ty as u64 * 16,
-                b.tile_entries as u64 * 4,
-                width as u64 * height as u64 * 4,
-            ]
-        });
+    /// The software rasterizer's buffers, as the frame graph creates them, for this budget,
+    /// the camera's `width x height` target when it draws the camera's strands, and the
+    /// light's map side when it draws the shadows (sized 0 where neither): segments and
+    /// entries (the views take turns), the tile table (`uvec4` per tile, the larger grid),
+    /// and the camera's opaque depth (one float per pixel).
+    pub fn buffers(self, camera: Option<(u32, u32)>, light: Option<u32>) -> [TransientBuffer; 4] {
+        let tiles = |(w, h)| {
+            let (tx, ty) = tile_grid(w, h);
+            tx as u64 * ty as u64 * 16
+        };
+        let any = camera.is_some() || light.is_some();
+        let need = [
+            any as u64 * self.segments as u64 * size_of::<SoftSegment>() as u64,
+            camera
+                .map_or(0, tiles)
+                .max(light.map_or(0, |r| tiles((r, r)))),
+            any as u64 * self.tile_entries as u64 * 4,
+            camera.map_or(0, |(w, h)| w as u64 * h as u64 * 4),
+        ];
         [
             TransientBuffer::storage("soft segments", need[0], FrameBinding::SoftSegments as u32),
             TransientBuffer::storage("soft tiles", need[1], FrameBinding::SoftTiles as u32),
@@ -213,6 +225,26 @@ impl SoftBudget {
             TransientBuffer::storage("soft depth", need[3], FrameBinding::SoftDepth as u32),
         ]
     }
+}
+
+/// The software shadow passes' outputs for a `side x side` map in `mode` (`None`: hardware
+/// light passes, sized 0): the hair depth (a float per texel) and, for deep opacity maps, the
+/// layers (an RGBA16F texel each), which transfers copy into the maps.
+pub fn shadow_buffers(light: Option<(u32, ShadowMode)>) -> [TransientBuffer; 2] {
+    let texels = light.map_or(0, |(side, _)| side as u64 * side as u64);
+    let layers = matches!(light, Some((_, ShadowMode::DeepOpacity)));
+    [
+        TransientBuffer::storage(
+            "soft shadow depth",
+            texels * 4,
+            FrameBinding::SoftShadowDepth as u32,
+        ),
+        TransientBuffer::storage(
+            "soft shadow layers",
+            layers as u64 * texels * 8,
+            FrameBinding::SoftShadowLayers as u32,
+        ),
+    ]
 }
 
 #[cfg(test)]

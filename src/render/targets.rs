@@ -100,8 +100,10 @@ pub struct ShadowMaps {
 impl ShadowMaps {
     /// Maps of `resolution` x `resolution` texels.
     pub fn new(ctx: &Arc<Context>, resolution: u32) -> GpuResult<Self> {
-        let depth_usage =
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        // Transfers: the software shadow passes copy their results in.
+        let depth_usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_DST;
         let depth = |name| {
             Image::new(
                 ctx,
@@ -119,7 +121,11 @@ impl ShadowMaps {
                     resolution,
                     resolution,
                 )
-                .usage(vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED),
+                .usage(
+                    vk::ImageUsageFlags::COLOR_ATTACHMENT
+                        | vk::ImageUsageFlags::SAMPLED
+                        | vk::ImageUsageFlags::TRANSFER_DST,
+                ),
             )?,
             access: [Access::Nothing; 3],
             sampler: crate::vk::Sampler::nearest_clamp(ctx)?,

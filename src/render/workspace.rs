@@ -225,7 +225,9 @@ impl Workspace {
                 | FrameBinding::SoftSegments
                 | FrameBinding::SoftTiles
                 | FrameBinding::SoftEntries
-                | FrameBinding::SoftDepth => continue,
+                | FrameBinding::SoftDepth
+                | FrameBinding::SoftShadowDepth
+                | FrameBinding::SoftShadowLayers => continue,
                 FrameBinding::ShadowHairDepth
                 | FrameBinding::ShadowPropDepth
                 | FrameBinding::ShadowLayers => {

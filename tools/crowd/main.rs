@@ -103,6 +103,11 @@ pub struct Args {
     /// oit transparency.
     #[arg(long, default_value = "hw")]
     draw: hairmesh::render::StrandRaster,
+    /// How the light's passes draw the hair with shadows on: hw (hardware strips) or soft
+    /// (the compute software rasterizer: nearest depth by atomic min, deep opacity layers by
+    /// fixed-point sums). soft needs the mesh or compute path.
+    #[arg(long, default_value = "hw")]
+    shadow_draw: hairmesh::render::LightRaster,
     /// Seed 000's thick-strand appearance term under LoD.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     lod_appearance: bool,
@@ -381,6 +386,7 @@ fn run(args: Args) -> Result<()> {
         raster: args.draw,
         transparency: args.transparency,
         msaa: args.msaa,
+        light_raster: args.shadow_draw,
     };
     if let Err(why) = settings.check_combination() {
         bail!("--draw / --msaa {} / --transparency: {why}", args.msaa);
@@ -448,6 +454,7 @@ fn run(args: Args) -> Result<()> {
             &FrameOptions {
                 read_image: true,
                 raster: args.draw,
+                light_raster: args.shadow_draw,
                 ..Default::default()
             },
         )?;

@@ -19,8 +19,8 @@ use hairmesh::outln;
 use hairmesh::render::soft::{DEFAULT_SOFT_K, StrandRaster};
 use hairmesh::render::transparency::{DEFAULT_OIT_BUDGET, DEFAULT_PEEL_LAYERS, MAX_OIT_BUDGET};
 use hairmesh::render::{
-    Camera, FrameOptions, FrameReport, FrameTicket, LodSettings, PresentTarget, RenderPath,
-    Renderer, ShadowMode, StrandParams, Transparency, View,
+    Camera, FrameOptions, FrameReport, FrameTicket, LightRaster, LodSettings, PresentTarget,
+    RenderPath, Renderer, ShadowMode, StrandParams, Transparency, View,
 };
 use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{
@@ -41,6 +41,7 @@ struct Controls {
     visible: usize,
     shading: ShadingModel,
     shadows: ShadowMode,
+    light_raster: LightRaster,
     transparency: Transparency,
     raster: StrandRaster,
     lod_appearance: bool,
@@ -105,6 +106,11 @@ impl Controls {
                     for m in ShadowMode::ALL {
                         ui.radio_value(&mut self.shadows, m, m.name());
                     }
+                });
+                ui.horizontal(|ui| {
+                    ui.label("shadow draw");
+                    ui.radio_value(&mut self.light_raster, LightRaster::Hardware, "hardware");
+                    ui.radio_value(&mut self.light_raster, LightRaster::Software, "software");
                 });
                 ui.horizontal(|ui| {
                     ui.label("transparency");
@@ -281,6 +287,8 @@ struct Running {
     path: RenderPath,
     shading: ShadingModel,
     shadows: ShadowMode,
+    /// How the light's passes draw (hardware where the settings refuse software).
+    light_raster: LightRaster,
     transparency: Transparency,
     raster: StrandRaster,
     /// The software rasterizer can draw this window's frames (device support, no MSAA).
@@ -442,6 +450,7 @@ impl App {
             path,
             shading: self.args.shading,
             shadows: self.args.shadows,
+            light_raster: self.args.shadow_draw,
             transparency: self.args.transparency,
             raster: self.args.draw,
             lod_appearance: self.args.lod_appearance,
@@ -543,7 +552,7 @@ impl Running {
             ..View::new(camera)
         };
         let (primitives, ppp, freed) = self.panel_frame(scene_len)?;
-        let raster = self.frame_raster();
+        let (raster, light_raster) = self.frame_raster();
         let chain = self.swapchain.as_ref().expect("created above");
         let semaphore = &self.acquire[(self.frame % self.acquire.len() as u64) as usize];
         let ui = &mut self.panel.ui;
@@ -556,6 +565,7 @@ impl Running {
             &FrameOptions {
                 path: Some(self.path),
                 raster,
+                light_raster,
                 describe_frame: self.show_graph,
                 ..Default::default()
             },
@@ -599,6 +609,7 @@ impl Running {
             visible: self.panel.visible,
             shading: self.shading,
             shadows: self.shadows,
+            light_raster: self.light_raster,
             transparency: self.transparency,
             raster: self.raster,
             lod_appearance: self.lod_appearance,
@@ -642,19 +653,27 @@ impl Running {
         self.soft_ok
     }
 
-    /// The raster of the next frame: the chosen one where the settings allow it
-    /// (`FrameSettings::validate` holds the rules), else hardware strips.
-    fn frame_raster(&self) -> StrandRaster {
-        let settings = hairmesh::render::FrameSettings {
+    /// The camera's and the light's raster of the next frame: the chosen ones where the
+    /// settings allow them (`FrameSettings::validate` holds the rules), else hardware.
+    fn frame_raster(&self) -> (StrandRaster, LightRaster) {
+        let settings = |raster, light_raster| hairmesh::render::FrameSettings {
             path: self.path,
-            raster: self.raster,
+            raster,
             transparency: self.transparency,
             msaa: self.renderer.msaa(),
+            light_raster,
         };
-        match settings.validate(&self.renderer.caps()) {
-            Ok(_) => self.raster,
-            Err(_) => StrandRaster::Hardware,
-        }
+        let caps = self.renderer.caps();
+        let ok = |r, l| settings(r, l).validate(&caps).is_ok();
+        let raster = match ok(self.raster, LightRaster::Hardware) {
+            true => self.raster,
+            false => StrandRaster::Hardware,
+        };
+        let light = match ok(raster, self.light_raster) {
+            true => self.light_raster,
+            false => LightRaster::Hardware,
+        };
+        (raster, light)
     }
 
     fn apply(&mut self, c: Controls) -> Result<()> {
@@ -674,6 +693,7 @@ impl Running {
         self.panel.lod = c.lod;
         self.shading = c.shading;
         self.shadows = c.shadows;
+        self.light_raster = c.light_raster;
         self.transparency = c.transparency;
         self.raster = c.raster;
         self.lod_appearance = c.lod_appearance;

@@ -18,8 +18,10 @@ pub use crate::render::workspace::{ScanLevel, scan_plan};
 pub enum GenerateView {
     /// The camera: software bundles append their segments (`soft_segments.glsl`).
     Camera,
-    /// The light's shadow passes: hardware strips only.
+    /// The light's hardware shadow passes: strips in the vertex pool.
     Light,
+    /// The light's software shadow passes: every bundle's segments, unshaded.
+    LightSoftware,
 }
 
 impl GenerateView {
@@ -27,7 +29,9 @@ impl GenerateView {
     pub fn scopes(self) -> [&'static str; 3] {
         match self {
             GenerateView::Camera => ["cull", "scan", "generate"],
-            GenerateView::Light => ["shadow cull", "shadow scan", "shadow generate"],
+            GenerateView::Light | GenerateView::LightSoftware => {
+                ["shadow cull", "shadow scan", "shadow generate"]
+            }
         }
     }
 }
@@ -40,7 +44,7 @@ pub struct ComputeGenerate {
     finalize: Pipeline,
     /// Strand workgroups for the light (no software rasterizer).
     generate_light: Pipeline,
-    /// Strand workgroups for the camera (`SOFT_RASTER`).
+    /// Strand workgroups for the camera and the light's software passes (`SOFT_RASTER`).
     generate_camera: Pipeline,
 }
 
@@ -97,7 +101,7 @@ impl ComputeGenerate {
         g.end_scope();
         g.begin_scope(scopes[2]);
         let generate = match view {
-            GenerateView::Camera => &self.generate_camera,
+            GenerateView::Camera | GenerateView::LightSoftware => &self.generate_camera,
             GenerateView::Light => &self.generate_light,
         };
         let args = r.args_buffer;
@@ -108,8 +112,9 @@ impl ComputeGenerate {
             .read(r.args, Access::IndirectRead)
             .write(r.args, rw)
             .discard(r.pool, rw);
-        if view == GenerateView::Camera {
-            // Software bundles are shaded here (shadow lookups included).
+        if view != GenerateView::Light {
+            // Software bundles are shaded here (shadow lookups included; the light's view
+            // shades nothing, but the pipeline binds the maps).
             p = p
                 .write(r.soft_segments, rw)
                 .read_all(&r.shadow, Access::SampledRead);

@@ -9,6 +9,7 @@ pub mod props;
 pub mod scalp;
 pub mod shadow;
 pub mod soft_raster;
+pub mod soft_shadow;
 pub mod strands;
 pub mod transparency;
 
@@ -17,6 +18,7 @@ use std::sync::Arc;
 use super::RenderPath;
 use super::graph::TransientBuffer;
 use super::graph::{FrameGraph, Res};
+use super::settings::{LightRaster, ShadowMode};
 use super::shared::GenerateArgs;
 use super::soft::SoftBudget;
 use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets, ShadowMaps};
@@ -223,6 +225,10 @@ pub struct FrameRes<'a> {
     pub soft_entries: Res,
     /// Software rasterizer: the opaque depth copy.
     pub soft_depth: Res,
+    /// Software shadows: the hair depth nearest the light.
+    pub soft_shadow_depth: Res,
+    /// Software shadows: the deep opacity layers.
+    pub soft_shadow_layers: Res,
     /// The `args` buffer (indirect commands name it).
     pub args_buffer: &'a Buffer,
     /// The imported images attachments and copies name.
@@ -261,30 +267,42 @@ pub struct FrameTransients {
     pub transparency: [TransientBuffer; 4],
     /// Software rasterizer segments, tiles, entries, depth.
     pub soft: [TransientBuffer; 4],
+    /// Software shadows: hair depth and deep opacity layers.
+    pub soft_shadow: [TransientBuffer; 2],
     /// Depth peeling's layer depth attachment, when peeling.
     pub peel_image: Option<ImageDesc>,
 }
 
 impl FrameTransients {
-    /// The transients of a frame at `size`, whose per-pixel buffers are
-    /// those of `transparency` (the software rasterizer composites through a k-buffer), with
-    /// the software rasterizer's budget when it draws.
+    /// The transients of a frame at `size`, whose per-pixel buffers are those of
+    /// `transparency` (the software rasterizer composites through a k-buffer), with the
+    /// software rasterizer's budget when it draws the camera's strands (`camera`) and when it
+    /// draws the light's (`light`: budget, map side, shadow mode).
     pub fn new(
         transparency: Transparency,
-        soft: Option<SoftBudget>,
+        (camera, light): (Option<SoftBudget>, Option<(SoftBudget, u32, ShadowMode)>),
         (width, height): (u32, u32),
     ) -> Self {
         let peel = matches!(transparency, Transparency::DepthPeeling { .. });
+        let budget = camera.or(light.map(|l| l.0));
+        let soft = budget.map_or_else(
+            || SoftBudget::buffers(SoftBudget::EMPTY, None, None),
+            |b| SoftBudget::buffers(b, camera.map(|_| (width, height)), light.map(|l| l.1)),
+        );
         FrameTransients {
             transparency: transparency.buffers(width as u64 * height as u64),
-            soft: SoftBudget::buffers(soft, width, height),
+            soft,
+            soft_shadow: super::soft::shadow_buffers(light.map(|l| (l.1, l.2))),
             peel_image: peel.then(|| super::transparency::peel_image(width, height)),
         }
     }
 
     /// Every transient buffer.
     pub fn buffers(&self) -> impl Iterator<Item = &TransientBuffer> {
-        self.transparency.iter().chain(&self.soft)
+        self.transparency
+            .iter()
+            .chain(&self.soft)
+            .chain(&self.soft_shadow)
     }
 }
 
@@ -317,6 +335,7 @@ impl<'a> FrameRes<'a> {
             t.transparency.map(|d| g.create_buffer(d));
         let [soft_segments, soft_tiles, soft_entries, soft_depth] =
             t.soft.map(|d| g.create_buffer(d));
+        let [soft_shadow_depth, soft_shadow_layers] = t.soft_shadow.map(|d| g.create_buffer(d));
         FrameRes {
             constants: g.host_input("frame constants"),
             textures: g.host_input("textures"),
@@ -346,6 +365,8 @@ impl<'a> FrameRes<'a> {
             soft_tiles,
             soft_entries,
             soft_depth,
+            soft_shadow_depth,
+            soft_shadow_layers,
             args_buffer: w.args,
             images: FrameImages {
                 color,
@@ -378,6 +399,8 @@ pub struct FrameInputs<'a> {
     pub transparency: super::Transparency,
     /// How strands are rasterized.
     pub raster: super::soft::StrandRaster,
+    /// How the light's passes draw the hair.
+    pub light_raster: LightRaster,
     /// k-buffer nodes per pixel of this frame (the OIT budget, or the software
     /// rasterizer's K in opaque frames).
     pub kbuffer_budget: u32,
@@ -401,6 +424,8 @@ pub struct FramePasses {
     transparency: TransparencyPass,
     /// The software rasterizer, on devices with 64-bit shared and buffer atomics.
     soft: Option<soft_raster::SoftRasterPass>,
+    /// The light's software passes (with `soft`).
+    soft_shadow: Option<soft_shadow::SoftShadowPass>,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
     lhs_skin: lhs_skin::LhsSkin,
 }
@@ -443,6 +468,11 @@ impl FramePasses {
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
             soft: if ctx.info.int64_atomics {
                 Some(soft_raster::SoftRasterPass::new(ctx, layout, task_bundles)?)
+            } else {
+                None
+            },
+            soft_shadow: if ctx.info.int64_atomics {
+                Some(soft_shadow::SoftShadowPass::new(ctx, layout)?)
             } else {
                 None
             },
@@ -561,8 +591,12 @@ impl FramePasses {
         }
         let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
         if let Some(mode) = inp.shadow {
+            let soft_light = inp.light_raster == LightRaster::Software;
             if compute {
-                let view = GenerateView::Light;
+                let view = match soft_light {
+                    true => GenerateView::LightSoftware,
+                    false => GenerateView::Light,
+                };
                 self.generate.add(g, r, inp.light_sets, inp.bundles, view);
             }
             let draw = ShadowDraw {
@@ -572,7 +606,13 @@ impl FramePasses {
                 path: inp.path,
                 props: inp.props,
             };
-            self.shadow.add(g, r, draw);
+            if soft_light {
+                let soft = self.soft.as_ref().zip(self.soft_shadow.as_ref());
+                let (raster, pass) = soft.ok_or_else(no_soft)?;
+                pass.add(g, r, (&self.shadow, raster), draw);
+            } else {
+                self.shadow.add(g, r, draw);
+            }
             // The camera's statistics start from zero again.
             if !keep_args {
                 add_clear_args(g, r);
@@ -603,7 +643,8 @@ impl FramePasses {
         if soft {
             let pass = self.soft.as_ref().ok_or_else(no_soft)?;
             if inp.path == RenderPath::Mesh {
-                pass.add_mesh_segments(g, r, inp.sets, inp.bundles, inp.size);
+                let view = (inp.sets, "soft segments");
+                pass.add_mesh_segments(g, r, view, inp.bundles, inp.size);
             }
             pass.add(g, r, inp.sets, inp.size, true);
         }

@@ -52,23 +52,11 @@ impl ShadowPass {
     /// Add the light's passes: the props' depth, the hair's depth and, for deep opacity
     /// maps, the hair's opacity layers; every map ends up sampled by the camera's passes.
     pub fn add<'a>(&'a self, g: &mut FrameGraph<'a>, r: &FrameRes<'a>, d: ShadowDraw<'a>) {
-        let [hair, prop, layers] = r.shadow;
+        let [hair, _, layers] = r.shadow;
         g.begin_scope("shadow draw");
-        let (sets, props) = (d.sets, d.props);
-        let [hair_image, prop_image, layers_image] = r.images.shadow;
-        g.pass("shadow props")
-            .read(r.constants, Access::VertexRead)
-            .discard(prop, Access::DepthAttachment)
-            .record(move |rec, _| {
-                rec.begin_rendering_depth(Attachment {
-                    image: prop_image,
-                    clear: Some([1.0; 4]),
-                    resolve: None,
-                });
-                self.props.record(rec, sets, props);
-                rec.end_rendering();
-                Ok(())
-            });
+        self.add_props(g, r, &d);
+        let sets = d.sets;
+        let [hair_image, _, layers_image] = r.images.shadow;
         let p = g
             .pass("shadow hair depth")
             .discard(hair, Access::DepthAttachment);
@@ -106,5 +94,24 @@ impl ShadowPass {
             });
         }
         g.end_scope();
+    }
+
+    /// Add the props' depth pass of the light (hardware triangles; both light rasters).
+    pub fn add_props<'a>(&'a self, g: &mut FrameGraph<'a>, r: &FrameRes<'a>, d: &ShadowDraw<'a>) {
+        let (sets, props) = (d.sets, d.props);
+        let prop_image = r.images.shadow[1];
+        g.pass("shadow props")
+            .read(r.constants, Access::VertexRead)
+            .discard(r.shadow[1], Access::DepthAttachment)
+            .record(move |rec, _| {
+                rec.begin_rendering_depth(Attachment {
+                    image: prop_image,
+                    clear: Some([1.0; 4]),
+                    resolve: None,
+                });
+                self.props.record(rec, sets, props);
+                rec.end_rendering();
+                Ok(())
+            });
     }
 }

@@ -75,18 +75,19 @@ impl SoftRasterPass {
 
     /// Mesh path: add the pass that builds the software bundles of `bundles` bundles in task
     /// and mesh shaders and appends their segments (compute generation appends them in
-    /// `generate.comp`).
+    /// `generate.comp`), timed as `scope`, for the view of `sets` (the camera's, or the
+    /// light's for the software shadows).
     pub fn add_mesh_segments<'a>(
         &'a self,
         g: &mut FrameGraph<'a>,
         r: &FrameRes<'a>,
-        sets: PassSets<'a>,
+        (sets, scope): (PassSets<'a>, &'static str),
         bundles: u32,
         size: (u32, u32),
     ) {
         let task_bundles = self.task_bundles;
         let pipeline = self.mesh_segments.as_ref();
-        g.begin_scope("soft segments");
+        g.begin_scope(scope);
         g.pass("soft segments (mesh)")
             .read_all(&[r.constants, r.textures], Access::TaskRead)
             .read(r.textures, Access::MeshRead)
@@ -122,7 +123,7 @@ impl SoftRasterPass {
     ) {
         let (tx, ty) = tile_grid(size.0, size.1);
         let rw = Access::ComputeReadWrite;
-        let (args, soft_depth, soft_tiles) = (r.args_buffer, r.soft_depth, r.soft_tiles);
+        let soft_depth = r.soft_depth;
         g.begin_scope("soft bin");
         if copy_depth {
             let depth = r.images.depth;
@@ -134,6 +135,38 @@ impl SoftRasterPass {
                     Ok(())
                 });
         }
+        self.add_binning(g, r, sets, size);
+        g.end_scope();
+        g.begin_scope("soft raster");
+        g.pass("soft raster")
+            .read(r.constants, Access::ComputeRead)
+            .read_all(&[r.soft_segments, r.soft_tiles], Access::ComputeRead)
+            .read_all(&[r.soft_entries, r.soft_depth], Access::ComputeRead)
+            .write(r.args, rw)
+            .write(r.oit_nodes, rw)
+            .write(r.oit_tail, rw)
+            .record(move |rec, _| {
+                rec.bind(&self.raster, &sets.both());
+                rec.dispatch(tx, ty, 1);
+                Ok(())
+            });
+        g.end_scope();
+    }
+
+    /// Add the binning of the segments appended this frame into the tiles of a
+    /// `size` view (the camera's target, or the light's map with the light's sets): the tile
+    /// table cleared, the dispatch sized, segments counted per tile, the tiles' ranges
+    /// scanned, segment indices scattered into them.
+    pub fn add_binning<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        sets: PassSets<'a>,
+        size: (u32, u32),
+    ) {
+        let (tx, ty) = tile_grid(size.0, size.1);
+        let rw = Access::ComputeReadWrite;
+        let (args, soft_tiles) = (r.args_buffer, r.soft_tiles);
         g.pass("soft tiles clear")
             .discard(r.soft_tiles, Access::TransferWrite)
             .record(move |rec, res| {
@@ -176,20 +209,5 @@ impl SoftRasterPass {
                 Ok(())
             });
         bin(g, "soft bin scatter", &self.scatter, true);
-        g.end_scope();
-        g.begin_scope("soft raster");
-        g.pass("soft raster")
-            .read(r.constants, Access::ComputeRead)
-            .read_all(&[r.soft_segments, r.soft_tiles], Access::ComputeRead)
-            .read_all(&[r.soft_entries, r.soft_depth], Access::ComputeRead)
-            .write(r.args, rw)
-            .write(r.oit_nodes, rw)
-            .write(r.oit_tail, rw)
-            .record(move |rec, _| {
-                rec.bind(&self.raster, &sets.both());
-                rec.dispatch(tx, ty, 1);
-                Ok(())
-            });
-        g.end_scope();
     }
 }
