@@ -26,6 +26,8 @@ use std::time::Instant;
 
 #[path = "bench/animate.rs"]
 mod animate;
+#[path = "bench/defaults.rs"]
+mod defaults;
 #[path = "bench/paper.rs"]
 mod paper;
 #[path = "bench/raster.rs"]
@@ -178,9 +180,9 @@ enum Cmd {
     /// pass, CPU ms to record a frame, peak RSS and GPU memory, for N characters, LoD on/off,
     /// both paths (and the mesh path with 1 vs 32 bundles per task workgroup).
     Crowd {
-        /// Character counts.
-        #[arg(long, value_delimiter = ',', default_value = "1,16,64,256")]
-        counts: Vec<usize>,
+        /// Character counts (default 1,16,64,256; with --compare-defaults, 100).
+        #[arg(long, value_delimiter = ',')]
+        counts: Option<Vec<usize>>,
         /// Image width.
         #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
         width: u32,
@@ -205,6 +207,11 @@ enum Cmd {
         /// Strand rasterization: hw, soft[:K] or auto[:K] (see `render --help`).
         #[arg(long, default_value = "hw")]
         draw: hairmesh::render::StrandRaster,
+        /// Instead: the crowd's default look (Marschner, deep opacity shadows) with the old
+        /// default rasterizers (hw for camera and light) against today's (auto and the
+        /// software light passes where supported), frame wall time and speed-up.
+        #[arg(long)]
+        compare_defaults: bool,
     },
 }
 
@@ -445,7 +452,7 @@ fn bench_crowd(
     runs: usize,
     device: Option<String>,
     picture: Option<PathBuf>,
-    raster: hairmesh::render::StrandRaster,
+    (raster, compare_defaults): (hairmesh::render::StrandRaster, bool),
 ) -> Result<()> {
     if counts.is_empty() || counts.iter().any(|&c| c == 0 || c > 1024) {
         bail!("--counts: every count must be in 1..=1024");
@@ -470,11 +477,26 @@ fn bench_crowd(
         ctx.info.driver,
         (1u32 << e) + 1
     )?;
+    let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
+    if compare_defaults {
+        let run = defaults::DefaultsRun {
+            ctx: &ctx,
+            meshes: &meshes,
+            params,
+            size: (width, height),
+            runs,
+            camera,
+        };
+        outln!("| N | path | rasterizers | GPU ms | frame wall ms |\n|---|---|---|---|---|")?;
+        for &count in &counts {
+            run.measure(count)?;
+        }
+        return Ok(());
+    }
     outln!(
         "| N | path | LoD | strands drawn (demanded) | triangles | GPU ms per pass | GPU ms | CPU record ms | GPU MiB | per-character KiB (textures) | peak RSS MiB | frame wall ms |"
     )?;
     outln!("|---|---|---|---|---|---|---|---|---|---|---|---|")?;
-    let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
     let mut configs = Vec::new();
     if hairmesh::render::passes::strands::mesh_path_supported(&ctx) {
         configs.push(("mesh (32/task)", 32, RenderPath::Mesh));
@@ -626,8 +648,12 @@ fn run(args: Args) -> Result<()> {
             device,
             picture,
             draw,
+            compare_defaults,
         } => bench_crowd(
-            counts,
+            counts.unwrap_or(match compare_defaults {
+                true => vec![100],
+                false => vec![1, 16, 64, 256],
+            }),
             width,
             height,
             strands_per_bundle,
@@ -635,7 +661,7 @@ fn run(args: Args) -> Result<()> {
             runs as usize,
             device,
             picture,
-            draw,
+            (draw, compare_defaults),
         )?,
         Cmd::Lod {
             mesh,

@@ -104,14 +104,16 @@ struct Args {
     /// Strand rasterization: hw (camera-facing strips through the hardware rasterizer),
     /// soft or soft:K (the compute software rasterizer keeping K fragments per pixel sorted,
     /// default 8), auto or auto:K (per bundle: strands drawn at most 1.5 pixels wide to
-    /// software, thicker ones to hardware). With the mesh or compute path.
-    #[arg(long, default_value = "hw")]
-    draw: hairmesh::render::StrandRaster,
+    /// software, thicker ones to hardware). With the mesh or compute path. Default: auto
+    /// where the device and the other settings allow it, else hw.
+    #[arg(long)]
+    draw: Option<hairmesh::render::StrandRaster>,
     /// How the light's passes draw the hair with shadows on: hw (hardware strips) or soft
     /// (the compute software rasterizer: nearest depth by atomic min, deep opacity layers by
-    /// fixed-point sums). soft needs the mesh or compute path.
-    #[arg(long, default_value = "hw")]
-    shadow_draw: hairmesh::render::LightRaster,
+    /// fixed-point sums). soft needs the mesh or compute path. Default: soft where the device
+    /// and the other settings allow it, else hw.
+    #[arg(long)]
+    shadow_draw: Option<hairmesh::render::LightRaster>,
     /// Render this many identical frames and report (and write) the last: later frames give
     /// steady-state timings (lavapipe compiles shaders during the first). With the mesh or
     /// compute path.
@@ -332,7 +334,7 @@ fn pick_camera(args: &Args, inputs: &Inputs) -> Result<Camera> {
 fn print_report(
     ctx: &Context,
     args: &Args,
-    characters: usize,
+    (characters, settings): (usize, hairmesh::render::FrameSettings),
     out: &FrameReport,
     wall: f64,
 ) -> std::io::Result<()> {
@@ -360,11 +362,16 @@ fn print_report(
     if let Some(q) = out.mesh_primitives {
         outln!("  mesh primitives generated (VK_EXT_mesh_shader query): {q}")?;
     }
-    if args.draw.uses_software() {
+    outln!(
+        "  draw {}, shadow draw {}",
+        settings.raster,
+        settings.light_raster
+    )?;
+    if settings.raster.uses_software() {
         let s = &out.stats;
         outln!(
             "  software raster ({}): {} segments, {} tile entries",
-            args.draw,
+            settings.raster,
             s.segments_written,
             s.tile_entries_written
         )?;
@@ -418,10 +425,10 @@ fn run(args: Args) -> Result<()> {
         .unwrap_or_default();
     let settings = hairmesh::render::FrameSettings {
         path: args.path.unwrap_or(RenderPath::Compute),
-        raster: args.draw,
+        raster: args.draw.unwrap_or_default(),
         transparency,
         msaa,
-        light_raster: args.shadow_draw,
+        light_raster: args.shadow_draw.unwrap_or_default(),
     };
     if let Err(why) = settings.check_combination() {
         anyhow::bail!("--draw / --shadow-draw / --msaa {msaa} / --transparency / --path: {why}");
@@ -446,6 +453,7 @@ fn run(args: Args) -> Result<()> {
     for c in &inputs.characters {
         renderer.add_character(&c.baked, &c.style, c.params, c.model)?;
     }
+    let settings = settings.with_fastest((args.draw, args.shadow_draw), &renderer.caps());
     let view = View {
         light_dir: match &args.light {
             Some(l) => {
@@ -477,8 +485,8 @@ fn run(args: Args) -> Result<()> {
         .filter(|p| matches!(p, RenderPath::Static | RenderPath::Lhs));
     let opts = FrameOptions {
         read_image: true,
-        raster: args.draw,
-        light_raster: args.shadow_draw,
+        raster: settings.raster,
+        light_raster: settings.light_raster,
         describe_frame: args.print_frame,
         ..Default::default()
     };
@@ -526,7 +534,7 @@ fn run(args: Args) -> Result<()> {
     let rgba = out.rgba.clone().context("no image read back")?;
     let png =
         hairmesh::fsutil::encode_png(&args.output.display().to_string(), width, height, rgba)?;
-    print_report(&ctx, &args, inputs.characters.len(), &out, wall)?;
+    print_report(&ctx, &args, (inputs.characters.len(), settings), &out, wall)?;
     // The last line comes before the file: a stdout that fails leaves no output behind.
     outln!("writing {}", args.output.display())?;
     output.write(&png)?;

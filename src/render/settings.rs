@@ -313,6 +313,35 @@ impl FrameSettings {
     }
 }
 
+impl FrameSettings {
+    /// These settings with the rasterizers left open (`None`) chosen for speed: the camera's
+    /// strands through `auto` (thin strands to the software rasterizer, thick ones as
+    /// hardware strips) and the light's through the software passes, each where the
+    /// settings and the device (`caps`) allow it, else hardware. Compute generation feeding
+    /// the software rasterizer keeps the hair out of the graphics pipeline, the narrow part
+    /// of data-centre GPUs and the slowest part of lavapipe (README, Software rasterizer).
+    pub fn with_fastest(
+        self,
+        (raster, light): (Option<super::soft::StrandRaster>, Option<LightRaster>),
+        caps: &DeviceCaps,
+    ) -> Self {
+        use super::soft::{DEFAULT_SOFT_K, StrandRaster};
+        let ok = |s: &FrameSettings| s.validate(caps).is_ok();
+        let mut s = FrameSettings {
+            raster: raster.unwrap_or(StrandRaster::Auto { k: DEFAULT_SOFT_K }),
+            ..self
+        };
+        if raster.is_none() && !ok(&s) {
+            s.raster = StrandRaster::Hardware;
+        }
+        s.light_raster = light.unwrap_or(LightRaster::Software);
+        if light.is_none() && !ok(&s) {
+            s.light_raster = LightRaster::Hardware;
+        }
+        s
+    }
+}
+
 /// Why the software rasterizer cannot draw with `path`, `msaa` samples and `transparency`
 /// (`None`: it can); tools check this before any work to name their flags.
 pub fn software_raster_conflict(

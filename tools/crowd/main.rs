@@ -100,14 +100,16 @@ pub struct Args {
     /// Strand rasterization: hw (hardware strips), soft or soft:K (the compute software
     /// rasterizer, K fragments per pixel kept sorted), auto or auto:K (per bundle: thin
     /// strands to software, thick ones to hardware). Software needs --msaa 1 and opaque or
-    /// oit transparency.
-    #[arg(long, default_value = "hw")]
-    draw: hairmesh::render::StrandRaster,
+    /// oit transparency. Default: auto where the device and the other settings allow it,
+    /// else hw.
+    #[arg(long)]
+    draw: Option<hairmesh::render::StrandRaster>,
     /// How the light's passes draw the hair with shadows on: hw (hardware strips) or soft
     /// (the compute software rasterizer: nearest depth by atomic min, deep opacity layers by
-    /// fixed-point sums). soft needs the mesh or compute path.
-    #[arg(long, default_value = "hw")]
-    shadow_draw: hairmesh::render::LightRaster,
+    /// fixed-point sums). soft needs the mesh or compute path. Default: soft where the device
+    /// and the other settings allow it, else hw.
+    #[arg(long)]
+    shadow_draw: Option<hairmesh::render::LightRaster>,
     /// Seed 000's thick-strand appearance term under LoD.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     lod_appearance: bool,
@@ -383,10 +385,10 @@ fn run(args: Args) -> Result<()> {
     let (width, height) = parse_size(&args.size)?;
     let settings = hairmesh::render::FrameSettings {
         path: args.path.unwrap_or(RenderPath::Compute),
-        raster: args.draw,
+        raster: args.draw.unwrap_or_default(),
         transparency: args.transparency,
         msaa: args.msaa,
-        light_raster: args.shadow_draw,
+        light_raster: args.shadow_draw.unwrap_or_default(),
     };
     if let Err(why) = settings.check_combination() {
         bail!("--draw / --msaa {} / --transparency: {why}", args.msaa);
@@ -405,6 +407,11 @@ fn run(args: Args) -> Result<()> {
             .device(args.device.clone()),
     )?);
     let mut renderer = scene.renderer(&ctx, &args, width, height)?;
+    let settings = hairmesh::render::FrameSettings {
+        path: renderer.default_path(),
+        ..settings
+    }
+    .with_fastest((args.draw, args.shadow_draw), &renderer.caps());
     let mut animation = scene.animation(&mut renderer, &args)?;
     let csv_path = args.out.join("stats.csv");
     let mut csv = String::from(
@@ -453,8 +460,8 @@ fn run(args: Args) -> Result<()> {
             &view,
             &FrameOptions {
                 read_image: true,
-                raster: args.draw,
-                light_raster: args.shadow_draw,
+                raster: settings.raster,
+                light_raster: settings.light_raster,
                 ..Default::default()
             },
         )?;

@@ -412,6 +412,14 @@ impl App {
             .map(|_| Semaphore::new(&ctx))
             .collect::<Result<_, _>>()?;
         let soft_ok = renderer.has_software_raster() && self.args.msaa == 1;
+        let chosen = hairmesh::render::FrameSettings {
+            path,
+            raster: self.args.draw.unwrap_or_default(),
+            transparency: self.args.transparency,
+            msaa: renderer.msaa(),
+            light_raster: self.args.shadow_draw.unwrap_or_default(),
+        }
+        .with_fastest((self.args.draw, self.args.shadow_draw), &renderer.caps());
         self.running = Some(Running {
             soft_ok,
             panel,
@@ -450,9 +458,9 @@ impl App {
             path,
             shading: self.args.shading,
             shadows: self.args.shadows,
-            light_raster: self.args.shadow_draw,
+            light_raster: chosen.light_raster,
             transparency: self.args.transparency,
-            raster: self.args.draw,
+            raster: chosen.raster,
             lod_appearance: self.args.lod_appearance,
             animation,
             last_draw: Instant::now(),
