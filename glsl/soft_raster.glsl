@@ -113,6 +113,16 @@ float pixel_coverage_exact(SegmentFrame f, float h, vec2 pmin) {
         vec2 q = pmin + vec2(float(i == 1 || i == 2), float(i >= 2)) - f.a;
         poly[i] = vec2(dot(q, f.d), dot(q, f.n));
     }
+    // The pixel wholly outside one side of the rectangle, or wholly inside it: no clipping
+    // (most pixels of a wide strand's footprint; the clip's local arrays are slow).
+    vec2 lo = min(min(poly[0], poly[1]), min(poly[2], poly[3]));
+    vec2 hi = max(max(poly[0], poly[1]), max(poly[2], poly[3]));
+    if (hi.x <= 0.0 || lo.x >= f.len || hi.y <= -h || lo.y >= h) {
+        return 0.0;
+    }
+    if (lo.x >= 0.0 && hi.x <= f.len && lo.y >= -h && hi.y <= h) {
+        return 1.0;
+    }
     int count = 4;
     // Keep sign * (p[axis] - bound) <= 0 for (axis, bound, sign) = (u, len, +), (u, 0, -),
     // (v, h, +), (v, -h, -).

@@ -329,6 +329,15 @@ fn exact_coverage(a: Vec2, d: Vec2, n: Vec2, len: f32, h: f32, pmin: Vec2) -> f3
             Vec2::new(q.dot(d), q.dot(n))
         })
         .collect();
+    // Wholly outside one side, or wholly inside: no clipping (as the GLSL).
+    let lo = poly.iter().fold(Vec2::splat(f32::MAX), |m, p| m.min(*p));
+    let hi = poly.iter().fold(Vec2::splat(f32::MIN), |m, p| m.max(*p));
+    if hi.x <= 0.0 || lo.x >= len || hi.y <= -h || lo.y >= h {
+        return 0.0;
+    }
+    if lo.x >= 0.0 && hi.x <= len && lo.y >= -h && hi.y <= h {
+        return 1.0;
+    }
     for (axis, bound, sign) in [(0, len, 1.0), (0, 0.0, -1.0), (1, h, 1.0), (1, -h, -1.0)] {
         let f = |p: Vec2| sign * (p[axis] - bound);
         let mut out = Vec::with_capacity(8);
