@@ -70,6 +70,22 @@ bool lod_is_soft(uint y) {
     return (y & LOD_SOFT) != 0u;
 }
 
+// The bundle of strand workgroup g: the last bundle whose first workgroup is <= g (never an
+// empty one for g below the total; generate.comp, pool_segments.comp).
+uint group_bundle(uint g) {
+    uint lo = 0u;
+    uint hi = frame.counts.x - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi + 1u) / 2u;
+        if (bundle_offsets[mid].w <= g) {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    return lo;
+}
+
 vec3 style_color() {
     return vec3(style.color[0], style.color[1], style.color[2]);
 }

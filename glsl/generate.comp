@@ -15,27 +15,12 @@ layout(local_size_x = STRAND_GROUP_SIZE) in;
 #include "soft_segments.glsl"
 #endif
 
-// Last bundle whose first workgroup is <= g (never an empty one for g < total).
-uint find_bundle(uint g) {
-    uint lo = 0u;
-    uint hi = frame.counts.x - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi + 1u) / 2u;
-        if (bundle_offsets[mid].w <= g) {
-            lo = mid;
-        } else {
-            hi = mid - 1u;
-        }
-    }
-    return lo;
-}
-
 void main() {
     uint g = gl_WorkGroupID.y * DISPATCH_ROW + gl_WorkGroupID.x;
     if (g >= args.stats.groups) {
         return;
     }
-    uint bundle = find_bundle(g);
+    uint bundle = group_bundle(g);
     bind_character(bundles[bundle].character);
     uvec4 lod = bundle_lods[bundle];
     uint segments = lod_segments(lod.y);

@@ -1,12 +1,13 @@
 #version 460
 // Software rasterizer, raster (src/render/soft.rs): one workgroup per 16x16 tile, one thread
 // per pixel for the setup and the merge, one thread per segment of the tile in between. Each
-// segment's footprint inside the tile is walked pixel row by pixel row; a pixel gets the
-// exact area of its square under the segment's rectangle (soft_raster.glsl), the depth and
-// colour at the centre line point nearest its centre, and, in front of the opaque depth, is
-// inserted into the pixel's K nearest fragments in shared memory (64-bit atomicMin of depth
-// bits << 32 | packed colour, as oit.frag) or merged into its tail. At the end every pixel
-// merges its list with the frame's k-buffer (oit.glsl), nearest first.
+// segment's footprint inside the tile is walked pixel row by pixel row; a pixel in front of the
+// opaque depth gets the area of its square under the segment's rectangle (soft_raster.glsl),
+// the depth and colour at the centre line point nearest its centre, and is inserted into the
+// pixel's K nearest fragments in shared memory (64-bit atomicMin of depth bits << 32 | packed
+// colour, as oit.frag) or merged into its fixed-point tail, so the result does not depend on
+// the order. At the end every pixel merges its list with the frame's k-buffer (oit.glsl),
+// nearest first.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
@@ -20,74 +21,97 @@ layout(local_size_x = SOFT_TILE, local_size_y = SOFT_TILE) in;
 #define TILE_PIXELS (SOFT_TILE * SOFT_TILE)
 
 shared uint64_t s_nodes[TILE_PIXELS * SOFT_MAX_K];
-shared uint s_tail[TILE_PIXELS * 4u];
+// Per pixel: the tail's fixed-point sums, (r, g) and (b, optical depth) in the low and high
+// halves of two 64-bit lanes.
+shared uint64_t s_tail[TILE_PIXELS * 2u];
 shared float s_depth[TILE_PIXELS];
+// optical_depth of each 8-bit fragment alpha (a log per evicted fragment otherwise).
+shared float s_optical_depth[256];
 
-void insert(uint lp, uint k, float z, vec3 c, float alpha) {
-    uint64_t v = (uint64_t(floatBitsToUint(z)) << 32) | uint64_t(pack_fragment(c, alpha));
-    for (uint i = 0u; i < k; i++) {
-        // A plain read first: nodes only ever get nearer, so a node already nearer than v
-        // stays so, and the atomic (a compare-and-swap loop on some GPUs, slow where hundreds
-        // of fragments meet in one pixel) is spent only where v displaces something.
-        if (v >= s_nodes[lp * SOFT_MAX_K + i]) {
-            continue;
+// Add fragment `v` to pixel lp's K nearest (k of them), or its tail.
+void insert(uint lp, uint k, uint64_t v) {
+    uint first = lp * SOFT_MAX_K;
+    // Nodes only ever get nearer and stay sorted once every insert has passed: a fragment
+    // not nearer than the K-th node now is not among the K nearest at the end either, so it
+    // goes straight to the tail (most fragments, where hair is dense) without the walk.
+    if (v < s_nodes[first + k - 1u]) {
+        for (uint i = 0u; i < k; i++) {
+            // A plain read first: a node already nearer than v stays so, and the atomic (a
+            // compare-and-swap loop on some GPUs, slow where hundreds of fragments meet in
+            // one pixel) is spent only where v displaces something.
+            if (v >= s_nodes[first + i]) {
+                continue;
+            }
+            uint64_t old = atomicMin(s_nodes[first + i], v);
+            if (old == OIT_EMPTY) {
+                return;
+            }
+            v = max(old, v);
         }
-        uint64_t old = atomicMin(s_nodes[lp * SOFT_MAX_K + i], v);
-        if (old == OIT_EMPTY) {
-            return;
-        }
-        v = max(old, v);
     }
-    vec4 f = unpack_fragment(uint(v & 0xFFFFFFFFul));
-    float tau = optical_depth(f.a);
+    // Two 32-bit sums in each 64-bit lane: a low half carries into the high half only past
+    // 2^32, where the frame's 32-bit k-buffer tail would overflow anyway (oit.glsl).
+    uint packed = uint(v & 0xFFFFFFFFul);
+    vec4 f = unpack_fragment(packed);
+    float tau = s_optical_depth[packed >> 24];
     uvec4 add = uvec4(round(vec4(f.rgb * tau, tau) * OIT_FIXED));
-    atomicAdd(s_tail[lp * 4u], add.x);
-    atomicAdd(s_tail[lp * 4u + 1u], add.y);
-    atomicAdd(s_tail[lp * 4u + 2u], add.z);
-    atomicAdd(s_tail[lp * 4u + 3u], add.w);
+    atomicAdd(s_tail[lp * 2u], uint64_t(add.x) | (uint64_t(add.y) << 32));
+    atomicAdd(s_tail[lp * 2u + 1u], uint64_t(add.z) | (uint64_t(add.w) << 32));
 }
 
-// Rasterize segment `s` inside the tile whose first pixel is `origin` (`extent` pixels of it
-// inside the image).
+// The fragment of a segment (frame f, half width h, depths z, packed end colours, strands it
+// stands for) in pixel `pixel` of the tile at `origin`: inserted when it lies in front of the
+// opaque depth and covers part of the pixel.
+void shade_pixel(SegmentFrame f, float h, vec2 z, uvec2 colors, float thickness, ivec2 pixel, ivec2 origin, uint k) {
+    vec2 pmin = vec2(pixel);
+    // Depth and colour at the centre line point nearest the pixel centre.
+    float u = clamp(dot(pmin + 0.5 - f.a, f.d) / f.len, 0.0, 1.0);
+    float depth = mix(z.x, z.y, u);
+    uint lp = uint(pixel.y - origin.y) * SOFT_TILE + uint(pixel.x - origin.x);
+    if (!(depth < s_depth[lp])) {
+        return;
+    }
+    float cov = pixel_coverage(f, h, pmin);
+    if (cov <= 0.0) {
+        return;
+    }
+    vec4 c = mix(unpack_fragment(colors.x), unpack_fragment(colors.y), u);
+    float alpha = cluster_opacity(frame.soft_params.y * cov * c.a, thickness);
+    if (alpha < 0.5 / 255.0) {
+        return;
+    }
+    uint64_t v = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(pack_fragment(c.rgb, alpha));
+    insert(lp, k, v);
+}
+
+// Rows [y0, y1] and columns [x0, x1] of the tile at `origin` (`extent` pixels of it inside
+// the image) that segment s's rectangle can touch.
+ivec4 footprint_box(Segment s, ivec2 origin, ivec2 extent) {
+    float h = s.half_width;
+    ivec2 lo = max(ivec2(floor(min(s.a, s.b) - h)), origin);
+    ivec2 hi = min(ivec2(floor(max(s.a, s.b) + h)), origin + extent - 1);
+    return ivec4(lo, hi);
+}
+
+// Rasterize segment `s` alone, walking its footprint inside the tile row by row.
 void raster_segment(Segment s, ivec2 origin, ivec2 extent, uint k) {
     float h = s.half_width;
     // The coverage frame once per segment, not per pixel.
-    SegmentFrame frame_ab = segment_frame(s.a, s.b);
-    vec2 d = s.b - s.a;
-    float len2 = dot(d, d);
-    vec4 ca = unpack_fragment(s.color_a);
-    vec4 cb = unpack_fragment(s.color_b);
-    float opacity = frame.soft_params.y;
-    int y0 = max(int(floor(min(s.a.y, s.b.y) - h)), origin.y);
-    int y1 = min(int(floor(max(s.a.y, s.b.y) + h)), origin.y + extent.y - 1);
-    for (int y = y0; y <= y1; y++) {
+    SegmentFrame f = segment_frame(s.a, s.b);
+    vec2 z = vec2(s.za, s.zb);
+    uvec2 colors = uvec2(s.color_a, s.color_b);
+    ivec4 box = footprint_box(s, origin, extent);
+    for (int y = box.y; y <= box.w; y++) {
         vec2 t = clip_param(s.a, s.b, 1, float(y) - h, float(y + 1) + h);
         if (t.x > t.y) {
             continue;
         }
         float xa = mix(s.a.x, s.b.x, t.x);
         float xb = mix(s.a.x, s.b.x, t.y);
-        int x0 = max(int(floor(min(xa, xb) - h)), origin.x);
-        int x1 = min(int(floor(max(xa, xb) + h)), origin.x + extent.x - 1);
+        int x0 = max(int(floor(min(xa, xb) - h)), box.x);
+        int x1 = min(int(floor(max(xa, xb) + h)), box.z);
         for (int x = x0; x <= x1; x++) {
-            vec2 pmin = vec2(x, y);
-            float cov = pixel_coverage(frame_ab, h, pmin);
-            if (cov <= 0.0) {
-                continue;
-            }
-            // Depth and colour at the centre line point nearest the pixel centre.
-            float u = clamp(dot(pmin + 0.5 - s.a, d) / len2, 0.0, 1.0);
-            float z = mix(s.za, s.zb, u);
-            uint lp = uint(y - origin.y) * SOFT_TILE + uint(x - origin.x);
-            if (!(z < s_depth[lp])) {
-                continue;
-            }
-            vec4 c = mix(ca, cb, u);
-            float alpha = cluster_opacity(opacity * cov * c.a, s.thickness);
-            if (alpha < 0.5 / 255.0) {
-                continue;
-            }
-            insert(lp, k, z, c.rgb, alpha);
+            shade_pixel(f, h, z, colors, s.thickness, ivec2(x, y), origin, k);
         }
     }
 }
@@ -110,10 +134,11 @@ void main() {
     for (uint i = 0u; i < SOFT_MAX_K; i++) {
         s_nodes[lp * SOFT_MAX_K + i] = OIT_EMPTY;
     }
-    for (uint i = 0u; i < 4u; i++) {
-        s_tail[lp * 4u + i] = 0u;
-    }
+    s_tail[lp * 2u] = 0ul;
+    s_tail[lp * 2u + 1u] = 0ul;
     s_depth[lp] = inside ? soft_depth[p] : 0.0;
+    // One entry per thread: TILE_PIXELS (256) threads, 256 alpha codes.
+    s_optical_depth[lp] = optical_depth(float(lp) / 255.0);
     barrier();
     for (uint e = lp; e < info.w; e += TILE_PIXELS) {
         raster_segment(load_segment(soft_entries[info.y + e]), origin, extent, k);
@@ -126,7 +151,9 @@ void main() {
     // thread's alone now): the nearest frame.transparency.y stay nodes, the others join the
     // tail.
     uint kg = frame.transparency.y;
-    uvec4 tail = uvec4(s_tail[lp * 4u], s_tail[lp * 4u + 1u], s_tail[lp * 4u + 2u], s_tail[lp * 4u + 3u]);
+    uint64_t rg = s_tail[lp * 2u];
+    uint64_t ba = s_tail[lp * 2u + 1u];
+    uvec4 tail = uvec4(uint(rg), uint(rg >> 32), uint(ba), uint(ba >> 32));
     uint start = 0u;
     for (uint j = 0u; j < k; j++) {
         uint64_t v = s_nodes[lp * SOFT_MAX_K + j];

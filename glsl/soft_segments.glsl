@@ -1,5 +1,5 @@
 // Software rasterizer, step 1 (src/render/soft.rs): the strand builders (generate.comp,
-// strands.mesh) hand a software bundle's strands, built in shared memory by
+// strands.mesh; pool_segments.comp for the stored strands of the static and LHS paths) hand a software bundle's strands, built in shared memory by
 // strand_build.glsl, to emit_soft_segments: every vertex is shaded (strand_radiance.glsl, the
 // same models as the fragment shaders, evaluated at the vertices and interpolated along the
 // segment) and projected; every segment with both ends in the depth range and its footprint
@@ -20,6 +20,19 @@ shared vec4 sv_screen[MAX_ENTRIES];
 // Per vertex: pack_fragment(radiance, covered share of the drawn width).
 shared uint sv_color[MAX_ENTRIES];
 shared uint s_soft_count;
+#ifdef SOFT_POOL
+// Per vertex: the stored strand width (pool_segments.comp loads it with the positions).
+shared float sw[MAX_ENTRIES];
+#endif
+
+// Width of shared vertex idx at parameter s: the stored one, or the builder's strand width.
+float soft_vertex_width(uint idx, float s, float width_scale) {
+#ifdef SOFT_POOL
+    return sw[idx];
+#else
+    return width_scale * strand_width_at(s);
+#endif
+}
 shared uint s_soft_base;
 
 // Longest segment kept, in pixels (the half-float end offset stays well inside its range).
@@ -64,7 +77,7 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
         vec3 p = sp[idx];
         vec4 c = frame.view_proj * vec4(p, 1.0);
         float pixel = pixel_size(p);
-        float width = width_scale * strand_width_at(s);
+        float width = soft_vertex_width(idx, s, width_scale);
         float drawn = soft_drawn_width(width, pixel, thickness, cap);
         bool in_range = c.w > 1e-6 && c.z >= 0.0 && c.z <= c.w;
         vec3 ndc = c.xyz / max(c.w, 1e-6);

@@ -44,7 +44,7 @@ use hairmesh::outln;
 use hairmesh::render::scene::load_mesh;
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, LodSettings, RenderPath, Renderer, RendererDesc,
-    StrandParams, View,
+    StrandParams, StrandRaster, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakeOptions, CpuGenerator, HairStyle, bake};
@@ -122,6 +122,10 @@ enum Cmd {
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
+        /// How every method's strands are rasterized: hw, soft[:K] or auto[:K] (the static
+        /// and LHS paths give their stored strands to the software rasterizer too).
+        #[arg(long, default_value = "hw")]
+        draw: StrandRaster,
     },
     /// The software rasterizer against hardware strips: one head at near / mid / far,
     /// ~100K strands, a crowd with LoD; median GPU ms and ratios per path.
@@ -144,6 +148,9 @@ enum Cmd {
         /// auto: strands drawn at most this many pixels wide go to the software rasterizer.
         #[arg(long, default_value_t = hairmesh::render::soft::AUTO_SPLIT_PIXELS)]
         auto_split: f32,
+        /// Only these columns: hw-opaque, hw-oit, soft, auto (default all).
+        #[arg(long, value_delimiter = ',')]
+        draws: Vec<String>,
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
@@ -372,6 +379,45 @@ struct CrowdRun<'a> {
 }
 
 impl CrowdRun<'_> {
+    /// An empty renderer at the run's size, `task_bundles` bundles per task workgroup.
+    fn renderer(&self, task_bundles: u32) -> Result<Renderer> {
+        let desc = RendererDesc {
+            task_bundles,
+            ..RendererDesc::default().size(self.size.0, self.size.1)
+        };
+        Ok(Renderer::new(self.ctx, &desc)?)
+    }
+
+    /// Add `count` characters of the run's meshes to `renderer`, in a square grid.
+    fn add_crowd(&self, renderer: &mut Renderer, count: usize) -> Result<()> {
+        let side = (count as f32).sqrt().ceil() as usize;
+        for i in 0..count {
+            let (baked, style) = &self.meshes[i % self.meshes.len()];
+            renderer.add_character(baked, style, self.params, crowd_model(i, side, baked))?;
+        }
+        Ok(())
+    }
+
+    /// The run's timed frames of `view` with `opts` (after the caller's warm-up), and their
+    /// median wall time (submit to completion), ms.
+    fn time(
+        &self,
+        renderer: &mut Renderer,
+        view: &View,
+        opts: &FrameOptions,
+    ) -> Result<(Vec<FrameReport>, f64)> {
+        let mut walls = Vec::new();
+        let reports = (0..self.runs)
+            .map(|_| {
+                let start = std::time::Instant::now();
+                let report = renderer.render_one(view, opts);
+                walls.push(start.elapsed().as_secs_f64() * 1e3);
+                report
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((reports, median(walls)))
+    }
+
     /// Print the LoD-on and LoD-off rows of `count` characters on `path`; returns the LoD-on
     /// image when asked for.
     fn measure(
@@ -382,18 +428,10 @@ impl CrowdRun<'_> {
         path: RenderPath,
     ) -> Result<Option<Vec<u8>>> {
         let ctx = self.ctx;
-        let side = (count as f32).sqrt().ceil() as usize;
         let before = ctx.memory_report().allocated_bytes;
-        let desc = RendererDesc {
-            task_bundles,
-            ..RendererDesc::default().size(self.size.0, self.size.1)
-        };
-        let mut renderer = Renderer::new(ctx, &desc)?;
+        let mut renderer = self.renderer(task_bundles)?;
         let empty = ctx.memory_report().allocated_bytes;
-        for i in 0..count {
-            let (baked, style) = &self.meshes[i % self.meshes.len()];
-            renderer.add_character(baked, style, self.params, crowd_model(i, side, baked))?;
-        }
+        self.add_crowd(&mut renderer, count)?;
         let full = ctx.memory_report().allocated_bytes;
         let per_char = (full - empty) as f64 / count as f64 / 1024.0;
         let tex_per_char = renderer.crowd().texture_bytes() as f64 / count as f64 / 1024.0;
@@ -407,16 +445,7 @@ impl CrowdRun<'_> {
             };
             let read_image = self.read_image && lod_on;
             let first = renderer.render_one(&view, &FrameOptions { read_image, ..opts })?;
-            let mut walls = Vec::new();
-            let reports = (0..self.runs)
-                .map(|_| {
-                    let start = std::time::Instant::now();
-                    let report = renderer.render_one(&view, &opts);
-                    walls.push(start.elapsed().as_secs_f64() * 1e3);
-                    report
-                })
-                .collect::<Result<Vec<_>, _>>()?;
-            let wall = median(walls);
+            let (reports, wall) = self.time(&mut renderer, &view, &opts)?;
             let passes: Vec<String> = median_passes(&first, &reports)
                 .iter()
                 .map(|(n, ms)| format!("{n} {ms:.1}"))
@@ -478,18 +507,20 @@ fn bench_crowd(
         (1u32 << e) + 1
     )?;
     let camera = Camera::look_at(Vec3::new(0.0, 1.7, 0.6), Vec3::new(0.0, 1.5, 6.0), 50.0);
+    let run = CrowdRun {
+        ctx: &ctx,
+        meshes: &meshes,
+        params,
+        size: (width, height),
+        runs,
+        camera,
+        read_image: picture.is_some(),
+        raster,
+    };
     if compare_defaults {
-        let run = defaults::DefaultsRun {
-            ctx: &ctx,
-            meshes: &meshes,
-            params,
-            size: (width, height),
-            runs,
-            camera,
-        };
         outln!("| N | path | rasterizers | GPU ms | frame wall ms |\n|---|---|---|---|---|")?;
         for &count in &counts {
-            run.measure(count)?;
+            defaults::compare(&run, count)?;
         }
         return Ok(());
     }
@@ -503,16 +534,6 @@ fn bench_crowd(
         configs.push(("mesh (1/task)", 1, RenderPath::Mesh));
     }
     configs.push(("compute", 32, RenderPath::Compute));
-    let run = CrowdRun {
-        ctx: &ctx,
-        meshes: &meshes,
-        params,
-        size: (width, height),
-        runs,
-        camera,
-        read_image: picture.is_some(),
-        raster,
-    };
     let mut last_picture = None;
     for &count in &counts {
         for &(label, task_bundles, path) in &configs {
@@ -581,7 +602,8 @@ fn run(args: Args) -> Result<()> {
             scenario,
             csv,
             device,
-        } => paper::bench_paper(&scale, &scenario, device, csv)?,
+            draw,
+        } => paper::bench_paper(&scale, &scenario, device, csv, draw)?,
         Cmd::Raster {
             size,
             runs,
@@ -589,9 +611,11 @@ fn run(args: Args) -> Result<()> {
             strands,
             scenes,
             auto_split,
+            draws,
             device,
         } => raster::bench_raster(raster::RasterArgs {
             auto_split,
+            draws,
             size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
             runs: runs as usize,
             crowd,

@@ -50,7 +50,6 @@
 #define HAIR_ETA 1.55
 #define KAJIYA_KAY_EXPONENT 80.0
 #define MARSCHNER_ENERGY_SCALE 0.9
-#define SOFT_THIN_WIDTH 2.0
 #define SHADOW_OPACITY_FIXED 4096.0
 #define BINDING_FRAME 0
 #define BINDING_CHARACTERS 1
@@ -155,6 +154,7 @@ struct FrameBlock {
     uvec4 transparency;
     uvec4 soft;
     vec4 soft_params;
+    uvec4 soft_grid;
 };
 
 struct CharacterRecord {

@@ -120,6 +120,21 @@ pub const TEAPOT_HEIGHT: f32 = 0.27;
 /// Grid spacing in metres.
 pub const SPACING: f32 = 0.9;
 
+/// The camera of frame `f` of a crowd of `count` characters of `preset`: orbiting the crowd's
+/// centre at eye height, far enough to see it (people a little above head height, teapots
+/// from further out and above).
+pub fn orbit_camera(preset: Preset, count: u32, f: u32) -> crate::render::Camera {
+    let side = (count as f32).sqrt().ceil();
+    let centre = Vec3::new(0.0, preset.focus_height(), (side - 1.0) * 0.5 * SPACING);
+    let (radius, rise) = match preset {
+        Preset::Teapots => ((side * SPACING * 1.05).max(1.2), 0.5 + 0.12 * side),
+        _ => ((side * SPACING * 0.75).max(1.6), 0.6 + 0.1 * side),
+    };
+    let angle = std::f32::consts::PI + f as f32 * 0.05;
+    let eye = centre + Vec3::new(angle.sin() * radius, rise, angle.cos() * radius);
+    crate::render::Camera::look_at(eye, centre, 45.0)
+}
+
 /// Build `count` characters of `preset` from `seed`.
 pub fn build(preset: Preset, count: usize, seed: u32) -> Result<Vec<CrowdCharacter>> {
     build_families(preset, count, seed, &StyleFamily::PEOPLE)

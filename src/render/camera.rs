@@ -298,6 +298,7 @@ impl View {
             // Filled in by the renderer for frames that use the software rasterizer.
             soft: [0; 4],
             soft_params: [0.0; 4],
+            soft_grid: [0; 4],
         }
     }
 }
@@ -340,6 +341,6 @@ mod tests {
             (c[0], c[7], c[5]),
             (Vec3::ZERO, Vec3::ONE, Vec3::new(1.0, 0.0, 1.0))
         );
-        assert_eq!(size_of::<FrameBlock>(), 416);
+        assert_eq!(size_of::<FrameBlock>(), 432);
     }
 }

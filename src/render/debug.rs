@@ -69,8 +69,7 @@ impl Renderer {
             1.0 / height as f32,
         ];
         block.transparency = kbuffer.frame_fields(1);
-        let split = self.desc.auto_split_pixels;
-        super::soft::frame_fields(&mut block, raster, self.soft_budget, opacity, split);
+        super::soft::frame_fields(&mut block, raster, opacity, self.soft_tuning());
         self.frames[i]
             .frame_ubo
             .write(0, bytemuck::bytes_of(&block))?;

@@ -194,8 +194,7 @@ impl Renderer {
                 Transparency::Opaque => 1.0,
                 _ => super::transparency::STRAND_OPACITY,
             };
-            let split = self.desc.auto_split_pixels;
-            super::soft::frame_fields(&mut block, raster, self.soft_budget, opacity, split);
+            super::soft::frame_fields(&mut block, raster, opacity, self.soft_tuning());
         }
         let light = self.light_view(view, &block);
         if let Some(l) = &light {

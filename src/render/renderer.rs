@@ -191,6 +191,14 @@ impl Renderer {
         self.soft_budget
     }
 
+    /// The software rasterizer's budgets and the `RendererDesc` choices it draws with.
+    pub fn soft_tuning(&self) -> super::soft::SoftTuning {
+        super::soft::SoftTuning {
+            budget: self.soft_budget,
+            auto_split_pixels: self.desc.auto_split_pixels,
+        }
+    }
+
     /// The characters.
     pub fn crowd(&self) -> &Crowd {
         &self.crowd

@@ -260,7 +260,7 @@ impl FrameSettings {
             return Err("depth peeling is the single-sample reference: use it without MSAA".into());
         }
         if self.raster.uses_software()
-            && let Some(why) = software_raster_conflict(self.path, self.msaa, self.transparency)
+            && let Some(why) = software_raster_conflict(self.msaa, self.transparency)
         {
             return Err(why);
         }
@@ -342,18 +342,10 @@ impl FrameSettings {
     }
 }
 
-/// Why the software rasterizer cannot draw with `path`, `msaa` samples and `transparency`
-/// (`None`: it can); tools check this before any work to name their flags.
-pub fn software_raster_conflict(
-    path: RenderPath,
-    msaa: u32,
-    transparency: super::Transparency,
-) -> Option<String> {
-    if !matches!(path, RenderPath::Mesh | RenderPath::Compute) {
-        return Some(
-            "the software rasterizer draws generated strands: use the mesh or compute path".into(),
-        );
-    }
+/// Why the software rasterizer cannot draw with `msaa` samples and `transparency` (`None`:
+/// it can; every generation path can, the static and LHS paths from their stored strands);
+/// tools check this before any work to name their flags.
+pub fn software_raster_conflict(msaa: u32, transparency: super::Transparency) -> Option<String> {
     if msaa > 1 {
         return Some(
             "the software rasterizer antialiases strands analytically and reads single-sample depth: use it without MSAA".into(),

@@ -136,12 +136,12 @@ impl LightView {
     ) -> FrameBlock {
         let res = self.resolution as f32;
         let (tx, ty) = super::soft::tile_grid(self.resolution, self.resolution);
-        let (soft, soft_params) = match soft {
+        let (soft, soft_grid) = match soft {
             Some(b) => (
                 [super::shared::RASTER_LIGHT, 0, b.segments, b.tile_entries],
-                [0.0, 0.0, tx as f32, ty as f32],
+                [tx, ty, 0, 0],
             ),
-            None => ([0; 4], [0.0; 4]),
+            None => ([0; 4], [0; 4]),
         };
         FrameBlock {
             view_proj: self.view_proj.to_cols_array_2d(),
@@ -152,7 +152,8 @@ impl LightView {
             lod: [lod.alpha_strands, lod.alpha_verts, lod.lambda, 0.0],
             lod_ortho: [self.size, 0.0, 0.0, 0.0],
             soft,
-            soft_params,
+            soft_params: [0.0; 4],
+            soft_grid,
             ..*camera
         }
     }

@@ -46,10 +46,6 @@ pub const DEFORM_GROUP_SIZE: u32 = 64;
 pub const MAX_OIT_BUDGET: u32 = 16;
 /// Opacity of one full-detail strand over the part of a pixel it covers.
 pub const STRAND_OPACITY: f32 = 0.7;
-/// Strands drawn at most this wide (pixels) take the software rasterizer's line-sampled
-/// coverage: much cheaper on GPUs than the exact area; the sum over pixels is still the
-/// strand's area (a pixel may get a little more than 1 and its neighbours as much less).
-pub const SOFT_THIN_WIDTH: f32 = 2.0;
 /// `FrameBlock::soft.x`: hardware strips.
 pub const RASTER_HARDWARE: u32 = 0;
 /// `FrameBlock::soft.x`: the software rasterizer.
@@ -404,15 +400,17 @@ pub struct FrameBlock {
     /// per bundle), y fragments kept sorted per pixel, z segment budget, w tile entry budget.
     pub soft: [u32; 4],
     /// Software rasterizer: x auto split (bundles whose strands are drawn at most this many
-    /// pixels wide go to software), y opacity of one strand, z tiles per row, w tile rows.
+    /// pixels wide go to software), y opacity of one strand; zw reserved.
     pub soft_params: [f32; 4],
+    /// Software rasterizer: x tiles per row, y tile rows; zw reserved.
+    pub soft_grid: [u32; 4],
 }
 
 gpu_struct!(FrameBlock as "FrameBlock" {
     view_proj: "mat4", camera_pos: "vec4", light_dir: "vec4", viewport: "vec4",
     planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4", shading: "uvec4",
     light_view_proj: "mat4", shadow: "uvec4", shadow_params: "vec4", transparency: "uvec4",
-    soft: "uvec4", soft_params: "vec4",
+    soft: "uvec4", soft_params: "vec4", soft_grid: "uvec4",
 });
 
 /// One character: where its bundles and textures are, how it is placed and styled.
@@ -786,7 +784,6 @@ fn float_constants() -> Vec<(&'static str, f32)> {
         ("HAIR_ETA", crate::shade::HAIR_ETA),
         ("KAJIYA_KAY_EXPONENT", crate::shade::KAJIYA_KAY_EXPONENT),
         ("MARSCHNER_ENERGY_SCALE", crate::shade::ENERGY_SCALE),
-        ("SOFT_THIN_WIDTH", SOFT_THIN_WIDTH),
         ("SHADOW_OPACITY_FIXED", SHADOW_OPACITY_FIXED),
     ]
 }

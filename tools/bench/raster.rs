@@ -34,6 +34,8 @@ pub struct RasterArgs {
     pub scenes: Vec<String>,
     /// `auto`: strands drawn at most this many pixels wide go to software.
     pub auto_split: f32,
+    /// Only these columns (`hw-opaque`, `hw-oit`, `soft`, `auto`); empty: all.
+    pub draws: Vec<String>,
 }
 
 struct Scene {
@@ -50,14 +52,11 @@ fn desc(a: &RasterArgs) -> RendererDesc {
     }
 }
 
-/// Median GPU ms of `runs` frames after one warm-up, the warm-up's statistics and the
-/// median ms of each pass.
-fn time(
-    r: &mut Renderer,
-    view: &View,
-    opts: FrameOptions,
-    runs: usize,
-) -> Result<(f64, hairmesh::render::FrameStats, String)> {
+/// Median GPU ms of a measurement, the warm-up's statistics and the median ms of each pass.
+type Timing = (f64, hairmesh::render::FrameStats, String);
+
+/// [`Timing`] of `runs` frames after one warm-up.
+fn time(r: &mut Renderer, view: &View, opts: FrameOptions, runs: usize) -> Result<Timing> {
     let first = r.render_one(view, &opts)?;
     let mut walls = Vec::new();
     let reports = (0..runs)
@@ -160,6 +159,10 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
         hairmesh::render::soft::DEFAULT_SOFT_K,
         a.auto_split
     )?;
+    const DRAWS: [&str; 4] = ["hw-opaque", "hw-oit", "soft", "auto"];
+    if let Some(d) = a.draws.iter().find(|d| !DRAWS.contains(&d.as_str())) {
+        bail!("--draws {d}: one of {}", DRAWS.join(", "));
+    }
     let mut scenes = head_scenes(&ctx, &a)?;
     scenes.push(crowd_scene(&ctx, &a)?);
     scenes.retain(|s| a.scenes.is_empty() || a.scenes.iter().any(|n| s.name.starts_with(n)));
@@ -197,26 +200,52 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
                 ..Default::default()
             };
             let r = &mut s.renderer;
-            let (hw_opaque, stats, _) =
-                time(r, &opaque_view, opts(StrandRaster::Hardware), a.runs)?;
-            let (hw_oit, _, hw_passes) = time(r, &oit_view, opts(StrandRaster::Hardware), a.runs)?;
-            let (sw, soft_stats, soft_passes) = time(r, &oit_view, opts(soft), a.runs)?;
-            let (au, _, _) = time(r, &oit_view, opts(auto), a.runs)?;
+            let wants = |d: &str| a.draws.is_empty() || a.draws.iter().any(|w| w == d);
+            let mut cell = |d: &str, v: &View, raster| -> Result<Option<Timing>> {
+                match wants(d) {
+                    true => Ok(Some(time(r, v, opts(raster), a.runs)?)),
+                    false => Ok(None),
+                }
+            };
+            let hw_opaque = cell("hw-opaque", &opaque_view, StrandRaster::Hardware)?;
+            let hw_oit = cell("hw-oit", &oit_view, StrandRaster::Hardware)?;
+            let sw = cell("soft", &oit_view, soft)?;
+            let au = cell("auto", &oit_view, auto)?;
+            let passes = |t: &Option<Timing>| t.as_ref().map_or("-".into(), |t| t.2.clone());
             pass_lines.push(format!(
-                "| {} | {path:?} | {hw_passes} | {soft_passes} |",
-                s.name
+                "| {} | {path:?} | {} | {} |",
+                s.name,
+                passes(&hw_oit),
+                passes(&sw)
             ));
-            let dropped = soft_stats.segments_written < soft_stats.segments_demanded
-                || soft_stats.tile_entries_written < soft_stats.tile_entries_demanded;
+            let ms = |t: &Option<Timing>| t.as_ref().map(|t| t.0);
+            let fmt = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.2}"));
+            let ratio = |x: Option<f64>, y: Option<f64>| fmt(x.zip(y).map(|(x, y)| x / y));
+            let stats = [&hw_opaque, &hw_oit, &sw, &au]
+                .into_iter()
+                .find_map(|t| t.as_ref().map(|t| t.1))
+                .unwrap_or_default();
+            let segments = sw.as_ref().map_or("-".into(), |t| {
+                let s = &t.1;
+                let dropped = s.segments_written < s.segments_demanded
+                    || s.tile_entries_written < s.tile_entries_demanded;
+                format!(
+                    "{}{}",
+                    s.segments_written,
+                    if dropped { " (overflow)" } else { "" }
+                )
+            });
             outln!(
-                "| {} | {path:?} | {} | {hw_opaque:.2} | {hw_oit:.2} | {sw:.2} | {au:.2} | {:.2} | {:.2} | {:.2} | {}{} |",
+                "| {} | {path:?} | {} | {} | {} | {} | {} | {} | {} | {} | {segments} |",
                 s.name,
                 stats.strands_drawn,
-                sw / hw_oit,
-                sw / hw_opaque,
-                au / hw_oit,
-                soft_stats.segments_written,
-                if dropped { " (overflow)" } else { "" }
+                fmt(ms(&hw_opaque)),
+                fmt(ms(&hw_oit)),
+                fmt(ms(&sw)),
+                fmt(ms(&au)),
+                ratio(ms(&sw), ms(&hw_oit)),
+                ratio(ms(&sw), ms(&hw_opaque)),
+                ratio(ms(&au), ms(&hw_oit)),
             )?;
         }
     }

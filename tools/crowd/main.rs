@@ -144,20 +144,6 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
     hairmesh::render::scene::parse_size(s).map_err(anyhow::Error::msg)
 }
 
-/// The camera of frame `f`: orbiting the crowd's centre at eye height, far enough to see it.
-pub fn orbit_camera(preset: Preset, count: u32, f: u32) -> Camera {
-    let side = (count as f32).sqrt().ceil();
-    let centre = Vec3::new(0.0, preset.focus_height(), (side - 1.0) * 0.5 * SPACING);
-    // People are seen from a little above head height; teapots from further out and above.
-    let (radius, rise) = match preset {
-        Preset::Teapots => ((side * SPACING * 1.05).max(1.2), 0.5 + 0.12 * side),
-        _ => ((side * SPACING * 0.75).max(1.6), 0.6 + 0.1 * side),
-    };
-    let angle = std::f32::consts::PI + f as f32 * 0.05;
-    let eye = centre + Vec3::new(angle.sin() * radius, rise, angle.cos() * radius);
-    Camera::look_at(eye, centre, 45.0)
-}
-
 /// A portrait of the head of a character placed by `model`: from the front, side or back,
 /// at eye height, 0.8 m away.
 pub fn portrait_camera(model: glam::Mat4, view: &str) -> Camera {
@@ -432,7 +418,11 @@ fn run(args: Args) -> Result<()> {
     };
     for f in 0..args.frames {
         let camera = match args.view.as_str() {
-            "orbit" => orbit_camera(args.preset, args.count, if args.orbit { f } else { 0 }),
+            "orbit" => hairmesh::characters::preset::orbit_camera(
+                args.preset,
+                args.count,
+                if args.orbit { f } else { 0 },
+            ),
             "eye" => {
                 let side = (args.count as f32).sqrt().ceil();
                 let depth = (side - 1.0) * SPACING;

@@ -5,6 +5,7 @@ pub mod compute_generate;
 pub mod hair_mesh_update;
 pub mod lhs_skin;
 pub mod output;
+pub mod pool_segments;
 pub mod props;
 pub mod scalp;
 pub mod shadow;
@@ -284,14 +285,11 @@ impl FrameTransients {
         (width, height): (u32, u32),
     ) -> Self {
         let peel = matches!(transparency, Transparency::DepthPeeling { .. });
-        let budget = camera.or(light.map(|l| l.0));
-        let soft = budget.map_or_else(
-            || SoftBudget::buffers(SoftBudget::EMPTY, None, None),
-            |b| SoftBudget::buffers(b, camera.map(|_| (width, height)), light.map(|l| l.1)),
-        );
+        let budget = camera.or(light.map(|l| l.0)).unwrap_or(SoftBudget::EMPTY);
+        let views = (camera.map(|_| (width, height)), light.map(|l| l.1));
         FrameTransients {
             transparency: transparency.buffers(width as u64 * height as u64),
-            soft,
+            soft: SoftBudget::buffers(budget, views.0, views.1),
             soft_shadow: super::soft::shadow_buffers(light.map(|l| (l.1, l.2))),
             peel_image: peel.then(|| super::transparency::peel_image(width, height)),
         }
@@ -426,6 +424,8 @@ pub struct FramePasses {
     soft: Option<soft_raster::SoftRasterPass>,
     /// The light's software passes (with `soft`).
     soft_shadow: Option<soft_shadow::SoftShadowPass>,
+    /// The static and LHS paths' segments (with `soft`).
+    pool_segments: Option<pool_segments::PoolSegments>,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
     lhs_skin: lhs_skin::LhsSkin,
 }
@@ -473,6 +473,11 @@ impl FramePasses {
             },
             soft_shadow: if ctx.info.int64_atomics {
                 Some(soft_shadow::SoftShadowPass::new(ctx, layout)?)
+            } else {
+                None
+            },
+            pool_segments: if ctx.info.int64_atomics {
+                Some(pool_segments::PoolSegments::new(ctx, layout)?)
             } else {
                 None
             },
@@ -591,28 +596,7 @@ impl FramePasses {
         }
         let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
         if let Some(mode) = inp.shadow {
-            let soft_light = inp.light_raster == LightRaster::Software;
-            if compute {
-                let view = match soft_light {
-                    true => GenerateView::LightSoftware,
-                    false => GenerateView::Light,
-                };
-                self.generate.add(g, r, inp.light_sets, inp.bundles, view);
-            }
-            let draw = ShadowDraw {
-                mode,
-                sets: inp.light_sets,
-                bundles: inp.bundles,
-                path: inp.path,
-                props: inp.props,
-            };
-            if soft_light {
-                let soft = self.soft.as_ref().zip(self.soft_shadow.as_ref());
-                let (raster, pass) = soft.ok_or_else(no_soft)?;
-                pass.add(g, r, (&self.shadow, raster), draw);
-            } else {
-                self.shadow.add(g, r, draw);
-            }
+            self.add_light(g, r, &inp, mode)?;
             // The camera's statistics start from zero again.
             if !keep_args {
                 add_clear_args(g, r);
@@ -622,8 +606,12 @@ impl FramePasses {
             let view = GenerateView::Camera;
             self.generate.add(g, r, inp.sets, inp.bundles, view);
         }
-        let transparent = inp.bundles > 0 && inp.transparency != super::Transparency::Opaque;
         let soft = inp.bundles > 0 && inp.raster.uses_software();
+        // The static and LHS paths' stored strands all go to the software rasterizer then:
+        // no hardware strand pass draws the pool.
+        let stored_soft = soft && matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
+        let transparent =
+            inp.bundles > 0 && inp.transparency != super::Transparency::Opaque && !stored_soft;
         let query = inp.mesh_query.take();
         let query = self.add_opaque(g, r, &inp, !transparent && !soft, query);
         if transparent {
@@ -641,17 +629,70 @@ impl FramePasses {
             TransparencyPass::add_kbuffer_clear(g, r, inp.kbuffer_budget, pixels);
         }
         if soft {
-            let pass = self.soft.as_ref().ok_or_else(no_soft)?;
-            if inp.path == RenderPath::Mesh {
-                let view = (inp.sets, "soft segments");
-                pass.add_mesh_segments(g, r, view, inp.bundles, inp.size);
-            }
-            pass.add(g, r, inp.sets, inp.size, true);
+            self.add_software(g, r, &inp)?;
         }
         if transparent || soft {
             let peel = matches!(inp.transparency, super::Transparency::DepthPeeling { .. });
             self.transparency.add_resolve(g, r, peel, inp.sets)?;
         }
+        Ok(())
+    }
+
+    /// The light's passes of a frame with shadows in `mode`: the light's generation (compute
+    /// path), then its hardware or software map passes.
+    fn add_light<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        inp: &FrameInputs<'a>,
+        mode: ShadowMode,
+    ) -> GpuResult<()> {
+        let soft_light = inp.light_raster == LightRaster::Software;
+        if inp.bundles > 0 && inp.path == RenderPath::Compute {
+            let view = match soft_light {
+                true => GenerateView::LightSoftware,
+                false => GenerateView::Light,
+            };
+            self.generate.add(g, r, inp.light_sets, inp.bundles, view);
+        }
+        let draw = ShadowDraw {
+            mode,
+            sets: inp.light_sets,
+            bundles: inp.bundles,
+            path: inp.path,
+            props: inp.props,
+        };
+        if soft_light {
+            let soft = self.soft.as_ref().zip(self.soft_shadow.as_ref());
+            let (raster, pass) = soft.ok_or_else(no_soft)?;
+            pass.add(g, r, (&self.shadow, raster), draw);
+        } else {
+            self.shadow.add(g, r, draw);
+        }
+        Ok(())
+    }
+
+    /// The software rasterizer's camera passes: the segments not yet appended (the mesh
+    /// path's segment pass; the static and LHS paths' stored strands), binning and raster.
+    fn add_software<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        inp: &FrameInputs<'a>,
+    ) -> GpuResult<()> {
+        let pass = self.soft.as_ref().ok_or_else(no_soft)?;
+        match inp.path {
+            RenderPath::Mesh => {
+                let view = (inp.sets, "soft segments");
+                pass.add_mesh_segments(g, r, view, inp.bundles, inp.size);
+            }
+            RenderPath::Static | RenderPath::Lhs => {
+                let pool = self.pool_segments.as_ref().ok_or_else(no_soft)?;
+                pool.add(g, r, inp.sets);
+            }
+            RenderPath::Compute => {}
+        }
+        pass.add(g, r, inp.sets, inp.size, true);
         Ok(())
     }
 

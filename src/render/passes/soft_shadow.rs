@@ -13,7 +13,7 @@ use super::shadow::{ShadowDraw, ShadowPass};
 use super::soft_raster::SoftRasterPass;
 use super::{FrameRes, shader_options};
 use crate::render::RenderPath;
-use crate::render::graph::FrameGraph;
+use crate::render::graph::{FrameGraph, Res};
 use crate::render::shadow::ShadowMode;
 use crate::render::soft::tile_grid;
 use crate::vk::shader::compile;
@@ -83,28 +83,13 @@ impl SoftShadowPass {
         d: &ShadowDraw<'a>,
         side: u32,
     ) {
-        let (tx, ty) = tile_grid(side, side);
-        let (sets, out) = (d.sets, r.soft_shadow_depth);
-        g.pass("soft shadow depth")
-            .read(r.constants, Access::ComputeRead)
-            .read_all(
-                &[r.soft_segments, r.soft_tiles, r.soft_entries],
-                Access::ComputeRead,
-            )
-            .discard(out, Access::ComputeReadWrite)
-            .record(move |rec, _| {
-                rec.bind(&self.depth, &sets.both());
-                rec.dispatch(tx, ty, 1);
-                Ok(())
-            });
-        let map = r.images.shadow[0];
-        g.pass("soft shadow depth copy")
-            .read(out, Access::TransferRead)
-            .discard(r.shadow[0], Access::TransferWrite)
-            .record(move |rec, res| {
-                rec.copy_buffer_to_image(res.buffer(out)?, map);
-                Ok(())
-            });
+        let step = MapStep {
+            names: ("soft shadow depth", "soft shadow depth copy"),
+            pipeline: &self.depth,
+            out: r.soft_shadow_depth,
+            map: 0,
+        };
+        add_map_step(g, r, d, side, step, &[]);
     }
 
     /// The deep opacity layers behind the hair depth, copied into the layers map.
@@ -115,28 +100,57 @@ impl SoftShadowPass {
         d: &ShadowDraw<'a>,
         side: u32,
     ) {
-        let (tx, ty) = tile_grid(side, side);
-        let (sets, out) = (d.sets, r.soft_shadow_layers);
-        g.pass("soft shadow opacity")
-            .read(r.constants, Access::ComputeRead)
-            .read_all(
-                &[r.soft_segments, r.soft_tiles, r.soft_entries],
-                Access::ComputeRead,
-            )
-            .read(r.soft_shadow_depth, Access::ComputeRead)
-            .discard(out, Access::ComputeReadWrite)
-            .record(move |rec, _| {
-                rec.bind(&self.opacity, &sets.both());
-                rec.dispatch(tx, ty, 1);
-                Ok(())
-            });
-        let map = r.images.shadow[2];
-        g.pass("soft shadow layers copy")
-            .read(out, Access::TransferRead)
-            .discard(r.shadow[2], Access::TransferWrite)
-            .record(move |rec, res| {
-                rec.copy_buffer_to_image(res.buffer(out)?, map);
-                Ok(())
-            });
+        let step = MapStep {
+            names: ("soft shadow opacity", "soft shadow layers copy"),
+            pipeline: &self.opacity,
+            out: r.soft_shadow_layers,
+            map: 2,
+        };
+        add_map_step(g, r, d, side, step, &[r.soft_shadow_depth]);
     }
+}
+
+/// One software shadow map: a compute pass over the map's tiles writing `out`, then its copy
+/// into shadow map `map` (0 hair depth, 2 layers).
+struct MapStep<'a> {
+    /// The compute pass's and the copy's names.
+    names: (&'static str, &'static str),
+    pipeline: &'a Pipeline,
+    out: Res,
+    map: usize,
+}
+
+/// Add `step`, whose compute pass also reads `extra` (besides the frame constants and the
+/// binned segments).
+fn add_map_step<'a>(
+    g: &mut FrameGraph<'a>,
+    r: &FrameRes<'a>,
+    d: &ShadowDraw<'a>,
+    side: u32,
+    step: MapStep<'a>,
+    extra: &[Res],
+) {
+    let (tx, ty) = tile_grid(side, side);
+    let (sets, out, pipeline) = (d.sets, step.out, step.pipeline);
+    g.pass(step.names.0)
+        .read(r.constants, Access::ComputeRead)
+        .read_all(
+            &[r.soft_segments, r.soft_tiles, r.soft_entries],
+            Access::ComputeRead,
+        )
+        .read_all(extra, Access::ComputeRead)
+        .discard(out, Access::ComputeReadWrite)
+        .record(move |rec, _| {
+            rec.bind(pipeline, &sets.both());
+            rec.dispatch(tx, ty, 1);
+            Ok(())
+        });
+    let map = r.images.shadow[step.map];
+    g.pass(step.names.1)
+        .read(out, Access::TransferRead)
+        .discard(r.shadow[step.map], Access::TransferWrite)
+        .record(move |rec, res| {
+            rec.copy_buffer_to_image(res.buffer(out)?, map);
+            Ok(())
+        });
 }
