@@ -174,3 +174,50 @@ fn print_frame_lists_every_pass_of_the_full_look() {
         assert!(stdout.contains(needle), "{needle}:\n{stdout}");
     }
 }
+
+/// Static and LHS runs: the generating frame draws hardware strips (software-drawn bundles
+/// would leave nothing in the pool), the second frame draws the stored strands with `--draw`.
+#[test]
+fn static_and_lhs_runs_draw_their_stored_strands_through_the_software_rasterizer() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let mesh = format!("{root}/hairmeshes/head_long.obj");
+    for path in ["static", "lhs"] {
+        let out = dir.path().join(format!("{path}.png"));
+        let o = render(&[
+            "--mesh",
+            &mesh,
+            "--size",
+            "80x60",
+            "--strands-per-bundle",
+            "8",
+            "--lod",
+            "off",
+            "--path",
+            path,
+            "--draw",
+            "soft",
+            "--validation",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            o.status.success(),
+            "{path}: {stdout}\n{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        // The second frame's report: its own segment pass and the software raster.
+        let second = stdout.split("then ").nth(1).unwrap_or_default();
+        assert!(
+            second.contains("soft segments") && second.contains("soft raster"),
+            "{path}: {stdout}"
+        );
+        let img = image::open(&out).unwrap().to_rgb8();
+        let background = *img.get_pixel(0, 0);
+        assert!(
+            img.pixels().filter(|p| **p != background).count() > 200,
+            "{path}: hair drawn"
+        );
+    }
+}

@@ -155,11 +155,15 @@ fn static_lhs_and_animated_frames_are_free_of_hazards() {
             let vertices = first.stats.vertex_slots_written;
             r.capture_lhs(vertices, 9, 0.05).unwrap();
         }
-        let opts = FrameOptions {
-            path: Some(path),
-            ..Default::default()
-        };
-        two_frames(&ctx, &mut r, &view, &opts, &format!("{path:?}"));
+        // Hardware strips, then the stored strands through the software rasterizer.
+        for raster in [StrandRaster::Hardware, StrandRaster::Software { k: 4 }] {
+            let opts = FrameOptions {
+                path: Some(path),
+                raster,
+                ..Default::default()
+            };
+            two_frames(&ctx, &mut r, &view, &opts, &format!("{path:?} {raster}"));
+        }
     }
     // An animated hair mesh: its textures are rebuilt on the GPU before the frame reads them.
     let dir = root().join("hairmeshes");

@@ -104,8 +104,9 @@ struct Args {
     /// Strand rasterization: hw (camera-facing strips through the hardware rasterizer),
     /// soft or soft:K (the compute software rasterizer keeping K fragments per pixel sorted,
     /// default 8), auto or auto:K (per bundle: strands drawn at most 1.5 pixels wide to
-    /// software, thicker ones to hardware). With the mesh or compute path. Default: auto
-    /// where the device and the other settings allow it, else hw.
+    /// software, thicker ones to hardware; the static and LHS paths' stored strands all go
+    /// to software). Default: auto where the device and the other settings allow it, else
+    /// hw.
     #[arg(long)]
     draw: Option<hairmesh::render::StrandRaster>,
     /// How the light's passes draw the hair with shadows on: hw (hardware strips) or soft
@@ -483,9 +484,14 @@ fn run(args: Args) -> Result<()> {
     let second = args
         .path
         .filter(|p| matches!(p, RenderPath::Static | RenderPath::Lhs));
+    // The generating frame of a static or LHS run draws hardware strips: software-drawn
+    // bundles leave no strands in the pool for the second frame to draw again.
     let opts = FrameOptions {
         read_image: true,
-        raster: settings.raster,
+        raster: match second {
+            Some(_) => hairmesh::render::StrandRaster::Hardware,
+            None => settings.raster,
+        },
         light_raster: settings.light_raster,
         describe_frame: args.print_frame,
         ..Default::default()
@@ -515,6 +521,8 @@ fn run(args: Args) -> Result<()> {
             &FrameOptions {
                 path: Some(second),
                 read_image: true,
+                raster: settings.raster,
+                light_raster: settings.light_raster,
                 describe_frame: args.print_frame,
                 ..Default::default()
             },

@@ -281,14 +281,26 @@ impl PaperRun {
             )
         };
         let (l, s) = (range(|r| r.0), range(|r| r.1));
+        let faster = |(lo, hi): (f64, f64), other: &str| match hi <= 1.0 {
+            true => format!(
+                "hair meshes {:.1}-{:.1}x faster than {other}",
+                1.0 / hi,
+                1.0 / lo
+            ),
+            false if lo >= 1.0 => format!("{other} {lo:.1}-{hi:.1}x faster than hair meshes"),
+            false => format!(
+                "hair meshes {:.1}x faster to {hi:.1}x slower than {other}",
+                1.0 / lo
+            ),
+        };
         outln!(
-            "ours / LHS {:.2}-{:.2} (hair meshes {:.1}-{:.1}x faster than LHS), ours / static {:.2}-{:.2}, draw {}",
+            "ours / LHS {:.2}-{:.2} ({}), ours / static {:.2}-{:.2} ({}), draw {}",
             l.0,
             l.1,
-            1.0 / l.1,
-            1.0 / l.0,
+            faster(l, "LHS"),
             s.0,
             s.1,
+            faster(s, "static strands"),
             self.draw
         )?;
         Ok(())
@@ -315,6 +327,8 @@ impl PaperRun {
                 let s = &f.stats;
                 s.strands_drawn < s.strands_demanded || s.segments_written < s.segments_demanded
             };
+            // Software frames draw segments, hardware ones triangles (auto: both).
+            let prims = |f: &FrameReport| f.stats.triangles_drawn + f.stats.segments_written;
             outln!(
                 "| {p:?} | {:.1} | {:.1} | {:.1}x | {} / {} | {} / {}{} |",
                 on.0,
@@ -322,8 +336,8 @@ impl PaperRun {
                 off.0 / on.0,
                 on.3.stats.strands_drawn,
                 off.3.stats.strands_drawn,
-                on.3.stats.triangles_drawn,
-                off.3.stats.triangles_drawn,
+                prims(&on.3),
+                prims(&off.3),
                 if dropped(&on.3) || dropped(&off.3) {
                     " (budget overflow)"
                 } else {
@@ -342,7 +356,7 @@ impl PaperRun {
             self.draw
         )?;
         outln!(
-            "| path | LoD on ms | LoD off ms | speedup | strands on / off | triangles on / off |"
+            "| path | LoD on ms | LoD off ms | speedup | strands on / off | triangles + segments on / off |"
         )?;
         outln!("|---|---|---|---|---|---|")?;
         let meshes: Vec<_> = super::CROWD_MESHES
@@ -404,7 +418,7 @@ impl PaperRun {
             self.draw
         )?;
         outln!(
-            "| path | LoD on ms | LoD off ms | speedup | strands on / off | triangles on / off |"
+            "| path | LoD on ms | LoD off ms | speedup | strands on / off | triangles + segments on / off |"
         )?;
         outln!("|---|---|---|---|---|---|")?;
         let mut r = self.renderer()?;
