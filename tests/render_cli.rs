@@ -10,6 +10,20 @@ fn render(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// Run `render` with validation on, writing `out`; it must succeed. Its standard output.
+fn render_ok(args: &[&str], out: &std::path::Path) -> String {
+    let mut all = args.to_vec();
+    all.extend(["--validation", "-o", out.to_str().unwrap()]);
+    let o = render(&all);
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "{args:?}: {stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    stdout
+}
+
 #[test]
 fn renders_a_scene_file_with_two_characters() {
     let dir = tempfile::tempdir().unwrap();
@@ -25,20 +39,7 @@ fn renders_a_scene_file_with_two_characters() {
     )
     .unwrap();
     let out = dir.path().join("scene.png");
-    let o = render(&[
-        "--scene",
-        scene.to_str().unwrap(),
-        "--validation",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "{}\n{}",
-        stdout,
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let stdout = render_ok(&["--scene", scene.to_str().unwrap()], &out);
     assert!(
         stdout.contains("2 character(s)") && stdout.contains("strand triangles"),
         "{stdout}"
@@ -105,29 +106,23 @@ fn print_frame_lists_every_pass_of_the_full_look() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("full.png");
     let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/hairmeshes/head_long.obj");
-    let o = render(&[
-        "--mesh",
-        mesh,
-        "--size",
-        "64x48",
-        "--strands-per-bundle",
-        "8",
-        "--path",
-        "compute",
-        "--shadows",
-        "deep-opacity",
-        "--transparency",
-        "oit",
-        "--validation",
-        "--print-frame",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&o.stderr)
+    let stdout = render_ok(
+        &[
+            "--mesh",
+            mesh,
+            "--size",
+            "64x48",
+            "--strands-per-bundle",
+            "8",
+            "--path",
+            "compute",
+            "--shadows",
+            "deep-opacity",
+            "--transparency",
+            "oit",
+            "--print-frame",
+        ],
+        &out,
     );
     // The defaults on lavapipe: auto for the camera, the software light passes.
     assert!(stdout.contains("draw auto:8, shadow draw soft"), "{stdout}");
@@ -184,28 +179,22 @@ fn static_and_lhs_runs_draw_their_stored_strands_through_the_software_rasterizer
     let mesh = format!("{root}/hairmeshes/head_long.obj");
     for path in ["static", "lhs"] {
         let out = dir.path().join(format!("{path}.png"));
-        let o = render(&[
-            "--mesh",
-            &mesh,
-            "--size",
-            "80x60",
-            "--strands-per-bundle",
-            "8",
-            "--lod",
-            "off",
-            "--path",
-            path,
-            "--draw",
-            "soft",
-            "--validation",
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        let stdout = String::from_utf8_lossy(&o.stdout);
-        assert!(
-            o.status.success(),
-            "{path}: {stdout}\n{}",
-            String::from_utf8_lossy(&o.stderr)
+        let stdout = render_ok(
+            &[
+                "--mesh",
+                &mesh,
+                "--size",
+                "80x60",
+                "--strands-per-bundle",
+                "8",
+                "--lod",
+                "off",
+                "--path",
+                path,
+                "--draw",
+                "soft",
+            ],
+            &out,
         );
         // The second frame's report: its own segment pass and the software raster.
         let second = stdout.split("then ").nth(1).unwrap_or_default();

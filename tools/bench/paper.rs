@@ -72,6 +72,19 @@ const MODELS: [&str; 3] = [
     "hairmeshes/triangle_tuft.obj",
 ];
 
+/// A preset character's hair mesh baked with the default options.
+fn bake_character(
+    c: &hairmesh::characters::preset::CrowdCharacter,
+) -> Result<hairmesh::BakedHairMesh> {
+    let options = hairmesh::BakeOptions::default();
+    Ok(hairmesh::bake(
+        &c.hair.mesh,
+        &c.hair.style,
+        options,
+        |_, _| {},
+    )?)
+}
+
 /// (d) for the crowd's generated hairstyles (people preset, 8 characters): bytes of the five
 /// textures against the LHS data (stored vertices 16 B, weights 24 B per strand, 1% guides) and
 /// a `.hair` file (points and thickness), at about `strands` strands each, 17 points per strand.
@@ -83,12 +96,7 @@ fn storage_of_generated_styles(strands: u32, rows: &mut String) -> Result<()> {
     outln!("| style | bundles | textures | LHS data | .hair | LHS / textures |")?;
     outln!("|---|---|---|---|---|---|")?;
     for c in preset::build(Preset::People, 8, 1)? {
-        let baked = hairmesh::bake(
-            &c.hair.mesh,
-            &c.hair.style,
-            hairmesh::BakeOptions::default(),
-            |_, _| {},
-        )?;
+        let baked = bake_character(&c)?;
         let (_, n) = strands_per_bundle_for(&baked, &c.hair.style, strands as u64);
         let points = n * 17;
         let guides = n.div_ceil(100);
@@ -314,6 +322,10 @@ impl PaperRun {
         camera: Camera,
         (scenario, name): (&str, &str),
     ) -> Result<()> {
+        outln!(
+            "| path | LoD on ms | LoD off ms | speedup | strands on / off | triangles + segments on / off |"
+        )?;
+        outln!("|---|---|---|---|---|---|")?;
         let mut paths = vec![RenderPath::Compute];
         if r.has_mesh_path() {
             paths.insert(0, RenderPath::Mesh);
@@ -355,10 +367,6 @@ impl PaperRun {
             "\n(b) crowd of {count} characters (sample meshes) of about {strands} strands each, LoD on vs off, draw {}",
             self.draw
         )?;
-        outln!(
-            "| path | LoD on ms | LoD off ms | speedup | strands on / off | triangles + segments on / off |"
-        )?;
-        outln!("|---|---|---|---|---|---|")?;
         let meshes: Vec<_> = super::CROWD_MESHES
             .iter()
             .map(|m| load_mesh(std::path::Path::new(m), None, Default::default()))
@@ -417,18 +425,9 @@ impl PaperRun {
             "\n(e) {count} furry teapots of about {strands} strands each, LoD on vs off, draw {}",
             self.draw
         )?;
-        outln!(
-            "| path | LoD on ms | LoD off ms | speedup | strands on / off | triangles + segments on / off |"
-        )?;
-        outln!("|---|---|---|---|---|---|")?;
         let mut r = self.renderer()?;
         for c in preset::build(Preset::Teapots, count, 1)? {
-            let baked = hairmesh::bake(
-                &c.hair.mesh,
-                &c.hair.style,
-                hairmesh::BakeOptions::default(),
-                |_, _| {},
-            )?;
+            let baked = bake_character(&c)?;
             let (per_bundle, _) = strands_per_bundle_for(&baked, &c.hair.style, strands as u64);
             let params = c.strand_params(StrandParams {
                 strands_per_bundle: per_bundle,
