@@ -59,24 +59,34 @@ void insert(uint lp, uint k, uint64_t v) {
     atomicAdd(s_tail[lp * 2u + 1u], uint64_t(add.z) | (uint64_t(add.w) << 32));
 }
 
-// The fragment of a segment (frame f, half width h, depths z, packed end colours, strands it
-// stands for) in pixel `pixel` of the tile at `origin`: inserted when it lies in front of the
-// opaque depth and covers part of the pixel.
-void shade_pixel(SegmentFrame f, float h, vec2 z, uvec2 colors, float thickness, ivec2 pixel, ivec2 origin, uint k) {
+// What the raster needs of a segment, computed once per segment: its coverage frame, half
+// width, end depths and unpacked end colours, and the strands it stands for.
+struct SegmentRaster {
+    SegmentFrame f;
+    float h;
+    vec2 z;
+    vec4 ca;
+    vec4 cb;
+    float thickness;
+};
+
+// The fragment of segment `s` in pixel `pixel` of the tile at `origin`: inserted when it lies
+// in front of the opaque depth and covers part of the pixel.
+void shade_pixel(SegmentRaster s, ivec2 pixel, ivec2 origin, uint k) {
     vec2 pmin = vec2(pixel);
     // Depth and colour at the centre line point nearest the pixel centre.
-    float u = clamp(dot(pmin + 0.5 - f.a, f.d) / f.len, 0.0, 1.0);
-    float depth = mix(z.x, z.y, u);
+    float u = clamp(dot(pmin + 0.5 - s.f.a, s.f.d) / s.f.len, 0.0, 1.0);
+    float depth = mix(s.z.x, s.z.y, u);
     uint lp = uint(pixel.y - origin.y) * SOFT_TILE + uint(pixel.x - origin.x);
     if (!(depth < s_depth[lp])) {
         return;
     }
-    float cov = pixel_coverage(f, h, pmin);
+    float cov = pixel_coverage(s.f, s.h, pmin);
     if (cov <= 0.0) {
         return;
     }
-    vec4 c = mix(unpack_fragment(colors.x), unpack_fragment(colors.y), u);
-    float alpha = cluster_opacity(frame.soft_params.y * cov * c.a, thickness);
+    vec4 c = mix(s.ca, s.cb, u);
+    float alpha = cluster_opacity(frame.soft_params.y * cov * c.a, s.thickness);
     if (alpha < 0.5 / 255.0) {
         return;
     }
@@ -96,10 +106,8 @@ ivec4 footprint_box(Segment s, ivec2 origin, ivec2 extent) {
 // Rasterize segment `s` alone, walking its footprint inside the tile row by row.
 void raster_segment(Segment s, ivec2 origin, ivec2 extent, uint k) {
     float h = s.half_width;
-    // The coverage frame once per segment, not per pixel.
-    SegmentFrame f = segment_frame(s.a, s.b);
-    vec2 z = vec2(s.za, s.zb);
-    uvec2 colors = uvec2(s.color_a, s.color_b);
+    SegmentRaster r = SegmentRaster(segment_frame(s.a, s.b), h, vec2(s.za, s.zb), unpack_fragment(s.color_a),
+                                    unpack_fragment(s.color_b), s.thickness);
     ivec4 box = footprint_box(s, origin, extent);
     for (int y = box.y; y <= box.w; y++) {
         vec2 t = clip_param(s.a, s.b, 1, float(y) - h, float(y + 1) + h);
@@ -111,7 +119,7 @@ void raster_segment(Segment s, ivec2 origin, ivec2 extent, uint k) {
         int x0 = max(int(floor(min(xa, xb) - h)), box.x);
         int x1 = min(int(floor(max(xa, xb) + h)), box.z);
         for (int x = x0; x <= x1; x++) {
-            shade_pixel(f, h, z, colors, s.thickness, ivec2(x, y), origin, k);
+            shade_pixel(r, ivec2(x, y), origin, k);
         }
     }
 }
@@ -137,8 +145,9 @@ void main() {
     s_tail[lp * 2u] = 0ul;
     s_tail[lp * 2u + 1u] = 0ul;
     s_depth[lp] = inside ? soft_depth[p] : 0.0;
-    // One entry per thread: TILE_PIXELS (256) threads, 256 alpha codes.
-    s_optical_depth[lp] = optical_depth(float(lp) / 255.0);
+    for (uint a = lp; a < 256u; a += TILE_PIXELS) {
+        s_optical_depth[a] = optical_depth(float(a) / 255.0);
+    }
     barrier();
     for (uint e = lp; e < info.w; e += TILE_PIXELS) {
         raster_segment(load_segment(soft_entries[info.y + e]), origin, extent, k);

@@ -59,40 +59,46 @@ vec2 clip_param(vec2 a, vec2 b, int axis, float lo, float hi) {
 }
 
 // A segment's frame for the coverage, computed once per segment: end a, unit direction d,
-// its normal n, length len.
+// its normal n, length len, and the box-filtered edge constants of both directions (their
+// larger and smaller absolute components e = max(|d.x|, |d.y|), f = min(...), 1 / e and
+// 1 / (2 e f); d and n share them).
 struct SegmentFrame {
     vec2 a;
     vec2 d;
     vec2 n;
     float len;
+    vec4 edge;
 };
 
 SegmentFrame segment_frame(vec2 a, vec2 b) {
     vec2 d = b - a;
     float len = length(d);
     d = len > 0.0 ? d / len : vec2(1.0, 0.0);
-    return SegmentFrame(a, d, vec2(-d.y, d.x), len);
+    float e = max(abs(d.x), abs(d.y));
+    float f = min(abs(d.x), abs(d.y));
+    return SegmentFrame(a, d, vec2(-d.y, d.x), len, vec4(e, f, 1.0 / e, 1.0 / (2.0 * e * f)));
 }
 
-// Area of the unit square centred on the origin where n . y <= t, for a unit normal n whose
-// larger and smaller absolute components are a and b (the box-filtered edge: a triangle, a
-// trapezoid, then the complement of a triangle). CPU twin: square_below in src/render/soft.rs.
-float square_below(float t, float a, float b) {
-    float s = t + 0.5 * (a + b);
+// Area of the unit square centred on the origin where n . y <= t, for a unit normal n with
+// edge constants `edge` (segment_frame) (the box-filtered edge: a triangle, a trapezoid, then
+// the complement of a triangle; with f = 0 only the trapezoid). CPU twin: square_below in
+// src/render/soft.rs.
+float square_below(float t, vec4 edge) {
+    float s = t + 0.5 * (edge.x + edge.y);
     if (s <= 0.0) {
         return 0.0;
     }
-    if (s >= a + b) {
+    if (s >= edge.x + edge.y) {
         return 1.0;
     }
-    if (s < b) {
-        return s * s / (2.0 * a * b);
+    if (s < edge.y) {
+        return s * s * edge.w;
     }
-    if (s <= a) {
-        return (s - 0.5 * b) / a;
+    if (s <= edge.x) {
+        return (s - 0.5 * edge.y) * edge.z;
     }
-    float e = a + b - s;
-    return 1.0 - e * e / (2.0 * a * b);
+    float r = edge.x + edge.y - s;
+    return 1.0 - r * r * edge.w;
 }
 
 // Share of the unit pixel square with corner `pmin` covered by the rectangle of half-width `h`
@@ -109,10 +115,8 @@ float pixel_coverage(SegmentFrame f, float h, vec2 pmin) {
     vec2 q = pmin + 0.5 - f.a;
     float uc = dot(q, f.d);
     float vc = dot(q, f.n);
-    float ea = max(abs(f.d.x), abs(f.d.y));
-    float eb = min(abs(f.d.x), abs(f.d.y));
-    float across = square_below(h - vc, ea, eb) - square_below(-h - vc, ea, eb);
-    float along = square_below(f.len - uc, ea, eb) - square_below(-uc, ea, eb);
+    float across = square_below(h - vc, f.edge) - square_below(-h - vc, f.edge);
+    float along = square_below(f.len - uc, f.edge) - square_below(-uc, f.edge);
     return across * along;
 }
 

@@ -284,23 +284,32 @@ mod tests {
     }
 }
 
+/// The box-filtered edge constants of a unit direction `d` (and of its normal, which shares
+/// them): the larger and smaller absolute components `e` and `f`, `1 / e` and `1 / (2 e f)`.
+/// CPU twin of the `edge` of `segment_frame` in `soft_raster.glsl`.
+pub fn edge_constants(d: Vec2) -> [f32; 4] {
+    let (e, f) = (d.x.abs().max(d.y.abs()), d.x.abs().min(d.y.abs()));
+    [e, f, 1.0 / e, 1.0 / (2.0 * e * f)]
+}
+
 /// Area of the unit square centred on the origin where `n . y <= t`, for a unit normal `n`
-/// whose larger and smaller absolute components are `a` and `b` (the box-filtered edge:
-/// a triangle, a trapezoid, then the complement of a triangle). CPU twin of `square_below` in
+/// with [`edge_constants`] `edge` (the box-filtered edge: a triangle, a trapezoid, then the
+/// complement of a triangle; with `f = 0` only the trapezoid). CPU twin of `square_below` in
 /// `soft_raster.glsl`.
-pub fn square_below(t: f32, a: f32, b: f32) -> f32 {
-    let s = t + 0.5 * (a + b);
+pub fn square_below(t: f32, edge: [f32; 4]) -> f32 {
+    let [e, f, inv_e, inv_2ef] = edge;
+    let s = t + 0.5 * (e + f);
     if s <= 0.0 {
         0.0
-    } else if s >= a + b {
+    } else if s >= e + f {
         1.0
-    } else if s < b {
-        s * s / (2.0 * a * b)
-    } else if s <= a {
-        (s - 0.5 * b) / a
+    } else if s < f {
+        s * s * inv_2ef
+    } else if s <= e {
+        (s - 0.5 * f) * inv_e
     } else {
-        let e = a + b - s;
-        1.0 - e * e / (2.0 * a * b)
+        let r = e + f - s;
+        1.0 - r * r * inv_2ef
     }
 }
 
@@ -319,9 +328,9 @@ pub fn pixel_coverage(a: Vec2, b: Vec2, h: f32, pmin: Vec2) -> f32 {
     let n = Vec2::new(-d.y, d.x);
     let q = pmin + Vec2::splat(0.5) - a;
     let (uc, vc) = (q.dot(d), q.dot(n));
-    let (ea, eb) = (d.x.abs().max(d.y.abs()), d.x.abs().min(d.y.abs()));
-    let across = square_below(h - vc, ea, eb) - square_below(-h - vc, ea, eb);
-    let along = square_below(len - uc, ea, eb) - square_below(-uc, ea, eb);
+    let edge = edge_constants(d);
+    let across = square_below(h - vc, edge) - square_below(-h - vc, edge);
+    let along = square_below(len - uc, edge) - square_below(-uc, edge);
     across * along
 }
 
