@@ -182,7 +182,7 @@ impl Renderer {
         opts: &FrameOptions,
         kbuffer_budget: u32,
     ) -> (FrameBlock, Option<FrameBlock>) {
-        let raster = opts.raster;
+        let raster = opts.raster.under(view.transparency);
         let (width, height) = self.targets.size();
         let bundles = self.crowd.bundle_count();
         let slots = self.crowd.slot_count();

@@ -74,6 +74,19 @@ impl StrandRaster {
         self != StrandRaster::Hardware
     }
 
+    /// What draws each bundle in a frame composited with `transparency`: `Auto` with k-buffer
+    /// OIT sends every bundle to software, since the software rasterizer is never slower than
+    /// hardware strips inserted into a k-buffer (README, `bench raster`); in opaque frames
+    /// thick bundles stay opaque hardware strips, which need no k-buffer.
+    pub fn under(self, transparency: super::Transparency) -> Self {
+        match (self, transparency) {
+            (StrandRaster::Auto { k }, super::Transparency::KBuffer { .. }) => {
+                StrandRaster::Software { k }
+            }
+            _ => self,
+        }
+    }
+
     /// Fragments per pixel kept sorted (0 for hardware).
     pub fn k(self) -> u32 {
         match self {

@@ -612,8 +612,12 @@ impl FramePasses {
         let stored_soft = soft && matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
         let transparent =
             inp.bundles > 0 && inp.transparency != super::Transparency::Opaque && !stored_soft;
+        // Hardware-drawn bundles: every bundle without the software rasterizer, the thick ones
+        // with `auto` (in opaque frames they are drawn here, with transparency in its passes).
+        let auto = matches!(inp.raster, super::soft::StrandRaster::Auto { .. });
+        let hardware_bundles = !soft || (auto && !stored_soft);
         let query = inp.mesh_query.take();
-        let query = self.add_opaque(g, r, &inp, !transparent && !soft, query);
+        let query = self.add_opaque(g, r, &inp, !transparent && hardware_bundles, query);
         if transparent {
             let draw = TransparentDraw {
                 mode: inp.transparency,
@@ -696,8 +700,9 @@ impl FramePasses {
         Ok(())
     }
 
-    /// The opaque pass: props, scalps and (unless drawn later) the strands; `resolve`: the
-    /// colour's MSAA resolve ends here. Returns the mesh query when this pass did not use it.
+    /// The opaque pass: props, scalps and, with `resolve`, the hardware-drawn strands (the
+    /// colour's MSAA resolve then ends here; MSAA frames draw no software strands). Returns
+    /// the mesh query when this pass did not use it.
     fn add_opaque<'a>(
         &'a self,
         g: &mut FrameGraph<'a>,
