@@ -81,7 +81,15 @@ fn a_thin_straight_strand_deposits_its_area() {
 
 /// A scene of characters for the image comparisons.
 fn scene(ctx: &std::sync::Arc<hairmesh::vk::Context>, size: u32, names: &[&str]) -> Renderer {
-    let mut r = Renderer::new(ctx, &RendererDesc::default().size(size, size)).unwrap();
+    scene_with(ctx, RendererDesc::default().size(size, size), names)
+}
+
+fn scene_with(
+    ctx: &std::sync::Arc<hairmesh::vk::Context>,
+    desc: RendererDesc,
+    names: &[&str],
+) -> Renderer {
+    let mut r = Renderer::new(ctx, &desc).unwrap();
     let side = (names.len() as f32).sqrt().ceil() as usize;
     for (i, name) in names.iter().enumerate() {
         let (baked, style) = sample(name);
@@ -342,14 +350,18 @@ fn stored_strands_take_the_software_rasterizer() {
 }
 
 /// `auto` in opaque frames: thin bundles to software, thick ones as opaque hardware strips in
-/// the opaque pass (frames once dropped those). At 128x128 the head framed is drawn as strips
-/// (its strands are wider than 1.5 px there), five times further in software; both paths:
+/// the opaque pass (frames once dropped those). At 128x128 with a 1.5 px split the head framed
+/// is drawn as strips (its strands are wider there), five times further in software; both paths:
 /// against hardware strips the same hair is drawn (FLIP mean within the bound of `SCENES`;
 /// measured 0 and 0.0044).
 #[test]
 fn auto_in_opaque_frames_draws_every_bundle() {
     let ctx = context();
-    let mut r = scene(&ctx, 128, &["head_long.obj"]);
+    let desc = RendererDesc {
+        auto_split_pixels: 1.5,
+        ..RendererDesc::default().size(128, 128)
+    };
+    let mut r = scene_with(&ctx, desc, &["head_long.obj"]);
     let near = view_of(&r, Transparency::Opaque);
     // (some frame drew hardware bundles, some software ones)
     let mut drawn = (false, false);

@@ -103,7 +103,7 @@ struct Args {
     lod_appearance: Option<bool>,
     /// Strand rasterization: hw (camera-facing strips through the hardware rasterizer),
     /// soft or soft:K (the compute software rasterizer keeping K fragments per pixel sorted,
-    /// default 8), auto or auto:K (per bundle: strands drawn at most 1.5 pixels wide to
+    /// default 8), auto or auto:K (per bundle: strands drawn at most 4 pixels wide to
     /// software, thicker ones to hardware; the static and LHS paths' stored strands all go
     /// to software). Default: auto where the device and the other settings allow it, else
     /// hw.
