@@ -420,14 +420,20 @@ pub struct FramePasses {
     scalp: ScalpPass,
     strands: StrandDraw,
     transparency: TransparencyPass,
-    /// The software rasterizer, on devices with 64-bit shared and buffer atomics.
-    soft: Option<soft_raster::SoftRasterPass>,
-    /// The light's software passes (with `soft`).
-    soft_shadow: Option<soft_shadow::SoftShadowPass>,
-    /// The static and LHS paths' segments (with `soft`).
-    pool_segments: Option<pool_segments::PoolSegments>,
+    /// The software rasterizer's passes, on devices with 64-bit shared and buffer atomics.
+    soft: Option<SoftPasses>,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
     lhs_skin: lhs_skin::LhsSkin,
+}
+
+/// The software rasterizer's passes (they need 64-bit shared and buffer atomics).
+struct SoftPasses {
+    /// Binning and raster (and the mesh path's segment pass).
+    raster: soft_raster::SoftRasterPass,
+    /// The light's maps.
+    shadow: soft_shadow::SoftShadowPass,
+    /// The static and LHS paths' stored strands as segments.
+    pool: pool_segments::PoolSegments,
 }
 
 /// Add the pass that zeroes `args` (indirect arguments and statistics).
@@ -466,20 +472,13 @@ impl FramePasses {
             scalp: ScalpPass::new(ctx, layout, targets)?,
             strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
-            soft: if ctx.info.int64_atomics {
-                Some(soft_raster::SoftRasterPass::new(ctx, layout, task_bundles)?)
-            } else {
-                None
-            },
-            soft_shadow: if ctx.info.int64_atomics {
-                Some(soft_shadow::SoftShadowPass::new(ctx, layout)?)
-            } else {
-                None
-            },
-            pool_segments: if ctx.info.int64_atomics {
-                Some(pool_segments::PoolSegments::new(ctx, layout)?)
-            } else {
-                None
+            soft: match ctx.info.int64_atomics {
+                true => Some(SoftPasses {
+                    raster: soft_raster::SoftRasterPass::new(ctx, layout, task_bundles)?,
+                    shadow: soft_shadow::SoftShadowPass::new(ctx, layout)?,
+                    pool: pool_segments::PoolSegments::new(ctx, layout)?,
+                }),
+                false => None,
             },
             hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
             lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
@@ -543,7 +542,7 @@ impl FramePasses {
         sets: PassSets<'a>,
         (segments, budget): (u32, u32),
     ) -> GpuResult<()> {
-        let pass = self.soft.as_ref().ok_or_else(no_soft)?;
+        let pass = &self.soft.as_ref().ok_or_else(no_soft)?.raster;
         let (w, h) = (r.images.color.desc.extent[0], r.images.color.desc.extent[1]);
         add_clear_args(g, r);
         let (args, soft_depth) = (r.args_buffer, r.soft_depth);
@@ -667,9 +666,8 @@ impl FramePasses {
             props: inp.props,
         };
         if soft_light {
-            let soft = self.soft.as_ref().zip(self.soft_shadow.as_ref());
-            let (raster, pass) = soft.ok_or_else(no_soft)?;
-            pass.add(g, r, (&self.shadow, raster), draw);
+            let soft = self.soft.as_ref().ok_or_else(no_soft)?;
+            soft.shadow.add(g, r, (&self.shadow, &soft.raster), draw);
         } else {
             self.shadow.add(g, r, draw);
         }
@@ -684,19 +682,17 @@ impl FramePasses {
         r: &FrameRes<'a>,
         inp: &FrameInputs<'a>,
     ) -> GpuResult<()> {
-        let pass = self.soft.as_ref().ok_or_else(no_soft)?;
+        let soft = self.soft.as_ref().ok_or_else(no_soft)?;
         match inp.path {
             RenderPath::Mesh => {
                 let view = (inp.sets, "soft segments");
-                pass.add_mesh_segments(g, r, view, inp.bundles, inp.size);
+                soft.raster
+                    .add_mesh_segments(g, r, view, inp.bundles, inp.size);
             }
-            RenderPath::Static | RenderPath::Lhs => {
-                let pool = self.pool_segments.as_ref().ok_or_else(no_soft)?;
-                pool.add(g, r, inp.sets);
-            }
+            RenderPath::Static | RenderPath::Lhs => soft.pool.add(g, r, inp.sets),
             RenderPath::Compute => {}
         }
-        pass.add(g, r, inp.sets, inp.size, true);
+        soft.raster.add(g, r, inp.sets, inp.size, true);
         Ok(())
     }
 
