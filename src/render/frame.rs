@@ -57,12 +57,14 @@ impl Renderer {
         mut present: Option<PresentTarget>,
     ) -> GpuResult<FrameTicket> {
         let (path, kbuffer_budget) = self.check_frame(view, opts)?;
-        let raster = opts.raster;
+        // What draws the frame's bundles, decided once (`auto` with k-buffer OIT is all
+        // software): the passes, buffers and frame blocks all follow it.
+        let raster = opts.raster.under(view.transparency);
         let i = self.next;
         self.retire_slot(i)?;
         self.prepare_workspace(i, path)?;
         let pose_updates = self.crowd.write_pending_poses(i)?;
-        let (block, light_block) = self.frame_blocks(view, opts, kbuffer_budget);
+        let (block, light_block) = self.frame_blocks(view, opts, (raster, kbuffer_budget));
         // Software light passes only where there is a light view this frame.
         let light_raster = match light_block {
             Some(_) => opts.light_raster,
@@ -175,14 +177,14 @@ impl Renderer {
         Ok(t)
     }
 
-    /// The camera's frame block and, with shadows and hair in view, the light's.
+    /// The camera's frame block and, with shadows and hair in view, the light's, for a frame
+    /// drawn with `raster` and a k-buffer of `kbuffer_budget` nodes.
     fn frame_blocks(
         &self,
         view: &View,
         opts: &FrameOptions,
-        kbuffer_budget: u32,
+        (raster, kbuffer_budget): (StrandRaster, u32),
     ) -> (FrameBlock, Option<FrameBlock>) {
-        let raster = opts.raster.under(view.transparency);
         let (width, height) = self.targets.size();
         let bundles = self.crowd.bundle_count();
         let slots = self.crowd.slot_count();

@@ -606,17 +606,19 @@ impl FramePasses {
             self.generate.add(g, r, inp.sets, inp.bundles, view);
         }
         let soft = inp.bundles > 0 && inp.raster.uses_software();
-        // The static and LHS paths' stored strands all go to the software rasterizer then:
-        // no hardware strand pass draws the pool.
-        let stored_soft = soft && matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
-        let transparent =
-            inp.bundles > 0 && inp.transparency != super::Transparency::Opaque && !stored_soft;
-        // Hardware-drawn bundles: every bundle without the software rasterizer, the thick ones
-        // with `auto` (in opaque frames they are drawn here, with transparency in its passes).
-        let auto = matches!(inp.raster, super::soft::StrandRaster::Auto { .. });
-        let hardware_bundles = !soft || (auto && !stored_soft);
+        // Bundles drawn as hardware strips: every one without the software rasterizer, the
+        // thick ones with `auto` (never the static and LHS paths' stored strands, which all go
+        // to software). They are drawn in the opaque pass, or with transparency in its passes.
+        let stored = matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
+        let hardware = inp.bundles > 0
+            && match inp.raster {
+                super::soft::StrandRaster::Hardware => true,
+                super::soft::StrandRaster::Auto { .. } => !stored,
+                super::soft::StrandRaster::Software { .. } => false,
+            };
+        let transparent = hardware && inp.transparency != super::Transparency::Opaque;
         let query = inp.mesh_query.take();
-        let query = self.add_opaque(g, r, &inp, !transparent && hardware_bundles, query);
+        let query = self.add_opaque(g, r, &inp, hardware && !transparent, query);
         if transparent {
             let draw = TransparentDraw {
                 mode: inp.transparency,
