@@ -105,9 +105,10 @@ float square_below(float t, vec4 edge) {
 // around the segment (no end caps, so consecutive segments of a straight strand tile it
 // exactly). Across: the exact area of the square inside the strip |v| <= h, two box-filtered
 // edges. Along: times the share of the square between the segment's end lines, the
-// box-filtered edges along it (1 for the pixels between them, most of them); the two shares of a joint between collinear
-// segments add up to 1, so a strand has no seam (per pixel within 0.06 of the exact clipped
-// area: src/render/soft.rs tests). No loops, no arrays: the same cost for every width.
+// box-filtered edges along it (1 for the pixels between them, most of them); the two shares
+// of a joint between collinear segments add up to 1, so a strand has no seam (per pixel
+// within 0.06 of the exact clipped area: src/render/soft.rs tests). No loops, no arrays: the
+// same cost for every width.
 float pixel_coverage(SegmentFrame f, float h, vec2 pmin) {
     if (f.len < 1e-9) {
         return 0.0;

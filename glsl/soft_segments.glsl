@@ -1,6 +1,7 @@
 // Software rasterizer, step 1 (src/render/soft.rs): the strand builders (generate.comp,
-// strands.mesh; pool_segments.comp for the stored strands of the static and LHS paths) hand a software bundle's strands, built in shared memory by
-// strand_build.glsl, to emit_soft_segments: every vertex is shaded (strand_radiance.glsl, the
+// strands.mesh; pool_segments.comp for the stored strands of the static and LHS paths) hand a
+// software bundle's strands, built (or loaded) in shared memory as strand_build.glsl lays
+// them out, to emit_soft_segments: every vertex is shaded (strand_radiance.glsl, the
 // same models as the fragment shaders, evaluated at the vertices and interpolated along the
 // segment) and projected; every segment with both ends in the depth range and its footprint
 // on screen is appended to soft_segments[]. The workgroup reserves its segments with one
@@ -20,6 +21,7 @@ shared vec4 sv_screen[MAX_ENTRIES];
 // Per vertex: pack_fragment(radiance, covered share of the drawn width).
 shared uint sv_color[MAX_ENTRIES];
 shared uint s_soft_count;
+shared uint s_soft_base;
 #ifdef SOFT_POOL
 // Per vertex: the stored strand width (pool_segments.comp loads it with the positions).
 shared float sw[MAX_ENTRIES];
@@ -33,7 +35,6 @@ float soft_vertex_width(uint idx, float s, float width_scale) {
     return width_scale * strand_width_at(s);
 #endif
 }
-shared uint s_soft_base;
 
 // Longest segment kept, in pixels (the half-float end offset stays well inside its range).
 #define SOFT_MAX_SEGMENT_PIXELS 16384.0

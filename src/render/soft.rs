@@ -333,7 +333,7 @@ pub fn square_below(t: f32, edge: [f32; 4]) -> f32 {
 /// `h` around the segment `a -> b`: CPU twin of `pixel_coverage` in `soft_raster.glsl`. The
 /// exact area of the square inside the strip `|v| <= h` ([`square_below`] twice) times the
 /// share of the square between the end lines (the same along the segment): exact for pixels
-/// between the end lines, within 0.06 of the clipped area ([`exact_coverage`]) where a pixel
+/// between the end lines, within 0.06 of the exactly clipped area where a pixel
 /// crosses an end line, and the shares of a joint between collinear segments add up to 1.
 pub fn pixel_coverage(a: Vec2, b: Vec2, h: f32, pmin: Vec2) -> f32 {
     let len = (b - a).length();
@@ -353,8 +353,9 @@ pub fn pixel_coverage(a: Vec2, b: Vec2, h: f32, pmin: Vec2) -> f32 {
 /// The exact share of the unit pixel square with corner `pmin` inside the rectangle of
 /// half-width `h` around the segment `a -> b`: the square in the segment's frame clipped to
 /// `[0, len] x [-h, h]` (Sutherland-Hodgman), its area. The reference [`pixel_coverage`] is
-/// tested against.
-pub fn exact_coverage(a: Vec2, b: Vec2, h: f32, pmin: Vec2) -> f32 {
+/// tested against (tests only).
+#[cfg(test)]
+fn exact_coverage(a: Vec2, b: Vec2, h: f32, pmin: Vec2) -> f32 {
     let len = (b - a).length();
     if len < 1e-9 {
         return 0.0;
@@ -450,7 +451,8 @@ mod coverage_tests {
     }
 
     /// Against the exact clipped area: exact for pixels between the end lines, within 0.06
-    /// (worst seen 0.042) where a pixel crosses one (short and long, thin and wide segments at every angle).
+    /// (worst seen 0.042) where a pixel crosses one (short and long, thin and wide segments
+    /// at every angle).
     #[test]
     fn coverage_is_the_exact_area_within_bounds() {
         let mut rng = crate::rng::Pcg32::new(7);
