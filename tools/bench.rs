@@ -398,26 +398,6 @@ impl CrowdRun<'_> {
         Ok(())
     }
 
-    /// The run's timed frames of `view` with `opts` (after the caller's warm-up), and their
-    /// median wall time (submit to completion), ms.
-    fn time(
-        &self,
-        renderer: &mut Renderer,
-        view: &View,
-        opts: &FrameOptions,
-    ) -> Result<(Vec<FrameReport>, f64)> {
-        let mut walls = Vec::new();
-        let reports = (0..self.runs)
-            .map(|_| {
-                let start = std::time::Instant::now();
-                let report = renderer.render_one(view, opts);
-                walls.push(start.elapsed().as_secs_f64() * 1e3);
-                report
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok((reports, median(walls)))
-    }
-
     /// Print the LoD-on and LoD-off rows of `count` characters on `path`; returns the LoD-on
     /// image when asked for.
     fn measure(
@@ -445,7 +425,7 @@ impl CrowdRun<'_> {
             };
             let read_image = self.read_image && lod_on;
             let first = renderer.render_one(&view, &FrameOptions { read_image, ..opts })?;
-            let (reports, wall) = self.time(&mut renderer, &view, &opts)?;
+            let (reports, wall) = timed_frames(&mut renderer, &view, &opts, self.runs)?;
             let passes: Vec<String> = median_passes(&first, &reports)
                 .iter()
                 .map(|(n, ms)| format!("{n} {ms:.1}"))
@@ -559,6 +539,26 @@ fn bench_view(camera: Camera, lod_on: bool) -> View {
         },
         ..View::new(camera)
     }
+}
+
+/// `runs` timed frames of `view` with `opts` (after the caller's warm-up), and their median
+/// wall time (submit to completion), ms.
+fn timed_frames(
+    renderer: &mut Renderer,
+    view: &View,
+    opts: &FrameOptions,
+    runs: usize,
+) -> Result<(Vec<FrameReport>, f64)> {
+    let mut walls = Vec::new();
+    let reports = (0..runs)
+        .map(|_| {
+            let start = Instant::now();
+            let report = renderer.render_one(view, opts);
+            walls.push(start.elapsed().as_secs_f64() * 1e3);
+            report
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((reports, median(walls)))
 }
 
 /// Median GPU ms of each pass of `first` over `reports`.

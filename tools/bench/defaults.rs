@@ -40,7 +40,7 @@ pub fn compare(run: &super::CrowdRun, count: usize) -> Result<()> {
             ..Default::default()
         };
         r.render_one(&view, &opts)?;
-        let (reports, wall) = run.time(&mut r, &view, &opts)?;
+        let (reports, wall) = super::timed_frames(&mut r, &view, &opts, run.runs)?;
         let gpu = super::median(reports.iter().map(|r| r.gpu_ms()).collect());
         outln!(
             "| {count} | {} | draw {}, shadow draw {} | {gpu:.1} | {wall:.1} |",

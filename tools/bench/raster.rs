@@ -58,21 +58,12 @@ type Timing = (f64, hairmesh::render::FrameStats, String);
 /// [`Timing`] of `runs` frames after one warm-up.
 fn time(r: &mut Renderer, view: &View, opts: FrameOptions, runs: usize) -> Result<Timing> {
     let first = r.render_one(view, &opts)?;
-    let mut walls = Vec::new();
-    let reports = (0..runs)
-        .map(|_| {
-            let start = std::time::Instant::now();
-            let report = r.render_one(view, &opts);
-            walls.push(start.elapsed().as_secs_f64() * 1e3);
-            report
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let (reports, wall) = super::timed_frames(r, view, &opts, runs)?;
     let passes: Vec<String> = super::median_passes(&first, &reports)
         .iter()
         .map(|(n, ms)| format!("{n} {ms:.2}"))
         .collect();
     let ms = super::median(reports.iter().map(|r| r.gpu_ms()).collect());
-    let wall = super::median(walls);
     Ok((
         ms,
         first.stats,
