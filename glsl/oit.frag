@@ -8,6 +8,7 @@
 #include "bindings.glsl"
 #include "strand_fragment.glsl"
 #include "oit.glsl"
+#include "temporal.glsl"
 
 layout(early_fragment_tests) in;
 
@@ -18,6 +19,7 @@ void main() {
     if (a < 0.5 / 255.0) {
         return;
     }
+    note_fragment(in_character);
     uint pixel = oit_pixel();
     uint k = frame.transparency.y;
     uint64_t v = (uint64_t(floatBitsToUint(gl_FragCoord.z)) << 32) | uint64_t(pack_fragment(shade_strand(), a));

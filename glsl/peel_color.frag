@@ -5,10 +5,12 @@
 #include "bindings.glsl"
 #include "strand_fragment.glsl"
 #include "peel.glsl"
+#include "temporal.glsl"
 
 layout(early_fragment_tests) in;
 
 void main() {
+    note_fragment(in_character);
     uint p = peel_pixel();
     float a = strand_alpha();
     vec4 acc = peel_accum[p];

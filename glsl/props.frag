@@ -5,10 +5,12 @@
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 #include "shadow_lookup.glsl"
+#include "temporal.glsl"
 
 layout(location = 0) in vec3 in_normal;
 layout(location = 1) flat in vec3 in_color;
 layout(location = 2) in vec3 in_pos;
+layout(location = 3) flat in uint in_instance;
 layout(location = 0) out vec4 out_color;
 
 #define PROP_ROUGHNESS 0.55
@@ -16,6 +18,7 @@ layout(location = 0) out vec4 out_color;
 #define AMBIENT 0.3
 
 void main() {
+    note_fragment(VISIBILITY_PROP | in_instance);
     vec3 n = normalize(in_normal);
     vec3 l = normalize(frame.light_dir.xyz);
     vec3 v = normalize(frame.camera_pos.xyz - in_pos);

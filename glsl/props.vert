@@ -10,6 +10,7 @@ layout(set = SET_FRAME, binding = BINDING_PROP_INSTANCES, std430) readonly buffe
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) flat out vec3 out_color;
 layout(location = 2) out vec3 out_pos;
+layout(location = 3) flat out uint out_instance;
 
 void main() {
     PropVertex v = prop_vertices[gl_VertexIndex];
@@ -19,5 +20,6 @@ void main() {
     out_normal = normalize(transpose(inverse(mat3(inst.model))) * v.normal.xyz);
     out_color = inst.color.rgb;
     out_pos = world.xyz;
+    out_instance = uint(gl_InstanceIndex);
     gl_Position = frame.view_proj * world;
 }

@@ -1,12 +1,15 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
+#include "temporal.glsl"
 
 layout(location = 0) in vec3 in_normal;
 layout(location = 1) flat in vec3 in_color;
+layout(location = 2) flat in uint in_character;
 layout(location = 0) out vec4 out_color;
 
 void main() {
+    note_fragment(VISIBILITY_SOLID | in_character);
     vec3 n = normalize(in_normal);
     // Two-sided: the scalp winding is arbitrary.
     float d = abs(dot(n, normalize(frame.light_dir.xyz)));

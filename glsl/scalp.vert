@@ -8,6 +8,7 @@
 
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) flat out vec3 out_color;
+layout(location = 2) flat out uint out_character;
 
 vec3 corner_pos(GpuBundle b, int c) {
     ivec3 t = ivec3(ivec2(b.origin) + ivec2(c & 1, c >> 1), 0);
@@ -20,6 +21,7 @@ void main() {
     GpuBundle b = bundles[g];
     bind_character(b.character);
     out_color = style_color() * 0.6;
+    out_character = b.character;
     if (!ch_visible) {
         out_normal = vec3(0.0, 1.0, 0.0);
         gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // outside the depth range: clipped

@@ -17,6 +17,7 @@ layout(local_size_x = SOFT_TILE, local_size_y = SOFT_TILE) in;
 #define OIT_COMPUTE
 #include "oit.glsl"
 #include "lod_appearance.glsl"
+#include "temporal.glsl"
 
 #define TILE_PIXELS (SOFT_TILE * SOFT_TILE)
 
@@ -27,6 +28,9 @@ shared uint64_t s_tail[TILE_PIXELS * 2u];
 shared float s_depth[TILE_PIXELS];
 // optical_depth of each 8-bit fragment alpha (a log per evicted fragment otherwise).
 shared float s_optical_depth[256];
+// Per pixel: the nearest fragment's depth bits << 32 | visibility id (temporal.glsl), noted
+// into the frame's visibility once per pixel at the end.
+shared uint64_t s_visible[TILE_PIXELS];
 
 // Add fragment `v` to pixel lp's K nearest (k of them), or its tail.
 void insert(uint lp, uint k, uint64_t v) {
@@ -68,6 +72,7 @@ struct SegmentRaster {
     vec4 ca;
     vec4 cb;
     float thickness;
+    uint id;
 };
 
 // The fragment of segment `s` in pixel `pixel` of the tile at `origin`: inserted when it lies
@@ -91,6 +96,9 @@ void shade_pixel(SegmentRaster s, ivec2 pixel, ivec2 origin, uint k) {
         return;
     }
     uint64_t v = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(pack_fragment(c.rgb, alpha));
+    if (frame.temporal.x != 0u) {
+        atomicMin(s_visible[lp], (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(s.id));
+    }
     insert(lp, k, v);
 }
 
@@ -107,7 +115,7 @@ ivec4 footprint_box(Segment s, ivec2 origin, ivec2 extent) {
 void raster_segment(Segment s, ivec2 origin, ivec2 extent, uint k) {
     float h = s.half_width;
     SegmentRaster r = SegmentRaster(segment_frame(s.a, s.b), h, vec2(s.za, s.zb), unpack_fragment(s.color_a),
-                                    unpack_fragment(s.color_b), s.thickness);
+                                    unpack_fragment(s.color_b), s.thickness, s.id);
     ivec4 box = footprint_box(s, origin, extent);
     for (int y = box.y; y <= box.w; y++) {
         vec2 t = clip_param(s.a, s.b, 1, float(y) - h, float(y + 1) + h);
@@ -144,6 +152,7 @@ void main() {
     }
     s_tail[lp * 2u] = 0ul;
     s_tail[lp * 2u + 1u] = 0ul;
+    s_visible[lp] = OIT_EMPTY;
     s_depth[lp] = inside ? soft_depth[p] : 0.0;
     for (uint a = lp; a < 256u; a += TILE_PIXELS) {
         s_optical_depth[a] = optical_depth(float(a) / 255.0);
@@ -155,6 +164,10 @@ void main() {
     barrier();
     if (!inside) {
         return;
+    }
+    uint64_t nearest = s_visible[lp];
+    if (nearest != OIT_EMPTY) {
+        note_visible(uvec2(pixel), uintBitsToFloat(uint(nearest >> 32)), uint(nearest));
     }
     // Insert the tile's fragments into the k-buffer's sorted list (the pixel is this
     // thread's alone now): the nearest frame.transparency.y stay nodes, the others join the

@@ -18,6 +18,7 @@ struct Segment {
     float zb;
     float half_width; // half the drawn width, pixels
     float thickness;  // strands it stands for (lod_appearance.glsl)
+    uint id;          // visibility id of its character (temporal.glsl)
     uint color_a;     // pack_fragment: colour, covered share of the drawn width
     uint color_b;
 };
@@ -25,10 +26,11 @@ struct Segment {
 Segment load_segment(uint i) {
     SoftSegment s = soft_segments[i];
     Segment r;
-    r.a = s.a.xy;
-    r.b = s.a.xy + unpackHalf2x16(s.b.x);
-    r.za = s.a.z;
-    r.zb = s.a.w;
+    r.a = s.a;
+    r.b = s.a + unpackHalf2x16(s.b.x);
+    r.za = s.za;
+    r.zb = s.za + unpackHalf2x16(s.dz_id & 0xFFFFu).x;
+    r.id = s.dz_id >> 16;
     vec2 wk = unpackHalf2x16(s.b.w);
     r.half_width = 0.5 * wk.x;
     r.thickness = wk.y;

@@ -111,7 +111,12 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
             if (out_index < budget) {
                 vec4 a = sv_screen[idx];
                 vec4 b = sv_screen[idx + 1u];
-                soft_segments[out_index].a = vec4(a.xy, a.z, b.z);
+                // The far end's depth as a half-float step from the near end's (relative
+                // precision 2^-11 of the step), beside the character's visibility id.
+                uint dz = packHalf2x16(vec2(b.z - a.z, 0.0)) & 0xFFFFu;
+                soft_segments[out_index].a = a.xy;
+                soft_segments[out_index].za = a.z;
+                soft_segments[out_index].dz_id = dz | ((character & VISIBILITY_INDEX) << 16);
                 soft_segments[out_index].b = uvec4(packHalf2x16(b.xy - a.xy), sv_color[idx], sv_color[idx + 1u],
                                                    packHalf2x16(vec2(0.5 * (a.w + b.w), thickness)));
             }

@@ -6,9 +6,11 @@
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 #include "strand_fragment.glsl"
+#include "temporal.glsl"
 
 layout(location = 0) out vec4 out_color;
 
 void main() {
+    note_fragment(in_character);
     out_color = vec4(shade_strand(), 1.0);
 }

@@ -86,6 +86,7 @@ fn hair_covers_the_scalp_seen_from_above() {
                 PropInstance {
                     model: model.to_cols_array_2d(),
                     color,
+                    clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
                 },
             )
         };

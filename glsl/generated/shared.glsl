@@ -44,6 +44,11 @@
 #define TRANSPARENCY_OPAQUE 0u
 #define TRANSPARENCY_KBUFFER 1u
 #define TRANSPARENCY_PEELING 2u
+#define VISIBILITY_EMPTY 4294967295u
+#define VISIBILITY_PROP 2147483648u
+#define VISIBILITY_SOLID 1073741824u
+#define VISIBILITY_INDEX 65535u
+#define TEMPORAL_GROUP 8u
 #define STRAND_OPACITY 0.7
 #define MARSCHNER_LUT_TRT_SCALE 5.0
 #define ROOT_PHONG_SHAPE 0.5
@@ -76,6 +81,11 @@
 #define BINDING_SOFT_DEPTH 22
 #define BINDING_SOFT_SHADOW_DEPTH 23
 #define BINDING_SOFT_SHADOW_LAYERS 24
+#define BINDING_VISIBILITY 25
+#define BINDING_MOTION 26
+#define BINDING_FRAME_COLOR 27
+#define BINDING_HISTORY_IN 28
+#define BINDING_HISTORY_OUT 29
 #define BINDING_TEX_POSITION 0
 #define BINDING_TEX_UV 1
 #define BINDING_TEX_W 2
@@ -155,6 +165,10 @@ struct FrameBlock {
     uvec4 soft;
     vec4 soft_params;
     uvec4 soft_grid;
+    uvec4 temporal;
+    vec4 temporal_params;
+    mat4 clip_to_prev;
+    mat4 unjittered_view_proj;
 };
 
 struct CharacterRecord {
@@ -169,6 +183,7 @@ struct CharacterRecord {
     uint flags;
     float model_scale;
     uint _pad;
+    mat4 clip_to_prev;
 };
 
 struct GpuBundle {
@@ -209,7 +224,9 @@ struct HairVertex {
 };
 
 struct SoftSegment {
-    vec4 a;
+    vec2 a;
+    float za;
+    uint dz_id;
     uvec4 b;
 };
 
@@ -221,6 +238,7 @@ struct PropVertex {
 struct PropInstance {
     mat4 model;
     vec4 color;
+    mat4 clip_to_prev;
 };
 
 struct TaskPayload {

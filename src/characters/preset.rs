@@ -212,6 +212,7 @@ pub fn world_props() -> Vec<(usize, PropInstance)> {
         PropInstance {
             model: Mat4::IDENTITY.to_cols_array_2d(),
             color: [0.32, 0.34, 0.3, 1.0],
+            clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
         },
     )]
 }
@@ -226,6 +227,7 @@ pub fn character_props(c: &CrowdCharacter) -> Result<Vec<(usize, PropInstance)>>
             PropInstance {
                 model: model.to_cols_array_2d(),
                 color,
+                clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
             },
         )
     };

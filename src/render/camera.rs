@@ -220,6 +220,8 @@ pub struct View {
     /// Seed 000's aggregated appearance for LoD-thickened strands (opacity and multiple
     /// scattering scaled by the strands a thick strand stands for).
     pub lod_appearance: bool,
+    /// Temporal accumulation (jitter, motion vectors, history).
+    pub temporal: super::temporal::Temporal,
 }
 
 impl View {
@@ -235,6 +237,7 @@ impl View {
             shadows: Default::default(),
             transparency: Default::default(),
             lod_appearance: true,
+            temporal: Default::default(),
         }
     }
 
@@ -295,6 +298,11 @@ impl View {
             shadow_params: [0.0; 4],
             // Samples filled in by the renderer.
             transparency: self.transparency.frame_fields(1),
+            // Filled in by the renderer for frames with motion vectors.
+            temporal: [0; 4],
+            temporal_params: [0.0; 4],
+            clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
+            unjittered_view_proj: vp.to_cols_array_2d(),
             // Filled in by the renderer for frames that use the software rasterizer.
             soft: [0; 4],
             soft_params: [0.0; 4],

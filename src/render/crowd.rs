@@ -603,6 +603,7 @@ impl Crowd {
                     flags: if c.visible { CHARACTER_VISIBLE } else { 0 },
                     model_scale: model_scale(&c.model),
                     _pad: 0,
+                    clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
                 },
                 None => bytemuck::Zeroable::zeroed(),
             })

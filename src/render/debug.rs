@@ -60,7 +60,7 @@ impl Renderer {
         let i = self.next;
         let (width, height) = self.targets.size();
         self.prepare_workspace(i, RenderPath::Mesh)?;
-        let transients = self.frame_transients((kbuffer, raster), None, k)?;
+        let transients = self.frame_transients((kbuffer, raster), None, k, None)?;
         let mut block: FrameBlock = bytemuck::Zeroable::zeroed();
         block.viewport = [
             width as f32,
@@ -111,6 +111,7 @@ impl Renderer {
             work: &self.work,
             targets: &mut self.targets,
             shadow: &mut self.shadow,
+            history: None,
         };
         let (passes, pool) = (&self.passes, &mut self.transients);
         let result = ctx.submit_and_wait(|rec| {

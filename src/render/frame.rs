@@ -13,6 +13,7 @@ use super::camera::View;
 use super::graph::FrameGraph;
 use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::PropDraw;
+use super::passes::temporal::TemporalWork;
 use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets};
 use super::renderer::{PresentTarget, Renderer};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
@@ -22,6 +23,7 @@ use super::slots::{
     FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
 };
 use super::soft::StrandRaster;
+use super::temporal::{FrameMotion, PreviousFrame, Temporal, TemporalTuning, jittered};
 use super::transparency::Transparency;
 use super::workspace::FrameBuffers;
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
@@ -43,6 +45,8 @@ pub(super) struct FrameWork<'a> {
     kbuffer_budget: u32,
     /// Character slots whose hair mesh pose changed (rebuilt this frame).
     pose_updates: Vec<usize>,
+    /// Motion vectors and accumulation, when the frame has them.
+    temporal: Option<TemporalWork>,
     /// The transient buffers and images the frame graph creates.
     transients: FrameTransients,
 }
@@ -57,23 +61,40 @@ impl Renderer {
         mut present: Option<PresentTarget>,
     ) -> GpuResult<FrameTicket> {
         let (path, kbuffer_budget) = self.check_frame(view, opts)?;
+        let temporal = self.temporal_work(view, opts)?;
         // What draws the frame's bundles, decided once (`auto` with k-buffer OIT is all
         // software): the passes, buffers and frame blocks all follow it.
         let raster = opts.raster.under(view.transparency);
         let i = self.next;
         self.retire_slot(i)?;
+        if temporal.is_some_and(|t| t.accumulate)
+            && let Some(old) = self
+                .temporal
+                .ensure_history(&self.ctx, self.targets.size())?
+        {
+            self.frames[i]
+                .retired
+                .push(Retired::Resource(Box::new(old)));
+        }
         self.prepare_workspace(i, path)?;
         let pose_updates = self.crowd.write_pending_poses(i)?;
-        let (block, light_block) = self.frame_blocks(view, opts, (raster, kbuffer_budget));
+        let (mut block, light_block) = self.frame_blocks(view, opts, (raster, kbuffer_budget));
+        let motion = self.temporal_fields(&mut block, temporal);
         // Software light passes only where there is a light view this frame.
         let light_raster = match light_block {
             Some(_) => opts.light_raster,
             None => LightRaster::Hardware,
         };
         let soft_light = (light_raster == LightRaster::Software).then_some(view.shadows);
-        let transients =
-            self.frame_transients((view.transparency, raster), soft_light, kbuffer_budget)?;
-        let prop_draws = self.write_slot(i, &block, light_block.as_ref(), opts.read_image)?;
+        let transients = self.frame_transients(
+            (view.transparency, raster),
+            soft_light,
+            kbuffer_budget,
+            temporal,
+        )?;
+        let records = self.crowd.records();
+        let blocks = (&block, light_block.as_ref());
+        let prop_draws = self.write_slot(i, blocks, &records, &motion, opts)?;
         let start = Instant::now();
         let work = FrameWork {
             path,
@@ -85,6 +106,7 @@ impl Renderer {
             light_raster,
             kbuffer_budget,
             pose_updates,
+            temporal,
             transients,
         };
         let frame_graph = self.record(i, work, opts, present.as_mut())?;
@@ -97,12 +119,62 @@ impl Renderer {
             height,
             record_ms,
             read_image: opts.read_image,
+            read_motion: opts.read_motion,
             frame_graph,
         };
         self.submit(i, pending, present.as_ref())?;
+        let models = records.iter().map(|r| {
+            (r.flags & super::shared::CHARACTER_VISIBLE != 0)
+                .then(|| glam::Mat4::from_cols_array_2d(&r.model))
+        });
+        let previous = PreviousFrame {
+            view_proj: motion.view_proj,
+            models: models.collect(),
+            size: self.targets.size(),
+        };
+        let accumulated = temporal.is_some_and(|t| t.accumulate);
+        self.temporal.advance(previous, accumulated);
         self.after_submit(path, raster);
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
         Ok(FrameTicket(self.frame_number - 1))
+    }
+
+    /// This frame's temporal work (`None`: no motion vectors), or why this device cannot
+    /// do it.
+    fn temporal_work(&self, view: &View, opts: &FrameOptions) -> GpuResult<Option<TemporalWork>> {
+        let accumulate = view.temporal == Temporal::Taa;
+        if !accumulate && !opts.read_motion {
+            return Ok(None);
+        }
+        if !self.passes.has_temporal() {
+            return Err(GpuError::Unsupported(format!(
+                "{}: motion vectors and temporal accumulation need shaderInt64 and 64-bit buffer atomics",
+                self.ctx.info.name
+            )));
+        }
+        Ok(Some(TemporalWork { accumulate }))
+    }
+
+    /// The camera block's temporal fields for `work` (the view-projection jittered when
+    /// accumulating), and the frame's motion matrices.
+    fn temporal_fields(&self, block: &mut FrameBlock, work: Option<TemporalWork>) -> FrameMotion {
+        let size = self.targets.size();
+        let view_proj = glam::Mat4::from_cols_array_2d(&block.unjittered_view_proj);
+        let motion = FrameMotion::new(view_proj, self.temporal.previous(size));
+        let Some(work) = work else {
+            return motion;
+        };
+        let jitter = match work.accumulate {
+            true => self.temporal.jitter(),
+            false => glam::Vec2::ZERO,
+        };
+        let valid = work.accumulate && self.temporal.history_valid(size);
+        let tuning = TemporalTuning::default();
+        block.view_proj = jittered(view_proj, jitter, size).to_cols_array_2d();
+        block.temporal = [1, work.accumulate as u32, valid as u32, 0];
+        block.temporal_params = [jitter.x, jitter.y, tuning.current_weight, tuning.hair_clamp];
+        block.clip_to_prev = motion.camera().to_cols_array_2d();
+        motion
     }
 
     /// Refuse a frame this renderer cannot draw (path state, 32-bit counters, settings);
@@ -152,6 +224,7 @@ impl Renderer {
         (transparency, raster): (Transparency, StrandRaster),
         soft_light: Option<ShadowMode>,
         kbuffer_budget: u32,
+        temporal: Option<TemporalWork>,
     ) -> GpuResult<FrameTransients> {
         let size = self.targets.size();
         // The software rasterizer composites through the k-buffer, in opaque frames too.
@@ -170,7 +243,7 @@ impl Renderer {
         }
         let soft = raster.uses_software().then_some(self.soft_budget);
         let light = soft_light.map(|mode| (self.soft_budget, self.shadow.resolution(), mode));
-        let t = FrameTransients::new(buffers_for, (soft, light), size);
+        let t = FrameTransients::new(buffers_for, (soft, light), size, temporal);
         for b in t.buffers() {
             self.transients.check(b)?;
         }
@@ -208,18 +281,27 @@ impl Renderer {
         (block, light_block)
     }
 
-    /// Write slot `i`'s frame blocks, records and prop instances (and size its image
-    /// readback); returns this frame's prop draws.
+    /// Write slot `i`'s frame blocks, `records` (with their motion) and prop instances (and
+    /// size its readbacks); returns this frame's prop draws.
     fn write_slot(
         &mut self,
         i: usize,
-        block: &FrameBlock,
-        light_block: Option<&FrameBlock>,
-        read_image: bool,
+        (block, light_block): (&FrameBlock, Option<&FrameBlock>),
+        records: &[super::shared::CharacterRecord],
+        motion: &FrameMotion,
+        opts: &FrameOptions,
     ) -> GpuResult<Vec<PropDraw>> {
-        let records = self.crowd.records();
+        let mut records = records.to_vec();
+        for (slot, r) in records.iter_mut().enumerate() {
+            let model = glam::Mat4::from_cols_array_2d(&r.model);
+            r.clip_to_prev = motion.character(slot, model).to_cols_array_2d();
+        }
         let crowd = &self.crowd;
-        let (prop_instances, prop_draws) = self.props.frame_lists(|id| crowd.drawn_model(id));
+        let moved = |id: super::crowd::CharacterId| {
+            let model = crowd.drawn_model(id)?;
+            Some((model, motion.character(id.slot() as usize, model)))
+        };
+        let (prop_instances, prop_draws) = self.props.frame_lists(moved, motion.camera());
         let (width, height) = self.targets.size();
         let slot = &mut self.frames[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;
@@ -234,8 +316,16 @@ impl Renderer {
             .image_readback
             .as_ref()
             .is_none_or(|b| b.size != image_bytes);
-        if read_image && stale {
+        if opts.read_image && stale {
             slot.image_readback = Some(image_readback(&self.ctx, image_bytes)?);
+        }
+        let motion_bytes = image_bytes * 4;
+        let stale = slot
+            .motion_readback
+            .as_ref()
+            .is_none_or(|b| b.size != motion_bytes);
+        if opts.read_motion && stale {
+            slot.motion_readback = Some(image_readback(&self.ctx, motion_bytes)?);
         }
         Ok(prop_draws)
     }
@@ -258,6 +348,7 @@ impl Renderer {
             light_set,
             stats_readback,
             image_readback,
+            motion_readback,
             retired,
             ..
         } = &mut self.frames[i];
@@ -276,6 +367,7 @@ impl Renderer {
             work: &self.work,
             targets: &mut self.targets,
             shadow: &mut self.shadow,
+            history: self.temporal.history(),
         };
         let r = FrameRes::new(&mut g, sources, &work.transients);
         g.bind_transients(set);
@@ -299,7 +391,8 @@ impl Renderer {
                 textures,
             },
         );
-        let inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
+        let mut inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
+        inputs.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
         self.passes.add(&mut g, &r, inputs)?;
         let (overlay, image) = match present {
             Some(p) => (p.overlay.as_deref_mut(), Some(p.image)),
@@ -400,6 +493,7 @@ impl Renderer {
                     bundle_table: self.crowd.bundle_table(),
                     prop_vertices: self.props.vertices.as_ref(),
                     shadow: &self.shadow,
+                    history: self.temporal.history(),
                 },
             )?;
         }
@@ -452,5 +546,7 @@ fn frame_inputs<'a>(
         kbuffer_budget: work.kbuffer_budget,
         size,
         mesh_query,
+        temporal: work.temporal,
+        motion_readback: None,
     }
 }

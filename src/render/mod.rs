@@ -19,6 +19,7 @@ pub mod shared;
 pub mod slots;
 pub mod soft;
 pub mod targets;
+pub mod temporal;
 pub mod transparency;
 pub mod workspace;
 
@@ -33,4 +34,5 @@ pub use shadow::ShadowMode;
 pub use shared::FrameStats;
 pub use slots::{FRAMES_IN_FLIGHT, FrameReport};
 pub use soft::StrandRaster;
+pub use temporal::Temporal;
 pub use transparency::Transparency;

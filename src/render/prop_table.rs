@@ -23,19 +23,26 @@ pub(super) struct Props {
 
 impl Props {
     /// This frame's instance records (sorted by mesh) and one draw per mesh: the world props
-    /// and, placed by `model_of` (`None`: not drawn), the characters' own.
+    /// (their motion: `world_clip_to_prev`, the camera's) and, placed by `model_of` (model
+    /// and clip_to_prev; `None`: not drawn), the characters' own.
     pub(super) fn frame_lists(
         &self,
-        model_of: impl Fn(CharacterId) -> Option<Mat4>,
+        model_of: impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
+        world_clip_to_prev: Mat4,
     ) -> (Vec<PropInstance>, Vec<PropDraw>) {
         let mut all = self.instances.clone();
+        for (_, inst) in &mut all {
+            inst.clip_to_prev = world_clip_to_prev.to_cols_array_2d();
+        }
         all.extend(self.attached.iter().filter_map(|(id, mesh, inst)| {
-            let model = model_of(*id)? * Mat4::from_cols_array_2d(&inst.model);
+            let (character, clip_to_prev) = model_of(*id)?;
+            let model = character * Mat4::from_cols_array_2d(&inst.model);
             Some((
                 *mesh,
                 PropInstance {
                     model: model.to_cols_array_2d(),
                     color: inst.color,
+                    clip_to_prev: clip_to_prev.to_cols_array_2d(),
                 },
             ))
         }));

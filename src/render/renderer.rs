@@ -73,6 +73,8 @@ pub struct Renderer {
     /// The LHS baseline's stored strands (`capture_lhs`), with the crowd version they are of.
     pub(super) lhs: Option<(u64, super::passes::lhs_skin::LhsState)>,
     pub(super) work: Workspace,
+    /// The previous frame's matrices and the temporal history.
+    pub(super) temporal: super::temporal::TemporalState,
     pub(super) completed: VecDeque<FrameReport>,
     /// Background colour (linear RGB).
     pub background: [f32; 3],
@@ -148,6 +150,7 @@ impl Renderer {
             args_structure: None,
             lhs: None,
             work,
+            temporal: Default::default(),
             completed: VecDeque::new(),
             background: [0.6, 0.65, 0.7],
         })
@@ -397,6 +400,15 @@ impl Renderer {
                 (Some(b), true) => Some(b.read_range(0, (p.width * p.height * 4) as usize)?),
                 _ => None,
             };
+            let motion = match (&mut slot.motion_readback, p.read_motion) {
+                (Some(b), true) => {
+                    let bytes = b.read_range(0, (p.width * p.height * 16) as usize)?;
+                    let words: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
+                    let decode = super::temporal::PixelMotion::from_words;
+                    Some(words.iter().copied().map(decode).collect())
+                }
+                _ => None,
+            };
             let mesh_primitives = match (&slot.mesh_query, p.path) {
                 (Some(q), RenderPath::Mesh) => q.result()?,
                 _ => None,
@@ -411,6 +423,7 @@ impl Renderer {
                 mesh_primitives,
                 record_ms: p.record_ms,
                 rgba,
+                motion,
                 frame_graph: p.frame_graph,
             });
             while self.completed.len() > 2 * FRAMES_IN_FLIGHT {

@@ -195,6 +195,9 @@ pub struct FrameOptions {
     pub clear: bool,
     /// Read the colour target back into the report.
     pub read_image: bool,
+    /// Compute the motion vectors (as temporal accumulation does) and read them back into
+    /// the report (`FrameReport::motion`).
+    pub read_motion: bool,
     /// Keep a printable account of the frame graph (passes, uses, derived dependencies) in the
     /// frame's report (`render --print-frame`).
     pub describe_frame: bool,
@@ -211,6 +214,7 @@ impl Default for FrameOptions {
             path: None,
             clear: true,
             read_image: false,
+            read_motion: false,
             describe_frame: false,
             raster: super::soft::StrandRaster::Hardware,
             light_raster: LightRaster::Hardware,

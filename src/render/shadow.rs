@@ -154,6 +154,9 @@ impl LightView {
             soft,
             soft_params: [0.0; 4],
             soft_grid,
+            // The light's views note no visibility and accumulate nothing.
+            temporal: [0; 4],
+            temporal_params: [0.0; 4],
             ..*camera
         }
     }

@@ -58,6 +58,17 @@ pub const RASTER_LIGHT: u32 = 3;
 /// Fixed-point scale of the software shadow pass's opacity sums (`soft_shadow.comp`): opacity
 /// `o` adds `round(o * SHADOW_OPACITY_FIXED)`.
 pub const SHADOW_OPACITY_FIXED: f32 = 4096.0;
+/// Temporal: the visibility id of a pixel no surface covers (the background).
+pub const VISIBILITY_EMPTY: u32 = u32::MAX;
+/// Temporal: visibility ids with this bit are prop instances (the rest, characters).
+pub const VISIBILITY_PROP: u32 = 1 << 31;
+/// Temporal: a character's solid surface (its scalp), not its hair.
+pub const VISIBILITY_SOLID: u32 = 1 << 30;
+/// Temporal: the character slot or prop instance of a visibility id (16 bits: the software
+/// rasterizer's segments carry it in half a word).
+pub const VISIBILITY_INDEX: u32 = (1 << 16) - 1;
+/// Temporal: threads per side of the temporal passes' square workgroups.
+pub const TEMPORAL_GROUP: u32 = 8;
 /// `FrameBlock::transparency.x`: opaque strands.
 pub const TRANSPARENCY_OPAQUE: u32 = 0;
 /// `FrameBlock::transparency.x`: k-buffer OIT.
@@ -143,11 +154,23 @@ pub enum FrameBinding {
     /// Software shadows: per light texel, the deep opacity layers (4 halves in a `uvec2`,
     /// the RGBA16F texel), copied into the layers map.
     SoftShadowLayers = 24,
+    /// Temporal: per pixel, the nearest surface (`uint64`: depth bits << 32 | visibility id,
+    /// `temporal.glsl`), the motion vectors' source.
+    Visibility = 25,
+    /// Temporal: per pixel, the screen motion to the previous frame (`vec2`, pixels).
+    Motion = 26,
+    /// Temporal: per pixel, the frame's colour (`uint`: RGBA8 sRGB, as the output image).
+    FrameColor = 27,
+    /// Temporal: per pixel, the accumulated history read (`uvec4`: rg and ba halves,
+    /// visibility id, depth bits).
+    HistoryIn = 28,
+    /// Temporal: per pixel, the accumulated history written this frame.
+    HistoryOut = 29,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 25] = [
+    pub const ALL: [(FrameBinding, &'static str); 30] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -173,6 +196,11 @@ impl FrameBinding {
         (FrameBinding::SoftDepth, "BINDING_SOFT_DEPTH"),
         (FrameBinding::SoftShadowDepth, "BINDING_SOFT_SHADOW_DEPTH"),
         (FrameBinding::SoftShadowLayers, "BINDING_SOFT_SHADOW_LAYERS"),
+        (FrameBinding::Visibility, "BINDING_VISIBILITY"),
+        (FrameBinding::Motion, "BINDING_MOTION"),
+        (FrameBinding::FrameColor, "BINDING_FRAME_COLOR"),
+        (FrameBinding::HistoryIn, "BINDING_HISTORY_IN"),
+        (FrameBinding::HistoryOut, "BINDING_HISTORY_OUT"),
     ];
 
     /// What the binding holds.
@@ -404,13 +432,25 @@ pub struct FrameBlock {
     pub soft_params: [f32; 4],
     /// Software rasterizer: x tiles per row, y tile rows; zw reserved.
     pub soft_grid: [u32; 4],
+    /// Temporal (`render::Temporal`): x passes note the nearest surface per pixel (motion
+    /// vectors), y accumulation on, z history valid, w frame index.
+    pub temporal: [u32; 4],
+    /// Temporal: xy this frame's sub-pixel jitter (pixels, in `view_proj`), z history
+    /// weight of a fully trusted pixel, w colour clamp width for hair (standard deviations).
+    pub temporal_params: [f32; 4],
+    /// Temporal: unjittered clip space of this frame to the previous frame's, for surfaces
+    /// that did not move (the background; `CharacterRecord::clip_to_prev` for hair).
+    pub clip_to_prev: [[f32; 4]; 4],
+    /// Temporal: the unjittered world to clip of this frame.
+    pub unjittered_view_proj: [[f32; 4]; 4],
 }
 
 gpu_struct!(FrameBlock as "FrameBlock" {
     view_proj: "mat4", camera_pos: "vec4", light_dir: "vec4", viewport: "vec4",
     planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4", shading: "uvec4",
     light_view_proj: "mat4", shadow: "uvec4", shadow_params: "vec4", transparency: "uvec4",
-    soft: "uvec4", soft_params: "vec4", soft_grid: "uvec4",
+    soft: "uvec4", soft_params: "vec4", soft_grid: "uvec4", temporal: "uvec4",
+    temporal_params: "vec4", clip_to_prev: "mat4", unjittered_view_proj: "mat4",
 });
 
 /// One character: where its bundles and textures are, how it is placed and styled.
@@ -439,12 +479,15 @@ pub struct CharacterRecord {
     pub model_scale: f32,
     /// Padding to 256 bytes.
     pub _pad: u32,
+    /// This frame's unjittered clip space to the previous frame's, for this character's
+    /// surfaces (hair and scalp): the camera's motion and the character's own.
+    pub clip_to_prev: [[f32; 4]; 4],
 }
 
 gpu_struct!(CharacterRecord as "CharacterRecord" {
     model: "mat4", mesh: "MeshInfo", style: "HairStyle", texture_slot: "uint",
     first_bundle: "uint", bundle_count: "uint", strands_per_bundle: "uint", verts_log2: "uint",
-    flags: "uint", model_scale: "float", _pad: "uint",
+    flags: "uint", model_scale: "float", _pad: "uint", clip_to_prev: "mat4",
 });
 
 /// One bundle of the crowd's bundle table: the baked [`BundleDesc`] plus its owner.
@@ -573,15 +616,20 @@ gpu_struct!(HairVertex as "HairVertex" { pos_width: "vec4", tangent_s: "vec4" })
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SoftSegment {
-    /// x, y: end a in pixels (y down, as `gl_FragCoord`); z, w: depth (0..1) of ends a and b.
-    pub a: [f32; 4],
+    /// End a in pixels (y down, as `gl_FragCoord`).
+    pub a: [f32; 2],
+    /// Depth (0..1) of end a.
+    pub za: f32,
+    /// Low half: `packHalf2x16` of end b's depth minus end a's; high half: the visibility id
+    /// of the segment's character (`temporal.glsl`).
+    pub dz_id: u32,
     /// x: `packHalf2x16(b.xy - a.xy)`; y, z: colour of ends a and b (`pack_fragment`: sqrt
     /// RGB, alpha = the share of the drawn width the strand covers); w:
     /// `packHalf2x16(drawn width in pixels, strands it stands for)`.
     pub b: [u32; 4],
 }
 
-gpu_struct!(SoftSegment as "SoftSegment" { a: "vec4", b: "uvec4" });
+gpu_struct!(SoftSegment as "SoftSegment" { a: "vec2", za: "float", dz_id: "uint", b: "uvec4" });
 
 /// A vertex of a prop mesh (bodies, ground): triangle lists, object space.
 #[repr(C)]
@@ -603,9 +651,12 @@ pub struct PropInstance {
     pub model: [[f32; 4]; 4],
     /// rgb linear colour, a unused.
     pub color: [f32; 4],
+    /// This frame's unjittered clip space to the previous frame's for this prop (filled in
+    /// by the renderer each frame).
+    pub clip_to_prev: [[f32; 4]; 4],
 }
 
-gpu_struct!(PropInstance as "PropInstance" { model: "mat4", color: "vec4" });
+gpu_struct!(PropInstance as "PropInstance" { model: "mat4", color: "vec4", clip_to_prev: "mat4" });
 
 /// Task shader -> mesh shader payload: up to [`TASK_PAYLOAD_BUNDLES`] visible bundles of one
 /// task workgroup, compacted, with the first mesh workgroup of each.
@@ -769,6 +820,11 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("TRANSPARENCY_OPAQUE", TRANSPARENCY_OPAQUE),
         uint("TRANSPARENCY_KBUFFER", TRANSPARENCY_KBUFFER),
         uint("TRANSPARENCY_PEELING", TRANSPARENCY_PEELING),
+        uint("VISIBILITY_EMPTY", VISIBILITY_EMPTY),
+        uint("VISIBILITY_PROP", VISIBILITY_PROP),
+        uint("VISIBILITY_SOLID", VISIBILITY_SOLID),
+        uint("VISIBILITY_INDEX", VISIBILITY_INDEX),
+        uint("TEMPORAL_GROUP", TEMPORAL_GROUP),
     ]
 }
 

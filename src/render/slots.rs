@@ -47,6 +47,9 @@ pub struct FrameReport {
     pub record_ms: f64,
     /// RGBA8 pixels (sRGB), top row first, when requested.
     pub rgba: Option<Vec<u8>>,
+    /// Motion vectors and nearest surfaces per pixel, top row first, when requested
+    /// (`FrameOptions::read_motion`).
+    pub motion: Option<Vec<super::temporal::PixelMotion>>,
     /// The frame graph's passes, uses and derived dependencies, when
     /// [`super::FrameOptions::describe_frame`] was set.
     pub frame_graph: Option<String>,
@@ -66,6 +69,7 @@ pub(crate) struct Pending {
     pub height: u32,
     pub record_ms: f64,
     pub read_image: bool,
+    pub read_motion: bool,
     /// The frame graph's description, when asked for.
     pub frame_graph: Option<String>,
 }
@@ -81,6 +85,8 @@ pub(crate) struct FrameSlot {
     pub prop_instances: Buffer,
     pub stats_readback: Buffer,
     pub image_readback: Option<Buffer>,
+    /// Motion vectors for the host (`uvec4` per pixel), when asked for.
+    pub motion_readback: Option<Buffer>,
     pub profiler: Profiler,
     pub mesh_query: Option<MeshPrimitivesQuery>,
     pub set: DescriptorSet,
@@ -109,6 +115,7 @@ impl FrameSlot {
                 .readback(),
             )?,
             image_readback: None,
+            motion_readback: None,
             profiler: Profiler::new(ctx)?,
             mesh_query: MeshPrimitivesQuery::new(ctx)?,
             set: DescriptorSet::new(ctx, "frame set", layout)?,

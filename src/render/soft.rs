@@ -535,7 +535,9 @@ impl SoftSegment {
     pub fn shaded(a: glam::Vec3, b: glam::Vec3, width: f32, rgb: [[f32; 3]; 2]) -> Self {
         let d = b - a;
         SoftSegment {
-            a: [a.x, a.y, a.z, b.z],
+            a: [a.x, a.y],
+            za: a.z,
+            dz_id: f16_bits(b.z - a.z),
             b: [
                 f16_bits(d.x) | f16_bits(d.y) << 16,
                 pack_fragment(rgb[0], 1.0),

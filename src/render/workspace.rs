@@ -36,6 +36,8 @@ pub struct FrameBuffers<'a> {
     pub prop_vertices: Option<&'a Buffer>,
     /// The light's maps.
     pub shadow: &'a super::targets::ShadowMaps,
+    /// The temporal history this frame reads and writes, once made.
+    pub history: Option<(&'a Buffer, &'a Buffer)>,
 }
 
 /// One level of the scan: `count` elements at `input` (level 0: the bundles), block sums at
@@ -227,7 +229,12 @@ impl Workspace {
                 | FrameBinding::SoftEntries
                 | FrameBinding::SoftDepth
                 | FrameBinding::SoftShadowDepth
-                | FrameBinding::SoftShadowLayers => continue,
+                | FrameBinding::SoftShadowLayers
+                | FrameBinding::Visibility
+                | FrameBinding::Motion
+                | FrameBinding::FrameColor => continue,
+                FrameBinding::HistoryIn => frame.history.map_or(&self.placeholder, |h| h.0),
+                FrameBinding::HistoryOut => frame.history.map_or(&self.placeholder, |h| h.1),
                 FrameBinding::ShadowHairDepth
                 | FrameBinding::ShadowPropDepth
                 | FrameBinding::ShadowLayers => {

@@ -234,6 +234,14 @@ impl<'a> PassBuilder<'_, 'a> {
         self.add(res, access, true)
     }
 
+    /// [`Self::write`] of `res` where there is one (a resource only some frames have).
+    pub fn write_some(self, res: Option<Res>, access: Access) -> Self {
+        match res {
+            Some(r) => self.write(r, access),
+            None => self,
+        }
+    }
+
     /// [`Self::read`] of every resource in `list`.
     pub fn read_all(self, list: &[Res], access: Access) -> Self {
         list.iter().fold(self, |p, r| p.read(*r, access))

@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets, dispatch_2d, shader_options};
+use super::{FrameRes, PassSets, device_shader_options, dispatch_2d};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::{CULL_GROUP_SIZE, GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
 use crate::vk::shader::compile;
@@ -51,7 +51,7 @@ pub struct ComputeGenerate {
 impl ComputeGenerate {
     /// Compile the pipelines.
     pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
-        let opts = shader_options(1);
+        let opts = device_shader_options(ctx, 1);
         let p =
             |name: &str, file: &str| Pipeline::compute(ctx, name, layout, &compile(file, &opts)?);
         Ok(ComputeGenerate {

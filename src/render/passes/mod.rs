@@ -12,6 +12,7 @@ pub mod shadow;
 pub mod soft_raster;
 pub mod soft_shadow;
 pub mod strands;
+pub mod temporal;
 pub mod transparency;
 
 use std::sync::Arc;
@@ -60,6 +61,16 @@ pub fn shader_options(task_bundles: u32) -> ShaderOptions {
     ShaderOptions::default()
         .include("shared.glsl", super::shared::glsl_header())
         .define("TASK_BUNDLES", task_bundles)
+}
+
+/// [`shader_options`] for `ctx`'s device: with `VISIBILITY` where it has 64-bit buffer
+/// atomics (camera passes note each pixel's nearest surface for the motion vectors,
+/// `temporal.glsl`).
+pub fn device_shader_options(ctx: &Context, task_bundles: u32) -> ShaderOptions {
+    match ctx.info.int64_atomics {
+        true => shader_options(task_bundles).define("VISIBILITY", 1),
+        false => shader_options(task_bundles),
+    }
 }
 
 /// Formats and sample count of the targets the graphics passes draw into.
@@ -145,7 +156,7 @@ pub fn vertex_pipeline(
     shaders: (&str, Option<&str>),
     target: DrawTarget,
 ) -> GpuResult<crate::vk::Pipeline> {
-    let opts = shader_options(1);
+    let opts = device_shader_options(ctx, 1);
     let v = compile(shaders.0, &opts)?;
     let f = shaders.1.map(|f| compile(f, &opts)).transpose()?;
     let mut desc = target
@@ -171,7 +182,7 @@ pub fn own_set_compute(
         .collect();
     let set_layout = crate::vk::DescriptorSetLayout::new(ctx, &bindings)?;
     let layout = PipelineLayout::new(ctx, std::slice::from_ref(&set_layout))?;
-    let spirv = compile(shader, &shader_options(1))?;
+    let spirv = compile(shader, &device_shader_options(ctx, 1))?;
     let pipeline = crate::vk::Pipeline::compute(ctx, name, &layout, &spirv)?;
     Ok((set_layout, pipeline))
 }
@@ -230,10 +241,26 @@ pub struct FrameRes<'a> {
     pub soft_shadow_depth: Res,
     /// Software shadows: the deep opacity layers.
     pub soft_shadow_layers: Res,
+    /// Per-pixel nearest surface (`temporal.glsl`), in frames with motion vectors: every
+    /// camera pass that draws a surface writes it.
+    pub visibility: Option<Res>,
+    /// The temporal passes' other resources, in frames with motion vectors.
+    pub temporal: Option<TemporalRes>,
     /// The `args` buffer (indirect commands name it).
     pub args_buffer: &'a Buffer,
     /// The imported images attachments and copies name.
     pub images: FrameImages<'a>,
+}
+
+/// The temporal passes' resources besides the visibility words.
+#[derive(Clone, Copy)]
+pub struct TemporalRes {
+    /// Motion vectors.
+    pub motion: Res,
+    /// The frame's colour as a buffer (accumulation).
+    pub frame_color: Res,
+    /// The history read and the one written (placeholders without accumulation).
+    pub history: (Res, Res),
 }
 
 /// The imported images of a frame that passes' commands name.
@@ -259,6 +286,8 @@ pub struct FrameSources<'a> {
     pub targets: &'a mut RenderTargets,
     /// Shadow maps.
     pub shadow: &'a mut ShadowMaps,
+    /// The temporal history (read, written), once made.
+    pub history: Option<(&'a Buffer, &'a Buffer)>,
 }
 
 /// The transient resources of a frame, sized for its settings; the frame graph creates them
@@ -272,6 +301,10 @@ pub struct FrameTransients {
     pub soft_shadow: [TransientBuffer; 2],
     /// Depth peeling's layer depth attachment, when peeling.
     pub peel_image: Option<ImageDesc>,
+    /// Visibility, motion and frame colour (`render::temporal::transient_buffers`).
+    pub temporal: [TransientBuffer; 3],
+    /// Whether the frame computes motion vectors.
+    pub motion: bool,
 }
 
 impl FrameTransients {
@@ -283,7 +316,11 @@ impl FrameTransients {
         transparency: Transparency,
         (camera, light): (Option<SoftBudget>, Option<(SoftBudget, u32, ShadowMode)>),
         (width, height): (u32, u32),
+        temporal: Option<temporal::TemporalWork>,
     ) -> Self {
+        let accumulate = temporal.is_some_and(|t| t.accumulate);
+        let temporal_buffers =
+            super::temporal::transient_buffers(temporal.is_some(), accumulate, (width, height));
         let peel = matches!(transparency, Transparency::DepthPeeling { .. });
         let budget = camera.or(light.map(|l| l.0)).unwrap_or(SoftBudget::EMPTY);
         let views = (camera.map(|_| (width, height)), light.map(|l| l.1));
@@ -292,6 +329,8 @@ impl FrameTransients {
             soft: SoftBudget::buffers(budget, views.0, views.1),
             soft_shadow: super::soft::shadow_buffers(light.map(|l| (l.1, l.2))),
             peel_image: peel.then(|| super::transparency::peel_image(width, height)),
+            temporal: temporal_buffers,
+            motion: temporal.is_some(),
         }
     }
 
@@ -301,6 +340,7 @@ impl FrameTransients {
             .iter()
             .chain(&self.soft)
             .chain(&self.soft_shadow)
+            .chain(&self.temporal)
     }
 }
 
@@ -334,6 +374,13 @@ impl<'a> FrameRes<'a> {
         let [soft_segments, soft_tiles, soft_entries, soft_depth] =
             t.soft.map(|d| g.create_buffer(d));
         let [soft_shadow_depth, soft_shadow_layers] = t.soft_shadow.map(|d| g.create_buffer(d));
+        let [visibility, motion, frame_color] = t.temporal.map(|d| g.create_buffer(d));
+        let history = src.history.map(|(read, write)| {
+            (
+                g.import_buffer("temporal history read", read),
+                g.import_buffer("temporal history written", write),
+            )
+        });
         FrameRes {
             constants: g.host_input("frame constants"),
             textures: g.host_input("textures"),
@@ -365,6 +412,12 @@ impl<'a> FrameRes<'a> {
             soft_depth,
             soft_shadow_depth,
             soft_shadow_layers,
+            visibility: t.motion.then_some(visibility),
+            temporal: t.motion.then_some(TemporalRes {
+                motion,
+                frame_color,
+                history: history.unwrap_or((frame_color, frame_color)),
+            }),
             args_buffer: w.args,
             images: FrameImages {
                 color,
@@ -406,6 +459,10 @@ pub struct FrameInputs<'a> {
     pub size: (u32, u32),
     /// The mesh path's primitive query (wraps the strand draw).
     pub mesh_query: Option<&'a mut MeshPrimitivesQuery>,
+    /// Motion vectors and accumulation, when the frame has them.
+    pub temporal: Option<temporal::TemporalWork>,
+    /// Where the motion vectors are copied for the host, when asked for.
+    pub motion_readback: Option<&'a Buffer>,
 }
 
 /// The pipelines of every pass of a frame; [`FramePasses::add`] adds them to the frame graph
@@ -422,6 +479,8 @@ pub struct FramePasses {
     transparency: TransparencyPass,
     /// The software rasterizer's passes, on devices with 64-bit shared and buffer atomics.
     soft: Option<SoftPasses>,
+    /// Motion vectors and temporal accumulation, on devices with 64-bit buffer atomics.
+    temporal: Option<temporal::TemporalPass>,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
     lhs_skin: lhs_skin::LhsSkin,
 }
@@ -480,6 +539,10 @@ impl FramePasses {
                 }),
                 false => None,
             },
+            temporal: match ctx.info.int64_atomics {
+                true => Some(temporal::TemporalPass::new(ctx, layout)?),
+                false => None,
+            },
             hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
             lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
         })
@@ -529,6 +592,11 @@ impl FramePasses {
     /// Whether the software rasterizer is available.
     pub fn has_software_raster(&self) -> bool {
         self.soft.is_some()
+    }
+
+    /// Whether motion vectors and temporal accumulation are available.
+    pub fn has_temporal(&self) -> bool {
+        self.temporal.is_some()
     }
 
     /// The software rasterizer alone over the targets (cleared to black first): `segments`
@@ -605,6 +673,7 @@ impl FramePasses {
             let view = GenerateView::Camera;
             self.generate.add(g, r, inp.sets, inp.bundles, view);
         }
+        temporal::TemporalPass::add_clear(g, r);
         let soft = inp.bundles > 0 && inp.raster.uses_software();
         // Bundles drawn as hardware strips: every one without the software rasterizer, the
         // thick ones with `auto` (never the static and LHS paths' stored strands, which all go
@@ -639,6 +708,9 @@ impl FramePasses {
         if transparent || soft {
             let peel = matches!(inp.transparency, super::Transparency::DepthPeeling { .. });
             self.transparency.add_resolve(g, r, peel, inp.sets)?;
+        }
+        if let (Some(pass), Some(work)) = (&self.temporal, inp.temporal) {
+            pass.add(g, r, (inp.sets, inp.size), work, inp.motion_readback);
         }
         Ok(())
     }
@@ -728,7 +800,8 @@ impl FramePasses {
         p = p
             .read(r.constants, Access::VertexRead)
             .read(r.textures, Access::VertexRead)
-            .read_all(&r.shadow, Access::SampledRead);
+            .read_all(&r.shadow, Access::SampledRead)
+            .write_some(r.visibility, Access::FragmentReadWrite);
         let strands = inp.bundles > 0 && resolve;
         if strands {
             p = strands::strand_uses(p, r, inp.path, true);

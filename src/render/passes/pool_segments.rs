@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets, shader_options};
+use super::{FrameRes, PassSets, device_shader_options};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::GenerateArgs;
 use crate::vk::shader::compile;
@@ -24,7 +24,7 @@ pub struct PoolSegments {
 impl PoolSegments {
     /// Compile the pipeline.
     pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
-        let spirv = compile("pool_segments.comp", &shader_options(1))?;
+        let spirv = compile("pool_segments.comp", &device_shader_options(ctx, 1))?;
         Ok(PoolSegments {
             pipeline: Pipeline::compute(ctx, "pool segments", layout, &spirv)?,
         })

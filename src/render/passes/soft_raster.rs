@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets, dispatch_2d, shader_options};
+use super::{FrameRes, PassSets, device_shader_options, dispatch_2d};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::GenerateArgs;
 use crate::render::soft::tile_grid;
@@ -36,7 +36,7 @@ impl SoftRasterPass {
         task_bundles: u32,
     ) -> GpuResult<Self> {
         let mesh_segments = if super::strands::mesh_path_supported(ctx) {
-            let opts = shader_options(task_bundles).define("SOFT_PASS", 1);
+            let opts = device_shader_options(ctx, task_bundles).define("SOFT_PASS", 1);
             let (task, mesh) = (
                 compile("strands.task", &opts)?,
                 compile("strands.mesh", &opts)?,
@@ -53,7 +53,7 @@ impl SoftRasterPass {
         } else {
             None
         };
-        let opts = shader_options(1);
+        let opts = device_shader_options(ctx, 1);
         let p = |name: &str, file: &str, scatter: bool| {
             let o = if scatter {
                 opts.clone().define("SCATTER", 1)
@@ -145,6 +145,7 @@ impl SoftRasterPass {
             .write(r.args, rw)
             .write(r.oit_nodes, rw)
             .write(r.oit_tail, rw)
+            .write_some(r.visibility, rw)
             .record(move |rec, _| {
                 rec.bind(&self.raster, &sets.both());
                 rec.dispatch(tx, ty, 1);

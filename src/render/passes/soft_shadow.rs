@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use super::shadow::{ShadowDraw, ShadowPass};
 use super::soft_raster::SoftRasterPass;
-use super::{FrameRes, shader_options};
+use super::{FrameRes, device_shader_options};
 use crate::render::RenderPath;
 use crate::render::graph::{FrameGraph, Res};
 use crate::render::shadow::ShadowMode;
@@ -28,7 +28,7 @@ pub struct SoftShadowPass {
 impl SoftShadowPass {
     /// Compile the depth and opacity pipelines.
     pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
-        let opts = shader_options(1);
+        let opts = device_shader_options(ctx, 1);
         let opacity = opts.clone().define("OPACITY_PASS", 1);
         Ok(SoftShadowPass {
             depth: Pipeline::compute(

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{DrawTarget, FrameRes, PassSets, dispatch_2d, shader_options};
+use super::{DrawTarget, FrameRes, PassSets, device_shader_options, dispatch_2d};
 use crate::render::RenderPath;
 use crate::render::graph::PassBuilder;
 use crate::render::shared::{
@@ -57,7 +57,7 @@ impl StrandDraw {
                 "task bundles per workgroup must be 1..={TASK_PAYLOAD_BUNDLES}"
             )));
         }
-        let opts = shader_options(task_bundles);
+        let opts = device_shader_options(ctx, task_bundles);
         let frag = target.strand_fragment_shader();
         let v = compile("strands.vert", &opts)?;
         let f = frag.map(|f| compile(f, &opts)).transpose()?;

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::strands::{StrandDraw, strand_uses};
-use super::{DrawTarget, FrameRes, PassSets, TargetFormats, shader_options};
+use super::{DrawTarget, FrameRes, PassSets, TargetFormats, device_shader_options};
 use crate::render::RenderPath;
 use crate::render::graph::FrameGraph;
 use crate::render::transparency::Transparency;
@@ -116,7 +116,7 @@ impl TransparencyPass {
     }
 
     fn resolve_pipeline(&self, peel: bool) -> GpuResult<Pipeline> {
-        let mut opts = shader_options(1);
+        let mut opts = device_shader_options(&self.ctx, 1);
         if peel {
             opts = opts.define("PEEL_RESOLVE", 1);
         }
@@ -173,7 +173,8 @@ impl TransparencyPass {
                     .pass("oit insert")
                     .write(r.depth, Access::DepthAttachment)
                     .write(r.oit_nodes, Access::FragmentReadWrite)
-                    .write(r.oit_tail, Access::FragmentReadWrite);
+                    .write(r.oit_tail, Access::FragmentReadWrite)
+                    .write_some(r.visibility, Access::FragmentReadWrite);
                 let (sets, bundles, path, args) =
                     (draw.sets, draw.bundles, draw.path, r.args_buffer);
                 let depth = r.images.depth;
@@ -290,6 +291,7 @@ impl TransparencyPass {
                     g.pass("peel colour")
                         .write(image_res, Access::DepthAttachment)
                         .write(r.peel_accum, Access::FragmentReadWrite)
+                        .write_some(r.visibility, Access::FragmentReadWrite)
                 };
                 let pass = pass.read(r.peel_depth, Access::FragmentRead);
                 strand_uses(pass, r, path, i == 1).record(move |rec, res| {

@@ -1,0 +1,204 @@
+#version 460
+// Temporal passes (src/render/temporal.rs), one thread per pixel.
+// Stage 0 (push.params.x == 0): the pixel's motion from its nearest surface (visibility word:
+// depth, id; the id's clip_to_prev matrix), written to the motion target; with accumulation
+// (frame.temporal.y) the history is reprojected (Catmull-Rom), checked against what the
+// pixel is (visibility id and depth of the nearest surface in the 3x3 neighbourhood, both
+// frames), clipped to the neighbourhood's colour box (wider on hair) and blended.
+// Stage 1: the accumulated colour back into the frame's colour buffer (sRGB bytes), which is
+// copied onto the output image.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#include "bindings.glsl"
+layout(local_size_x = TEMPORAL_GROUP, local_size_y = TEMPORAL_GROUP) in;
+
+layout(set = SET_FRAME, binding = BINDING_VISIBILITY, std430) readonly buffer VisibilityWords { uint64_t visibility[]; };
+layout(set = SET_FRAME, binding = BINDING_MOTION, std430) writeonly buffer MotionOut { uvec4 motion_out[]; };
+layout(set = SET_FRAME, binding = BINDING_FRAME_COLOR, std430) buffer FrameColor { uint frame_color[]; };
+layout(set = SET_FRAME, binding = BINDING_HISTORY_IN, std430) readonly buffer HistoryIn { uvec4 history_in[]; };
+layout(set = SET_FRAME, binding = BINDING_HISTORY_OUT, std430) buffer HistoryOut { uvec4 history_out[]; };
+layout(set = SET_FRAME, binding = BINDING_PROP_INSTANCES, std430) readonly buffer PropInstances { PropInstance prop_instances[]; };
+
+ivec2 image_size() {
+    return ivec2(frame.viewport.xy);
+}
+
+uint index_of(ivec2 p) {
+    ivec2 q = clamp(p, ivec2(0), image_size() - 1);
+    return uint(q.y) * uint(image_size().x) + uint(q.x);
+}
+
+// The nearest surface at p: (visibility id, depth); the background is at the far plane.
+uvec2 surface_at(ivec2 p) {
+    uint64_t v = visibility[index_of(p)];
+    uint id = uint(v & 0xFFFFFFFFul);
+    return uvec2(id, id == VISIBILITY_EMPTY ? floatBitsToUint(1.0) : uint(v >> 32));
+}
+
+mat4 clip_to_prev_of(uint id) {
+    if (id == VISIBILITY_EMPTY) {
+        return frame.clip_to_prev;
+    }
+    uint i = id & VISIBILITY_INDEX;
+    if ((id & VISIBILITY_PROP) != 0u) {
+        return prop_instances[i].clip_to_prev;
+    }
+    return characters[i].clip_to_prev;
+}
+
+// Previous clip position of the surface at pixel centre `centre` and depth `depth` (CPU twin:
+// render::temporal::motion_at).
+vec4 previous_clip(uint id, vec2 centre, float depth) {
+    vec2 ndc = centre / vec2(image_size()) * 2.0 - 1.0;
+    return clip_to_prev_of(id) * vec4(ndc, depth, 1.0);
+}
+
+vec2 motion_at(uint id, vec2 centre, float depth) {
+    vec4 prev = previous_clip(id, centre, depth);
+    if (abs(prev.w) < 1e-12) {
+        return vec2(0.0);
+    }
+    return centre - (prev.xy / prev.w + 1.0) * 0.5 * vec2(image_size());
+}
+
+bool is_hair(uint id) {
+    return id != VISIBILITY_EMPTY && (id & (VISIBILITY_PROP | VISIBILITY_SOLID)) == 0u;
+}
+
+vec3 srgb_to_linear(vec3 c) {
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+vec3 linear_to_srgb(vec3 l) {
+    l = clamp(l, 0.0, 1.0);
+    return mix(l * 12.92, 1.055 * pow(l, vec3(1.0 / 2.4)) - 0.055, greaterThan(l, vec3(0.0031308)));
+}
+
+vec3 to_ycocg(vec3 c) {
+    return vec3(0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b);
+}
+
+vec3 from_ycocg(vec3 c) {
+    return vec3(c.x + c.y - c.z, c.x + c.z, c.x - c.y - c.z);
+}
+
+vec3 current_color(ivec2 p) {
+    return srgb_to_linear(unpackUnorm4x8(frame_color[index_of(p)]).rgb);
+}
+
+vec3 history_color(ivec2 p) {
+    uvec4 h = history_in[index_of(p)];
+    return vec3(unpackHalf2x16(h.x), unpackHalf2x16(h.y).x);
+}
+
+// Catmull-Rom weights of the four taps around a sample at fraction f.
+vec4 catmull_rom(float f) {
+    return vec4(f * (-0.5 + f * (1.0 - 0.5 * f)), 1.0 + f * f * (-2.5 + 1.5 * f),
+                f * (0.5 + f * (2.0 - 1.5 * f)), f * f * (-0.5 + 0.5 * f));
+}
+
+// The history at position q (pixels) through a 4x4 Catmull-Rom filter: sharp, so single
+// strands survive many frames of reprojection (a bilinear history blurs a little each frame).
+vec3 history_at(vec2 q) {
+    vec2 t = q - 0.5;
+    vec2 f = fract(t);
+    ivec2 base = ivec2(floor(t)) - 1;
+    vec4 wx = catmull_rom(f.x);
+    vec4 wy = catmull_rom(f.y);
+    vec3 sum = vec3(0.0);
+    for (int j = 0; j < 4; j++) {
+        for (int i = 0; i < 4; i++) {
+            sum += wx[i] * wy[j] * history_color(base + ivec2(i, j));
+        }
+    }
+    return max(sum, vec3(0.0));
+}
+
+// Whether the history near q saw the surface `id` at the depth it should have had then
+// (`expected`, NDC): some pixel of the 3x3 around q holds the same id at a depth within 10%
+// in distance ((1 - z) is close to proportional to 1 / distance). Hair is thin: its pixel
+// may have held the strand or what is behind it, so the neighbourhood is searched.
+bool history_saw(vec2 q, uint id, float expected) {
+    ivec2 c = ivec2(floor(q));
+    for (int j = -1; j <= 1; j++) {
+        for (int i = -1; i <= 1; i++) {
+            uvec4 h = history_in[index_of(c + ivec2(i, j))];
+            if (h.z != id) {
+                continue;
+            }
+            if (id == VISIBILITY_EMPTY) {
+                return true;
+            }
+            float ratio = (1.0 - uintBitsToFloat(h.w)) / max(1.0 - expected, 1e-9);
+            if (ratio > 0.9 && ratio < 1.1) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+// Clip `h` toward the centre of the box `mean` +- `extent` (YCoCg).
+vec3 clip_to_box(vec3 h, vec3 mean, vec3 extent) {
+    vec3 d = h - mean;
+    vec3 ratio = abs(d) / max(extent, vec3(1e-6));
+    float most = max(ratio.x, max(ratio.y, ratio.z));
+    return most > 1.0 ? mean + d / most : h;
+}
+
+vec3 accumulate(ivec2 p, uvec2 own) {
+    vec3 current = current_color(p);
+    // The nearest surface of the 3x3 neighbourhood moves the pixel: a strand crossing it
+    // drags its history along rather than the background behind.
+    uvec2 near = own;
+    vec3 m1 = vec3(0.0);
+    vec3 m2 = vec3(0.0);
+    for (int j = -1; j <= 1; j++) {
+        for (int i = -1; i <= 1; i++) {
+            ivec2 q = p + ivec2(i, j);
+            uvec2 s = surface_at(q);
+            if (uintBitsToFloat(s.y) < uintBitsToFloat(near.y)) {
+                near = s;
+            }
+            vec3 c = to_ycocg(current_color(q));
+            m1 += c;
+            m2 += c * c;
+        }
+    }
+    if (frame.temporal.z == 0u) {
+        return current;
+    }
+    vec2 centre = vec2(p) + 0.5;
+    float depth = uintBitsToFloat(near.y);
+    vec4 prev = previous_clip(near.x, centre, depth);
+    vec2 q = (prev.xy / prev.w + 1.0) * 0.5 * vec2(image_size());
+    bool inside = prev.w > 0.0 && all(greaterThanEqual(q, vec2(0.0))) && all(lessThan(q, vec2(image_size())));
+    if (!inside || !history_saw(q, near.x, prev.z / prev.w)) {
+        return current;
+    }
+    vec3 mean = m1 / 9.0;
+    vec3 sigma = sqrt(max(m2 / 9.0 - mean * mean, vec3(0.0)));
+    float gamma = is_hair(near.x) ? frame.temporal_params.w : 1.0;
+    vec3 h = clip_to_box(to_ycocg(history_at(q)), mean, gamma * sigma + 1e-4);
+    return mix(from_ycocg(h), current, frame.temporal_params.z);
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, image_size()))) {
+        return;
+    }
+    uint i = index_of(p);
+    if (push.params.x == 1u) {
+        uvec4 h = history_out[i];
+        frame_color[i] = packUnorm4x8(vec4(linear_to_srgb(vec3(unpackHalf2x16(h.x), unpackHalf2x16(h.y).x)), 1.0));
+        return;
+    }
+    uvec2 own = surface_at(p);
+    vec2 m = motion_at(own.x, vec2(p) + 0.5, uintBitsToFloat(own.y));
+    motion_out[i] = uvec4(floatBitsToUint(m), own);
+    if (frame.temporal.y != 0u) {
+        vec3 c = accumulate(p, own);
+        history_out[i] = uvec4(packHalf2x16(c.rg), packHalf2x16(vec2(c.b, 1.0)), own);
+    }
+}

@@ -1,0 +1,140 @@
+//! The temporal passes (`render::temporal`): the visibility words are emptied before the
+//! camera's drawing (whose passes note each pixel's nearest surface); after it the motion
+//! pass turns them into motion vectors and, with accumulation, blends the reprojected history
+//! into the frame (`temporal.comp`), whose colour is copied out of the output image first and
+//! back onto it last. What each step reads and writes is declared where it is added.
+
+use std::sync::Arc;
+
+use super::{FrameRes, PassSets, device_shader_options};
+use crate::render::graph::FrameGraph;
+use crate::render::shared::TEMPORAL_GROUP;
+use crate::vk::shader::compile;
+use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
+
+/// What a frame's temporal passes do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TemporalWork {
+    /// Blend the reprojected history into the frame (else motion vectors only).
+    pub accumulate: bool,
+}
+
+/// The motion and accumulation pipeline (`temporal.comp`, two stages).
+pub struct TemporalPass {
+    pipeline: Pipeline,
+}
+
+impl TemporalPass {
+    /// Compile the pipeline (it reads 64-bit visibility words: the caller creates this pass
+    /// only on devices with 64-bit buffer atomics).
+    pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
+        let spirv = compile("temporal.comp", &device_shader_options(ctx, 1))?;
+        Ok(TemporalPass {
+            pipeline: Pipeline::compute(ctx, "temporal", layout, &spirv)?,
+        })
+    }
+
+    /// Add the pass that empties the visibility words (before any camera pass notes them).
+    pub fn add_clear<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
+        let Some(visibility) = r.visibility else {
+            return;
+        };
+        g.pass("visibility clear")
+            .discard(visibility, Access::TransferWrite)
+            .record(move |rec, res| {
+                rec.fill_buffer(res.buffer(visibility)?, 0, ash::vk::WHOLE_SIZE, u32::MAX);
+                Ok(())
+            });
+    }
+
+    /// Add the motion pass and, with `work.accumulate`, the accumulation around it (after
+    /// every camera pass); the motion vectors are copied into `readback` where given.
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        (sets, size): (PassSets<'a>, (u32, u32)),
+        work: TemporalWork,
+        readback: Option<&'a Buffer>,
+    ) {
+        let (Some(visibility), Some(t)) = (r.visibility, r.temporal) else {
+            return;
+        };
+        let output = r.images.output;
+        if work.accumulate {
+            g.pass("temporal input")
+                .read(r.output, Access::TransferRead)
+                .discard(t.frame_color, Access::TransferWrite)
+                .record(move |rec, res| {
+                    rec.copy_image_to_buffer(output, res.buffer(t.frame_color)?);
+                    Ok(())
+                });
+        }
+        let groups = (
+            size.0.div_ceil(TEMPORAL_GROUP),
+            size.1.div_ceil(TEMPORAL_GROUP),
+        );
+        let rw = Access::ComputeReadWrite;
+        let mut p = g
+            .pass("temporal")
+            .read_all(&[r.constants, visibility], Access::ComputeRead)
+            .discard(t.motion, rw);
+        if work.accumulate {
+            p = p
+                .read_all(&[t.frame_color, t.history.0], Access::ComputeRead)
+                .discard(t.history.1, rw);
+        }
+        p.record(move |rec, _| {
+            rec.bind(&self.pipeline, &sets.both());
+            rec.push_constants(&self.pipeline, &[0u32; 4]);
+            rec.dispatch(groups.0, groups.1, 1);
+            Ok(())
+        });
+        if work.accumulate {
+            self.add_output(g, r, (sets, groups));
+        }
+        if let Some(buffer) = readback {
+            let target = g.import_buffer("motion readback", buffer);
+            g.pass("motion readback")
+                .read(t.motion, Access::TransferRead)
+                .discard(target, Access::TransferWrite)
+                .record(move |rec, res| {
+                    let motion = res.buffer(t.motion)?;
+                    rec.copy_buffer(motion, 0, buffer, 0, buffer.size.min(motion.size));
+                    Ok(())
+                });
+            g.pass("motion host read")
+                .read(target, Access::HostRead)
+                .done();
+        }
+    }
+
+    /// The accumulated colour into the frame's colour buffer, then onto the output image.
+    fn add_output<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        (sets, groups): (PassSets<'a>, (u32, u32)),
+    ) {
+        let Some(t) = r.temporal else {
+            return;
+        };
+        g.pass("temporal resolve")
+            .read(t.history.1, Access::ComputeRead)
+            .write(t.frame_color, Access::ComputeReadWrite)
+            .record(move |rec, _| {
+                rec.bind(&self.pipeline, &sets.both());
+                rec.push_constants(&self.pipeline, &[1u32, 0, 0, 0]);
+                rec.dispatch(groups.0, groups.1, 1);
+                Ok(())
+            });
+        let output = r.images.output;
+        g.pass("temporal output")
+            .read(t.frame_color, Access::TransferRead)
+            .write(r.output, Access::TransferWrite)
+            .record(move |rec, res| {
+                rec.copy_buffer_to_image(res.buffer(t.frame_color)?, output);
+                Ok(())
+            });
+    }
+}

@@ -1,0 +1,538 @@
+//! Temporal stability: motion vectors, temporal accumulation made for strands, sub-pixel
+//! jitter, and the CPU side of the flicker measure (`bench temporal`).
+//!
+//! **Motion.** Every camera pass that draws a surface (strand fragments in every
+//! transparency mode, the software rasterizer's fragments, scalps, props) notes the nearest
+//! surface of each pixel in a visibility word: depth bits << 32 | visibility id, by 64-bit
+//! `atomicMin` (`temporal.glsl`). The id names a character (hair, or its scalp with
+//! [`VISIBILITY_SOLID`]) or a prop instance, and each of those carries the matrix from this
+//! frame's unjittered clip space to the previous frame's (`clip_to_prev`: the previous
+//! view-projection, the surface's own rigid motion, the inverse of this one), so a pixel's
+//! motion follows from its depth alone, exactly for camera motion and characters that move
+//! as a whole (walk, turn, sway). Hair generated from the same textures and seed lands on
+//! the same strands both frames, so this is the strands' own motion; a hair mesh that
+//! changes pose relative to its head (dynamics) moves with the head only.
+//!
+//! **Accumulation** (`temporal.comp`): the history is reprojected with a Catmull-Rom filter
+//! (sharp: a single strand stays a strand), and trusted by what the pixel *is*, not only by
+//! its colour: a history pixel whose visibility id differs, or whose depth disagrees with the
+//! reprojected depth, is a disocclusion and is dropped; on hair the colour clamp is wider
+//! ([`TemporalTuning::hair_clamp`] standard deviations of the 3x3 neighbourhood in YCoCg),
+//! because a sub-pixel strand's neighbourhood rarely brackets its own history, and a tight
+//! clamp erases strands. The jitter (Halton 2, 3 over 8 frames) moves the raster by under a
+//! pixel each frame, so the history integrates 8 sample positions per pixel.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+use super::graph::TransientBuffer;
+use super::shared::{
+    FrameBinding, VISIBILITY_EMPTY, VISIBILITY_INDEX, VISIBILITY_PROP, VISIBILITY_SOLID,
+};
+use crate::vk::{Buffer, BufferDesc, Context, GpuResult};
+
+/// Temporal accumulation of a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Temporal {
+    /// Every frame on its own (no jitter, no history).
+    #[default]
+    Off,
+    /// Temporal anti-aliasing made for strands: jitter, motion vectors, history.
+    Taa,
+}
+
+impl Temporal {
+    /// Every mode, in menu order.
+    pub const ALL: [Temporal; 2] = [Temporal::Off, Temporal::Taa];
+
+    /// Name used by flags and scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Temporal::Off => "off",
+            Temporal::Taa => "taa",
+        }
+    }
+}
+
+impl std::str::FromStr for Temporal {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Temporal::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| format!("temporal {s:?}: off or taa"))
+    }
+}
+
+impl std::fmt::Display for Temporal {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The accumulation's constants (`FrameBlock::temporal_params`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TemporalTuning {
+    /// Weight of the current frame in a pixel whose history is trusted (the rest is history):
+    /// about the last `1 / current_weight` frames contribute.
+    pub current_weight: f32,
+    /// Width of the colour clamp on hair, in standard deviations of the neighbourhood (1 on
+    /// solid surfaces).
+    pub hair_clamp: f32,
+}
+
+impl Default for TemporalTuning {
+    fn default() -> Self {
+        TemporalTuning {
+            current_weight: 0.125,
+            hair_clamp: 2.0,
+        }
+    }
+}
+
+/// Sub-pixel jitter of frame `index`, in pixels in `[-0.5, 0.5)`: the Halton (2, 3) sequence
+/// over 8 frames (`index` 0 is the sequence's first point).
+pub fn jitter(index: u64) -> Vec2 {
+    let i = (index % 8) as u32 + 1;
+    Vec2::new(radical_inverse(i, 2), radical_inverse(i, 3)) - 0.5
+}
+
+fn radical_inverse(mut i: u32, base: u32) -> f32 {
+    let (mut inv, mut f) = (0.0f32, 1.0f32 / base as f32);
+    while i > 0 {
+        inv += (i % base) as f32 * f;
+        i /= base;
+        f /= base as f32;
+    }
+    inv
+}
+
+/// `view_proj` moved by `pixels` on a `size` target (clip-space translation scaled by w, so
+/// every point moves by the same sub-pixel offset).
+pub fn jittered(view_proj: Mat4, pixels: Vec2, size: (u32, u32)) -> Mat4 {
+    let ndc = Vec2::new(
+        2.0 * pixels.x / size.0 as f32,
+        2.0 * pixels.y / size.1 as f32,
+    );
+    Mat4::from_translation(ndc.extend(0.0)) * view_proj
+}
+
+/// This frame's unjittered clip space to the previous frame's, for a surface that moved by
+/// `prev_from_now` in world space (its previous model times the inverse of its current one):
+/// `prev_view_proj * prev_from_now * view_proj^-1`.
+pub fn clip_to_prev(prev_view_proj: Mat4, prev_from_now: Mat4, view_proj: Mat4) -> Mat4 {
+    prev_view_proj * prev_from_now * view_proj.inverse()
+}
+
+/// Screen motion (pixels, this frame's position minus the previous frame's) of the surface at
+/// pixel centre `centre` (pixels, y down) and depth `depth` (0..1) on a `size` target; the
+/// CPU twin of `motion_at` in `temporal.comp`.
+pub fn motion_at(clip_to_prev: Mat4, centre: Vec2, depth: f32, size: Vec2) -> Vec2 {
+    let ndc = centre / size * 2.0 - 1.0;
+    let prev = clip_to_prev * Vec4::new(ndc.x, ndc.y, depth, 1.0);
+    if prev.w.abs() < 1e-12 {
+        return Vec2::ZERO;
+    }
+    let prev_px = (Vec2::new(prev.x, prev.y) / prev.w + 1.0) * 0.5 * size;
+    centre - prev_px
+}
+
+/// Bytes per pixel of the history (`uvec4`: rg and ba halves, visibility id, depth bits).
+const HISTORY_TEXEL: u64 = 16;
+
+/// What the renderer keeps between frames for temporal work: the previous frame's matrices
+/// (motion vectors) and the accumulated history (two buffers, read one, write the other).
+#[derive(Default)]
+pub struct TemporalState {
+    /// The previous frame's unjittered view-projection and each character slot's model.
+    prev: Option<PreviousFrame>,
+    /// History buffers for the target size they were made for.
+    history: Option<([Buffer; 2], (u32, u32))>,
+    /// Which history buffer this frame writes.
+    parity: usize,
+    /// Whether the history read this frame holds an earlier accumulated frame.
+    valid: bool,
+    /// Frames accumulated since the history was reset (jitter phase).
+    index: u64,
+}
+
+/// What a frame leaves for the next one's motion.
+#[derive(Clone, Debug)]
+pub struct PreviousFrame {
+    /// Unjittered world to clip.
+    pub view_proj: Mat4,
+    /// Model of each character slot (`None`: empty or hidden).
+    pub models: Vec<Option<Mat4>>,
+    /// Target size.
+    pub size: (u32, u32),
+}
+
+impl TemporalState {
+    /// Forget the history and the previous frame (a cut: the next frame starts afresh).
+    pub fn reset(&mut self) {
+        self.prev = None;
+        self.valid = false;
+        self.index = 0;
+    }
+
+    /// The previous frame, when there is one of the same target size.
+    pub fn previous(&self, size: (u32, u32)) -> Option<&PreviousFrame> {
+        self.prev.as_ref().filter(|p| p.size == size)
+    }
+
+    /// This frame's jitter (pixels) with accumulation on.
+    pub fn jitter(&self) -> Vec2 {
+        jitter(self.index)
+    }
+
+    /// Whether the history holds an accumulated frame of `size` to blend with.
+    pub fn history_valid(&self, size: (u32, u32)) -> bool {
+        self.valid && self.history.as_ref().is_some_and(|h| h.1 == size)
+    }
+
+    /// Make the history buffers for `size` (new ones start invalid); returns the replaced
+    /// ones, which frames in flight may still use.
+    pub fn ensure_history(
+        &mut self,
+        ctx: &Arc<Context>,
+        size: (u32, u32),
+    ) -> GpuResult<Option<[Buffer; 2]>> {
+        if self.history.as_ref().is_some_and(|h| h.1 == size) {
+            return Ok(None);
+        }
+        let bytes = size.0 as u64 * size.1 as u64 * HISTORY_TEXEL;
+        let make = |name| {
+            Buffer::new(
+                ctx,
+                &BufferDesc::new(name, bytes, vk::BufferUsageFlags::STORAGE_BUFFER),
+            )
+        };
+        let fresh = [make("temporal history a")?, make("temporal history b")?];
+        self.valid = false;
+        self.index = 0;
+        Ok(self.history.replace((fresh, size)).map(|h| h.0))
+    }
+
+    /// The history buffers as `(read, write)` this frame, once made.
+    pub fn history(&self) -> Option<(&Buffer, &Buffer)> {
+        self.history
+            .as_ref()
+            .map(|(h, _)| (&h[1 - self.parity], &h[self.parity]))
+    }
+
+    /// After a frame is recorded: remember its matrices; with accumulation, the history it
+    /// wrote becomes the next frame's to read.
+    pub fn advance(&mut self, prev: PreviousFrame, accumulated: bool) {
+        self.prev = Some(prev);
+        if accumulated {
+            self.parity = 1 - self.parity;
+            self.valid = true;
+            self.index += 1;
+        } else {
+            self.valid = false;
+            self.index = 0;
+        }
+    }
+}
+
+/// The motion matrices of a frame: the camera's `clip_to_prev`, and what a character's adds.
+#[derive(Clone, Debug)]
+pub struct FrameMotion {
+    /// This frame's unjittered view-projection.
+    pub view_proj: Mat4,
+    /// The previous frame's (this frame's where there is none: no motion).
+    pub prev_view_proj: Mat4,
+    /// The previous frame's model of each character slot.
+    pub prev_models: Vec<Option<Mat4>>,
+}
+
+impl FrameMotion {
+    /// The motion of this frame seen from `view_proj` (unjittered), after `prev`.
+    pub fn new(view_proj: Mat4, prev: Option<&PreviousFrame>) -> Self {
+        FrameMotion {
+            view_proj,
+            prev_view_proj: prev.map_or(view_proj, |p| p.view_proj),
+            prev_models: prev.map_or_else(Vec::new, |p| p.models.clone()),
+        }
+    }
+
+    /// `clip_to_prev` of what did not move (the background, world props).
+    pub fn camera(&self) -> Mat4 {
+        clip_to_prev(self.prev_view_proj, Mat4::IDENTITY, self.view_proj)
+    }
+
+    /// `clip_to_prev` of character slot `slot` at `model` now (the camera's where the slot
+    /// had no model last frame).
+    pub fn character(&self, slot: usize, model: Mat4) -> Mat4 {
+        match self.prev_models.get(slot).copied().flatten() {
+            Some(before) if model.determinant().abs() > 1e-20 => clip_to_prev(
+                self.prev_view_proj,
+                before * model.inverse(),
+                self.view_proj,
+            ),
+            _ => self.camera(),
+        }
+    }
+}
+
+/// The temporal passes' transient buffers of a `width x height` frame: visibility, motion and
+/// the frame's colour (0 bytes where unused: `motion` off, or no accumulation).
+pub fn transient_buffers(
+    motion: bool,
+    accumulate: bool,
+    (w, h): (u32, u32),
+) -> [TransientBuffer; 3] {
+    let pixels = w as u64 * h as u64;
+    let on = |bytes: u64, used: bool| if used { bytes * pixels } else { 0 };
+    [
+        TransientBuffer::storage("visibility", on(8, motion), FrameBinding::Visibility as u32),
+        TransientBuffer::storage("motion", on(16, motion), FrameBinding::Motion as u32),
+        TransientBuffer::storage(
+            "frame colour",
+            on(4, accumulate),
+            FrameBinding::FrameColor as u32,
+        ),
+    ]
+}
+
+/// One pixel of the motion target as read back.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelMotion {
+    /// This frame's position minus the previous frame's, pixels.
+    pub motion: Vec2,
+    /// Visibility id of the nearest surface ([`VISIBILITY_EMPTY`]: none).
+    pub id: u32,
+    /// Depth (0..1) of the nearest surface (1 where none).
+    pub depth: f32,
+}
+
+impl PixelMotion {
+    /// Decode the GPU's `uvec4` (motion x, y bits, id, depth bits).
+    pub fn from_words(w: [u32; 4]) -> Self {
+        PixelMotion {
+            motion: Vec2::new(f32::from_bits(w[0]), f32::from_bits(w[1])),
+            id: w[2],
+            depth: f32::from_bits(w[3]),
+        }
+    }
+
+    /// Whether the nearest surface is a character's hair.
+    pub fn is_hair(&self) -> bool {
+        self.id != VISIBILITY_EMPTY && self.id & (VISIBILITY_PROP | VISIBILITY_SOLID) == 0
+    }
+
+    /// The character slot of a hair or scalp pixel.
+    pub fn character(&self) -> Option<u32> {
+        (self.id != VISIBILITY_EMPTY && self.id & VISIBILITY_PROP == 0)
+            .then_some(self.id & VISIBILITY_INDEX)
+    }
+}
+
+/// Rec. 709 luminance of an sRGB-encoded RGBA8 pixel, linear.
+pub fn luminance(rgba: &[u8]) -> f32 {
+    let lin = |c: u8| {
+        let c = c as f32 / 255.0;
+        match c <= 0.04045 {
+            true => c / 12.92,
+            false => ((c + 0.055) / 1.055).powf(2.4),
+        }
+    };
+    Vec3::new(lin(rgba[0]), lin(rgba[1]), lin(rgba[2])).dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// Luminance of `image` (RGBA8 sRGB, `width` wide) sampled bilinearly at `p` (pixels; centres
+/// at half-integers), or `None` outside the image.
+fn sample_luminance(image: &[u8], (width, height): (u32, u32), p: Vec2) -> Option<f32> {
+    let q = p - 0.5;
+    let (x0, y0) = (q.x.floor(), q.y.floor());
+    if x0 < 0.0 || y0 < 0.0 || x0 + 1.0 >= width as f32 || y0 + 1.0 >= height as f32 {
+        return None;
+    }
+    let (fx, fy) = (q.x - x0, q.y - y0);
+    let at = |x: f32, y: f32| {
+        let i = (y as usize * width as usize + x as usize) * 4;
+        luminance(&image[i..i + 4])
+    };
+    let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1.0, y0) * fx;
+    let bottom = at(x0, y0 + 1.0) * (1.0 - fx) + at(x0 + 1.0, y0 + 1.0) * fx;
+    Some(top * (1.0 - fy) + bottom * fy)
+}
+
+/// The flicker measure of one pair of frames: the mean absolute change of luminance over the
+/// pixels `mask` selects (hair), after moving the previous frame's image along the current
+/// frame's `motion` (bilinear), over pixels whose previous position is inside the image.
+/// Returns `(mean change, pixels measured)`.
+pub fn reprojected_change(
+    previous: &[u8],
+    current: &[u8],
+    motion: &[PixelMotion],
+    mask: &[bool],
+    size: (u32, u32),
+) -> (f64, usize) {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (i, m) in motion.iter().enumerate() {
+        if !mask[i] {
+            continue;
+        }
+        let centre = Vec2::new((i as u32 % size.0) as f32, (i as u32 / size.0) as f32) + 0.5;
+        let Some(before) = sample_luminance(previous, size, centre - m.motion) else {
+            continue;
+        };
+        sum += (luminance(&current[i * 4..i * 4 + 4]) - before).abs() as f64;
+        n += 1;
+    }
+    (if n > 0 { sum / n as f64 } else { 0.0 }, n)
+}
+
+/// Box-filter an RGBA8 sRGB image of `size` down by `factor` per side (in linear light), the
+/// supersampled reference's resolve.
+pub fn downsample(rgba: &[u8], size: (u32, u32), factor: u32) -> Vec<u8> {
+    let (w, h) = (size.0 / factor, size.1 / factor);
+    let decode = |c: u8| {
+        let c = c as f32 / 255.0;
+        match c <= 0.04045 {
+            true => c / 12.92,
+            false => ((c + 0.055) / 1.055).powf(2.4),
+        }
+    };
+    let encode = |l: f32| {
+        let c = match l <= 0.0031308 {
+            true => l * 12.92,
+            false => 1.055 * l.powf(1.0 / 2.4) - 0.055,
+        };
+        (c.clamp(0.0, 1.0) * 255.0).round() as u8
+    };
+    let mut out = vec![0u8; (w * h * 4) as usize];
+    let n = (factor * factor) as f32;
+    for y in 0..h {
+        for x in 0..w {
+            let mut acc = [0.0f32; 4];
+            for sy in 0..factor {
+                for sx in 0..factor {
+                    let i = (((y * factor + sy) * size.0 + x * factor + sx) * 4) as usize;
+                    for c in 0..3 {
+                        acc[c] += decode(rgba[i + c]);
+                    }
+                    acc[3] += rgba[i + 3] as f32 / 255.0;
+                }
+            }
+            let o = ((y * w + x) * 4) as usize;
+            for c in 0..3 {
+                out[o + c] = encode(acc[c] / n);
+            }
+            out[o + 3] = (acc[3] / n * 255.0).round() as u8;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jitter_covers_the_pixel_in_eight_frames() {
+        let points: Vec<Vec2> = (0..8).map(jitter).collect();
+        assert!(points.iter().all(|p| p.abs().max_element() < 0.5));
+        let mean = points.iter().sum::<Vec2>() / 8.0;
+        assert!(mean.length() < 0.1, "mean {mean}");
+        assert_eq!(jitter(3), jitter(11));
+        for (i, a) in points.iter().enumerate() {
+            for b in &points[i + 1..] {
+                assert!(a.distance(*b) > 0.1);
+            }
+        }
+    }
+
+    #[test]
+    fn motion_of_a_camera_move_is_the_projected_difference() {
+        let size = Vec2::new(320.0, 180.0);
+        let proj = Mat4::perspective_rh(0.8, size.x / size.y, 0.1, 10.0);
+        let view = |eye: Vec3| proj * Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y);
+        let (before, now) = (
+            view(Vec3::new(0.1, 0.0, 3.0)),
+            view(Vec3::new(0.0, 0.0, 3.0)),
+        );
+        let point = Vec3::new(0.3, -0.2, 0.1);
+        let project = |vp: Mat4| {
+            let c = vp * point.extend(1.0);
+            let ndc = c / c.w;
+            ((Vec2::new(ndc.x, ndc.y) + 1.0) * 0.5 * size, ndc.z)
+        };
+        let ((p_now, depth), (p_before, _)) = (project(now), project(before));
+        let m = motion_at(
+            clip_to_prev(before, Mat4::IDENTITY, now),
+            p_now,
+            depth,
+            size,
+        );
+        assert!(
+            (m - (p_now - p_before)).length() < 1e-3,
+            "{m} vs {}",
+            p_now - p_before
+        );
+        // A character that moved with the camera stays put on screen.
+        let moved = Mat4::from_translation(Vec3::new(0.1, 0.0, 0.0));
+        let m = motion_at(
+            clip_to_prev(before, moved.inverse(), now),
+            p_now,
+            depth,
+            size,
+        );
+        assert!(m.length() > 1.0);
+    }
+
+    #[test]
+    fn jittered_projection_moves_every_point_by_the_jitter() {
+        let size = (200u32, 100u32);
+        let vp = Mat4::perspective_rh(0.8, 2.0, 0.1, 10.0);
+        let j = jittered(vp, Vec2::new(0.25, -0.5), size);
+        for p in [Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.5, 0.3, -4.0)] {
+            let a = vp * p.extend(1.0);
+            let b = j * p.extend(1.0);
+            let d = (Vec2::new(b.x, b.y) / b.w - Vec2::new(a.x, a.y) / a.w) * 0.5;
+            let px = d * Vec2::new(size.0 as f32, size.1 as f32);
+            assert!((px - Vec2::new(0.25, -0.5)).length() < 1e-4, "{px}");
+        }
+    }
+
+    #[test]
+    fn reprojected_change_is_zero_for_a_moved_image_and_not_without_motion() {
+        let size = (16u32, 8u32);
+        let image = |shift: u32| {
+            let mut v = vec![0u8; 16 * 8 * 4];
+            for y in 0..8 {
+                for x in 0..16u32 {
+                    let i = ((y * 16 + x) * 4) as usize;
+                    let g = (((x + 16 - shift) % 16) * 16) as u8;
+                    v[i..i + 4].copy_from_slice(&[g, g, g, 255]);
+                }
+            }
+            v
+        };
+        let (before, now) = (image(0), image(2));
+        let mask = vec![true; 128];
+        let moved = PixelMotion {
+            motion: Vec2::new(2.0, 0.0),
+            ..Default::default()
+        };
+        let (c, n) = reprojected_change(&before, &now, &[moved; 128], &mask, size);
+        assert!(n > 0 && c < 1e-6, "{c}");
+        let still = PixelMotion::default();
+        let (c0, _) = reprojected_change(&before, &now, &[still; 128], &mask, size);
+        assert!(c0 > 0.01, "{c0}");
+    }
+
+    #[test]
+    fn downsample_averages_in_linear_light() {
+        let px = [
+            255u8, 255, 255, 255, 0, 0, 0, 255, 255, 255, 255, 255, 0, 0, 0, 255,
+        ];
+        let out = downsample(&px, (2, 2), 2);
+        // Half white in linear light is sRGB 188.
+        assert_eq!(out[0], 188);
+        assert_eq!(out[3], 255);
+    }
+}
