@@ -14,7 +14,7 @@ use glam::{Mat4, Vec3};
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::render::{
     FrameOptions, FrameSettings, LightRaster, LodSettings, RenderPath, Renderer, RendererDesc,
-    ShadowMode, StrandParams, StrandRaster, Transparency, View,
+    ShadowMode, StrandParams, StrandRaster, Temporal, Transparency, View,
 };
 use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{Access, Context, ContextDesc};
@@ -106,9 +106,16 @@ fn every_pass_combination_is_free_of_hazards() {
                         }
                         valid += 1;
                         soft_lights += (light_raster == LightRaster::Software) as u32;
+                        // Every third combination accumulates (its second frame blends the
+                        // first's history), the next reads motion vectors back.
+                        let temporal = match valid % 3 {
+                            0 => Temporal::Taa,
+                            _ => Temporal::Off,
+                        };
                         let view = View {
                             shadows,
                             transparency,
+                            temporal,
                             ..base
                         };
                         let opts = FrameOptions {
@@ -116,10 +123,11 @@ fn every_pass_combination_is_free_of_hazards() {
                             raster,
                             light_raster,
                             read_image: valid % 2 == 0,
+                            read_motion: valid % 3 == 1,
                             ..Default::default()
                         };
                         let what = format!(
-                            "{path:?} {raster} {shadows:?} (light {light_raster}) {transparency} {msaa}x"
+                            "{path:?} {raster} {shadows:?} (light {light_raster}) {transparency} {msaa}x temporal {temporal}"
                         );
                         two_frames(&ctx, &mut r, &view, &opts, &what);
                     }

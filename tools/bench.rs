@@ -17,6 +17,9 @@
 //! software rasterizer vs hardware strips (opaque and OIT) and the per-bundle split, for one
 //! head at near / mid / far, ~100K strands, and a crowd; both paths.
 //!
+//! `bench temporal [--size 320x180] [--frames 16] [--scenarios orbit,dolly,crowd]`: the
+//! flicker measure with temporal accumulation off and on against a supersampled reference.
+//!
 //! `bench animate [--mesh M] [--wind 30] [--frames 90] [--strip out.png]`: one hair mesh in
 //! wind, simulated and re-textured every frame: CPU ms of the dynamics, GPU ms of the texture
 //! rebuild and of the frame (medians); optionally a strip of frames side by side.
@@ -32,6 +35,8 @@ mod defaults;
 mod paper;
 #[path = "bench/raster.rs"]
 mod raster;
+#[path = "bench/temporal.rs"]
+mod temporal;
 
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
@@ -151,6 +156,33 @@ enum Cmd {
         /// Only these columns: hw-opaque, hw-oit, soft, auto (default all).
         #[arg(long, value_delimiter = ',')]
         draws: Vec<String>,
+        /// Choose the GPU by name substring.
+        #[arg(long)]
+        device: Option<String>,
+    },
+    /// The flicker measure: a slow orbit, a slow dolly and an animated crowd rendered with
+    /// temporal accumulation off and on and as a supersampled reference; the change of the
+    /// hair's luminance between frames moved along the true motion, ours over the
+    /// reference's, FLIP against the reference, and the accumulation's GPU ms.
+    Temporal {
+        /// Image size (the reference is rendered --supersample times larger per side).
+        #[arg(long, default_value = "320x180")]
+        size: String,
+        /// Frames per run.
+        #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(3..=10000))]
+        frames: u32,
+        /// Frames left out of the measure at the start (accumulation converging).
+        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=10000))]
+        warmup: u32,
+        /// Reference samples per pixel per side.
+        #[arg(long, default_value_t = 4)]
+        supersample: u32,
+        /// Scenarios: orbit, dolly, crowd.
+        #[arg(long, value_delimiter = ',', default_value = "orbit,dolly,crowd")]
+        scenarios: Vec<String>,
+        /// How our frames' strands are rasterized: hw, soft[:K] or auto[:K].
+        #[arg(long, default_value = "hw")]
+        draw: StrandRaster,
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
@@ -640,6 +672,23 @@ fn run(args: Args) -> Result<()> {
             strands_per_bundle,
             strip,
             strip_frames,
+            device,
+        })?,
+        Cmd::Temporal {
+            size,
+            frames,
+            warmup,
+            supersample,
+            scenarios,
+            draw,
+            device,
+        } => temporal::bench_temporal(temporal::TemporalArgs {
+            size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
+            frames,
+            warmup,
+            supersample,
+            scenarios,
+            draw,
             device,
         })?,
         Cmd::Fuzz { iterations, seed } => {

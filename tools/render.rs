@@ -97,6 +97,11 @@ struct Args {
     /// reference); default: the scene's `[look] transparency`, else opaque.
     #[arg(long)]
     transparency: Option<hairmesh::render::Transparency>,
+    /// Temporal accumulation: off, or taa (jittered frames blended along exact motion
+    /// vectors; with --frames N the last of N accumulated frames is written); default: the
+    /// scene's `[look] temporal`, else off.
+    #[arg(long)]
+    temporal: Option<hairmesh::render::Temporal>,
     /// Seed 000's thick-strand appearance term under LoD (true/false); default: the scene's
     /// `[look] lod_appearance`, else true.
     #[arg(long)]
@@ -475,6 +480,10 @@ fn run(args: Args) -> Result<()> {
             .or(inputs.look.shadow_mode())
             .unwrap_or_default(),
         transparency,
+        temporal: args
+            .temporal
+            .or(inputs.look.temporal_mode())
+            .unwrap_or_default(),
         lod_appearance: args
             .lod_appearance
             .or(inputs.look.lod_appearance)

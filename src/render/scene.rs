@@ -13,6 +13,7 @@
 //! shadows = "deep-opacity"         # off, deep-opacity, approximate
 //! msaa = 4                         # samples per pixel
 //! transparency = "oit:8"           # opaque, oit[:K] (K-buffer), peel[:N] (depth peeling)
+//! temporal = "taa"                 # off, taa (temporal accumulation made for strands)
 //! lod_appearance = true            # seed 000's thick-strand term under LoD (default on)
 //! [[character]]
 //! mesh = "hairmeshes/head_long.obj" # .obj (baked on load) or .hmb; relative to this file
@@ -79,6 +80,8 @@ pub struct LookDesc {
     pub transparency: Option<String>,
     /// Thick-strand appearance term under LoD.
     pub lod_appearance: Option<bool>,
+    /// Temporal accumulation (`render::Temporal`): `off` or `taa`.
+    pub temporal: Option<String>,
 }
 
 impl LookDesc {
@@ -95,6 +98,11 @@ impl LookDesc {
     /// The transparency mode, if given (validated by [`SceneDesc::validate`]).
     pub fn transparency_mode(&self) -> Option<crate::render::Transparency> {
         self.transparency.as_deref().and_then(|s| s.parse().ok())
+    }
+
+    /// The temporal mode, if given (validated by [`SceneDesc::validate`]).
+    pub fn temporal_mode(&self) -> Option<crate::render::Temporal> {
+        self.temporal.as_deref().and_then(|s| s.parse().ok())
     }
 }
 
@@ -247,6 +255,10 @@ impl SceneDesc {
             s.parse::<crate::render::Transparency>()
                 .map_err(|e| format!("[look]: {e}"))?;
         }
+        if let Some(s) = &self.look.temporal {
+            s.parse::<crate::render::Temporal>()
+                .map_err(|e| format!("[look]: {e}"))?;
+        }
         if let Some(m) = self.look.msaa
             && !(m.is_power_of_two() && m <= 64)
         {
@@ -377,6 +389,7 @@ mod look_tests {
             ("msaa = 3", "msaa 3"),
             ("transparency = \"oit:99\"", "OIT budget 99"),
             ("transparency = \"glass\"", "unknown transparency"),
+            ("temporal = \"blur\"", "temporal \"blur\""),
         ] {
             let text = format!("[look]\n{bad}\n{CHARACTER}");
             let e = SceneDesc::parse("s.toml", &text, base)

@@ -68,7 +68,7 @@ pub const VISIBILITY_SOLID: u32 = 1 << 30;
 /// rasterizer's segments carry it in half a word).
 pub const VISIBILITY_INDEX: u32 = (1 << 16) - 1;
 /// Temporal: threads per side of the temporal passes' square workgroups.
-pub const TEMPORAL_GROUP: u32 = 8;
+pub const TEMPORAL_GROUP: u32 = 16;
 /// `FrameBlock::transparency.x`: opaque strands.
 pub const TRANSPARENCY_OPAQUE: u32 = 0;
 /// `FrameBlock::transparency.x`: k-buffer OIT.
@@ -161,8 +161,8 @@ pub enum FrameBinding {
     Motion = 26,
     /// Temporal: per pixel, the frame's colour (`uint`: RGBA8 sRGB, as the output image).
     FrameColor = 27,
-    /// Temporal: per pixel, the accumulated history read (`uvec4`: rg and ba halves,
-    /// visibility id, depth bits).
+    /// Temporal: the accumulated history read: per pixel the colour (`uvec2`: rg and b
+    /// halves), then per pixel the surface it showed (`uvec2`: visibility id, depth bits).
     HistoryIn = 28,
     /// Temporal: per pixel, the accumulated history written this frame.
     HistoryOut = 29,

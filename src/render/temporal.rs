@@ -139,7 +139,8 @@ pub fn motion_at(clip_to_prev: Mat4, centre: Vec2, depth: f32, size: Vec2) -> Ve
     centre - prev_px
 }
 
-/// Bytes per pixel of the history (`uvec4`: rg and ba halves, visibility id, depth bits).
+/// Bytes per pixel of the history (`uvec2` colour: rg and b halves; `uvec2` surface:
+/// visibility id, depth bits).
 const HISTORY_TEXEL: u64 = 16;
 
 /// What the renderer keeps between frames for temporal work: the previous frame's matrices
@@ -449,8 +450,9 @@ mod tests {
     #[test]
     fn motion_of_a_camera_move_is_the_projected_difference() {
         let size = Vec2::new(320.0, 180.0);
-        let proj = Mat4::perspective_rh(0.8, size.x / size.y, 0.1, 10.0);
-        let view = |eye: Vec3| proj * Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y);
+        let view = |eye: Vec3| {
+            crate::render::Camera::look_at(eye, Vec3::ZERO, 45.0).view_proj(size.x / size.y)
+        };
         let (before, now) = (
             view(Vec3::new(0.1, 0.0, 3.0)),
             view(Vec3::new(0.0, 0.0, 3.0)),
@@ -487,7 +489,8 @@ mod tests {
     #[test]
     fn jittered_projection_moves_every_point_by_the_jitter() {
         let size = (200u32, 100u32);
-        let vp = Mat4::perspective_rh(0.8, 2.0, 0.1, 10.0);
+        let vp = crate::render::Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 45.0)
+            .view_proj(2.0);
         let j = jittered(vp, Vec2::new(0.25, -0.5), size);
         for p in [Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.5, 0.3, -4.0)] {
             let a = vp * p.extend(1.0);

@@ -97,6 +97,10 @@ pub struct Args {
     /// 8) or peel or peel:N (depth peeling, N layers: the slow reference).
     #[arg(long, default_value = "opaque")]
     transparency: hairmesh::render::Transparency,
+    /// Temporal accumulation: off, or taa (jittered frames blended along exact motion
+    /// vectors: steadier sub-pixel strands).
+    #[arg(long, default_value = "off")]
+    temporal: hairmesh::render::Temporal,
     /// Strand rasterization: hw (hardware strips), soft or soft:K (the compute software
     /// rasterizer, K fragments per pixel kept sorted), auto or auto:K (per bundle: thin
     /// strands to software, thick ones to hardware). Software needs --msaa 1 and opaque or
@@ -442,6 +446,7 @@ fn run(args: Args) -> Result<()> {
             shading: args.shading,
             shadows: args.shadows,
             transparency: args.transparency,
+            temporal: args.temporal,
             lod_appearance: args.lod_appearance,
             ..View::new(camera)
         };

@@ -16,6 +16,7 @@ use anyhow::{Context as _, Result};
 use glam::Vec3;
 use hairmesh::characters::preset;
 use hairmesh::outln;
+use hairmesh::render::Temporal;
 use hairmesh::render::soft::{DEFAULT_SOFT_K, StrandRaster};
 use hairmesh::render::transparency::{DEFAULT_OIT_BUDGET, DEFAULT_PEEL_LAYERS, MAX_OIT_BUDGET};
 use hairmesh::render::{
@@ -43,6 +44,7 @@ struct Controls {
     shadows: ShadowMode,
     light_raster: LightRaster,
     transparency: Transparency,
+    temporal: Temporal,
     raster: StrandRaster,
     lod_appearance: bool,
     moving: bool,
@@ -111,6 +113,12 @@ impl Controls {
                     ui.label("shadow draw");
                     ui.radio_value(&mut self.light_raster, LightRaster::Hardware, "hardware");
                     ui.radio_value(&mut self.light_raster, LightRaster::Software, "software");
+                });
+                ui.horizontal(|ui| {
+                    ui.label("temporal");
+                    for t in Temporal::ALL {
+                        ui.radio_value(&mut self.temporal, t, t.name());
+                    }
                 });
                 ui.horizontal(|ui| {
                     ui.label("transparency");
@@ -290,6 +298,7 @@ struct Running {
     /// How the light's passes draw (hardware where the settings refuse software).
     light_raster: LightRaster,
     transparency: Transparency,
+    temporal: Temporal,
     raster: StrandRaster,
     /// The software rasterizer can draw this window's frames (device support, no MSAA).
     soft_ok: bool,
@@ -460,6 +469,7 @@ impl App {
             shadows: self.args.shadows,
             light_raster: chosen.light_raster,
             transparency: self.args.transparency,
+            temporal: self.args.temporal,
             raster: chosen.raster,
             lod_appearance: self.args.lod_appearance,
             animation,
@@ -556,6 +566,7 @@ impl Running {
             shading: self.shading,
             shadows: self.shadows,
             transparency: self.transparency,
+            temporal: self.temporal,
             lod_appearance: self.lod_appearance,
             ..View::new(camera)
         };
@@ -619,6 +630,7 @@ impl Running {
             shadows: self.shadows,
             light_raster: self.light_raster,
             transparency: self.transparency,
+            temporal: self.temporal,
             raster: self.raster,
             lod_appearance: self.lod_appearance,
             moving: self.animation.moving,
@@ -703,6 +715,7 @@ impl Running {
         self.shadows = c.shadows;
         self.light_raster = c.light_raster;
         self.transparency = c.transparency;
+        self.temporal = c.temporal;
         self.raster = c.raster;
         self.lod_appearance = c.lod_appearance;
         self.animation.moving = c.moving;

@@ -62,6 +62,7 @@ impl TemporalPass {
         };
         let output = r.images.output;
         if work.accumulate {
+            g.begin_scope("temporal input");
             g.pass("temporal input")
                 .read(r.output, Access::TransferRead)
                 .discard(t.frame_color, Access::TransferWrite)
@@ -69,7 +70,9 @@ impl TemporalPass {
                     rec.copy_image_to_buffer(output, res.buffer(t.frame_color)?);
                     Ok(())
                 });
+            g.end_scope();
         }
+        g.begin_scope("temporal");
         let groups = (
             size.0.div_ceil(TEMPORAL_GROUP),
             size.1.div_ceil(TEMPORAL_GROUP),
@@ -90,8 +93,11 @@ impl TemporalPass {
             rec.dispatch(groups.0, groups.1, 1);
             Ok(())
         });
+        g.end_scope();
         if work.accumulate {
+            g.begin_scope("temporal output");
             self.add_output(g, r, (sets, groups));
+            g.end_scope();
         }
         if let Some(buffer) = readback {
             let target = g.import_buffer("motion readback", buffer);
