@@ -63,14 +63,19 @@ impl Scenario for Head {
 }
 
 /// Four people idling in wind (their hair simulated and re-textured every frame), seen from
-/// a slowly orbiting camera.
+/// a camera orbiting them by 0.25 degrees a frame.
 struct Crowd {
     animation: CrowdAnimation,
 }
 
 impl Scenario for Crowd {
     fn frame(&mut self, r: &mut Renderer, f: u32, height: u32) -> Result<Camera> {
-        let camera = preset::orbit_camera(Preset::People, 4, f / 4);
+        let base = preset::orbit_camera(Preset::People, 4, 0);
+        let turn = Mat4::from_rotation_y(0.25f32.to_radians() * f as f32);
+        let camera = Camera {
+            eye: base.target + turn.transform_vector3(base.eye - base.target),
+            ..base
+        };
         if f > 0 {
             self.animation.advance(r, 1.0 / 30.0, &camera, height)?;
         }
