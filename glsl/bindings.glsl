@@ -61,13 +61,20 @@ void bind_character(uint c) {
 #define TEX_V tex_v[tex_slot]
 
 // bundle_lods[].y: vertex level e in the low byte, LOD_SOFT when the software rasterizer
-// draws the bundle.
+// draws the bundle, the newest strand's width share in the high half (lod_strand_fade).
 uint lod_segments(uint y) {
     return 1u << (y & LOD_LEVEL_MASK);
 }
 
 bool lod_is_soft(uint y) {
     return (y & LOD_SOFT) != 0u;
+}
+
+// Width factor of strand `strand` of a bundle with LoD decision `lod`: the newest strand
+// (lod.x - 1) is drawn as wide as eq. 8's fractional part (bundle_lods[].y bits 16..31, 16-bit
+// fixed point), the others whole; src/reference/lod.rs: newest_strand_fade.
+float lod_strand_fade(uvec4 lod, uint strand) {
+    return strand + 1u == lod.x ? float(lod.y >> 16u) / 65535.0 : 1.0;
 }
 
 // The bundle of strand workgroup g: the last bundle whose first workgroup is <= g (never an

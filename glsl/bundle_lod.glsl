@@ -11,11 +11,13 @@ struct BundleLod {
     float gamma;      // eq. 12 geomorph factor toward level e - 1 (0: none)
     float thickness;  // sec. 3.6.1 width factor min(1/L, N)
     bool soft;        // drawn by the software rasterizer (src/render/soft.rs)
+    float fade;       // width share of the newest strand (newest_strand_fade)
 };
 
 // bundle_lods[] / payload encoding of a decision.
 uvec4 encode_lod(BundleLod r) {
-    return uvec4(r.strands, r.e | (r.soft ? LOD_SOFT : 0u), floatBitsToUint(r.gamma), floatBitsToUint(r.thickness));
+    uint fade = uint(round(clamp(r.fade, 0.0, 1.0) * 65535.0)) << 16;
+    return uvec4(r.strands, r.e | (r.soft ? LOD_SOFT : 0u) | fade, floatBitsToUint(r.gamma), floatBitsToUint(r.thickness));
 }
 
 // Software or hardware raster (frame.soft.x: RASTER_HARDWARE, RASTER_SOFTWARE, RASTER_AUTO, or
@@ -75,7 +77,7 @@ BundleLod bundle_lod(uint g) {
     uint count = style.density_by_area != 0u ? uint(round(float(n) * desc.density)) : n;
     count = clamp(count, 1u, MAX_STRANDS_PER_BUNDLE);
     uint emax = ch_emax;
-    BundleLod r = BundleLod(count, emax, 0.0, 1.0, false);
+    BundleLod r = BundleLod(count, emax, 0.0, 1.0, false, 1.0);
     // Curved roots leave the hull by at most the root cell's bulge bound; the LoD distance
     // below stays that of the hull (src/reference/root_surface.rs).
     float bulge = scale * root_bulge_bound(root_cell(desc.origin));
@@ -93,7 +95,12 @@ BundleLod bundle_lod(uint g) {
     // Strand LoD: eq. 7 and eq. 8 with a per-bundle increment delta_i, clamped to N_i.
     float ls = detail_level(h, d, frame.lod.x);
     float delta = hash_f32(hash_u32(desc.local_index ^ 0x2545f491u) ^ style.seed);
-    r.strands = ls > 0.0 ? clamp(uint(ceil(ls * (float(count) + delta))), 1u, count) : 0u;
+    float wanted = ls * (float(count) + delta);
+    r.strands = ls > 0.0 ? clamp(uint(ceil(wanted)), 1u, count) : 0u;
+    // Stable LoD: the newest strand comes in as wide as eq. 8's fractional part, so a bundle's
+    // strands fade in one by one as it nears instead of popping (CPU twin:
+    // newest_strand_fade in src/reference/lod.rs).
+    r.fade = r.strands > 1u && wanted < float(r.strands) ? wanted - float(r.strands - 1u) : 1.0;
     r.thickness = min(1.0 / max(ls, 1e-6), float(count));
     // Vertex LoD: eq. 9, 10, 12.
     float lv = detail_level(h, d, frame.lod.y);

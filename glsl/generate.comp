@@ -34,6 +34,8 @@ void main() {
 #ifdef SOFT_RASTER
     if (lod_is_soft(lod.y)) {
         float cap = model_scale * bundles[bundle].rest_size;
+        soft_fade = lod_strand_fade(lod, lod.x - 1u);
+        soft_fade_strand = lod.x - 1u - first;
         emit_soft_segments(count, segments, width_scale, uintBitsToFloat(lod.w), cap, style_color(), bundles[bundle].character, t);
         return;
     }
@@ -45,7 +47,8 @@ void main() {
         float s = float(k) / float(segments);
         uint out_index = bundle_offsets[bundle].y + (first + j) * stride + k;
         if (out_index < limit) {
-            hair_vertices[out_index].pos_width = vec4(sp[idx], width_scale * strand_width_at(s));
+            float fade = lod_strand_fade(lod, first + j);
+            hair_vertices[out_index].pos_width = vec4(sp[idx], width_scale * fade * strand_width_at(s));
             hair_vertices[out_index].tangent_s = vec4(st[idx], s);
         }
     }

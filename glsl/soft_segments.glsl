@@ -28,11 +28,19 @@ shared float sw[MAX_ENTRIES];
 #endif
 
 // Width of shared vertex idx at parameter s: the stored one, or the builder's strand width.
-float soft_vertex_width(uint idx, float s, float width_scale) {
+// The newest strand's width share (lod_strand_fade) and its index among the strands handed to
+// emit_soft_segments (set by the generators before the call; the pool's stored widths
+// already carry it).
+float soft_fade = 1.0;
+uint soft_fade_strand = 0xFFFFFFFFu;
+
+// Width of entry idx (strand `strand` of those handed over) at parameter s.
+float soft_vertex_width(uint idx, uint strand, float s, float width_scale) {
 #ifdef SOFT_POOL
     return sw[idx];
 #else
-    return width_scale * strand_width_at(s);
+    float fade = strand == soft_fade_strand ? soft_fade : 1.0;
+    return width_scale * fade * strand_width_at(s);
 #endif
 }
 
@@ -78,7 +86,7 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
         vec3 p = sp[idx];
         vec4 c = frame.view_proj * vec4(p, 1.0);
         float pixel = pixel_size(p);
-        float width = soft_vertex_width(idx, s, width_scale);
+        float width = soft_vertex_width(idx, idx / stride, s, width_scale);
         float drawn = soft_drawn_width(width, pixel, thickness, cap);
         bool in_range = c.w > 1e-6 && c.z >= 0.0 && c.z <= c.w;
         vec3 ndc = c.xyz / max(c.w, 1e-6);

@@ -469,7 +469,12 @@ impl CpuGenerator {
                 crate::reference::lod::apply_geomorph(&mut p, &mut t, lod.gamma);
                 set.positions.extend(p);
                 set.tangents.extend(t);
-                set.widths.extend(w.iter().map(|x| x * lod.thickness));
+                let fade = match strand + 1 == lod.strands {
+                    true => lod.fade,
+                    false => 1.0,
+                };
+                set.widths
+                    .extend(w.iter().map(|x| x * lod.thickness * fade));
                 set.strand_bundle.push(bundle as u32);
                 counts.push(verts);
             }

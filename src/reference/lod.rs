@@ -25,6 +25,20 @@ pub fn strands_at_level(l: f32, n: u32, delta: f32) -> u32 {
     ((l * (n as f32 + delta)).ceil() as u32).clamp(1, n)
 }
 
+/// Stable strand LoD: the width share of a bundle's newest strand, eq. 8's fractional part
+/// (`L (N + delta) - (strands - 1)`), so strands fade in one at a time as a bundle nears rather
+/// than pop; 1 with a single strand (the far cluster keeps its width) and at full detail.
+/// Quantised to 16 bits as the GPU carries it (`lod_strand_fade` in `bindings.glsl`).
+pub fn newest_strand_fade(l: f32, n: u32, delta: f32) -> f32 {
+    let strands = strands_at_level(l, n, delta);
+    let wanted = l * (n as f32 + delta);
+    let fade = match strands > 1 && wanted < strands as f32 {
+        true => wanted - (strands - 1) as f32,
+        false => 1.0,
+    };
+    (fade.clamp(0.0, 1.0) * 65535.0).round() / 65535.0
+}
+
 /// Thickness compensation of section 3.6.1: widths grow by `min(1 / L, N)`.
 pub fn thickness_scale(l: f32, n: u32) -> f32 {
     (1.0 / l.max(1e-6)).min(n.max(1) as f32)
@@ -107,6 +121,29 @@ mod tests {
         assert_eq!(thickness_scale(0.001, 3), 3.0);
     }
 
+    /// Stable LoD: the drawn width of a bundle, `(strands - 1 + fade) * thickness`, changes
+    /// continuously with L (no jump when a strand is added), where the whole-strand count
+    /// alone jumps by a strand's width.
+    #[test]
+    fn newest_strand_fades_in_without_a_jump() {
+        let (n, delta) = (32u32, 0.4f32);
+        let drawn = |l: f32| {
+            let s = strands_at_level(l, n, delta) as f32;
+            (s - 1.0 + newest_strand_fade(l, n, delta)) * thickness_scale(l, n)
+        };
+        let whole = |l: f32| strands_at_level(l, n, delta) as f32 * thickness_scale(l, n);
+        let (mut worst, mut worst_whole) = (0.0f32, 0.0f32);
+        for i in 200..2000 {
+            let (a, b) = (i as f32 / 2000.0, (i + 1) as f32 / 2000.0);
+            worst = worst.max((drawn(b) - drawn(a)).abs());
+            worst_whole = worst_whole.max((whole(b) - whole(a)).abs());
+        }
+        assert!(worst < 0.05, "drawn width jumps by {worst} strands");
+        assert!(worst_whole > 0.9, "whole strands jump by {worst_whole}");
+        assert_eq!(newest_strand_fade(1.0, n, delta), 1.0);
+        assert_eq!(newest_strand_fade(1e-4, n, delta), 1.0);
+    }
+
     #[test]
     fn vertex_level_is_power_of_two_plus_one() {
         assert_eq!(vertex_level(1.0, 32), 5);
@@ -161,6 +198,8 @@ pub struct BundleLod {
     pub gamma: f32,
     /// Width factor `min(1/L, N)`.
     pub thickness: f32,
+    /// Width share of the newest strand ([`newest_strand_fade`]).
+    pub fade: f32,
 }
 
 /// Per-bundle random increment `delta_i` of eq. 8 (GLSL: in `bundle_lod`).
@@ -205,7 +244,8 @@ pub fn bundle_lod(
     let d = view.eye.distance(view.eye.clamp(lo, hi));
     let h = baked.bundles[b].rest_size;
     let ls = detail_level(h, view.resolution, d, view.fov_y, view.alpha_strands);
-    let strands = strands_at_level(ls, n, bundle_delta(b as u32, style.seed));
+    let delta = bundle_delta(b as u32, style.seed);
+    let strands = strands_at_level(ls, n, delta);
     let lv = detail_level(h, view.resolution, d, view.fov_y, view.alpha_verts);
     let ns = 1u32 << e_max;
     let e = vertex_level(lv, ns);
@@ -215,5 +255,6 @@ pub fn bundle_lod(
         e,
         gamma,
         thickness: thickness_scale(ls, n),
+        fade: newest_strand_fade(ls, n, delta),
     }
 }

@@ -349,6 +349,6 @@ mod tests {
             (c[0], c[7], c[5]),
             (Vec3::ZERO, Vec3::ONE, Vec3::new(1.0, 0.0, 1.0))
         );
-        assert_eq!(size_of::<FrameBlock>(), 432);
+        assert_eq!(size_of::<FrameBlock>(), 592);
     }
 }
