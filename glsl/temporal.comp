@@ -71,6 +71,12 @@ bool is_hair(uint id) {
     return id != VISIBILITY_EMPTY && (id & (VISIBILITY_PROP | VISIBILITY_SOLID)) == 0u;
 }
 
+// Hair whose mesh changed pose this frame: it moves relative to its head, which the motion
+// vectors (rigid per character) do not follow.
+bool deforming(uint id) {
+    return is_hair(id) && (characters[id & VISIBILITY_INDEX].flags & CHARACTER_DEFORMING) != 0u;
+}
+
 vec3 linear_to_srgb(vec3 l) {
     l = clamp(l, 0.0, 1.0);
     return mix(l * 12.92, 1.055 * pow(l, vec3(1.0 / 2.4)) - 0.055, greaterThan(l, vec3(0.0031308)));
@@ -193,9 +199,13 @@ vec3 accumulate(ivec2 p, uvec2 own) {
     }
     vec3 mean = m1 / 9.0;
     vec3 sigma = sqrt(max(m2 / 9.0 - mean * mean, vec3(0.0)));
-    float gamma = is_hair(near.x) ? frame.temporal_params.w : 1.0;
+    // Hair keeps a wide clamp (a tight one erases single strands); hair that deforms is
+    // clamped like a solid surface and weighs the new frame more, against smearing.
+    bool moving = deforming(near.x);
+    float gamma = is_hair(near.x) && !moving ? frame.temporal_params.w : 1.0;
+    float weight = moving ? max(frame.temporal_params.z, TEMPORAL_DEFORMING_WEIGHT) : frame.temporal_params.z;
     vec3 h = clip_to_box(to_ycocg(history_at(q)), mean, gamma * sigma + 1e-4);
-    return mix(from_ycocg(h), current, frame.temporal_params.z);
+    return mix(from_ycocg(h), current, weight);
 }
 
 void main() {

@@ -253,3 +253,38 @@ fn accumulation_converges_on_a_still_frame() {
     }
     assert_no_validation_errors(&ctx);
 }
+
+/// After `reset_temporal` (a camera cut) the next frame has no previous frame: no motion,
+/// however far the camera jumped; the frame after it moves again.
+#[test]
+fn a_cut_has_no_motion() {
+    let ctx = context();
+    let (baked, style) = sample("head_long.obj");
+    let mut r = renderer(&ctx, SIZE);
+    upload(&mut r, &baked, &style, 16, 4);
+    let base = framing(&baked);
+    let motion_at_step = |r: &mut Renderer, step: f32| {
+        let opts = FrameOptions {
+            read_motion: true,
+            ..Default::default()
+        };
+        let v = view(turned(&base, step), Transparency::Opaque, Temporal::Off);
+        let motion = r.render_one(&v, &opts).unwrap().motion.unwrap();
+        motion
+            .iter()
+            .map(|p| p.motion.length())
+            .fold(0.0f32, f32::max)
+    };
+    motion_at_step(&mut r, 0.0);
+    assert!(motion_at_step(&mut r, 5.0) > 1.0, "a turn moves the pixels");
+    r.reset_temporal();
+    assert!(
+        motion_at_step(&mut r, 10.0) < 1e-3,
+        "no motion across a cut"
+    );
+    assert!(
+        motion_at_step(&mut r, 15.0) > 1.0,
+        "motion again after the cut"
+    );
+    assert_no_validation_errors(&ctx);
+}

@@ -164,29 +164,7 @@ enum Cmd {
     /// temporal accumulation off and on and as a supersampled reference; the change of the
     /// hair's luminance between frames moved along the true motion, ours over the
     /// reference's, FLIP against the reference, and the accumulation's GPU ms.
-    Temporal {
-        /// Image size (the reference is rendered --supersample times larger per side).
-        #[arg(long, default_value = "320x180")]
-        size: String,
-        /// Frames per run.
-        #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(3..=10000))]
-        frames: u32,
-        /// Frames left out of the measure at the start (accumulation converging).
-        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=10000))]
-        warmup: u32,
-        /// Reference samples per pixel per side.
-        #[arg(long, default_value_t = 4)]
-        supersample: u32,
-        /// Scenarios: orbit, dolly, crowd.
-        #[arg(long, value_delimiter = ',', default_value = "orbit,dolly,crowd")]
-        scenarios: Vec<String>,
-        /// How our frames' strands are rasterized: hw, soft[:K] or auto[:K].
-        #[arg(long, default_value = "hw")]
-        draw: StrandRaster,
-        /// Choose the GPU by name substring.
-        #[arg(long)]
-        device: Option<String>,
-    },
+    Temporal(temporal::TemporalArgs),
     /// One hair mesh in wind, simulated and re-textured every frame (30 Hz): CPU ms of the
     /// dynamics, GPU ms of the texture rebuild and of the frame; optionally a strip of frames.
     Animate {
@@ -674,23 +652,7 @@ fn run(args: Args) -> Result<()> {
             strip_frames,
             device,
         })?,
-        Cmd::Temporal {
-            size,
-            frames,
-            warmup,
-            supersample,
-            scenarios,
-            draw,
-            device,
-        } => temporal::bench_temporal(temporal::TemporalArgs {
-            size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
-            frames,
-            warmup,
-            supersample,
-            scenarios,
-            draw,
-            device,
-        })?,
+        Cmd::Temporal(args) => temporal::bench_temporal(args)?,
         Cmd::Fuzz { iterations, seed } => {
             outln!("| reader | inputs | accepted | rejected | panics | slowest ms | seconds |")?;
             outln!("|---|---|---|---|---|---|---|")?;

@@ -92,7 +92,7 @@ impl Renderer {
             kbuffer_budget,
             temporal,
         )?;
-        let records = self.crowd.records();
+        let records = self.frame_records(&pose_updates);
         let blocks = (&block, light_block.as_ref());
         let prop_draws = self.write_slot(i, blocks, &records, &motion, opts)?;
         let start = Instant::now();
@@ -123,6 +123,31 @@ impl Renderer {
             frame_graph,
         };
         self.submit(i, pending, present.as_ref())?;
+        self.remember_frame(&records, &motion, temporal);
+        self.after_submit(path, raster);
+        self.next = (i + 1) % FRAMES_IN_FLIGHT;
+        Ok(FrameTicket(self.frame_number - 1))
+    }
+
+    /// The character records of this frame, those in `pose_updates` marked deforming.
+    fn frame_records(&self, pose_updates: &[usize]) -> Vec<super::shared::CharacterRecord> {
+        let mut records = self.crowd.records();
+        for &slot in pose_updates {
+            if let Some(r) = records.get_mut(slot) {
+                r.flags |= super::shared::CHARACTER_DEFORMING;
+            }
+        }
+        records
+    }
+
+    /// After a frame is submitted: its matrices become the next frame's previous ones, and
+    /// with accumulation its history the next frame's to read.
+    fn remember_frame(
+        &mut self,
+        records: &[super::shared::CharacterRecord],
+        motion: &FrameMotion,
+        temporal: Option<TemporalWork>,
+    ) {
         let models = records.iter().map(|r| {
             (r.flags & super::shared::CHARACTER_VISIBLE != 0)
                 .then(|| glam::Mat4::from_cols_array_2d(&r.model))
@@ -132,11 +157,8 @@ impl Renderer {
             models: models.collect(),
             size: self.targets.size(),
         };
-        let accumulated = temporal.is_some_and(|t| t.accumulate);
-        self.temporal.advance(previous, accumulated);
-        self.after_submit(path, raster);
-        self.next = (i + 1) % FRAMES_IN_FLIGHT;
-        Ok(FrameTicket(self.frame_number - 1))
+        self.temporal
+            .advance(previous, temporal.is_some_and(|t| t.accumulate));
     }
 
     /// This frame's temporal work (`None`: no motion vectors), or why this device cannot
@@ -311,22 +333,19 @@ impl Renderer {
         slot.records.write(0, bytemuck::cast_slice(&records))?;
         slot.prop_instances
             .write(0, bytemuck::cast_slice(&prop_instances))?;
-        let image_bytes = width as u64 * height as u64 * 4;
-        let stale = slot
-            .image_readback
-            .as_ref()
-            .is_none_or(|b| b.size != image_bytes);
-        if opts.read_image && stale {
-            slot.image_readback = Some(image_readback(&self.ctx, image_bytes)?);
-        }
-        let motion_bytes = image_bytes * 4;
-        let stale = slot
-            .motion_readback
-            .as_ref()
-            .is_none_or(|b| b.size != motion_bytes);
-        if opts.read_motion && stale {
-            slot.motion_readback = Some(image_readback(&self.ctx, motion_bytes)?);
-        }
+        let pixels = width as u64 * height as u64;
+        size_readback(
+            &self.ctx,
+            &mut slot.image_readback,
+            opts.read_image,
+            pixels * 4,
+        )?;
+        size_readback(
+            &self.ctx,
+            &mut slot.motion_readback,
+            opts.read_motion,
+            pixels * 16,
+        )?;
         Ok(prop_draws)
     }
 
@@ -514,6 +533,19 @@ impl Renderer {
             .collect();
         LightView::fit(&bounds, view.light_dir, self.shadow.resolution())
     }
+}
+
+/// Make `readback` a buffer of `bytes` when the frame `wants` it and it is not one already.
+fn size_readback(
+    ctx: &Arc<Context>,
+    readback: &mut Option<Buffer>,
+    wants: bool,
+    bytes: u64,
+) -> GpuResult<()> {
+    if wants && readback.as_ref().is_none_or(|b| b.size != bytes) {
+        *readback = Some(image_readback(ctx, bytes)?);
+    }
+    Ok(())
 }
 
 /// A host-readable buffer for the frame's image.

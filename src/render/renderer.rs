@@ -184,6 +184,12 @@ impl Renderer {
         }
     }
 
+    /// Forget the previous frame and the temporal history (a camera cut): the next frame has
+    /// no motion and starts accumulating afresh.
+    pub fn reset_temporal(&mut self) {
+        self.temporal.reset();
+    }
+
     /// Samples per pixel of the targets.
     pub fn msaa(&self) -> u32 {
         self.desc.msaa

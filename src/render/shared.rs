@@ -28,6 +28,11 @@ pub const SCAN_BLOCK: u32 = 1024;
 pub const DISPATCH_ROW: u32 = 65535;
 /// `CharacterRecord::flags`: the character is drawn this frame.
 pub const CHARACTER_VISIBLE: u32 = 1;
+/// `CharacterRecord::flags`: the character's hair mesh changed pose this frame (its hair moves
+/// relative to its head, which the rigid motion vectors do not follow).
+pub const CHARACTER_DEFORMING: u32 = 2;
+/// Temporal: the current frame's weight, at least, in hair of a deforming character.
+pub const TEMPORAL_DEFORMING_WEIGHT: f32 = 0.5;
 pub use crate::shade::lut::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE};
 
 /// Software rasterizer: side of a square screen tile in pixels (one raster workgroup).
@@ -473,7 +478,7 @@ pub struct CharacterRecord {
     pub strands_per_bundle: u32,
     /// Full-detail vertex level `e` (`2^e` segments).
     pub verts_log2: u32,
-    /// [`CHARACTER_VISIBLE`].
+    /// [`CHARACTER_VISIBLE`], [`CHARACTER_DEFORMING`].
     pub flags: u32,
     /// Uniform scale of `model` (widths and styling margins).
     pub model_scale: f32,
@@ -791,6 +796,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         layout("DEFORM_GROUP_SIZE", DEFORM_GROUP_SIZE),
         layout("LHS_GROUP_SIZE", LHS_GROUP_SIZE),
         uint("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
+        uint("CHARACTER_DEFORMING", CHARACTER_DEFORMING),
         uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
         uint("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
         layout("SET_FRAME", SET_FRAME),
@@ -832,6 +838,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
 fn float_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("STRAND_OPACITY", STRAND_OPACITY),
+        ("TEMPORAL_DEFORMING_WEIGHT", TEMPORAL_DEFORMING_WEIGHT),
         ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
         (
             "ROOT_PHONG_SHAPE",

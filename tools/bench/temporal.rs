@@ -23,14 +23,33 @@ use hairmesh::render::{
 use hairmesh::vk::{Context, ContextDesc};
 
 /// What `bench temporal` runs.
+#[derive(clap::Args)]
 pub struct TemporalArgs {
-    pub size: (u32, u32),
-    pub frames: u32,
-    pub warmup: u32,
-    pub supersample: u32,
-    pub scenarios: Vec<String>,
-    pub draw: StrandRaster,
-    pub device: Option<String>,
+    /// Image size (the reference is rendered --supersample times larger per side).
+    #[arg(long, default_value = "320x180", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Frames per run.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(3..=10000))]
+    frames: u32,
+    /// Frames left out of the measure at the start (accumulation converging).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=10000))]
+    warmup: u32,
+    /// Reference samples per pixel per side (1..=8).
+    #[arg(long, default_value_t = 4)]
+    supersample: u32,
+    /// Scenarios: orbit, dolly, crowd.
+    #[arg(long, value_delimiter = ',', default_value = "orbit,dolly,crowd")]
+    scenarios: Vec<String>,
+    /// How our frames' strands are rasterized: hw, soft[:K] or auto[:K].
+    #[arg(long, default_value = "hw")]
+    draw: StrandRaster,
+    /// Choose the GPU by name substring.
+    #[arg(long)]
+    device: Option<String>,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    hairmesh::render::scene::parse_size(s)
 }
 
 /// A scenario: its characters, and what moves each frame.

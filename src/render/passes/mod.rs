@@ -263,6 +263,32 @@ pub struct TemporalRes {
     pub history: (Res, Res),
 }
 
+impl TemporalRes {
+    /// Create the temporal transients of `t` (visibility, motion, frame colour) and import
+    /// the history buffers: the visibility words and the rest, in frames with motion vectors.
+    fn new<'a>(
+        g: &mut FrameGraph<'a>,
+        t: &FrameTransients,
+        history: Option<(&'a Buffer, &'a Buffer)>,
+    ) -> Option<(Res, Self)> {
+        let [visibility, motion, frame_color] = t.temporal.map(|d| g.create_buffer(d));
+        let history = history.map(|(read, write)| {
+            (
+                g.import_buffer("temporal history read", read),
+                g.import_buffer("temporal history written", write),
+            )
+        });
+        t.motion.then_some((
+            visibility,
+            TemporalRes {
+                motion,
+                frame_color,
+                history: history.unwrap_or((frame_color, frame_color)),
+            },
+        ))
+    }
+}
+
 /// The imported images of a frame that passes' commands name.
 #[derive(Clone, Copy)]
 pub struct FrameImages<'a> {
@@ -374,13 +400,8 @@ impl<'a> FrameRes<'a> {
         let [soft_segments, soft_tiles, soft_entries, soft_depth] =
             t.soft.map(|d| g.create_buffer(d));
         let [soft_shadow_depth, soft_shadow_layers] = t.soft_shadow.map(|d| g.create_buffer(d));
-        let [visibility, motion, frame_color] = t.temporal.map(|d| g.create_buffer(d));
-        let history = src.history.map(|(read, write)| {
-            (
-                g.import_buffer("temporal history read", read),
-                g.import_buffer("temporal history written", write),
-            )
-        });
+        let temporal = TemporalRes::new(g, t, src.history);
+        let visibility = temporal.map(|t| t.0);
         FrameRes {
             constants: g.host_input("frame constants"),
             textures: g.host_input("textures"),
@@ -412,12 +433,8 @@ impl<'a> FrameRes<'a> {
             soft_depth,
             soft_shadow_depth,
             soft_shadow_layers,
-            visibility: t.motion.then_some(visibility),
-            temporal: t.motion.then_some(TemporalRes {
-                motion,
-                frame_color,
-                history: history.unwrap_or((frame_color, frame_color)),
-            }),
+            visibility,
+            temporal: temporal.map(|t| t.1),
             args_buffer: w.args,
             images: FrameImages {
                 color,
