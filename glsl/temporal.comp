@@ -200,12 +200,11 @@ vec3 accumulate(ivec2 p, uvec2 own) {
     vec3 mean = m1 / 9.0;
     vec3 sigma = sqrt(max(m2 / 9.0 - mean * mean, vec3(0.0)));
     // Hair keeps a wide clamp (a tight one erases single strands); hair that deforms is
-    // clamped like a solid surface and weighs the new frame more, against smearing.
-    bool moving = deforming(near.x);
-    float gamma = is_hair(near.x) && !moving ? frame.temporal_params.w : 1.0;
-    float weight = moving ? max(frame.temporal_params.z, TEMPORAL_DEFORMING_WEIGHT) : frame.temporal_params.z;
+    // clamped like a solid surface, against trails where its history is not where the
+    // rigid motion puts it.
+    float gamma = is_hair(near.x) && !deforming(near.x) ? frame.temporal_params.w : 1.0;
     vec3 h = clip_to_box(to_ycocg(history_at(q)), mean, gamma * sigma + 1e-4);
-    return mix(from_ycocg(h), current, weight);
+    return mix(from_ycocg(h), current, frame.temporal_params.z);
 }
 
 void main() {

@@ -31,8 +31,7 @@ pub const CHARACTER_VISIBLE: u32 = 1;
 /// `CharacterRecord::flags`: the character's hair mesh changed pose this frame (its hair moves
 /// relative to its head, which the rigid motion vectors do not follow).
 pub const CHARACTER_DEFORMING: u32 = 2;
-/// Temporal: the current frame's weight, at least, in hair of a deforming character.
-pub const TEMPORAL_DEFORMING_WEIGHT: f32 = 0.5;
+
 pub use crate::shade::lut::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE};
 
 /// Software rasterizer: side of a square screen tile in pixels (one raster workgroup).
@@ -838,7 +837,6 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
 fn float_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("STRAND_OPACITY", STRAND_OPACITY),
-        ("TEMPORAL_DEFORMING_WEIGHT", TEMPORAL_DEFORMING_WEIGHT),
         ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
         (
             "ROOT_PHONG_SHAPE",

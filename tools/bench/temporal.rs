@@ -222,9 +222,6 @@ fn run(
             .pass_ms
             .iter()
             .filter(|(n, _)| n.starts_with("temporal"));
-        if std::env::var_os("BENCH_TEMPORAL_PASSES").is_some() {
-            eprintln!("{:?}", temporal.clone().collect::<Vec<_>>());
-        }
         let t: f64 = temporal.map(|p| p.1).sum();
         out.temporal_ms.push(t);
     }
