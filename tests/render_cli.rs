@@ -171,6 +171,62 @@ fn print_frame_lists_every_pass_of_the_full_look() {
     }
 }
 
+/// `--temporal taa`: the visibility words are emptied before the camera's passes, every pass
+/// that draws a surface writes them, and the temporal passes end the frame's drawing before
+/// the image is read back; `--repeat` accumulates.
+#[test]
+fn temporal_accumulation_adds_its_passes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("taa.png");
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/hairmeshes/head_long.obj");
+    let stdout = render_ok(
+        &[
+            "--mesh",
+            mesh,
+            "--size",
+            "64x48",
+            "--strands-per-bundle",
+            "8",
+            "--path",
+            "compute",
+            "--draw",
+            "auto",
+            "--temporal",
+            "taa",
+            "--repeat",
+            "3",
+            "--print-frame",
+        ],
+        &out,
+    );
+    let passes = [
+        "visibility clear",
+        "opaque",
+        "soft raster",
+        "transparency resolve",
+        "temporal input",
+        "temporal",
+        "temporal resolve",
+        "temporal output",
+        "image readback",
+    ];
+    let mut at = 0;
+    for p in passes {
+        let line = format!(". {p}\n");
+        let found = stdout[at..]
+            .find(&line)
+            .unwrap_or_else(|| panic!("no pass {p} after byte {at}:\n{stdout}"));
+        at += found + line.len();
+    }
+    for needle in [
+        "visibility (FragmentReadWrite)",
+        "visibility (ComputeReadWrite)",
+    ] {
+        assert!(stdout.contains(needle), "{needle}:\n{stdout}");
+    }
+    assert!(out.exists());
+}
+
 /// Static and LHS runs: the generating frame draws hardware strips (software-drawn bundles
 /// would leave nothing in the pool), the second frame draws the stored strands with `--draw`.
 #[test]
