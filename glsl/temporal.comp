@@ -1,12 +1,11 @@
 #version 460
-// Temporal passes (src/render/temporal.rs), one thread per pixel.
-// Stage 0 (push.params.x == 0): the pixel's motion from its nearest surface (visibility word:
-// depth, id; the id's clip_to_prev matrix), written to the motion target; with accumulation
-// (frame.temporal.y) the history is reprojected (Catmull-Rom), checked against what the
-// pixel is (visibility id and depth of the nearest surface in the 3x3 neighbourhood, both
-// frames), clipped to the neighbourhood's colour box (wider on hair) and blended.
-// Stage 1: the accumulated colour back into the frame's colour buffer (sRGB bytes), which is
-// copied onto the output image.
+// Temporal pass (src/render/temporal.rs), one thread per pixel. With push.params.x, the
+// pixel's motion from its nearest surface (visibility word: depth, id; the id's clip_to_prev
+// matrix) is written to the motion target. With accumulation (frame.temporal.y) the history
+// is reprojected (Catmull-Rom), checked against what the pixel is (visibility id and depth of
+// the nearest surface in the 3x3 neighbourhood, both frames), clipped to the neighbourhood's
+// colour box (wider on hair) and blended; the result goes to the history and, as sRGB bytes,
+// to the second half of the frame's colour buffer, which is copied onto the output image.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "bindings.glsl"
@@ -209,25 +208,19 @@ vec3 accumulate(ivec2 p, uvec2 own) {
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    bool inside = all(lessThan(p, image_size()));
+    if (any(greaterThanEqual(p, image_size()))) {
+        return;
+    }
     uint i = index_of(p);
-    if (push.params.x == 1u) {
-        if (inside) {
-            uvec2 h = history_out[i];
-            frame_color[i] = packUnorm4x8(vec4(linear_to_srgb(vec3(unpackHalf2x16(h.x), unpackHalf2x16(h.y).x)), 1.0));
-        }
-        return;
-    }
-    bool accumulating = frame.temporal.y != 0u;
-    if (!inside) {
-        return;
-    }
     uvec2 own = surface_at(p);
-    vec2 m = motion_at(own.x, vec2(p) + 0.5, uintBitsToFloat(own.y));
-    motion_out[i] = uvec4(floatBitsToUint(m), own);
-    if (accumulating) {
+    if (push.params.x != 0u) {
+        vec2 m = motion_at(own.x, vec2(p) + 0.5, uintBitsToFloat(own.y));
+        motion_out[i] = uvec4(floatBitsToUint(m), own);
+    }
+    if (frame.temporal.y != 0u) {
         vec3 c = accumulate(p, own);
         history_out[i] = uvec2(packHalf2x16(c.rg), packHalf2x16(vec2(c.b, 1.0)));
         history_out[pixel_count() + i] = own;
+        frame_color[pixel_count() + i] = packUnorm4x8(vec4(linear_to_srgb(c), 1.0));
     }
 }

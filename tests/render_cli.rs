@@ -206,7 +206,6 @@ fn temporal_accumulation_adds_its_passes() {
         "transparency resolve",
         "temporal input",
         "temporal",
-        "temporal resolve",
         "temporal output",
         "image readback",
     ];

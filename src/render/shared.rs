@@ -161,9 +161,11 @@ pub enum FrameBinding {
     /// Temporal: per pixel, the nearest surface (`uint64`: depth bits << 32 | visibility id,
     /// `temporal.glsl`), the motion vectors' source.
     Visibility = 25,
-    /// Temporal: per pixel, the screen motion to the previous frame (`vec2`, pixels).
+    /// Temporal: per pixel, the screen motion to the previous frame (`uvec4`: motion x and y
+    /// bits in pixels, visibility id, depth bits), written when read back.
     Motion = 26,
-    /// Temporal: per pixel, the frame's colour (`uint`: RGBA8 sRGB, as the output image).
+    /// Temporal: per pixel, the frame's colour (`uint`: RGBA8 sRGB, as the output image), then
+    /// per pixel the accumulated colour (the same encoding).
     FrameColor = 27,
     /// Temporal: the accumulated history read: per pixel the colour (`uvec2`: rg and b
     /// halves), then per pixel the surface it showed (`uvec2`: visibility id, depth bits).

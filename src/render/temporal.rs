@@ -290,9 +290,10 @@ pub fn transient_buffers(
     [
         TransientBuffer::storage("visibility", on(8, motion), FrameBinding::Visibility as u32),
         TransientBuffer::storage("motion", on(16, motion), FrameBinding::Motion as u32),
+        // The frame's colour, then the accumulated one.
         TransientBuffer::storage(
             "frame colour",
-            on(4, accumulate),
+            on(8, accumulate),
             FrameBinding::FrameColor as u32,
         ),
     ]

@@ -551,7 +551,12 @@ impl CommandRecorder<'_> {
 
     /// Copy tightly packed texels from `src` into all of `dst` (in [`Access::TransferWrite`]).
     pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
-        let region = [whole_image_copy(dst)];
+        self.copy_buffer_to_image_at(src, 0, dst);
+    }
+
+    /// [`Self::copy_buffer_to_image`] with the texels from byte `offset` of `src`.
+    pub fn copy_buffer_to_image_at(&mut self, src: &Buffer, offset: u64, dst: &Image) {
+        let region = [whole_image_copy(dst).buffer_offset(offset)];
         // SAFETY: the image is in TRANSFER_DST_OPTIMAL; the buffer size is checked by the caller.
         unsafe {
             self.ctx.device.cmd_copy_buffer_to_image(

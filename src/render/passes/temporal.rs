@@ -78,25 +78,39 @@ impl TemporalPass {
             size.1.div_ceil(TEMPORAL_GROUP),
         );
         let rw = Access::ComputeReadWrite;
+        // The motion target is written where it is read back or is the frame's only work.
+        let write_motion = readback.is_some() || !work.accumulate;
         let mut p = g
             .pass("temporal")
-            .read_all(&[r.constants, visibility], Access::ComputeRead)
-            .discard(t.motion, rw);
+            .read_all(&[r.constants, visibility], Access::ComputeRead);
+        if write_motion {
+            p = p.discard(t.motion, rw);
+        }
         if work.accumulate {
+            // Reads the frame's colour (first half), writes the accumulated one (second).
             p = p
-                .read_all(&[t.frame_color, t.history.0], Access::ComputeRead)
+                .write(t.frame_color, rw)
+                .read(t.history.0, Access::ComputeRead)
                 .discard(t.history.1, rw);
         }
         p.record(move |rec, _| {
             rec.bind(&self.pipeline, &sets.both());
-            rec.push_constants(&self.pipeline, &[0u32; 4]);
+            rec.push_constants(&self.pipeline, &[write_motion as u32, 0, 0, 0]);
             rec.dispatch(groups.0, groups.1, 1);
             Ok(())
         });
         g.end_scope();
         if work.accumulate {
             g.begin_scope("temporal output");
-            self.add_output(g, r, (sets, groups));
+            let (frame_color, pixels) = (t.frame_color, size.0 as u64 * size.1 as u64);
+            g.pass("temporal output")
+                .read(t.frame_color, Access::TransferRead)
+                .write(r.output, Access::TransferWrite)
+                .record(move |rec, res| {
+                    let colors = res.buffer(frame_color)?;
+                    rec.copy_buffer_to_image_at(colors, pixels * 4, output);
+                    Ok(())
+                });
             g.end_scope();
         }
         if let Some(buffer) = readback {
@@ -113,34 +127,5 @@ impl TemporalPass {
                 .read(target, Access::HostRead)
                 .done();
         }
-    }
-
-    /// The accumulated colour into the frame's colour buffer, then onto the output image.
-    fn add_output<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes<'a>,
-        (sets, groups): (PassSets<'a>, (u32, u32)),
-    ) {
-        let Some(t) = r.temporal else {
-            return;
-        };
-        g.pass("temporal resolve")
-            .read(t.history.1, Access::ComputeRead)
-            .write(t.frame_color, Access::ComputeReadWrite)
-            .record(move |rec, _| {
-                rec.bind(&self.pipeline, &sets.both());
-                rec.push_constants(&self.pipeline, &[1u32, 0, 0, 0]);
-                rec.dispatch(groups.0, groups.1, 1);
-                Ok(())
-            });
-        let output = r.images.output;
-        g.pass("temporal output")
-            .read(t.frame_color, Access::TransferRead)
-            .write(r.output, Access::TransferWrite)
-            .record(move |rec, res| {
-                rec.copy_buffer_to_image(res.buffer(t.frame_color)?, output);
-                Ok(())
-            });
     }
 }
