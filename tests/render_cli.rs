@@ -10,6 +10,18 @@ fn render(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// `passes` appear in `--print-frame` output `stdout` in this order.
+fn assert_passes_in_order(stdout: &str, passes: &[&str]) {
+    let mut at = 0;
+    for p in passes {
+        let line = format!(". {p}\n");
+        let found = stdout[at..]
+            .find(&line)
+            .unwrap_or_else(|| panic!("no pass {p} after byte {at}:\n{stdout}"));
+        at += found + line.len();
+    }
+}
+
 /// Run `render` with validation on, writing `out`; it must succeed. Its standard output.
 fn render_ok(args: &[&str], out: &std::path::Path) -> String {
     let mut all = args.to_vec();
@@ -149,14 +161,7 @@ fn print_frame_lists_every_pass_of_the_full_look() {
         "image readback",
         "host reads",
     ];
-    let mut at = 0;
-    for p in passes {
-        let line = format!(". {p}\n");
-        let found = stdout[at..]
-            .find(&line)
-            .unwrap_or_else(|| panic!("no pass {p} after byte {at}:\n{stdout}"));
-        at += found + line.len();
-    }
+    assert_passes_in_order(&stdout, &passes);
     // `auto` with k-buffer OIT draws every bundle in software: no hardware insert pass.
     assert!(!stdout.contains(". oit insert\n"), "{stdout}");
     for needle in [
@@ -209,14 +214,7 @@ fn temporal_accumulation_adds_its_passes() {
         "temporal output",
         "image readback",
     ];
-    let mut at = 0;
-    for p in passes {
-        let line = format!(". {p}\n");
-        let found = stdout[at..]
-            .find(&line)
-            .unwrap_or_else(|| panic!("no pass {p} after byte {at}:\n{stdout}"));
-        at += found + line.len();
-    }
+    assert_passes_in_order(&stdout, &passes);
     for needle in [
         "visibility (FragmentReadWrite)",
         "visibility (ComputeReadWrite)",
