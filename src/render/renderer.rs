@@ -83,33 +83,7 @@ pub struct Renderer {
 impl Renderer {
     /// Create pipelines, targets and frame slots; checks the device limits the settings need.
     pub fn new(ctx: &Arc<Context>, desc: &RendererDesc) -> GpuResult<Self> {
-        super::settings::check_size(desc.width, desc.height)?;
-        let range = ctx.info.max_storage_buffer_range;
-        if desc.vertex_pool_bytes < size_of::<HairVertex>() as u64 || desc.vertex_pool_bytes > range
-        {
-            return Err(GpuError::Unsupported(format!(
-                "vertex pool of {} bytes: must be {}..={range} (maxStorageBufferRange of {})",
-                desc.vertex_pool_bytes,
-                size_of::<HairVertex>(),
-                ctx.info.name
-            )));
-        }
-        if !(16..=8192).contains(&desc.shadow_resolution) {
-            return Err(GpuError::Unsupported(format!(
-                "shadow map resolution {} outside 16..=8192",
-                desc.shadow_resolution
-            )));
-        }
-        let soft_budget = desc
-            .soft_budget
-            .unwrap_or_else(|| SoftBudget::for_range(range));
-        soft_budget.validate(range).map_err(GpuError::Unsupported)?;
-        if !(desc.auto_split_pixels > 0.0 && desc.auto_split_pixels.is_finite()) {
-            return Err(GpuError::Unsupported(format!(
-                "auto split width {} pixels must be finite and positive",
-                desc.auto_split_pixels
-            )));
-        }
+        let soft_budget = check_desc(ctx, desc)?;
         let crowd = Crowd::new(ctx, desc.max_characters)?;
         let bindings: Vec<BindingDesc> = FrameBinding::ALL
             .iter()
@@ -505,4 +479,44 @@ impl Drop for Renderer {
         // Every frame's resources are released after the GPU is done with them.
         self.ctx.wait_idle();
     }
+}
+
+/// Check `desc` against itself and `ctx`'s device limits before anything is created; the
+/// software rasterizer's budgets it asks for.
+fn check_desc(ctx: &Context, desc: &RendererDesc) -> GpuResult<SoftBudget> {
+    super::settings::check_size(desc.width, desc.height)?;
+    let range = ctx.info.max_storage_buffer_range;
+    if desc.vertex_pool_bytes < size_of::<HairVertex>() as u64 || desc.vertex_pool_bytes > range {
+        return Err(GpuError::Unsupported(format!(
+            "vertex pool of {} bytes: must be {}..={range} (maxStorageBufferRange of {})",
+            desc.vertex_pool_bytes,
+            size_of::<HairVertex>(),
+            ctx.info.name
+        )));
+    }
+    if !(16..=8192).contains(&desc.shadow_resolution) {
+        return Err(GpuError::Unsupported(format!(
+            "shadow map resolution {} outside 16..=8192",
+            desc.shadow_resolution
+        )));
+    }
+    let soft_budget = desc
+        .soft_budget
+        .unwrap_or_else(|| SoftBudget::for_range(range));
+    soft_budget.validate(range).map_err(GpuError::Unsupported)?;
+    if !(desc.auto_split_pixels > 0.0 && desc.auto_split_pixels.is_finite()) {
+        return Err(GpuError::Unsupported(format!(
+            "auto split width {} pixels must be finite and positive",
+            desc.auto_split_pixels
+        )));
+    }
+    // Visibility ids carry the character slot in 16 bits (temporal.glsl).
+    let most = super::shared::VISIBILITY_INDEX + 1;
+    if desc.max_characters > most {
+        return Err(GpuError::Unsupported(format!(
+            "room for {} characters: at most {most} (motion vectors name a character in 16 bits)",
+            desc.max_characters
+        )));
+    }
+    Ok(soft_budget)
 }
