@@ -34,8 +34,7 @@ void main() {
 #ifdef SOFT_RASTER
     if (lod_is_soft(lod.y)) {
         float cap = model_scale * bundles[bundle].rest_size;
-        soft_fade = lod_strand_fade(lod, lod.x - 1u);
-        soft_fade_strand = lod.x - 1u - first;
+        fade_newest_strand(lod, first);
         emit_soft_segments(count, segments, width_scale, uintBitsToFloat(lod.w), cap, style_color(), bundles[bundle].character, t);
         return;
     }

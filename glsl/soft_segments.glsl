@@ -34,6 +34,13 @@ shared float sw[MAX_ENTRIES];
 float soft_fade = 1.0;
 uint soft_fade_strand = 0xFFFFFFFFu;
 
+// Before emit_soft_segments: the strands handed over start at strand `first` of a bundle
+// with LoD decision `lod`; its newest strand (if among them) fades in.
+void fade_newest_strand(uvec4 lod, uint first) {
+    soft_fade = lod_strand_fade(lod, lod.x - 1u);
+    soft_fade_strand = lod.x - 1u - first;
+}
+
 // Width of entry idx (strand `strand` of those handed over) at parameter s.
 float soft_vertex_width(uint idx, uint strand, float s, float width_scale) {
 #ifdef SOFT_POOL

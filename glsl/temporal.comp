@@ -168,6 +168,9 @@ vec3 clip_to_box(vec3 h, vec3 mean, vec3 extent) {
 
 vec3 accumulate(ivec2 p, uvec2 own) {
     vec3 current = current_color(p);
+    if (frame.temporal.z == 0u) {
+        return current;
+    }
     // The nearest surface of the 3x3 neighbourhood moves the pixel: a strand crossing it
     // drags its history along rather than the background behind.
     uvec2 near = own;
@@ -184,9 +187,6 @@ vec3 accumulate(ivec2 p, uvec2 own) {
             m1 += c;
             m2 += c * c;
         }
-    }
-    if (frame.temporal.z == 0u) {
-        return current;
     }
     vec2 centre = vec2(p) + 0.5;
     float depth = uintBitsToFloat(near.y);

@@ -92,9 +92,11 @@ impl Renderer {
             kbuffer_budget,
             temporal,
         )?;
-        let records = self.frame_records(&pose_updates);
+        // Motion matrices only where the frame's temporal pass reads them.
+        let moving = temporal.map(|_| &motion);
+        let records = self.frame_records(&pose_updates, moving);
         let blocks = (&block, light_block.as_ref());
-        let prop_draws = self.write_slot(i, blocks, &records, &motion, opts)?;
+        let prop_draws = self.write_slot(i, blocks, &records, moving, opts)?;
         let start = Instant::now();
         let work = FrameWork {
             path,
@@ -129,12 +131,23 @@ impl Renderer {
         Ok(FrameTicket(self.frame_number - 1))
     }
 
-    /// The character records of this frame, those in `pose_updates` marked deforming.
-    fn frame_records(&self, pose_updates: &[usize]) -> Vec<super::shared::CharacterRecord> {
+    /// The character records of this frame: those in `pose_updates` marked deforming, with
+    /// their motion where the frame has motion vectors.
+    fn frame_records(
+        &self,
+        pose_updates: &[usize],
+        motion: Option<&FrameMotion>,
+    ) -> Vec<super::shared::CharacterRecord> {
         let mut records = self.crowd.records();
         for &slot in pose_updates {
             if let Some(r) = records.get_mut(slot) {
                 r.flags |= super::shared::CHARACTER_DEFORMING;
+            }
+        }
+        if let Some(motion) = motion {
+            for (slot, r) in records.iter_mut().enumerate() {
+                let model = glam::Mat4::from_cols_array_2d(&r.model);
+                r.clip_to_prev = motion.character(slot, model).to_cols_array_2d();
             }
         }
         records
@@ -303,34 +316,34 @@ impl Renderer {
         (block, light_block)
     }
 
-    /// Write slot `i`'s frame blocks, `records` (with their motion) and prop instances (and
-    /// size its readbacks); returns this frame's prop draws.
+    /// Write slot `i`'s frame blocks, `records` and prop instances (with their motion where
+    /// the frame has motion vectors) and size its readbacks; returns this frame's prop draws.
     fn write_slot(
         &mut self,
         i: usize,
         (block, light_block): (&FrameBlock, Option<&FrameBlock>),
         records: &[super::shared::CharacterRecord],
-        motion: &FrameMotion,
+        motion: Option<&FrameMotion>,
         opts: &FrameOptions,
     ) -> GpuResult<Vec<PropDraw>> {
-        let mut records = records.to_vec();
-        for (slot, r) in records.iter_mut().enumerate() {
-            let model = glam::Mat4::from_cols_array_2d(&r.model);
-            r.clip_to_prev = motion.character(slot, model).to_cols_array_2d();
-        }
         let crowd = &self.crowd;
+        let still = glam::Mat4::IDENTITY;
         let moved = |id: super::crowd::CharacterId| {
             let model = crowd.drawn_model(id)?;
-            Some((model, motion.character(id.slot() as usize, model)))
+            Some((
+                model,
+                motion.map_or(still, |m| m.character(id.slot() as usize, model)),
+            ))
         };
-        let (prop_instances, prop_draws) = self.props.frame_lists(moved, motion.camera());
+        let world = motion.map_or(still, FrameMotion::camera);
+        let (prop_instances, prop_draws) = self.props.frame_lists(moved, world);
         let (width, height) = self.targets.size();
         let slot = &mut self.frames[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;
         if let Some(lb) = light_block {
             slot.light_ubo.write(0, bytemuck::bytes_of(lb))?;
         }
-        slot.records.write(0, bytemuck::cast_slice(&records))?;
+        slot.records.write(0, bytemuck::cast_slice(records))?;
         slot.prop_instances
             .write(0, bytemuck::cast_slice(&prop_instances))?;
         let pixels = width as u64 * height as u64;

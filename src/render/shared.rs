@@ -439,7 +439,7 @@ pub struct FrameBlock {
     /// Software rasterizer: x tiles per row, y tile rows; zw reserved.
     pub soft_grid: [u32; 4],
     /// Temporal (`render::Temporal`): x passes note the nearest surface per pixel (motion
-    /// vectors), y accumulation on, z history valid, w frame index.
+    /// vectors), y accumulation on, z history valid; w reserved.
     pub temporal: [u32; 4],
     /// Temporal: xy this frame's sub-pixel jitter (pixels, in `view_proj`), z history
     /// weight of a fully trusted pixel, w colour clamp width for hair (standard deviations).

@@ -28,9 +28,7 @@ use ash::vk;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::graph::TransientBuffer;
-use super::shared::{
-    FrameBinding, VISIBILITY_EMPTY, VISIBILITY_INDEX, VISIBILITY_PROP, VISIBILITY_SOLID,
-};
+use super::shared::{FrameBinding, VISIBILITY_EMPTY, VISIBILITY_PROP, VISIBILITY_SOLID};
 use crate::vk::{Buffer, BufferDesc, Context, GpuResult};
 
 /// Temporal accumulation of a frame.
@@ -243,6 +241,8 @@ impl TemporalState {
 pub struct FrameMotion {
     /// This frame's unjittered view-projection.
     pub view_proj: Mat4,
+    /// Its inverse (computed once: every character's `clip_to_prev` ends with it).
+    view_proj_inverse: Mat4,
     /// The previous frame's (this frame's where there is none: no motion).
     pub prev_view_proj: Mat4,
     /// The previous frame's model of each character slot.
@@ -254,6 +254,7 @@ impl FrameMotion {
     pub fn new(view_proj: Mat4, prev: Option<&PreviousFrame>) -> Self {
         FrameMotion {
             view_proj,
+            view_proj_inverse: view_proj.inverse(),
             prev_view_proj: prev.map_or(view_proj, |p| p.view_proj),
             prev_models: prev.map_or_else(Vec::new, |p| p.models.clone()),
         }
@@ -261,18 +262,16 @@ impl FrameMotion {
 
     /// `clip_to_prev` of what did not move (the background, world props).
     pub fn camera(&self) -> Mat4 {
-        clip_to_prev(self.prev_view_proj, Mat4::IDENTITY, self.view_proj)
+        self.prev_view_proj * self.view_proj_inverse
     }
 
     /// `clip_to_prev` of character slot `slot` at `model` now (the camera's where the slot
-    /// had no model last frame).
+    /// had no model last frame): [`clip_to_prev`] with the inverse computed once.
     pub fn character(&self, slot: usize, model: Mat4) -> Mat4 {
         match self.prev_models.get(slot).copied().flatten() {
-            Some(before) if model.determinant().abs() > 1e-20 => clip_to_prev(
-                self.prev_view_proj,
-                before * model.inverse(),
-                self.view_proj,
-            ),
+            Some(before) if model.determinant().abs() > 1e-20 => {
+                self.prev_view_proj * before * model.inverse() * self.view_proj_inverse
+            }
             _ => self.camera(),
         }
     }
@@ -323,12 +322,6 @@ impl PixelMotion {
     /// Whether the nearest surface is a character's hair.
     pub fn is_hair(&self) -> bool {
         self.id != VISIBILITY_EMPTY && self.id & (VISIBILITY_PROP | VISIBILITY_SOLID) == 0
-    }
-
-    /// The character slot of a hair or scalp pixel.
-    pub fn character(&self) -> Option<u32> {
-        (self.id != VISIBILITY_EMPTY && self.id & VISIBILITY_PROP == 0)
-            .then_some(self.id & VISIBILITY_INDEX)
     }
 }
 
