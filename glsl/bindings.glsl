@@ -35,6 +35,7 @@ HairStyle style;
 mat4 model;
 float model_scale;
 uint tex_slot;
+uint ch_prev_slot;  // texture slot of the previous frame's pose (tex_slot unless it changed)
 uint ch_strands;    // N of eq. 8
 uint ch_emax;       // full-detail vertex level e
 bool ch_visible;
@@ -45,6 +46,7 @@ void bind_character(uint c) {
     model = characters[c].model;
     model_scale = characters[c].model_scale;
     tex_slot = characters[c].texture_slot;
+    ch_prev_slot = characters[c].prev_texture_slot;
     ch_strands = characters[c].strands_per_bundle;
     ch_emax = characters[c].verts_log2;
     ch_visible = (characters[c].flags & CHARACTER_VISIBLE) != 0u;

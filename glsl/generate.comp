@@ -49,6 +49,11 @@ void main() {
             float fade = lod_strand_fade(lod, first + j);
             hair_vertices[out_index].pos_width = vec4(sp[idx], width_scale * fade * strand_width_at(s));
             hair_vertices[out_index].tangent_s = vec4(st[idx], s);
+#ifdef VISIBILITY
+            if (frame.temporal.w != 0u) {
+                vertex_motion[out_index] = packHalf2x16(entry_residual(idx, bundles[bundle].character));
+            }
+#endif
         }
     }
 }

@@ -19,7 +19,7 @@ void main() {
     if (a < 0.5 / 255.0) {
         return;
     }
-    note_fragment(in_character);
+    note_fragment(in_character, in_residual);
     uint pixel = oit_pixel();
     uint k = frame.transparency.y;
     uint64_t v = (uint64_t(floatBitsToUint(gl_FragCoord.z)) << 32) | uint64_t(pack_fragment(shade_strand(), a));

@@ -10,7 +10,7 @@
 layout(early_fragment_tests) in;
 
 void main() {
-    note_fragment(in_character);
+    note_fragment(in_character, in_residual);
     uint p = peel_pixel();
     float a = strand_alpha();
     vec4 acc = peel_accum[p];

@@ -18,7 +18,7 @@ layout(location = 0) out vec4 out_color;
 #define AMBIENT 0.3
 
 void main() {
-    note_fragment(VISIBILITY_PROP | in_instance);
+    note_fragment(VISIBILITY_PROP | in_instance, vec2(0.0));
     vec3 n = normalize(in_normal);
     vec3 l = normalize(frame.light_dir.xyz);
     vec3 v = normalize(frame.camera_pos.xyz - in_pos);

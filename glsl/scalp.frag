@@ -9,7 +9,7 @@ layout(location = 2) flat in uint in_character;
 layout(location = 0) out vec4 out_color;
 
 void main() {
-    note_fragment(VISIBILITY_SOLID | in_character);
+    note_fragment(VISIBILITY_SOLID | in_character, vec2(0.0));
     vec3 n = normalize(in_normal);
     // Two-sided: the scalp winding is arbitrary.
     float d = abs(dot(n, normalize(frame.light_dir.xyz)));

@@ -28,9 +28,11 @@ shared uint64_t s_tail[TILE_PIXELS * 2u];
 shared float s_depth[TILE_PIXELS];
 // optical_depth of each 8-bit fragment alpha (a log per evicted fragment otherwise).
 shared float s_optical_depth[256];
-// Per pixel: the nearest fragment's depth bits << 32 | visibility id (temporal.glsl), noted
-// into the frame's visibility once per pixel at the end.
+#ifdef VISIBILITY
+// Per pixel: the nearest fragment's visibility word (temporal.glsl), noted into the frame's
+// visibility once per pixel at the end.
 shared uint64_t s_visible[TILE_PIXELS];
+#endif
 
 // Add fragment `v` to pixel lp's K nearest (k of them), or its tail.
 void insert(uint lp, uint k, uint64_t v) {
@@ -73,6 +75,7 @@ struct SegmentRaster {
     vec4 cb;
     float thickness;
     uint id;
+    vec2 residual;  // deformation residual (temporal.glsl)
 };
 
 // The fragment of segment `s` in pixel `pixel` of the tile at `origin`: inserted when it lies
@@ -96,9 +99,11 @@ void shade_pixel(SegmentRaster s, ivec2 pixel, ivec2 origin, uint k) {
         return;
     }
     uint64_t v = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(pack_fragment(c.rgb, alpha));
+#ifdef VISIBILITY
     if (frame.temporal.x != 0u) {
-        atomicMin(s_visible[lp], (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(s.id));
+        atomicMin(s_visible[lp], visibility_word(depth, s.id, s.residual));
     }
+#endif
     insert(lp, k, v);
 }
 
@@ -112,10 +117,10 @@ ivec4 footprint_box(Segment s, ivec2 origin, ivec2 extent) {
 }
 
 // Rasterize segment `s` alone, walking its footprint inside the tile row by row.
-void raster_segment(Segment s, ivec2 origin, ivec2 extent, uint k) {
+void raster_segment(Segment s, vec2 residual, ivec2 origin, ivec2 extent, uint k) {
     float h = s.half_width;
     SegmentRaster r = SegmentRaster(segment_frame(s.a, s.b), h, vec2(s.za, s.zb), unpack_fragment(s.color_a),
-                                    unpack_fragment(s.color_b), s.thickness, s.id);
+                                    unpack_fragment(s.color_b), s.thickness, s.id, residual);
     ivec4 box = footprint_box(s, origin, extent);
     for (int y = box.y; y <= box.w; y++) {
         vec2 t = clip_param(s.a, s.b, 1, float(y) - h, float(y + 1) + h);
@@ -152,23 +157,34 @@ void main() {
     }
     s_tail[lp * 2u] = 0ul;
     s_tail[lp * 2u + 1u] = 0ul;
+#ifdef VISIBILITY
     s_visible[lp] = OIT_EMPTY;
+#endif
     s_depth[lp] = inside ? soft_depth[p] : 0.0;
     for (uint a = lp; a < 256u; a += TILE_PIXELS) {
         s_optical_depth[a] = optical_depth(float(a) / 255.0);
     }
     barrier();
     for (uint e = lp; e < info.w; e += TILE_PIXELS) {
-        raster_segment(load_segment(soft_entries[info.y + e]), origin, extent, k);
+        uint si = soft_entries[info.y + e];
+        vec2 residual = vec2(0.0);
+#ifdef VISIBILITY
+        if (frame.temporal.x != 0u) {
+            residual = unpackHalf2x16(segment_motion[si]);
+        }
+#endif
+        raster_segment(load_segment(si), residual, origin, extent, k);
     }
     barrier();
     if (!inside) {
         return;
     }
+#ifdef VISIBILITY
     uint64_t nearest = s_visible[lp];
     if (nearest != OIT_EMPTY) {
-        note_visible(uvec2(pixel), uintBitsToFloat(uint(nearest >> 32)), uint(nearest));
+        note_visible_word(uvec2(pixel), nearest);
     }
+#endif
     // Insert the tile's fragments into the k-buffer's sorted list (the pixel is this
     // thread's alone now): the nearest frame.transparency.y stay nodes, the others join the
     // tail.

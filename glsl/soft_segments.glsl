@@ -134,6 +134,18 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
                 soft_segments[out_index].dz_id = dz | ((character & VISIBILITY_INDEX) << 16);
                 soft_segments[out_index].b = uvec4(packHalf2x16(b.xy - a.xy), sv_color[idx], sv_color[idx + 1u],
                                                    packHalf2x16(vec2(0.5 * (a.w + b.w), thickness)));
+#ifdef VISIBILITY
+                if (frame.temporal.x != 0u) {
+                    // The segment's deformation residual: its ends' mean (the stored strands
+                    // of the static and LHS paths have none).
+#ifdef SOFT_POOL
+                    vec2 residual = vec2(0.0);
+#else
+                    vec2 residual = 0.5 * (entry_residual(idx, character) + entry_residual(idx + 1u, character));
+#endif
+                    segment_motion[out_index] = packHalf2x16(residual);
+                }
+#endif
             }
             out_index++;
         }

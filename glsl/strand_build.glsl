@@ -8,6 +8,8 @@
 #ifndef STRAND_BUILD_GLSL
 #define STRAND_BUILD_GLSL
 
+#include "temporal.glsl"
+
 #define S uint(STRAND_GROUP_SIZE)
 
 // Shared entries: P strands x (segments + 1) vertices <= S + P <= MAX_SEGMENTS + 1.
@@ -17,6 +19,10 @@
 
 shared vec3 sp[MAX_ENTRIES];   // positions, strand j at j * (segments + 1)
 shared vec3 st[MAX_ENTRIES];   // tangents
+#ifdef VISIBILITY
+// With deform_motion() (temporal.glsl): the previous pose's position minus this one's.
+shared vec3 sd[MAX_ENTRIES];
+#endif
 
 // Strands one workgroup builds for strands of `segments` segments.
 uint strands_per_group(uint segments) {
@@ -58,28 +64,59 @@ vec3 coarse_tangent_at(uint base, uint k, uint segments) {
     return coarse_tangent_at_even(base, k, segments);
 }
 
+// Shared entry idx: vertex k of strand si, world space; with `moving`, also its displacement
+// to the previous pose (the same strand from the previous texture set: same seed and root).
+void place_vertex(uint idx, StrandInfo si, uint k, uint segments, bool moving) {
+    vec3 now = (model * vec4(strand_vertex(si, k, segments), 1.0)).xyz;
+    sp[idx] = now;
+#ifdef VISIBILITY
+    if (moving) {
+        uint current = tex_slot;
+        tex_slot = ch_prev_slot;
+        sd[idx] = (model * vec4(strand_vertex(si, k, segments), 1.0)).xyz - now;
+        tex_slot = current;
+    }
+#endif
+}
+
+// Deformation residual (temporal.glsl) of shared entry idx of `character`, the bound one:
+// zero unless deform_motion().
+vec2 entry_residual(uint idx, uint character) {
+#ifdef VISIBILITY
+    if (deform_motion()) {
+        return deformation_residual(character, sp[idx], sd[idx]);
+    }
+#endif
+    return vec2(0.0);
+}
+
 // Build strands first .. first + strands_per_group(segments) - 1 of crowd bundle `bundle` (extra strands
 // past the bundle's count are computed and ignored by the caller). Must be called by all S
-// threads (contains barriers). World-space results in sp / st.
+// threads (contains barriers). World-space results in sp / st (and sd with deform_motion()).
 void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) {
     uint per = strands_per_group(segments);
     uint stride = segments + 1u;
+#ifdef VISIBILITY
+    bool moving = deform_motion();
+#else
+    bool moving = false;
+#endif
     if (per == 1u) {
         StrandInfo si = strand_info(bundle, first);
         uint n = segments / S;
         for (uint i = 0u; i < n; i++) {
             uint k = t * n + i + 1u;
-            sp[k] = (model * vec4(strand_vertex(si, k, segments), 1.0)).xyz;
+            place_vertex(k, si, k, segments, moving);
         }
         if (t == 0u) {
-            sp[0] = (model * vec4(strand_vertex(si, 0u, segments), 1.0)).xyz;
+            place_vertex(0u, si, 0u, segments, moving);
         }
     } else {
         uint j = t / segments;
         uint k = t % segments + 1u;
-        sp[j * stride + k] = (model * vec4(strand_vertex(strand_info(bundle, first + j), k, segments), 1.0)).xyz;
+        place_vertex(j * stride + k, strand_info(bundle, first + j), k, segments, moving);
         if (t < per) {
-            sp[t * stride] = (model * vec4(strand_vertex(strand_info(bundle, first + t), 0u, segments), 1.0)).xyz;
+            place_vertex(t * stride, strand_info(bundle, first + t), 0u, segments, moving);
         }
     }
     barrier();
@@ -89,6 +126,10 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
     // unmorphed positions, so results are written back after a barrier.
     vec3 tl[PER_THREAD];
     vec3 morphed[PER_THREAD];
+#ifdef VISIBILITY
+    // Eq. 11 is linear in the positions: the displacements morph alike.
+    vec3 morphed_d[PER_THREAD];
+#endif
     for (uint i = 0u; i < PER_THREAD; i++) {
         uint idx = t + i * S;
         if (idx < entries) {
@@ -104,6 +145,15 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
             }
             tl[i] = tk;
             morphed[i] = pk;
+#ifdef VISIBILITY
+            if (moving) {
+                vec3 dk = sd[idx];
+                if (gamma > 0.0 && segments >= 2u && (k & 1u) == 1u && k < segments) {
+                    dk = mix(dk, 0.5 * (sd[idx - 1u] + sd[idx + 1u]), gamma);
+                }
+                morphed_d[i] = dk;
+            }
+#endif
         }
     }
     barrier();
@@ -112,6 +162,11 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
         if (idx < entries) {
             st[idx] = tl[i];
             sp[idx] = morphed[i];
+#ifdef VISIBILITY
+            if (moving) {
+                sd[idx] = morphed_d[i];
+            }
+#endif
         }
     }
     barrier();

@@ -15,6 +15,8 @@ layout(location = 4) flat in uint in_character;
 layout(location = 5) in float in_coverage;
 // Strands this strip stands for under strand LoD (sec. 3.6.1 width factor; 1 at full detail).
 layout(location = 6) flat in float in_thickness;
+// Deformation residual of the strand here (temporal.glsl), pixels.
+layout(location = 7) in vec2 in_residual;
 
 // Radiance toward the eye of this fragment's strand.
 vec3 shade_strand() {

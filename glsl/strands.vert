@@ -4,6 +4,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 #include "strip.glsl"
+#include "temporal.glsl"
 
 layout(location = 0) out vec3 out_tangent;
 layout(location = 1) out float out_s;
@@ -12,6 +13,7 @@ layout(location = 3) flat out vec3 out_color;
 layout(location = 4) flat out uint out_character;
 layout(location = 5) out float out_coverage;
 layout(location = 6) flat out float out_thickness;
+layout(location = 7) out vec2 out_residual;
 
 void main() {
     uint idx = uint(gl_VertexIndex);
@@ -35,7 +37,8 @@ void main() {
     // Triangles (a-, a+, b-) and (b-, a+, b+).
     uint end = (corner == 2u || corner == 3u || corner == 5u) ? 1u : 0u;
     float side = (corner == 1u || corner == 4u || corner == 5u) ? 1.0 : -1.0;
-    HairVertex v = hair_vertices[bundle_offsets[lo].y + strand * (segments + 1u) + seg + end];
+    uint slot = bundle_offsets[lo].y + strand * (segments + 1u) + seg + end;
+    HairVertex v = hair_vertices[slot];
     float thickness = uintBitsToFloat(bundle_lods[lo].w);
     float drawn = drawn_width(v.pos_width.xyz, v.pos_width.w, thickness, model_scale * bundles[lo].rest_size);
     vec3 world = strip_offset(v.pos_width.xyz, v.tangent_s.xyz, drawn, side);
@@ -47,4 +50,11 @@ void main() {
     out_character = bundles[lo].character;
     out_coverage = strip_coverage(v.pos_width.w, drawn);
     out_thickness = thickness;
+    out_residual = vec2(0.0);
+#ifdef VISIBILITY
+    // Frames with motion on the compute path: generate.comp wrote every vertex's residual.
+    if (frame.temporal.x != 0u && frame.temporal.w != 0u) {
+        out_residual = unpackHalf2x16(vertex_motion[slot]);
+    }
+#endif
 }

@@ -1,7 +1,7 @@
 #version 460
 // Temporal pass (src/render/temporal.rs), one thread per pixel. With push.params.x, the
-// pixel's motion from its nearest surface (visibility word: depth, id; the id's clip_to_prev
-// matrix) is written to the motion target. With accumulation (frame.temporal.y) the history
+// pixel's motion from its nearest surface (visibility word: depth, id, deformation residual;
+// the id's clip_to_prev matrix) is written to the motion target. With accumulation (frame.temporal.y) the history
 // is reprojected (Catmull-Rom), checked against what the pixel is (visibility id and depth of
 // the nearest surface in the 3x3 neighbourhood, both frames), clipped to the neighbourhood's
 // colour box (wider on hair) and blended; the result goes to the history and, as sRGB bytes,
@@ -9,9 +9,9 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "bindings.glsl"
+#include "temporal.glsl"
 layout(local_size_x = TEMPORAL_GROUP, local_size_y = TEMPORAL_GROUP) in;
 
-layout(set = SET_FRAME, binding = BINDING_VISIBILITY, std430) readonly buffer VisibilityWords { uint64_t visibility[]; };
 layout(set = SET_FRAME, binding = BINDING_MOTION, std430) writeonly buffer MotionOut { uvec4 motion_out[]; };
 layout(set = SET_FRAME, binding = BINDING_FRAME_COLOR, std430) buffer FrameColor { uint frame_color[]; };
 // History: per pixel, the colour (rg and b halves) at [p], the surface (id, depth bits) at
@@ -33,11 +33,9 @@ uint index_of(ivec2 p) {
     return uint(q.y) * uint(image_size().x) + uint(q.x);
 }
 
-// The nearest surface at p: (visibility id, depth); the background is at the far plane.
+// The nearest surface at p: (visibility id, depth bits); the background is at the far plane.
 uvec2 surface_at(ivec2 p) {
-    uint64_t v = visibility[index_of(p)];
-    uint id = uint(v & 0xFFFFFFFFul);
-    return uvec2(id, id == VISIBILITY_EMPTY ? floatBitsToUint(1.0) : uint(v >> 32));
+    return visibility_surface(visibility[index_of(p)]);
 }
 
 mat4 clip_to_prev_of(uint id) {
@@ -58,22 +56,17 @@ vec4 previous_clip(uint id, vec2 centre, float depth) {
     return clip_to_prev_of(id) * vec4(ndc, depth, 1.0);
 }
 
-vec2 motion_at(uint id, vec2 centre, float depth) {
+// Rigid motion minus the deformation residual: this position minus the previous one.
+vec2 motion_at(uint id, vec2 centre, float depth, vec2 residual) {
     vec4 prev = previous_clip(id, centre, depth);
     if (abs(prev.w) < 1e-12) {
         return vec2(0.0);
     }
-    return centre - (prev.xy / prev.w + 1.0) * 0.5 * vec2(image_size());
+    return centre - (prev.xy / prev.w + 1.0) * 0.5 * vec2(image_size()) - residual;
 }
 
 bool is_hair(uint id) {
     return id != VISIBILITY_EMPTY && (id & (VISIBILITY_PROP | VISIBILITY_SOLID)) == 0u;
-}
-
-// Hair whose mesh changed pose this frame: it moves relative to its head, which the motion
-// vectors (rigid per character) do not follow.
-bool deforming(uint id) {
-    return is_hair(id) && (characters[id & VISIBILITY_INDEX].flags & CHARACTER_DEFORMING) != 0u;
 }
 
 vec3 linear_to_srgb(vec3 l) {
@@ -174,14 +167,17 @@ vec3 accumulate(ivec2 p, uvec2 own) {
     // The nearest surface of the 3x3 neighbourhood moves the pixel: a strand crossing it
     // drags its history along rather than the background behind.
     uvec2 near = own;
+    vec2 residual = visibility_residual(visibility[index_of(p)]);
     vec3 m1 = vec3(0.0);
     vec3 m2 = vec3(0.0);
     for (int j = -1; j <= 1; j++) {
         for (int i = -1; i <= 1; i++) {
             ivec2 q = p + ivec2(i, j);
-            uvec2 s = surface_at(q);
+            uint64_t w = visibility[index_of(q)];
+            uvec2 s = visibility_surface(w);
             if (uintBitsToFloat(s.y) < uintBitsToFloat(near.y)) {
                 near = s;
+                residual = visibility_residual(w);
             }
             vec3 c = to_ycocg(current_color(q));
             m1 += c;
@@ -191,17 +187,15 @@ vec3 accumulate(ivec2 p, uvec2 own) {
     vec2 centre = vec2(p) + 0.5;
     float depth = uintBitsToFloat(near.y);
     vec4 prev = previous_clip(near.x, centre, depth);
-    vec2 q = (prev.xy / prev.w + 1.0) * 0.5 * vec2(image_size());
+    vec2 q = (prev.xy / prev.w + 1.0) * 0.5 * vec2(image_size()) + residual;
     bool inside = prev.w > 0.0 && all(greaterThanEqual(q, vec2(0.0))) && all(lessThan(q, vec2(image_size())));
     if (!inside || !history_saw(q, near.x, prev.z / prev.w)) {
         return current;
     }
     vec3 mean = m1 / 9.0;
     vec3 sigma = sqrt(max(m2 / 9.0 - mean * mean, vec3(0.0)));
-    // Hair keeps a wide clamp (a tight one erases single strands); hair that deforms is
-    // clamped like a solid surface, against trails where its history is not where the
-    // rigid motion puts it.
-    float gamma = is_hair(near.x) && !deforming(near.x) ? frame.temporal_params.w : 1.0;
+    // Hair keeps a wide clamp (a tight one erases single strands).
+    float gamma = is_hair(near.x) ? frame.temporal_params.w : 1.0;
     vec3 h = clip_to_box(to_ycocg(history_at(q)), mean, gamma * sigma + 1e-4);
     return mix(from_ycocg(h), current, frame.temporal_params.z);
 }
@@ -214,7 +208,8 @@ void main() {
     uint i = index_of(p);
     uvec2 own = surface_at(p);
     if (push.params.x != 0u) {
-        vec2 m = motion_at(own.x, vec2(p) + 0.5, uintBitsToFloat(own.y));
+        vec2 residual = visibility_residual(visibility[i]);
+        vec2 m = motion_at(own.x, vec2(p) + 0.5, uintBitsToFloat(own.y), residual);
         motion_out[i] = uvec4(floatBitsToUint(m), own);
     }
     if (frame.temporal.y != 0u) {

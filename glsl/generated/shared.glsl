@@ -50,7 +50,9 @@
 #define VISIBILITY_SOLID 1073741824u
 #define VISIBILITY_INDEX 65535u
 #define TEMPORAL_GROUP 16u
+#define VISIBILITY_DEPTH_SHIFT 6u
 #define STRAND_OPACITY 0.7
+#define VISIBILITY_RESIDUAL_STEPS 8.0
 #define MARSCHNER_LUT_TRT_SCALE 5.0
 #define ROOT_PHONG_SHAPE 0.5
 #define HAIR_ETA 1.55
@@ -87,6 +89,8 @@
 #define BINDING_FRAME_COLOR 27
 #define BINDING_HISTORY_IN 28
 #define BINDING_HISTORY_OUT 29
+#define BINDING_VERTEX_MOTION 30
+#define BINDING_SEGMENT_MOTION 31
 #define BINDING_TEX_POSITION 0
 #define BINDING_TEX_UV 1
 #define BINDING_TEX_W 2
@@ -183,7 +187,7 @@ struct CharacterRecord {
     uint verts_log2;
     uint flags;
     float model_scale;
-    uint _pad;
+    uint prev_texture_slot;
     mat4 clip_to_prev;
 };
 

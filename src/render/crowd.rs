@@ -10,7 +10,7 @@ use ash::vk;
 use glam::Mat4;
 
 use super::shared::{
-    CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, TextureBinding,
+    CHARACTER_DEFORMING, CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, TextureBinding,
 };
 use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::bake::{BakedHairMesh, MeshInfo};
@@ -103,11 +103,27 @@ fn model_scale(model: &Mat4) -> f32 {
 }
 
 /// The GPU resources of one character: its five textures and, when its hair mesh moves, the
-/// update state.
+/// update state (with the other set of position, u and v textures).
 pub struct CharacterTextures {
     images: Vec<Image>,
     bytes: u64,
     deform: Option<super::deform::DeformState>,
+}
+
+impl CharacterTextures {
+    /// The image of texture `binding` made when the character was added.
+    pub(super) fn own_image(&self, binding: TextureBinding) -> &Image {
+        &self.images[binding as usize]
+    }
+
+    /// The current image of texture `binding`.
+    fn image(&self, binding: TextureBinding) -> &Image {
+        self.deform
+            .as_ref()
+            .filter(|d| d.alternate_current())
+            .and_then(|d| d.alternate(binding))
+            .unwrap_or(&self.images[binding as usize])
+    }
 }
 
 struct Character {
@@ -155,14 +171,15 @@ pub struct Crowd {
 
 impl Crowd {
     /// Room for `capacity` characters; fails with a clear message when the device's
-    /// descriptor-indexing limits cannot hold five textures per character.
+    /// descriptor-indexing limits cannot hold two sets of five textures per character (the
+    /// second: an animated character's other pose, elements `capacity..2 capacity`).
     pub fn new(ctx: &Arc<Context>, capacity: u32) -> GpuResult<Self> {
-        let limit = ctx.info.max_bindless_sampled_images / 5;
+        let limit = ctx.info.max_bindless_sampled_images / 10;
         if capacity == 0 || capacity > limit {
             return Err(GpuError::Unsupported(format!(
                 "{}: room for {capacity} characters needs {} bindless sampled images; the device allows {} ({limit} characters)",
                 ctx.info.name,
-                capacity as u64 * 5,
+                capacity as u64 * 10,
                 ctx.info.max_bindless_sampled_images
             )));
         }
@@ -176,7 +193,9 @@ impl Crowd {
         }
         let bindings: Vec<BindingDesc> = TextureBinding::ALL
             .iter()
-            .map(|(b, _)| BindingDesc::bindless(*b as u32, DescriptorKind::SampledImage, capacity))
+            .map(|(b, _)| {
+                BindingDesc::bindless(*b as u32, DescriptorKind::SampledImage, 2 * capacity)
+            })
             .collect();
         let texture_layout = DescriptorSetLayout::new(ctx, &bindings)?;
         let texture_set = DescriptorSet::new(ctx, "character textures", &texture_layout)?;
@@ -344,14 +363,32 @@ impl Crowd {
         basis: crate::bake::deform::DeformBasis,
         layout: &Arc<DescriptorSetLayout>,
     ) -> GpuResult<()> {
-        let ctx = self.ctx.clone();
-        let c = self.get_mut(id)?;
+        self.get_mut(id)?;
+        let c = self.slots[id.slot as usize]
+            .as_mut()
+            .expect("checked by get_mut");
         if basis.info != c.info {
             return Err(GpuError::Unsupported(
                 "the deform basis belongs to another bake (decode box or layout differ)".into(),
             ));
         }
-        c.textures.deform = Some(super::deform::DeformState::new(&ctx, basis, layout)?);
+        if c.textures.deform.is_some() {
+            return Err(GpuError::Unsupported(format!(
+                "character {id:?} is already deformable"
+            )));
+        }
+        let state = super::deform::DeformState::new(&self.ctx, basis, layout, &c.textures)?;
+        // The other texture set: its own position, u and v; the shared uv and w. No frame
+        // reads those elements before the first pose update.
+        let other = id.slot + self.capacity;
+        for (binding, _) in TextureBinding::ALL {
+            let image = state
+                .alternate(binding)
+                .unwrap_or(&c.textures.images[binding as usize]);
+            self.texture_set
+                .write_image(binding as u32, other, image, &self.sampler)?;
+        }
+        c.textures.deform = Some(state);
         Ok(())
     }
 
@@ -392,7 +429,7 @@ impl Crowd {
             .filter_map(|c| {
                 let d = c.textures.deform.as_ref()?;
                 let (set, groups) = d.dispatch(frame);
-                let img = |b: TextureBinding| &c.textures.images[b as usize];
+                let img = |b: TextureBinding| c.textures.image(b);
                 Some(super::passes::hair_mesh_update::UpdateJob {
                     set,
                     groups,
@@ -413,7 +450,7 @@ impl Crowd {
             .get(id.slot as usize)
             .and_then(|c| c.as_ref())
             .filter(|c| c.generation == id.generation)
-            .map(|c| &c.textures.images[binding as usize])
+            .map(|c| c.textures.image(binding))
             .ok_or_else(|| GpuError::Unsupported(format!("no character {id:?}")))
     }
 
@@ -585,9 +622,12 @@ impl Crowd {
         Ok(old)
     }
 
-    /// The character records of every slot (empty slots are invisible, with no bundles).
-    pub fn records(&self) -> Vec<CharacterRecord> {
-        self.slots
+    /// The character records of every slot (empty slots are invisible, with no bundles);
+    /// those in `deforming` (their pose changed this frame) flagged, with the previous pose's
+    /// texture set.
+    pub fn records(&self, deforming: &[usize]) -> Vec<CharacterRecord> {
+        let mut records: Vec<CharacterRecord> = self
+            .slots
             .iter()
             .enumerate()
             .map(|(slot, c)| match c {
@@ -595,18 +635,36 @@ impl Crowd {
                     model: c.model.to_cols_array_2d(),
                     mesh: c.info,
                     style: c.style,
-                    texture_slot: slot as u32,
+                    texture_slot: self.texture_element(slot, c, false),
                     first_bundle: c.first_bundle,
                     bundle_count: c.bundles.len() as u32,
                     strands_per_bundle: c.params.strands_per_bundle,
                     verts_log2: c.params.verts_log2,
                     flags: if c.visible { CHARACTER_VISIBLE } else { 0 },
                     model_scale: model_scale(&c.model),
-                    _pad: 0,
+                    prev_texture_slot: self.texture_element(slot, c, false),
                     clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
                 },
                 None => bytemuck::Zeroable::zeroed(),
             })
-            .collect()
+            .collect();
+        for &slot in deforming {
+            if let (Some(r), Some(Some(c))) = (records.get_mut(slot), self.slots.get(slot)) {
+                r.flags |= CHARACTER_DEFORMING;
+                r.prev_texture_slot = self.texture_element(slot, c, true);
+            }
+        }
+        records
+    }
+
+    /// The texture array element of slot `slot`'s current texture set (`previous`: the other
+    /// one, which holds the pose before the last update).
+    fn texture_element(&self, slot: usize, c: &Character, previous: bool) -> u32 {
+        let other = c
+            .textures
+            .deform
+            .as_ref()
+            .is_some_and(|d| d.alternate_current() != previous);
+        slot as u32 + if other { self.capacity } else { 0 }
     }
 }

@@ -1,7 +1,9 @@
 //! The GPU side of moving hair meshes (`bake::deform`): per animated character, the static
 //! basis (texel -> column map, styling terms, decode box) in buffers, one host-visible pose
 //! buffer per frame in flight, and the packed texels `glsl/hair_mesh_update.comp` writes before
-//! `passes::hair_mesh_update` copies them into the character's textures.
+//! `passes::hair_mesh_update` copies them into the character's textures. Its position, u and
+//! v textures exist twice: each pose update writes the set the last frame did not read, so
+//! the previous pose stays for the motion vectors (`render::temporal`).
 
 use std::sync::Arc;
 
@@ -11,9 +13,15 @@ use glam::Vec3;
 use super::shared::{DeformBinding, DeformParams};
 use super::slots::FRAMES_IN_FLIGHT;
 use crate::bake::deform::DeformBasis;
+use super::crowd::CharacterTextures;
+use super::shared::TextureBinding;
 use crate::vk::{
-    Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult,
+    Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult, Image,
 };
+
+/// The textures a pose update rewrites, in the order of the update's outputs.
+pub const POSED_TEXTURES: [TextureBinding; 3] =
+    [TextureBinding::Position, TextureBinding::U, TextureBinding::V];
 
 pub use super::shared::DEFORM_GROUP_SIZE;
 
@@ -24,6 +32,10 @@ pub struct DeformState {
     poses: Vec<(Buffer, DescriptorSet)>,
     /// Packed output texels: hair mesh texture, u, v.
     pub outputs: [Buffer; 3],
+    /// The other set of hair mesh, u and v textures.
+    alternates: [Image; 3],
+    /// Whether the alternates hold the current pose (else the character's own images).
+    alternate_current: bool,
     _static: [Buffer; 4],
     /// A pose given since the last frame, waiting for a frame slot.
     pending: Option<Vec<[f32; 4]>>,
@@ -50,12 +62,24 @@ fn with_data(ctx: &Arc<Context>, name: &str, bytes: &[u8]) -> GpuResult<Buffer> 
 }
 
 impl DeformState {
-    /// Buffers for `basis`; sets from `layout` (the update pass's).
+    /// Buffers for `basis`; sets from `layout` (the update pass's); the other texture set
+    /// made like `textures`' (zeroed: the first update writes it).
     pub fn new(
         ctx: &Arc<Context>,
         basis: DeformBasis,
         layout: &Arc<DescriptorSetLayout>,
+        textures: &CharacterTextures,
     ) -> GpuResult<Self> {
+        let alternate = |b: TextureBinding| {
+            let own = textures.own_image(b);
+            let desc = own.desc.clone();
+            Image::with_data(ctx, &desc, &vec![0; own.byte_size() as usize])
+        };
+        let alternates = [
+            alternate(POSED_TEXTURES[0])?,
+            alternate(POSED_TEXTURES[1])?,
+            alternate(POSED_TEXTURES[2])?,
+        ];
         let info = &basis.info;
         let slice = info.slice_texels() as u64;
         let layers = info.layers as u64;
@@ -125,10 +149,23 @@ impl DeformState {
             basis,
             poses,
             outputs,
+            alternates,
+            alternate_current: false,
             _static: statics,
             pending: None,
             pose_bounds: None,
         })
+    }
+
+    /// The other set's image of texture `binding` (`None`: uv and w, which poses keep).
+    pub fn alternate(&self, binding: TextureBinding) -> Option<&Image> {
+        let i = POSED_TEXTURES.iter().position(|b| *b == binding)?;
+        Some(&self.alternates[i])
+    }
+
+    /// Whether the other set holds the current pose.
+    pub fn alternate_current(&self) -> bool {
+        self.alternate_current
     }
 
     /// The basis (decode box, layout, styling terms).
@@ -173,13 +210,15 @@ impl DeformState {
         self.pose_bounds
     }
 
-    /// Write a pending pose into frame slot `slot`'s buffer (its earlier frame has completed);
-    /// whether there was one.
+    /// Write a pending pose into frame slot `slot`'s buffer (its earlier frame has completed)
+    /// and make the other texture set current (this frame's update writes it); whether there
+    /// was one.
     pub fn write_pending(&mut self, slot: usize) -> GpuResult<bool> {
         let Some(pose) = self.pending.take() else {
             return Ok(false);
         };
         self.poses[slot].0.write(0, bytemuck::cast_slice(&pose))?;
+        self.alternate_current = !self.alternate_current;
         Ok(true)
     }
 

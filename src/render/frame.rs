@@ -18,7 +18,7 @@ use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSe
 use super::renderer::{PresentTarget, Renderer};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
-use super::shared::{FrameBlock, PropInstance};
+use super::shared::{FrameBlock, HairVertex, PropInstance};
 use super::slots::{
     FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
 };
@@ -61,7 +61,7 @@ impl Renderer {
         mut present: Option<PresentTarget>,
     ) -> GpuResult<FrameTicket> {
         let (path, kbuffer_budget) = self.check_frame(view, opts)?;
-        let temporal = self.temporal_work(view, opts)?;
+        let temporal = self.temporal_work(view, opts, path)?;
         // What draws the frame's bundles, decided once (`auto` with k-buffer OIT is all
         // software): the passes, buffers and frame blocks all follow it.
         let raster = opts.raster.under(view.transparency);
@@ -131,19 +131,14 @@ impl Renderer {
         Ok(FrameTicket(self.frame_number - 1))
     }
 
-    /// The character records of this frame: those in `pose_updates` marked deforming, with
-    /// their motion where the frame has motion vectors.
+    /// The character records of this frame: those in `pose_updates` marked deforming (with
+    /// their previous pose's textures), with their motion where the frame has motion vectors.
     fn frame_records(
         &self,
         pose_updates: &[usize],
         motion: Option<&FrameMotion>,
     ) -> Vec<super::shared::CharacterRecord> {
-        let mut records = self.crowd.records();
-        for &slot in pose_updates {
-            if let Some(r) = records.get_mut(slot) {
-                r.flags |= super::shared::CHARACTER_DEFORMING;
-            }
-        }
+        let mut records = self.crowd.records(pose_updates);
         if let Some(motion) = motion {
             for (slot, r) in records.iter_mut().enumerate() {
                 let model = glam::Mat4::from_cols_array_2d(&r.model);
@@ -176,7 +171,12 @@ impl Renderer {
 
     /// This frame's temporal work (`None`: no motion vectors), or why this device cannot
     /// do it.
-    fn temporal_work(&self, view: &View, opts: &FrameOptions) -> GpuResult<Option<TemporalWork>> {
+    fn temporal_work(
+        &self,
+        view: &View,
+        opts: &FrameOptions,
+        path: RenderPath,
+    ) -> GpuResult<Option<TemporalWork>> {
         let accumulate = view.temporal == Temporal::Taa;
         if !accumulate && !opts.read_motion {
             return Ok(None);
@@ -187,7 +187,14 @@ impl Renderer {
                 self.ctx.info.name
             )));
         }
-        Ok(Some(TemporalWork { accumulate }))
+        let vertex_slots = match path {
+            RenderPath::Compute => self.desc.vertex_pool_bytes / size_of::<HairVertex>() as u64,
+            _ => 0,
+        };
+        Ok(Some(TemporalWork {
+            accumulate,
+            vertex_slots,
+        }))
     }
 
     /// The camera block's temporal fields for `work` (the view-projection jittered when
@@ -206,7 +213,8 @@ impl Renderer {
         let valid = work.accumulate && self.temporal.history_valid(size);
         let tuning = TemporalTuning::default();
         block.view_proj = jittered(view_proj, jitter, size).to_cols_array_2d();
-        block.temporal = [1, work.accumulate as u32, valid as u32, 0];
+        let residuals = work.vertex_slots > 0;
+        block.temporal = [1, work.accumulate as u32, valid as u32, residuals as u32];
         block.temporal_params = [jitter.x, jitter.y, tuning.current_weight, tuning.hair_clamp];
         block.clip_to_prev = motion.camera().to_cols_array_2d();
         motion

@@ -71,6 +71,13 @@ pub const VISIBILITY_SOLID: u32 = 1 << 30;
 /// Temporal: the character slot or prop instance of a visibility id (16 bits: the software
 /// rasterizer's segments carry it in half a word).
 pub const VISIBILITY_INDEX: u32 = (1 << 16) - 1;
+/// Temporal: the visibility word (`temporal.glsl`, [`super::temporal::VisibilityWord`]) keeps
+/// the depth's float bits shifted right by this (24 bits: depths lie in [0, 1], so the top two
+/// bits are zero).
+pub const VISIBILITY_DEPTH_SHIFT: u32 = 6;
+/// Temporal: steps per pixel of the visibility word's deformation residual (two signed 11-bit
+/// fields: +-128 pixels in eighths).
+pub const VISIBILITY_RESIDUAL_STEPS: f32 = 8.0;
 /// Temporal: threads per side of the temporal passes' square workgroups.
 pub const TEMPORAL_GROUP: u32 = 16;
 /// `FrameBlock::transparency.x`: opaque strands.
@@ -158,8 +165,8 @@ pub enum FrameBinding {
     /// Software shadows: per light texel, the deep opacity layers (4 halves in a `uvec2`,
     /// the RGBA16F texel), copied into the layers map.
     SoftShadowLayers = 24,
-    /// Temporal: per pixel, the nearest surface (`uint64`: depth bits << 32 | visibility id,
-    /// `temporal.glsl`), the motion vectors' source.
+    /// Temporal: per pixel, the nearest surface (`uint64` visibility word: depth, visibility
+    /// id, deformation residual; `temporal.glsl`), the motion vectors' source.
     Visibility = 25,
     /// Temporal: per pixel, the screen motion to the previous frame (`uvec4`: motion x and y
     /// bits in pixels, visibility id, depth bits), written when read back.
@@ -172,11 +179,16 @@ pub enum FrameBinding {
     HistoryIn = 28,
     /// Temporal: per pixel, the accumulated history written this frame.
     HistoryOut = 29,
+    /// Temporal: per slot of the vertex pool, the deformation residual of the vertex (`uint`:
+    /// two halves, pixels; `temporal.glsl`), written by the compute path with its vertices.
+    VertexMotion = 30,
+    /// Temporal: per software segment, its deformation residual (as `VertexMotion`).
+    SegmentMotion = 31,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 30] = [
+    pub const ALL: [(FrameBinding, &'static str); 32] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -207,6 +219,8 @@ impl FrameBinding {
         (FrameBinding::FrameColor, "BINDING_FRAME_COLOR"),
         (FrameBinding::HistoryIn, "BINDING_HISTORY_IN"),
         (FrameBinding::HistoryOut, "BINDING_HISTORY_OUT"),
+        (FrameBinding::VertexMotion, "BINDING_VERTEX_MOTION"),
+        (FrameBinding::SegmentMotion, "BINDING_SEGMENT_MOTION"),
     ];
 
     /// What the binding holds.
@@ -469,7 +483,8 @@ pub struct CharacterRecord {
     pub mesh: MeshInfo,
     /// Styling.
     pub style: HairStyle,
-    /// Element of the bindless texture arrays.
+    /// Element of the bindless texture arrays (the character's slot, or its slot plus the
+    /// crowd's capacity where an animated character's other texture set is current).
     pub texture_slot: u32,
     /// First bundle in the crowd's bundle table.
     pub first_bundle: u32,
@@ -483,8 +498,9 @@ pub struct CharacterRecord {
     pub flags: u32,
     /// Uniform scale of `model` (widths and styling margins).
     pub model_scale: f32,
-    /// Padding to 256 bytes.
-    pub _pad: u32,
+    /// Element of the textures of the previous frame's pose: `texture_slot` unless the pose
+    /// changed this frame (the generators evaluate both for exact motion vectors).
+    pub prev_texture_slot: u32,
     /// This frame's unjittered clip space to the previous frame's, for this character's
     /// surfaces (hair and scalp): the camera's motion and the character's own.
     pub clip_to_prev: [[f32; 4]; 4],
@@ -493,7 +509,7 @@ pub struct CharacterRecord {
 gpu_struct!(CharacterRecord as "CharacterRecord" {
     model: "mat4", mesh: "MeshInfo", style: "HairStyle", texture_slot: "uint",
     first_bundle: "uint", bundle_count: "uint", strands_per_bundle: "uint", verts_log2: "uint",
-    flags: "uint", model_scale: "float", _pad: "uint", clip_to_prev: "mat4",
+    flags: "uint", model_scale: "float", prev_texture_slot: "uint", clip_to_prev: "mat4",
 });
 
 /// One bundle of the crowd's bundle table: the baked [`BundleDesc`] plus its owner.
@@ -832,6 +848,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("VISIBILITY_SOLID", VISIBILITY_SOLID),
         uint("VISIBILITY_INDEX", VISIBILITY_INDEX),
         uint("TEMPORAL_GROUP", TEMPORAL_GROUP),
+        uint("VISIBILITY_DEPTH_SHIFT", VISIBILITY_DEPTH_SHIFT),
     ]
 }
 
@@ -839,6 +856,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
 fn float_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("STRAND_OPACITY", STRAND_OPACITY),
+        ("VISIBILITY_RESIDUAL_STEPS", VISIBILITY_RESIDUAL_STEPS),
         ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
         (
             "ROOT_PHONG_SHAPE",

@@ -3,15 +3,19 @@
 //!
 //! **Motion.** Every camera pass that draws a surface (strand fragments in every
 //! transparency mode, the software rasterizer's fragments, scalps, props) notes the nearest
-//! surface of each pixel in a visibility word: depth bits << 32 | visibility id, by 64-bit
-//! `atomicMin` (`temporal.glsl`). The id names a character (hair, or its scalp with
-//! [`VISIBILITY_SOLID`]) or a prop instance, and each of those carries the matrix from this
-//! frame's unjittered clip space to the previous frame's (`clip_to_prev`: the previous
-//! view-projection, the surface's own rigid motion, the inverse of this one), so a pixel's
-//! motion follows from its depth alone, exactly for camera motion and characters that move
-//! as a whole (walk, turn, sway). Hair generated from the same textures and seed lands on
-//! the same strands both frames, so this is the strands' own motion; a hair mesh that
-//! changes pose relative to its head (dynamics) moves with the head only.
+//! surface of each pixel in a visibility word ([`VisibilityWord`]: depth, visibility id,
+//! deformation residual), by 64-bit `atomicMin` (`temporal.glsl`). The id names a character
+//! (hair, or its scalp with [`VISIBILITY_SOLID`]) or a prop instance, and each of those
+//! carries the matrix from this frame's unjittered clip space to the previous frame's
+//! (`clip_to_prev`: the previous view-projection, the surface's own rigid motion, the
+//! inverse of this one), so a pixel's rigid motion follows from its depth alone, exactly for
+//! camera motion and characters that move as a whole (walk, turn, sway). Hair generated from
+//! the same textures and seed lands on the same strands both frames. Where a hair mesh also
+//! changed pose relative to its head this frame (dynamics, wind), the generators evaluate
+//! every strand vertex a second time from the previous pose's textures (an animated
+//! character keeps two texture sets and alternates between them) and carry the difference,
+//! projected into the previous frame's pixels, as the residual: rigid motion minus residual
+//! is the strand's exact motion.
 //!
 //! **Accumulation** (`temporal.comp`): the history is reprojected with a Catmull-Rom filter
 //! (sharp: a single strand stays a strand), and trusted by what the pixel *is*, not only by
@@ -28,7 +32,10 @@ use ash::vk;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::graph::TransientBuffer;
-use super::shared::{FrameBinding, VISIBILITY_EMPTY, VISIBILITY_PROP, VISIBILITY_SOLID};
+use super::shared::{
+    FrameBinding, VISIBILITY_DEPTH_SHIFT, VISIBILITY_EMPTY, VISIBILITY_INDEX, VISIBILITY_PROP,
+    VISIBILITY_RESIDUAL_STEPS, VISIBILITY_SOLID,
+};
 use crate::vk::{Buffer, BufferDesc, Context, GpuResult};
 
 /// Temporal accumulation of a frame.
@@ -135,6 +142,64 @@ pub fn motion_at(clip_to_prev: Mat4, centre: Vec2, depth: f32, size: Vec2) -> Ve
     }
     let prev_px = (Vec2::new(prev.x, prev.y) / prev.w + 1.0) * 0.5 * size;
     centre - prev_px
+}
+
+/// A pixel's visibility word, the CPU twin of `temporal.glsl`: from the top, 24 bits of the
+/// depth's float bits (nearest wins the `atomicMin`), the visibility id in 18 bits (16 of
+/// index, then [`VISIBILITY_SOLID`] and [`VISIBILITY_PROP`]), and the deformation residual
+/// in two signed 11-bit fields of [`VISIBILITY_RESIDUAL_STEPS`] per pixel. An empty word
+/// (all ones) decodes as [`VISIBILITY_EMPTY`] at depth 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisibilityWord {
+    /// Depth, 0..1 (quantised to the word's 24 bits).
+    pub depth: f32,
+    /// Visibility id.
+    pub id: u32,
+    /// Previous-frame position of the strand minus its rigidly moved position, pixels.
+    pub residual: Vec2,
+}
+
+const RESIDUAL_BIAS: i32 = 1 << 10;
+const ID_EMPTY: u64 = (1 << 18) - 1;
+
+impl VisibilityWord {
+    /// Pack into the GPU's word.
+    pub fn pack(&self) -> u64 {
+        let depth = (self.depth.clamp(0.0, 1.0).to_bits() >> VISIBILITY_DEPTH_SHIFT) as u64;
+        let id = if self.id == VISIBILITY_EMPTY {
+            ID_EMPTY
+        } else {
+            let kind = (self.id & VISIBILITY_SOLID != 0) as u64 | 2 * (self.id & VISIBILITY_PROP != 0) as u64;
+            (self.id & VISIBILITY_INDEX) as u64 | kind << 16
+        };
+        let field = |r: f32| {
+            let steps = (r * VISIBILITY_RESIDUAL_STEPS + 0.5).floor() as i32;
+            (steps.clamp(-RESIDUAL_BIAS, RESIDUAL_BIAS - 1) + RESIDUAL_BIAS) as u64
+        };
+        depth << 40 | id << 22 | field(self.residual.x) << 11 | field(self.residual.y)
+    }
+
+    /// Decode the GPU's word.
+    pub fn unpack(word: u64) -> Self {
+        let id18 = (word >> 22) & ID_EMPTY;
+        if id18 == ID_EMPTY {
+            return VisibilityWord {
+                depth: 1.0,
+                id: VISIBILITY_EMPTY,
+                residual: Vec2::ZERO,
+            };
+        }
+        let kind = id18 >> 16;
+        let id = (id18 & VISIBILITY_INDEX as u64) as u32
+            | if kind & 1 != 0 { VISIBILITY_SOLID } else { 0 }
+            | if kind & 2 != 0 { VISIBILITY_PROP } else { 0 };
+        let field = |f: u64| ((f & 0x7FF) as i32 - RESIDUAL_BIAS) as f32 / VISIBILITY_RESIDUAL_STEPS;
+        VisibilityWord {
+            depth: f32::from_bits(((word >> 40) as u32) << VISIBILITY_DEPTH_SHIFT),
+            id,
+            residual: Vec2::new(field(word >> 11), field(word)),
+        }
+    }
 }
 
 /// Bytes per pixel of the history (`uvec2` colour: rg and b halves; `uvec2` surface:
@@ -277,15 +342,29 @@ impl FrameMotion {
     }
 }
 
-/// The temporal passes' transient buffers of a `width x height` frame: visibility, motion and
-/// the frame's colour (0 bytes where unused: `motion` off, or no accumulation).
+/// What a frame's temporal passes do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TemporalWork {
+    /// Blend the reprojected history into the frame (else motion vectors only).
+    pub accumulate: bool,
+    /// Vertex pool slots whose deformation residuals the compute path writes (0 on the other
+    /// paths: the mesh path hands them to its fragments, the stored strands have none).
+    pub vertex_slots: u64,
+}
+
+/// The temporal passes' transient buffers of a `width x height` frame: visibility, motion,
+/// the frame's colour, and the deformation residuals of the compute path's vertices and the
+/// software rasterizer's `segments` (0 bytes where unused: no motion, no accumulation).
 pub fn transient_buffers(
-    motion: bool,
-    accumulate: bool,
+    work: Option<TemporalWork>,
+    segments: u32,
     (w, h): (u32, u32),
-) -> [TransientBuffer; 3] {
+) -> [TransientBuffer; 5] {
     let pixels = w as u64 * h as u64;
+    let motion = work.is_some();
+    let accumulate = work.is_some_and(|t| t.accumulate);
     let on = |bytes: u64, used: bool| if used { bytes * pixels } else { 0 };
+    let residuals = |count: u64| if motion { 4 * count } else { 0 };
     [
         TransientBuffer::storage("visibility", on(8, motion), FrameBinding::Visibility as u32),
         TransientBuffer::storage("motion", on(16, motion), FrameBinding::Motion as u32),
@@ -294,6 +373,16 @@ pub fn transient_buffers(
             "frame colour",
             on(8, accumulate),
             FrameBinding::FrameColor as u32,
+        ),
+        TransientBuffer::storage(
+            "vertex motion",
+            residuals(work.map_or(0, |t| t.vertex_slots)),
+            FrameBinding::VertexMotion as u32,
+        ),
+        TransientBuffer::storage(
+            "segment motion",
+            residuals(segments as u64),
+            FrameBinding::SegmentMotion as u32,
         ),
     ]
 }
@@ -426,6 +515,34 @@ pub fn downsample(rgba: &[u8], size: (u32, u32), factor: u32) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn visibility_words_order_by_depth_and_round_trip() {
+        let word = |depth: f32, id: u32, r: Vec2| VisibilityWord {
+            depth,
+            id,
+            residual: r,
+        };
+        let cases = [
+            word(0.25, 7, Vec2::new(3.5, -1.25)),
+            word(0.999, VISIBILITY_SOLID | 65535, Vec2::ZERO),
+            word(1.0, VISIBILITY_PROP | 3, Vec2::new(-128.0, 127.875)),
+        ];
+        for w in cases {
+            let back = VisibilityWord::unpack(w.pack());
+            assert_eq!(back.id, w.id);
+            assert_eq!(back.residual, w.residual);
+            assert!((back.depth - w.depth).abs() <= w.depth * 2f32.powi(-16), "{back:?}");
+        }
+        // Nearer wins whatever the id and residual; residuals past the range clamp.
+        let far = word(0.5001, 0, Vec2::splat(-200.0));
+        let near = word(0.5, VISIBILITY_PROP | 65535, Vec2::splat(200.0));
+        assert!(near.pack() < far.pack());
+        assert_eq!(VisibilityWord::unpack(far.pack()).residual, Vec2::splat(-128.0));
+        let empty = VisibilityWord::unpack(u64::MAX);
+        assert_eq!((empty.id, empty.depth), (VISIBILITY_EMPTY, 1.0));
+        assert!(word(1.0, VISIBILITY_PROP | 65535, Vec2::splat(127.0)).pack() < u64::MAX);
+    }
 
     #[test]
     fn jitter_covers_the_pixel_in_eight_frames() {

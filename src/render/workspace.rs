@@ -232,7 +232,9 @@ impl Workspace {
                 | FrameBinding::SoftShadowLayers
                 | FrameBinding::Visibility
                 | FrameBinding::Motion
-                | FrameBinding::FrameColor => continue,
+                | FrameBinding::FrameColor
+                | FrameBinding::VertexMotion
+                | FrameBinding::SegmentMotion => continue,
                 FrameBinding::HistoryIn => frame.history.map_or(&self.placeholder, |h| h.0),
                 FrameBinding::HistoryOut => frame.history.map_or(&self.placeholder, |h| h.1),
                 FrameBinding::ShadowHairDepth

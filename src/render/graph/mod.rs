@@ -242,6 +242,14 @@ impl<'a> PassBuilder<'_, 'a> {
         }
     }
 
+    /// [`Self::read`] of `res` where there is one.
+    pub fn read_some(self, res: Option<Res>, access: Access) -> Self {
+        match res {
+            Some(r) => self.read(r, access),
+            None => self,
+        }
+    }
+
     /// [`Self::read`] of every resource in `list`.
     pub fn read_all(self, list: &[Res], access: Access) -> Self {
         list.iter().fold(self, |p, r| p.read(*r, access))

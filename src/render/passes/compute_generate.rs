@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets, device_shader_options, dispatch_2d};
+use super::{FrameRes, TemporalRes, PassSets, device_shader_options, dispatch_2d};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::{CULL_GROUP_SIZE, GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
 use crate::vk::shader::compile;
@@ -118,6 +118,12 @@ impl ComputeGenerate {
             p = p
                 .write(r.soft_segments, rw)
                 .read_all(&r.shadow, Access::SampledRead);
+        }
+        if view == GenerateView::Camera {
+            // Frames with motion vectors: the vertices' and segments' deformation residuals.
+            p = p
+                .write_some(TemporalRes::vertex_motion(r.temporal), rw)
+                .write_some(TemporalRes::segment_motion(r.temporal), rw);
         }
         p.record(move |rec, _| {
             rec.bind(generate, &sets.both());

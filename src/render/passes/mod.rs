@@ -259,11 +259,25 @@ pub struct TemporalRes {
     pub motion: Res,
     /// The frame's colour as a buffer (accumulation).
     pub frame_color: Res,
+    /// Deformation residuals of the compute path's vertices.
+    pub vertex_motion: Res,
+    /// Deformation residuals of the software rasterizer's segments.
+    pub segment_motion: Res,
     /// The history read and the one written (placeholders without accumulation).
     pub history: (Res, Res),
 }
 
 impl TemporalRes {
+    /// The vertex residuals of `t`, if the frame has motion vectors.
+    pub fn vertex_motion(t: Option<Self>) -> Option<Res> {
+        t.map(|t| t.vertex_motion)
+    }
+
+    /// The segment residuals of `t`, if the frame has motion vectors.
+    pub fn segment_motion(t: Option<Self>) -> Option<Res> {
+        t.map(|t| t.segment_motion)
+    }
+
     /// Create the temporal transients of `t` (visibility, motion, frame colour) and import
     /// the history buffers: the visibility words and the rest, in frames with motion vectors.
     fn new<'a>(
@@ -271,7 +285,8 @@ impl TemporalRes {
         t: &FrameTransients,
         history: Option<(&'a Buffer, &'a Buffer)>,
     ) -> Option<(Res, Self)> {
-        let [visibility, motion, frame_color] = t.temporal.map(|d| g.create_buffer(d));
+        let [visibility, motion, frame_color, vertex_motion, segment_motion] =
+            t.temporal.map(|d| g.create_buffer(d));
         let history = history.map(|(read, write)| {
             (
                 g.import_buffer("temporal history read", read),
@@ -283,6 +298,8 @@ impl TemporalRes {
             TemporalRes {
                 motion,
                 frame_color,
+                vertex_motion,
+                segment_motion,
                 history: history.unwrap_or((frame_color, frame_color)),
             },
         ))
@@ -327,8 +344,9 @@ pub struct FrameTransients {
     pub soft_shadow: [TransientBuffer; 2],
     /// Depth peeling's layer depth attachment, when peeling.
     pub peel_image: Option<ImageDesc>,
-    /// Visibility, motion and frame colour (`render::temporal::transient_buffers`).
-    pub temporal: [TransientBuffer; 3],
+    /// Visibility, motion, frame colour, vertex and segment residuals
+    /// (`render::temporal::transient_buffers`).
+    pub temporal: [TransientBuffer; 5],
     /// Whether the frame computes motion vectors.
     pub motion: bool,
 }
@@ -344,9 +362,9 @@ impl FrameTransients {
         (width, height): (u32, u32),
         temporal: Option<temporal::TemporalWork>,
     ) -> Self {
-        let accumulate = temporal.is_some_and(|t| t.accumulate);
+        let segments = camera.map_or(0, |b| b.segments);
         let temporal_buffers =
-            super::temporal::transient_buffers(temporal.is_some(), accumulate, (width, height));
+            super::temporal::transient_buffers(temporal, segments, (width, height));
         let peel = matches!(transparency, Transparency::DepthPeeling { .. });
         let budget = camera.or(light.map(|l| l.0)).unwrap_or(SoftBudget::EMPTY);
         let views = (camera.map(|_| (width, height)), light.map(|l| l.1));
@@ -821,7 +839,7 @@ impl FramePasses {
             .write_some(r.visibility, Access::FragmentReadWrite);
         let strands = inp.bundles > 0 && resolve;
         if strands {
-            p = strands::strand_uses(p, r, inp.path, true);
+            p = strands::strand_uses(p, r, inp.path, strands::StrandUse::CameraShaded);
         }
         let (mut query, rest) = match strands && mesh {
             true => (query, None),

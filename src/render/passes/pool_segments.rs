@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets, device_shader_options};
+use super::{FrameRes, TemporalRes, PassSets, device_shader_options};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::GenerateArgs;
 use crate::vk::shader::compile;
@@ -49,6 +49,7 @@ impl PoolSegments {
             .read(r.args, Access::IndirectRead)
             .write(r.args, rw)
             .write(r.soft_segments, rw)
+            .write_some(TemporalRes::segment_motion(r.temporal), rw)
             .read_all(&r.shadow, Access::SampledRead)
             .record(move |rec, _| {
                 rec.bind(&self.pipeline, &sets.both());

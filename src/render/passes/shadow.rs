@@ -7,7 +7,7 @@
 use std::sync::Arc;
 
 use super::props::{PropDraw, PropPass};
-use super::strands::{StrandDraw, strand_uses};
+use super::strands::{StrandDraw, StrandUse, strand_uses};
 use super::{DrawTarget, FrameRes, PassSets};
 use crate::render::RenderPath;
 use crate::render::graph::FrameGraph;
@@ -61,7 +61,7 @@ impl ShadowPass {
             .pass("shadow hair depth")
             .discard(hair, Access::DepthAttachment);
         let (path, bundles, args) = (d.path, d.bundles, r.args_buffer);
-        strand_uses(p, r, path, false).record(move |rec, _| {
+        strand_uses(p, r, path, StrandUse::Light).record(move |rec, _| {
             rec.begin_rendering_depth(Attachment {
                 image: hair_image,
                 clear: Some([1.0; 4]),
@@ -79,7 +79,7 @@ impl ShadowPass {
                 .pass("shadow opacity")
                 .read(hair, Access::SampledRead)
                 .discard(layers, Access::ColorAttachment);
-            strand_uses(p, r, path, false).record(move |rec, _| {
+            strand_uses(p, r, path, StrandUse::Light).record(move |rec, _| {
                 rec.begin_rendering_color(Attachment {
                     image: layers_image,
                     clear: Some([0.0; 4]),

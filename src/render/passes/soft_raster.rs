@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets, device_shader_options, dispatch_2d};
+use super::{FrameRes, TemporalRes, PassSets, device_shader_options, dispatch_2d};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::GenerateArgs;
 use crate::render::soft::tile_grid;
@@ -94,6 +94,10 @@ impl SoftRasterPass {
             .write(r.args, Access::TaskReadWrite)
             .write(r.args, Access::MeshReadWrite)
             .write(r.soft_segments, Access::MeshReadWrite)
+            .write_some(
+                TemporalRes::segment_motion(r.temporal),
+                Access::MeshReadWrite,
+            )
             .read_all(&r.shadow, Access::SampledRead)
             .record(move |rec, _| {
                 let p = pipeline.ok_or_else(|| {
@@ -146,6 +150,7 @@ impl SoftRasterPass {
             .write(r.oit_nodes, rw)
             .write(r.oit_tail, rw)
             .write_some(r.visibility, rw)
+            .read_some(TemporalRes::segment_motion(r.temporal), Access::ComputeRead)
             .record(move |rec, _| {
                 rec.bind(&self.raster, &sets.both());
                 rec.dispatch(tx, ty, 1);

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{DrawTarget, FrameRes, PassSets, device_shader_options, dispatch_2d};
+use super::{DrawTarget, FrameRes, TemporalRes, PassSets, device_shader_options, dispatch_2d};
 use crate::render::RenderPath;
 use crate::render::graph::PassBuilder;
 use crate::render::shared::{
@@ -144,26 +144,42 @@ impl StrandDraw {
     }
 }
 
+/// Which view a strand draw serves, and whether its fragments are lit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StrandUse {
+    /// The light's view: depth and opacity only.
+    Light,
+    /// The camera's view, depth only (depth peeling's layer pass).
+    CameraDepth,
+    /// The camera's view, lit (shadow maps, shading table).
+    CameraShaded,
+}
+
 /// Declare what drawing the strands as `path` does reads and writes (beside the pass's
-/// targets): the pulled paths read the vertex pool, LoDs and offsets and the draw arguments;
-/// the mesh path's task shaders read the textures and add to the statistics. `shaded`: the
-/// fragment shaders light the strands (shadow maps, shading table).
+/// targets): the pulled paths read the vertex pool, LoDs and offsets and the draw arguments
+/// (and in the camera's view the vertices' deformation residuals); the mesh path's task
+/// shaders read the textures and add to the statistics.
 pub fn strand_uses<'g, 'a>(
     p: PassBuilder<'g, 'a>,
     r: &FrameRes,
     path: RenderPath,
-    shaded: bool,
+    used: StrandUse,
 ) -> PassBuilder<'g, 'a> {
+    let residuals = match used {
+        StrandUse::Light => None,
+        _ => TemporalRes::vertex_motion(r.temporal),
+    };
     let p = if path.pulls_vertices() {
         p.read(r.constants, Access::VertexRead)
             .read_all(&[r.pool, r.lods, r.offsets], Access::VertexRead)
+            .read_some(residuals, Access::VertexRead)
             .read(r.args, Access::IndirectRead)
     } else {
         p.read_all(&[r.constants, r.textures], Access::TaskRead)
             .read(r.textures, Access::MeshRead)
             .write(r.args, Access::TaskReadWrite)
     };
-    if shaded {
+    if used == StrandUse::CameraShaded {
         p.read_all(&r.shadow, Access::SampledRead)
     } else {
         p

@@ -12,12 +12,7 @@ use crate::render::shared::TEMPORAL_GROUP;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 
-/// What a frame's temporal passes do.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct TemporalWork {
-    /// Blend the reprojected history into the frame (else motion vectors only).
-    pub accumulate: bool,
-}
+pub use crate::render::temporal::TemporalWork;
 
 /// The motion and accumulation pipeline (`temporal.comp`, two stages).
 pub struct TemporalPass {

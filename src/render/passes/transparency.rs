@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::strands::{StrandDraw, strand_uses};
+use super::strands::{StrandDraw, StrandUse, strand_uses};
 use super::{DrawTarget, FrameRes, PassSets, TargetFormats, device_shader_options};
 use crate::render::RenderPath;
 use crate::render::graph::FrameGraph;
@@ -179,7 +179,7 @@ impl TransparencyPass {
                     (draw.sets, draw.bundles, draw.path, r.args_buffer);
                 let depth = r.images.depth;
                 let mut query = draw.mesh_query.filter(|_| path == RenderPath::Mesh);
-                strand_uses(pass, r, path, true).record(move |rec, _| {
+                strand_uses(pass, r, path, StrandUse::CameraShaded).record(move |rec, _| {
                     rec.begin_rendering_depth(Attachment {
                         image: depth,
                         clear: None,
@@ -294,7 +294,11 @@ impl TransparencyPass {
                         .write_some(r.visibility, Access::FragmentReadWrite)
                 };
                 let pass = pass.read(r.peel_depth, Access::FragmentRead);
-                strand_uses(pass, r, path, i == 1).record(move |rec, res| {
+                let used = match i {
+                    0 => StrandUse::CameraDepth,
+                    _ => StrandUse::CameraShaded,
+                };
+                strand_uses(pass, r, path, used).record(move |rec, res| {
                     rec.begin_rendering_depth(Attachment {
                         image: res.image(image_res)?,
                         clear: (i == 0).then_some([1.0; 4]),
