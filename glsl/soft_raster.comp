@@ -137,6 +137,16 @@ void raster_segment(Segment s, vec2 residual, ivec2 origin, ivec2 extent, uint k
     }
 }
 
+// Deformation residual of segment si (temporal.glsl), in frames with motion vectors.
+vec2 segment_residual(uint si) {
+#ifdef VISIBILITY
+    if (frame.temporal.x != 0u) {
+        return unpackHalf2x16(segment_motion[si]);
+    }
+#endif
+    return vec2(0.0);
+}
+
 void main() {
     uint cols = tiles_per_row();
     uint tile = gl_WorkGroupID.y * cols + gl_WorkGroupID.x;
@@ -167,13 +177,7 @@ void main() {
     barrier();
     for (uint e = lp; e < info.w; e += TILE_PIXELS) {
         uint si = soft_entries[info.y + e];
-        vec2 residual = vec2(0.0);
-#ifdef VISIBILITY
-        if (frame.temporal.x != 0u) {
-            residual = unpackHalf2x16(segment_motion[si]);
-        }
-#endif
-        raster_segment(load_segment(si), residual, origin, extent, k);
+        raster_segment(load_segment(si), segment_residual(si), origin, extent, k);
     }
     barrier();
     if (!inside) {

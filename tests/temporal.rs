@@ -289,6 +289,57 @@ fn a_cut_has_no_motion() {
     assert_no_validation_errors(&ctx);
 }
 
+/// A hair mesh swung sideways and back, more toward the tips, and its rest pose (layer-major).
+fn swing(mesh: &hairmesh::model::hair_mesh::HairMesh) -> [Vec<Vec3>; 2] {
+    let rest: Vec<Vec3> = mesh.layers.iter().flatten().copied().collect();
+    let n = mesh.vertices_per_layer();
+    let swung = rest
+        .iter()
+        .enumerate()
+        .map(|(j, p)| {
+            let d = p.distance(mesh.layers[0][j % n]);
+            *p + Vec3::new(0.4 * d, 0.0, -0.15 * d)
+        })
+        .collect();
+    [rest, swung]
+}
+
+/// Compare `motion` at every strand vertex of `after` (world space, projected by `vp`) that is
+/// the nearest surface of its pixel with the vertex's move from `before`: the medians of the
+/// error and of the move, and how many vertices were compared.
+fn strand_motion_error(
+    motion: &[PixelMotion],
+    (before, after): (&[Vec3], &[Vec3]),
+    vp: Mat4,
+) -> (f32, f32, usize) {
+    let size = Vec2::splat(SIZE as f32);
+    let project = |p: Vec3| {
+        let c = vp * p.extend(1.0);
+        let ndc = c.truncate() / c.w;
+        ((Vec2::new(ndc.x, ndc.y) + 1.0) * 0.5 * size, ndc.z)
+    };
+    let (mut errors, mut moves) = (Vec::new(), Vec::new());
+    for (b, a) in after.iter().zip(before) {
+        let ((pb, zb), (pa, _)) = (project(*b), project(*a));
+        if pb.min_element() < 0.0 || pb.max_element() >= size.x {
+            continue;
+        }
+        let p = motion[pb.y as usize * SIZE as usize + pb.x as usize];
+        // Only where this vertex's strand is the pixel's nearest surface.
+        let ratio = (1.0 - p.depth) / (1.0 - zb).max(1e-9);
+        if p.is_hair() && (0.98..1.02).contains(&ratio) {
+            errors.push((p.motion - (pb - pa)).length());
+            moves.push((pb - pa).length());
+        }
+    }
+    let median = |mut v: Vec<f32>| {
+        v.sort_by(f32::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f32::NAN)
+    };
+    let count = errors.len();
+    (median(errors), median(moves), count)
+}
+
 /// Hair that deforms relative to its head (a new hair mesh pose, still camera) has the motion
 /// of its own strands: at every strand vertex of the new pose that is the nearest surface of
 /// its pixel, the GPU's motion equals the vertex's screen position minus its position in the
@@ -315,17 +366,7 @@ fn deforming_hair_has_the_motion_of_its_strands() {
     };
     let baked = bake(&mesh, &style, options, |_, _| {}).unwrap();
     let basis = DeformBasis::new(&mesh, &baked, options).unwrap();
-    let rest: Vec<Vec3> = mesh.layers.iter().flatten().copied().collect();
-    // The hair swings sideways and back, more toward the tips.
-    let n = mesh.vertices_per_layer();
-    let swung: Vec<Vec3> = rest
-        .iter()
-        .enumerate()
-        .map(|(j, p)| {
-            let d = p.distance(mesh.layers[0][j % n]);
-            *p + Vec3::new(0.4 * d, 0.0, -0.15 * d)
-        })
-        .collect();
+    let poses = swing(&mesh);
     let strands = |pose: &[Vec3]| {
         let t = basis.rebuild(pose);
         let posed = BakedHairMesh {
@@ -336,15 +377,8 @@ fn deforming_hair_has_the_motion_of_its_strands() {
         };
         CpuGenerator::new(&posed, style).generate(16, 4).positions
     };
-    let (before, after) = (strands(&rest), strands(&swung));
+    let (before, after) = (strands(&poses[0]), strands(&poses[1]));
     let cam = framing(&baked);
-    let vp = cam.view_proj(1.0);
-    let size = Vec2::splat(SIZE as f32);
-    let project = |p: Vec3| {
-        let c = vp * p.extend(1.0);
-        let ndc = c.truncate() / c.w;
-        ((Vec2::new(ndc.x, ndc.y) + 1.0) * 0.5 * size, ndc.z)
-    };
     let modes = [
         (RenderPath::Mesh, StrandRaster::Hardware),
         (RenderPath::Compute, StrandRaster::Hardware),
@@ -355,7 +389,7 @@ fn deforming_hair_has_the_motion_of_its_strands() {
         let id = upload(&mut r, &baked, &style, 16, 4);
         r.make_deformable(id, basis.clone()).unwrap();
         let mut motion = Vec::new();
-        for pose in [&rest, &swung] {
+        for pose in &poses {
             r.set_hair_mesh_pose(id, pose).unwrap();
             let opts = FrameOptions {
                 path: Some(path),
@@ -366,28 +400,11 @@ fn deforming_hair_has_the_motion_of_its_strands() {
             let v = view(cam, Transparency::Opaque, Temporal::Off);
             motion = r.render_one(&v, &opts).unwrap().motion.unwrap();
         }
-        let (mut errors, mut moves) = (Vec::new(), Vec::new());
-        for (b, a) in after.iter().zip(&before) {
-            let ((pb, zb), (pa, _)) = (project(*b), project(*a));
-            if pb.min_element() < 0.0 || pb.max_element() >= size.x {
-                continue;
-            }
-            let p = motion[pb.y as usize * SIZE as usize + pb.x as usize];
-            // Only where this vertex's strand is the pixel's nearest surface.
-            let ratio = (1.0 - p.depth) / (1.0 - zb).max(1e-9);
-            if p.is_hair() && (0.98..1.02).contains(&ratio) {
-                let expected = pb - pa;
-                errors.push((p.motion - expected).length());
-                moves.push(expected.length());
-            }
-        }
-        let median = |v: &mut Vec<f32>| {
-            v.sort_by(f32::total_cmp);
-            v[v.len() / 2]
-        };
-        let count = errors.len();
-        let (error, moved) = (median(&mut errors), median(&mut moves));
-        println!("{path:?} {raster:?}: {count} vertices, median error {error:.3} px, median move {moved:.3} px");
+        let pair = (before.as_slice(), after.as_slice());
+        let (error, moved, count) = strand_motion_error(&motion, pair, cam.view_proj(1.0));
+        println!(
+            "{path:?} {raster:?}: {count} vertices, median error {error:.3} px, median move {moved:.3} px"
+        );
         assert!(count > 200, "{path:?} {raster:?}: {count} vertices seen");
         assert!(moved > 1.5, "the pose moved the hair {moved} px");
         assert!(

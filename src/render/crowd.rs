@@ -10,7 +10,8 @@ use ash::vk;
 use glam::Mat4;
 
 use super::shared::{
-    CHARACTER_DEFORMING, CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, TextureBinding,
+    CHARACTER_DEFORMING, CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2,
+    TextureBinding,
 };
 use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::bake::{BakedHairMesh, MeshInfo};

@@ -10,18 +10,21 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec3;
 
+use super::crowd::CharacterTextures;
+use super::shared::TextureBinding;
 use super::shared::{DeformBinding, DeformParams};
 use super::slots::FRAMES_IN_FLIGHT;
 use crate::bake::deform::DeformBasis;
-use super::crowd::CharacterTextures;
-use super::shared::TextureBinding;
 use crate::vk::{
     Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult, Image,
 };
 
 /// The textures a pose update rewrites, in the order of the update's outputs.
-pub const POSED_TEXTURES: [TextureBinding; 3] =
-    [TextureBinding::Position, TextureBinding::U, TextureBinding::V];
+pub const POSED_TEXTURES: [TextureBinding; 3] = [
+    TextureBinding::Position,
+    TextureBinding::U,
+    TextureBinding::V,
+];
 
 pub use super::shared::DEFORM_GROUP_SIZE;
 
@@ -61,25 +64,30 @@ fn with_data(ctx: &Arc<Context>, name: &str, bytes: &[u8]) -> GpuResult<Buffer> 
     Buffer::device_local_with_data(ctx, name, vk::BufferUsageFlags::STORAGE_BUFFER, &padded)
 }
 
+/// The other set of posed textures, made like `textures`' (zeroed: the first update writes
+/// it).
+fn alternates(ctx: &Arc<Context>, textures: &CharacterTextures) -> GpuResult<[Image; 3]> {
+    let alternate = |b: TextureBinding| {
+        let own = textures.own_image(b);
+        Image::with_data(ctx, &own.desc, &vec![0; own.byte_size() as usize])
+    };
+    Ok([
+        alternate(POSED_TEXTURES[0])?,
+        alternate(POSED_TEXTURES[1])?,
+        alternate(POSED_TEXTURES[2])?,
+    ])
+}
+
 impl DeformState {
     /// Buffers for `basis`; sets from `layout` (the update pass's); the other texture set
-    /// made like `textures`' (zeroed: the first update writes it).
+    /// made like `textures`'.
     pub fn new(
         ctx: &Arc<Context>,
         basis: DeformBasis,
         layout: &Arc<DescriptorSetLayout>,
         textures: &CharacterTextures,
     ) -> GpuResult<Self> {
-        let alternate = |b: TextureBinding| {
-            let own = textures.own_image(b);
-            let desc = own.desc.clone();
-            Image::with_data(ctx, &desc, &vec![0; own.byte_size() as usize])
-        };
-        let alternates = [
-            alternate(POSED_TEXTURES[0])?,
-            alternate(POSED_TEXTURES[1])?,
-            alternate(POSED_TEXTURES[2])?,
-        ];
+        let alternates = alternates(ctx, textures)?;
         let info = &basis.info;
         let slice = info.slice_texels() as u64;
         let layers = info.layers as u64;

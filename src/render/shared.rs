@@ -29,7 +29,7 @@ pub const DISPATCH_ROW: u32 = 65535;
 /// `CharacterRecord::flags`: the character is drawn this frame.
 pub const CHARACTER_VISIBLE: u32 = 1;
 /// `CharacterRecord::flags`: the character's hair mesh changed pose this frame (its hair moves
-/// relative to its head, which the rigid motion vectors do not follow).
+/// relative to its head; `prev_texture_slot` holds the previous pose).
 pub const CHARACTER_DEFORMING: u32 = 2;
 
 pub use crate::shade::lut::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE};

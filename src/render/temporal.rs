@@ -169,7 +169,8 @@ impl VisibilityWord {
         let id = if self.id == VISIBILITY_EMPTY {
             ID_EMPTY
         } else {
-            let kind = (self.id & VISIBILITY_SOLID != 0) as u64 | 2 * (self.id & VISIBILITY_PROP != 0) as u64;
+            let kind = (self.id & VISIBILITY_SOLID != 0) as u64
+                | 2 * (self.id & VISIBILITY_PROP != 0) as u64;
             (self.id & VISIBILITY_INDEX) as u64 | kind << 16
         };
         let field = |r: f32| {
@@ -193,7 +194,8 @@ impl VisibilityWord {
         let id = (id18 & VISIBILITY_INDEX as u64) as u32
             | if kind & 1 != 0 { VISIBILITY_SOLID } else { 0 }
             | if kind & 2 != 0 { VISIBILITY_PROP } else { 0 };
-        let field = |f: u64| ((f & 0x7FF) as i32 - RESIDUAL_BIAS) as f32 / VISIBILITY_RESIDUAL_STEPS;
+        let field =
+            |f: u64| ((f & 0x7FF) as i32 - RESIDUAL_BIAS) as f32 / VISIBILITY_RESIDUAL_STEPS;
         VisibilityWord {
             depth: f32::from_bits(((word >> 40) as u32) << VISIBILITY_DEPTH_SHIFT),
             id,
@@ -532,13 +534,19 @@ mod tests {
             let back = VisibilityWord::unpack(w.pack());
             assert_eq!(back.id, w.id);
             assert_eq!(back.residual, w.residual);
-            assert!((back.depth - w.depth).abs() <= w.depth * 2f32.powi(-16), "{back:?}");
+            assert!(
+                (back.depth - w.depth).abs() <= w.depth * 2f32.powi(-16),
+                "{back:?}"
+            );
         }
         // Nearer wins whatever the id and residual; residuals past the range clamp.
         let far = word(0.5001, 0, Vec2::splat(-200.0));
         let near = word(0.5, VISIBILITY_PROP | 65535, Vec2::splat(200.0));
         assert!(near.pack() < far.pack());
-        assert_eq!(VisibilityWord::unpack(far.pack()).residual, Vec2::splat(-128.0));
+        assert_eq!(
+            VisibilityWord::unpack(far.pack()).residual,
+            Vec2::splat(-128.0)
+        );
         let empty = VisibilityWord::unpack(u64::MAX);
         assert_eq!((empty.id, empty.depth), (VISIBILITY_EMPTY, 1.0));
         assert!(word(1.0, VISIBILITY_PROP | 65535, Vec2::splat(127.0)).pack() < u64::MAX);

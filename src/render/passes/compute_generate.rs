@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, TemporalRes, PassSets, device_shader_options, dispatch_2d};
+use super::{FrameRes, PassSets, TemporalRes, device_shader_options, dispatch_2d};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::{CULL_GROUP_SIZE, GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
 use crate::vk::shader::compile;

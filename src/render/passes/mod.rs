@@ -285,8 +285,13 @@ impl TemporalRes {
         t: &FrameTransients,
         history: Option<(&'a Buffer, &'a Buffer)>,
     ) -> Option<(Res, Self)> {
-        let [visibility, motion, frame_color, vertex_motion, segment_motion] =
-            t.temporal.map(|d| g.create_buffer(d));
+        let [
+            visibility,
+            motion,
+            frame_color,
+            vertex_motion,
+            segment_motion,
+        ] = t.temporal.map(|d| g.create_buffer(d));
         let history = history.map(|(read, write)| {
             (
                 g.import_buffer("temporal history read", read),

@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, TemporalRes, PassSets, device_shader_options};
+use super::{FrameRes, PassSets, TemporalRes, device_shader_options};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::GenerateArgs;
 use crate::vk::shader::compile;

@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, TemporalRes, PassSets, device_shader_options, dispatch_2d};
+use super::{FrameRes, PassSets, TemporalRes, device_shader_options, dispatch_2d};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::GenerateArgs;
 use crate::render::soft::tile_grid;

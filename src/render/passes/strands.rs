@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{DrawTarget, FrameRes, TemporalRes, PassSets, device_shader_options, dispatch_2d};
+use super::{DrawTarget, FrameRes, PassSets, TemporalRes, device_shader_options, dispatch_2d};
 use crate::render::RenderPath;
 use crate::render::graph::PassBuilder;
 use crate::render::shared::{
