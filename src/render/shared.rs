@@ -78,6 +78,14 @@ pub const VISIBILITY_DEPTH_SHIFT: u32 = 6;
 /// Temporal: steps per pixel of the visibility word's deformation residual (two signed 11-bit
 /// fields: +-128 pixels in eighths).
 pub const VISIBILITY_RESIDUAL_STEPS: f32 = 8.0;
+/// Temporal: the current frame's weight on a solid surface (scalp, prop) moving by
+/// [`TEMPORAL_SOLID_MOTION`] pixels a frame or more (still ones take the tuning's weight; in
+/// between it grows linearly): a long history blurs and lags moving solid edges, which do not
+/// flicker like strands.
+pub const TEMPORAL_SOLID_MOVING_WEIGHT: f32 = 0.5;
+/// Temporal: the motion, pixels a frame, from which a solid surface takes
+/// [`TEMPORAL_SOLID_MOVING_WEIGHT`].
+pub const TEMPORAL_SOLID_MOTION: f32 = 0.25;
 /// Temporal: threads per side of the temporal passes' square workgroups.
 pub const TEMPORAL_GROUP: u32 = 16;
 /// `FrameBlock::transparency.x`: opaque strands.
@@ -857,6 +865,8 @@ fn float_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("STRAND_OPACITY", STRAND_OPACITY),
         ("VISIBILITY_RESIDUAL_STEPS", VISIBILITY_RESIDUAL_STEPS),
+        ("TEMPORAL_SOLID_MOVING_WEIGHT", TEMPORAL_SOLID_MOVING_WEIGHT),
+        ("TEMPORAL_SOLID_MOTION", TEMPORAL_SOLID_MOTION),
         ("MARSCHNER_LUT_TRT_SCALE", MARSCHNER_LUT_TRT_SCALE),
         (
             "ROOT_PHONG_SHAPE",

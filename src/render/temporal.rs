@@ -23,8 +23,12 @@
 //! reprojected depth, is a disocclusion and is dropped; on hair the colour clamp is wider
 //! ([`TemporalTuning::hair_clamp`] standard deviations of the 3x3 neighbourhood in YCoCg),
 //! because a sub-pixel strand's neighbourhood rarely brackets its own history, and a tight
-//! clamp erases strands. The jitter (Halton 2, 3 over 8 frames) moves the raster by under a
-//! pixel each frame, so the history integrates 8 sample positions per pixel.
+//! clamp erases strands. A pixel moves with the nearest hair of its 3x3 neighbourhood (a
+//! strand thinner than a pixel drags its history along) but never with a neighbouring solid
+//! (its silhouette would smear). Moving solid surfaces keep a shorter history
+//! ([`super::shared::TEMPORAL_SOLID_MOVING_WEIGHT`]) against blur and lag on their edges. The
+//! jitter (Halton 2, 3 over 8 frames) moves the raster by under a pixel each frame, so the
+//! history integrates 8 sample positions per pixel.
 
 use std::sync::Arc;
 
@@ -169,8 +173,9 @@ impl VisibilityWord {
         let id = if self.id == VISIBILITY_EMPTY {
             ID_EMPTY
         } else {
-            let kind = (self.id & VISIBILITY_SOLID != 0) as u64
-                | 2 * (self.id & VISIBILITY_PROP != 0) as u64;
+            let solid = (self.id & VISIBILITY_SOLID != 0) as u64;
+            let prop = (self.id & VISIBILITY_PROP != 0) as u64;
+            let kind = solid | (prop << 1);
             (self.id & VISIBILITY_INDEX) as u64 | kind << 16
         };
         let field = |r: f32| {

@@ -46,6 +46,27 @@ pub struct TemporalArgs {
     /// Choose the GPU by name substring.
     #[arg(long)]
     device: Option<String>,
+    /// Write the last frame of every scenario as a PNG strip: reference, off, taa side by
+    /// side, one row per scenario.
+    #[arg(long)]
+    strip: Option<std::path::PathBuf>,
+}
+
+/// Rows of side-by-side images of `size` into one RGBA image.
+fn compose(rows: &[Vec<Vec<u8>>], (w, h): (u32, u32)) -> (Vec<u8>, u32, u32) {
+    let cols = rows.iter().map(Vec::len).max().unwrap_or(0) as u32;
+    let (width, height) = (w * cols, h * rows.len() as u32);
+    let mut out = vec![0u8; (width * height * 4) as usize];
+    for (r, row) in rows.iter().enumerate() {
+        for (c, img) in row.iter().enumerate() {
+            for y in 0..h as usize {
+                let src = &img[y * w as usize * 4..(y + 1) * w as usize * 4];
+                let at = ((r * h as usize + y) * width as usize + c * w as usize) * 4;
+                out[at..at + src.len()].copy_from_slice(src);
+            }
+        }
+    }
+    (out, width, height)
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -273,9 +294,15 @@ pub fn bench_temporal(a: TemporalArgs) -> Result<()> {
     if !(1..=8).contains(&a.supersample) {
         bail!("--supersample {}: 1..=8", a.supersample);
     }
+    let strip = a
+        .strip
+        .as_ref()
+        .map(|p| hairmesh::fsutil::OutputPath::check(p, &[]))
+        .transpose()?;
     let ctx = Arc::new(Context::new(
         &ContextDesc::default().device(a.device.clone()),
     )?);
+    let mut rows = Vec::new();
     outln!(
         "{}: {}x{}, {} frames ({} warm-up), reference {}x{} samples per pixel, full detail",
         ctx.info.name,
@@ -300,6 +327,7 @@ pub fn bench_temporal(a: TemporalArgs) -> Result<()> {
             a.frames,
         )?;
         let mut motion = Vec::new();
+        let mut row = vec![reference.images.last().cloned().unwrap_or_default()];
         for temporal in Temporal::ALL {
             let ours = run(&ctx, name, (a.size, 1), (temporal, a.draw, true), a.frames)?;
             if temporal == Temporal::Off {
@@ -315,7 +343,13 @@ pub fn bench_temporal(a: TemporalArgs) -> Result<()> {
                 super::median(ours.gpu_ms[skip..].to_vec()),
                 super::median(ours.temporal_ms[skip..].to_vec())
             )?;
+            row.push(ours.images.last().cloned().unwrap_or_default());
         }
+        rows.push(row);
+    }
+    if let Some(out) = strip {
+        let (rgba, w, h) = compose(&rows, a.size);
+        super::write_png(&out, rgba, w, h)?;
     }
     Ok(())
 }
