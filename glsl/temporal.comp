@@ -8,6 +8,11 @@
 // to the second half of the frame's colour buffer, which is copied onto the output image.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+// Only ever built for devices with 64-bit atomics (passes::temporal), whose shaders note
+// visibility words.
+#ifndef VISIBILITY
+#define VISIBILITY 1
+#endif
 #include "bindings.glsl"
 #include "temporal.glsl"
 layout(local_size_x = TEMPORAL_GROUP, local_size_y = TEMPORAL_GROUP) in;

@@ -165,8 +165,9 @@ enum Cmd {
     /// hair's luminance between frames moved along the true motion, ours over the
     /// reference's, FLIP against the reference, and the accumulation's GPU ms.
     Temporal(temporal::TemporalArgs),
-    /// One hair mesh in wind, simulated and re-textured every frame (30 Hz): CPU ms of the
-    /// dynamics, GPU ms of the texture rebuild and of the frame; optionally a strip of frames.
+    /// Copies of one hair mesh in wind, simulated and re-textured every frame (30 Hz), for
+    /// each character count: CPU ms of the dynamics (all cores), GPU ms of the texture rebuild
+    /// and of the frame; optionally a strip of frames.
     Animate {
         /// Hair mesh OBJ (style: the .toml beside it).
         #[arg(long, default_value = "hairmeshes/head_long.obj")]
@@ -183,7 +184,11 @@ enum Cmd {
         /// Strands per bundle.
         #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=4096))]
         strands_per_bundle: u32,
-        /// Write frames side by side here.
+        /// Character counts, one run each (copies of the mesh on a grid, all simulated every
+        /// frame on all cores).
+        #[arg(long, value_delimiter = ',', default_value = "1")]
+        counts: Vec<u32>,
+        /// Write frames (of the first count) side by side here.
         #[arg(long)]
         strip: Option<PathBuf>,
         /// Frames in the strip (evenly spaced).
@@ -639,6 +644,7 @@ fn run(args: Args) -> Result<()> {
             wind,
             size,
             strands_per_bundle,
+            counts,
             strip,
             strip_frames,
             device,
@@ -648,6 +654,7 @@ fn run(args: Args) -> Result<()> {
             wind,
             size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
             strands_per_bundle,
+            counts,
             strip,
             strip_frames,
             device,

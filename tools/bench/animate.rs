@@ -1,6 +1,7 @@
-//! `bench animate`: one hair mesh in wind, simulated and re-textured every frame: CPU ms of
-//! the hair dynamics, GPU ms of the texture rebuild, GPU ms of the frame, per frame (medians);
-//! optionally a strip of frames side by side.
+//! `bench animate`: copies of one hair mesh in wind, each simulated (on all cores) and
+//! re-textured every frame: CPU ms of the hair dynamics, GPU ms of the texture rebuild, GPU ms
+//! of the frame, per frame (medians), for each character count; optionally a strip of frames
+//! of the first count side by side.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -9,13 +10,15 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use glam::{Mat4, Vec3};
 use hairmesh::animate::{CharacterMotion, Collider, DynamicsSettings, HairDynamics, Wind};
+use hairmesh::bake::BakedHairMesh;
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::fsutil::OutputPath;
+use hairmesh::model::hair_mesh::HairMesh;
 use hairmesh::model::obj_io::load_hair_mesh_obj;
 use hairmesh::outln;
 use hairmesh::render::{
-    Camera, FrameOptions, LodSettings, Renderer, RendererDesc, ShadowMode, StrandParams,
-    Transparency, View,
+    Camera, CharacterId, FrameOptions, LodSettings, Renderer, RendererDesc, ShadowMode,
+    StrandParams, Transparency, View,
 };
 use hairmesh::vk::{Context, ContextDesc};
 use hairmesh::{BakeOptions, HairStyle, bake};
@@ -27,22 +30,28 @@ pub struct AnimateArgs {
     pub wind: f32,
     pub size: (u32, u32),
     pub strands_per_bundle: u32,
+    pub counts: Vec<u32>,
     pub strip: Option<PathBuf>,
     pub strip_frames: u32,
     pub device: Option<String>,
 }
 
-pub fn bench_animate(a: AnimateArgs) -> Result<()> {
-    if !(0.0..=100.0).contains(&a.wind) {
-        bail!("--wind {}: must be 0..=100", a.wind);
-    }
-    let strip = a
-        .strip
-        .as_ref()
-        .map(|p| OutputPath::check(p, &[a.mesh.as_path()]))
-        .transpose()?;
-    let mesh = load_hair_mesh_obj(&a.mesh)?;
-    let style = match HairStyle::beside(&a.mesh) {
+/// Most characters one run animates (the renderer's default room).
+const MOST_CHARACTERS: u32 = 1024;
+
+/// The hair mesh, its style and bake, and its size.
+struct Sample {
+    mesh: HairMesh,
+    style: HairStyle,
+    baked: BakedHairMesh,
+    options: BakeOptions,
+    centre: Vec3,
+    size: f32,
+}
+
+fn load(path: &std::path::Path) -> Result<Sample> {
+    let mesh = load_hair_mesh_obj(path)?;
+    let style = match HairStyle::beside(path) {
         Some(p) => HairStyle::load(&p)?,
         None => HairStyle::default(),
     };
@@ -53,17 +62,32 @@ pub fn bench_animate(a: AnimateArgs) -> Result<()> {
         ..Default::default()
     };
     let baked = bake(&mesh, &style, options, |_, _| {})?;
-    let ctx = Arc::new(Context::new(
-        &ContextDesc::default().device(a.device.clone()),
-    )?);
+    Ok(Sample {
+        mesh,
+        style,
+        baked,
+        options,
+        centre: (lo + hi) * 0.5,
+        size,
+    })
+}
+
+/// `count` animated copies of the sample on a square grid, and a camera that sees them all.
+struct Herd {
+    renderer: Renderer,
+    ids: Vec<CharacterId>,
+    dynamics: Vec<HairDynamics>,
+    motions: Vec<CharacterMotion>,
+    camera: Camera,
+}
+
+fn herd(ctx: &Arc<Context>, s: &Sample, count: u32, a: &AnimateArgs) -> Result<Herd> {
     let (w, h) = a.size;
-    let mut renderer = Renderer::new(&ctx, &RendererDesc::default().size(w, h))?;
+    let mut renderer = Renderer::new(ctx, &RendererDesc::default().size(w, h))?;
     let params = StrandParams {
         strands_per_bundle: a.strands_per_bundle,
         verts_log2: 5,
     };
-    let id = renderer.add_character(&baked, &style, params, Mat4::IDENTITY)?;
-    renderer.make_deformable(id, DeformBasis::new(&mesh, &baked, options)?)?;
     let settings = DynamicsSettings {
         wind: Wind {
             direction: Vec3::new(1.0, 0.1, 0.6),
@@ -72,99 +96,182 @@ pub fn bench_animate(a: AnimateArgs) -> Result<()> {
         },
         ..Default::default()
     };
-    let mut dynamics = HairDynamics::new(
-        &mesh,
-        vec![Collider::fit_scalp(&mesh)],
-        settings,
-        Mat4::IDENTITY,
-    );
-    let motion = CharacterMotion {
-        turn: 0.5,
-        turn_rate: 0.25,
-        sway: 0.04,
-        ..CharacterMotion::still(Mat4::IDENTITY)
-    };
-    let centre = (lo + hi) * 0.5;
+    let side = (count as f32).sqrt().ceil() as u32;
+    let spacing = 1.5 * s.size;
+    let (mut ids, mut dynamics, mut motions) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 0..count {
+        let offset = Vec3::new((k % side) as f32, 0.0, (k / side) as f32) * spacing;
+        let home = Mat4::from_translation(offset);
+        let id = renderer.add_character(&s.baked, &s.style, params, home)?;
+        renderer.make_deformable(id, DeformBasis::new(&s.mesh, &s.baked, s.options)?)?;
+        let collider = vec![Collider::fit_scalp(&s.mesh)];
+        dynamics.push(HairDynamics::new(&s.mesh, collider, settings, home));
+        // Each turns on its own phase, so the herd is not in lockstep.
+        motions.push(CharacterMotion {
+            turn: 0.5,
+            turn_rate: 0.25 + 0.01 * (k % 7) as f32,
+            sway: 0.04,
+            ..CharacterMotion::still(home)
+        });
+        ids.push(id);
+    }
+    let middle = s.centre + Vec3::new(1.0, 0.0, 1.0) * spacing * (side - 1) as f32 * 0.5;
+    let reach = (0.75 + 0.9 * (side - 1) as f32) * s.size;
     let camera = Camera::look_at(
-        centre + Vec3::new(0.9, 0.25, 1.4) * size * 0.75,
-        centre + Vec3::Y * 0.12 * size,
+        middle + Vec3::new(0.9, 0.25 + 0.3 * (side > 1) as u32 as f32, 1.4) * reach,
+        middle + Vec3::Y * 0.12 * s.size,
         40.0,
     );
+    Ok(Herd {
+        renderer,
+        ids,
+        dynamics,
+        motions,
+        camera,
+    })
+}
+
+/// Step every character by `dt` to its model, on all cores (characters are independent, as in
+/// `animate::CrowdAnimation`); their poses, in order.
+fn step_all(dynamics: &mut [HairDynamics], models: &[Mat4], dt: f32) -> Vec<Vec<Vec3>> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let chunk = dynamics.len().div_ceil(threads).max(1);
+    let mut poses = vec![Vec::new(); dynamics.len()];
+    std::thread::scope(|scope| {
+        for ((part, m), out) in dynamics
+            .chunks_mut(chunk)
+            .zip(models.chunks(chunk))
+            .zip(poses.chunks_mut(chunk))
+        {
+            scope.spawn(move || {
+                for ((d, model), pose) in part.iter_mut().zip(m).zip(out) {
+                    d.step(dt, *model);
+                    *pose = d.pose();
+                }
+            });
+        }
+    });
+    poses
+}
+
+/// Per-frame figures of one run.
+#[derive(Default)]
+struct Timings {
+    sim_ms: Vec<f64>,
+    update_ms: Vec<f64>,
+    gpu_ms: Vec<f64>,
+    strip: Vec<Vec<u8>>,
+}
+
+fn run_frames(herd: &mut Herd, a: &AnimateArgs, strip: bool) -> Result<Timings> {
     let strip_every = (a.frames / a.strip_frames.max(1)).max(1);
-    let (mut sim_ms, mut update_ms, mut gpu_ms) = (Vec::new(), Vec::new(), Vec::new());
-    let mut strip_images = Vec::new();
+    let mut t = Timings::default();
     for f in 0..a.frames {
-        let t = (f + 1) as f32 / 30.0;
-        let model = motion.model(t);
+        let time = (f + 1) as f32 / 30.0;
+        let models: Vec<Mat4> = herd.motions.iter().map(|m| m.model(time)).collect();
         let start = Instant::now();
-        dynamics.step(1.0 / 30.0, model);
-        let pose = dynamics.pose();
-        sim_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        renderer.set_model(id, model)?;
-        renderer.set_hair_mesh_pose(id, &pose)?;
+        let poses = step_all(&mut herd.dynamics, &models, 1.0 / 30.0);
+        t.sim_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        for ((id, model), pose) in herd.ids.iter().zip(&models).zip(&poses) {
+            herd.renderer.set_model(*id, *model)?;
+            herd.renderer.set_hair_mesh_pose(*id, pose)?;
+        }
         let view = View {
             light_dir: Vec3::new(-0.6, 0.8, 0.4),
             lod: LodSettings::off(),
             shading: hairmesh::shade::ShadingModel::Marschner,
             shadows: ShadowMode::DeepOpacity,
             transparency: Transparency::KBuffer { budget: 8 },
-            ..View::new(camera)
+            ..View::new(herd.camera)
         };
-        let wants_image = strip.is_some() && (f + 1) % strip_every == 0;
-        let report = renderer.render_one(
-            &view,
-            &FrameOptions {
-                read_image: wants_image,
-                ..Default::default()
-            },
-        )?;
-        update_ms.push(
-            report
-                .pass_ms
-                .iter()
-                .filter(|(n, _)| *n == "hair mesh update")
-                .map(|p| p.1)
-                .sum::<f64>(),
-        );
-        gpu_ms.push(report.gpu_ms());
+        let wants_image = strip && (f + 1) % strip_every == 0;
+        let opts = FrameOptions {
+            read_image: wants_image,
+            ..Default::default()
+        };
+        let report = herd.renderer.render_one(&view, &opts)?;
+        let update = report
+            .pass_ms
+            .iter()
+            .filter(|(n, _)| *n == "hair mesh update");
+        t.update_ms.push(update.map(|p| p.1).sum::<f64>());
+        t.gpu_ms.push(report.gpu_ms());
         if let Some(rgba) = report.rgba
-            && strip_images.len() < a.strip_frames as usize
+            && t.strip.len() < a.strip_frames as usize
         {
-            strip_images.push(rgba);
+            t.strip.push(rgba);
         }
     }
+    Ok(t)
+}
+
+fn write_strip(out: &OutputPath, images: Vec<Vec<u8>>, (w, h): (u32, u32)) -> Result<()> {
+    let n = images.len() as u32;
+    let mut img = image::RgbaImage::new(w * n, h);
+    for (k, rgba) in images.into_iter().enumerate() {
+        let frame = image::RgbaImage::from_raw(w, h, rgba)
+            .ok_or_else(|| anyhow::anyhow!("frame {k}: wrong size"))?;
+        image::imageops::replace(&mut img, &frame, k as i64 * w as i64, 0);
+    }
+    let path = out.path().display().to_string();
+    out.write(&hairmesh::fsutil::encode_png(
+        &path,
+        w * n,
+        h,
+        img.into_raw(),
+    )?)?;
+    outln!("wrote {n} frames side by side")?;
+    Ok(())
+}
+
+pub fn bench_animate(a: AnimateArgs) -> Result<()> {
+    if !(0.0..=100.0).contains(&a.wind) {
+        bail!("--wind {}: must be 0..=100", a.wind);
+    }
+    if let Some(&n) = a.counts.iter().find(|&&n| n == 0 || n > MOST_CHARACTERS) {
+        bail!("--counts {n}: each must be 1..={MOST_CHARACTERS}");
+    }
+    let strip = a
+        .strip
+        .as_ref()
+        .map(|p| OutputPath::check(p, &[a.mesh.as_path()]))
+        .transpose()?;
+    let sample = load(&a.mesh)?;
+    let ctx = Arc::new(Context::new(
+        &ContextDesc::default().device(a.device.clone()),
+    )?);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     outln!(
-        "{}: {} layer vertices ({} columns x {} layers), {} frames at 30 Hz, wind {} m/s^2",
+        "{}: {} layer vertices ({} columns x {} layers) per character, {} frames at 30 Hz, wind {} m/s^2; {}, {threads} CPU threads",
         a.mesh.display(),
-        dynamics.vertex_count(),
-        mesh.vertices_per_layer(),
-        mesh.layer_count(),
+        sample.mesh.vertices_per_layer() * sample.mesh.layer_count(),
+        sample.mesh.vertices_per_layer(),
+        sample.mesh.layer_count(),
         a.frames,
-        a.wind
-    )?;
-    outln!(
-        "median per frame: hair dynamics {:.2} ms CPU, texture rebuild {:.2} ms GPU, frame {:.1} ms GPU ({})",
-        super::median(sim_ms),
-        super::median(update_ms),
-        super::median(gpu_ms),
+        a.wind,
         ctx.info.name
     )?;
-    if let (Some(out), false) = (strip, strip_images.is_empty()) {
-        let n = strip_images.len() as u32;
-        let mut img = image::RgbaImage::new(w * n, h);
-        for (k, rgba) in strip_images.into_iter().enumerate() {
-            let frame = image::RgbaImage::from_raw(w, h, rgba)
-                .ok_or_else(|| anyhow::anyhow!("frame {k}: wrong size"))?;
-            image::imageops::replace(&mut img, &frame, k as i64 * w as i64, 0);
-        }
-        let png = hairmesh::fsutil::encode_png(
-            &out.path().display().to_string(),
-            w * n,
-            h,
-            img.into_raw(),
+    outln!(
+        "| characters | dynamics ms CPU | per character ms | texture rebuild ms GPU | frame ms GPU |"
+    )?;
+    outln!("|---|---|---|---|---|")?;
+    let mut strip_images = Vec::new();
+    for (k, &count) in a.counts.iter().enumerate() {
+        let mut h = herd(&ctx, &sample, count, &a)?;
+        let t = run_frames(&mut h, &a, k == 0 && strip.is_some())?;
+        let sim = super::median(t.sim_ms);
+        outln!(
+            "| {count} | {sim:.2} | {:.3} | {:.2} | {:.1} |",
+            sim / count as f64,
+            super::median(t.update_ms),
+            super::median(t.gpu_ms)
         )?;
-        out.write(&png)?;
-        outln!("wrote {} frames side by side", n)?;
+        if k == 0 {
+            strip_images = t.strip;
+        }
+    }
+    if let (Some(out), false) = (strip, strip_images.is_empty()) {
+        write_strip(&out, strip_images, a.size)?;
     }
     Ok(())
 }
