@@ -178,7 +178,11 @@ fn run_frames(herd: &mut Herd, a: &AnimateArgs, strip: bool) -> Result<Timings> 
         }
         let view = View {
             light_dir: Vec3::new(-0.6, 0.8, 0.4),
-            lod: LodSettings::off(),
+            // One character at full detail (the strip); a herd with LoD, as a crowd is drawn.
+            lod: match herd.ids.len() {
+                1 => LodSettings::off(),
+                _ => LodSettings::default(),
+            },
             shading: hairmesh::shade::ShadingModel::Marschner,
             shadows: ShadowMode::DeepOpacity,
             transparency: Transparency::KBuffer { budget: 8 },
