@@ -190,6 +190,8 @@ fn absurd_arguments_are_refused_before_allocating() {
         ),
         (vec!["lod", "--mesh", mesh, "--width", "100000"], "--width"),
         (vec!["crowd", "--counts", "0"], "--counts"),
+        (vec!["animate", "--counts", "0"], "--counts"),
+        (vec!["animate", "--counts", "1,5000"], "--counts"),
         (
             vec!["crowd", "--strands-per-bundle", "5000"],
             "--strands-per-bundle",
