@@ -25,6 +25,9 @@ shared uint s_soft_base;
 #ifdef SOFT_POOL
 // Per vertex: the stored strand width (pool_segments.comp loads it with the positions).
 shared float sw[MAX_ENTRIES];
+#elif defined(VISIBILITY)
+// Per vertex: its deformation residual (temporal.glsl), in frames with motion vectors.
+shared vec2 sv_residual[MAX_ENTRIES];
 #endif
 
 // Width of shared vertex idx at parameter s: the stored one, or the builder's strand width.
@@ -101,6 +104,9 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
         sv_screen[idx] = vec4(screen, ndc.z, in_range ? drawn / pixel : -1.0);
         vec3 radiance = frame.soft.x == RASTER_LIGHT ? vec3(0.0) : strand_radiance(st[idx], s, p, color, character);
         sv_color[idx] = pack_fragment(radiance, width / max(drawn, 1e-20));
+#if defined(VISIBILITY) && !defined(SOFT_POOL)
+        sv_residual[idx] = entry_residual(idx, character);
+#endif
     }
     barrier();
     // Count the kept segments (bit i of `kept`: this thread's i-th entry), reserve them with
@@ -141,7 +147,7 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
 #ifdef SOFT_POOL
                     vec2 residual = vec2(0.0);
 #else
-                    vec2 residual = 0.5 * (entry_residual(idx, character) + entry_residual(idx + 1u, character));
+                    vec2 residual = 0.5 * (sv_residual[idx] + sv_residual[idx + 1u]);
 #endif
                     segment_motion[out_index] = packHalf2x16(residual);
                 }

@@ -137,9 +137,10 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
             uint k = idx - base;
             vec3 tk = tangent_at(base, k, segments);
             vec3 pk = sp[idx];
+            bool morph_odd = gamma > 0.0 && segments >= 2u && (k & 1u) == 1u && k < segments;
             if (gamma > 0.0 && segments >= 2u) {
                 tk = safe_normalize(mix(tk, coarse_tangent_at(base, k, segments), gamma), tk);
-                if ((k & 1u) == 1u && k < segments) {
+                if (morph_odd) {
                     pk = mix(pk, 0.5 * (sp[idx - 1u] + sp[idx + 1u]), gamma);
                 }
             }
@@ -148,10 +149,7 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
 #ifdef VISIBILITY
             if (moving) {
                 vec3 dk = sd[idx];
-                if (gamma > 0.0 && segments >= 2u && (k & 1u) == 1u && k < segments) {
-                    dk = mix(dk, 0.5 * (sd[idx - 1u] + sd[idx + 1u]), gamma);
-                }
-                morphed_d[i] = dk;
+                morphed_d[i] = morph_odd ? mix(dk, 0.5 * (sd[idx - 1u] + sd[idx + 1u]), gamma) : dk;
             }
 #endif
         }

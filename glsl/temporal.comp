@@ -38,11 +38,6 @@ uint index_of(ivec2 p) {
     return uint(q.y) * uint(image_size().x) + uint(q.x);
 }
 
-// The nearest surface at p: (visibility id, depth bits); the background is at the far plane.
-uvec2 surface_at(ivec2 p) {
-    return visibility_surface(visibility[index_of(p)]);
-}
-
 mat4 clip_to_prev_of(uint id) {
     if (id == VISIBILITY_EMPTY) {
         return frame.clip_to_prev;
@@ -136,6 +131,11 @@ vec3 history_at(vec2 q) {
     return max(sum / total, vec3(0.0));
 }
 
+// Offset of neighbour k (0..8) in the 3x3 around a pixel, row by row.
+ivec2 neighbour(int k) {
+    return ivec2(k % 3 - 1, k / 3 - 1);
+}
+
 // Whether the history near q saw the surface `id` at the depth it should have had then
 // (`expected`, NDC): some pixel of the 3x3 around q holds the same id at a depth within 10%
 // in distance ((1 - z) is close to proportional to 1 / distance). Hair is thin: its pixel
@@ -144,7 +144,7 @@ bool history_saw(vec2 q, uint id, float expected) {
     ivec2 c = ivec2(floor(q));
     // The centre first: where the history holds the surface, it is usually there.
     for (int k = 0; k < 9; k++) {
-        ivec2 d = ivec2((k + 4) % 9 % 3 - 1, (k + 4) % 9 / 3 - 1);
+        ivec2 d = neighbour((k + 4) % 9);
         {
             uvec2 h = history_in[pixel_count() + index_of(c + d)];
             if (h.x != id) {
@@ -170,7 +170,8 @@ vec3 clip_to_box(vec3 h, vec3 mean, vec3 extent) {
     return most > 1.0 ? mean + d / most : h;
 }
 
-vec3 accumulate(ivec2 p) {
+// The accumulated colour of pixel p, whose own visibility word is `own`.
+vec3 accumulate(ivec2 p, uint64_t own) {
     vec3 current = current_color(p);
     if (frame.temporal.z == 0u) {
         return current;
@@ -178,18 +179,20 @@ vec3 accumulate(ivec2 p) {
     // The nearest surface of the 3x3 neighbourhood moves the pixel: a strand crossing it
     // drags its history along rather than the background behind. The depth leads the word,
     // so the smallest word is the nearest surface.
-    uint64_t nearest = visibility[index_of(p)];
+    uint64_t nearest = own;
     for (int k = 0; k < 9; k++) {
-        nearest = min(nearest, visibility[index_of(p + ivec2(k % 3 - 1, k / 3 - 1))]);
+        if (k != 4) {
+            nearest = min(nearest, visibility[index_of(p + neighbour(k))]);
+        }
     }
     // Nothing drawn around: the clear colour, which needs no history.
-    if (visibility_surface(nearest).x == VISIBILITY_EMPTY) {
+    if (visibility_empty(nearest)) {
         return current;
     }
     vec3 m1 = vec3(0.0);
     vec3 m2 = vec3(0.0);
     for (int k = 0; k < 9; k++) {
-        vec3 c = to_ycocg(current_color(p + ivec2(k % 3 - 1, k / 3 - 1)));
+        vec3 c = to_ycocg(k == 4 ? current : current_color(p + neighbour(k)));
         m1 += c;
         m2 += c * c;
     }
@@ -197,7 +200,7 @@ vec3 accumulate(ivec2 p) {
     // that shows what is behind it moves with that, or the solid's silhouette smears out.
     uvec2 near = visibility_surface(nearest);
     if (!is_hair(near.x)) {
-        nearest = visibility[index_of(p)];
+        nearest = own;
         near = visibility_surface(nearest);
     }
     vec2 residual = visibility_residual(nearest);
@@ -229,14 +232,14 @@ void main() {
         return;
     }
     uint i = index_of(p);
-    uvec2 own = surface_at(p);
+    uint64_t word = visibility[i];
+    uvec2 own = visibility_surface(word);
     if (push.params.x != 0u) {
-        vec2 residual = visibility_residual(visibility[i]);
-        vec2 m = motion_at(own.x, vec2(p) + 0.5, uintBitsToFloat(own.y), residual);
+        vec2 m = motion_at(own.x, vec2(p) + 0.5, uintBitsToFloat(own.y), visibility_residual(word));
         motion_out[i] = uvec4(floatBitsToUint(m), own);
     }
     if (frame.temporal.y != 0u) {
-        vec3 c = accumulate(p);
+        vec3 c = accumulate(p, word);
         history_out[i] = uvec2(packHalf2x16(c.rg), packHalf2x16(vec2(c.b, 1.0)));
         history_out[pixel_count() + i] = own;
         frame_color[pixel_count() + i] = packUnorm4x8(vec4(linear_to_srgb(c), 1.0));

@@ -30,6 +30,11 @@ uint64_t visibility_word(float depth, uint id, vec2 residual) {
     return (uint64_t(d) << 40) | (uint64_t(id18) << 22) | uint64_t(low);
 }
 
+// Whether the word is an empty pixel's.
+bool visibility_empty(uint64_t w) {
+    return (uint(w >> 22) & VISIBILITY_ID_EMPTY) == VISIBILITY_ID_EMPTY;
+}
+
 // The word's visibility id and depth bits (VisibilityWord::unpack); empty: depth 1.
 uvec2 visibility_surface(uint64_t w) {
     uint id18 = uint(w >> 22) & VISIBILITY_ID_EMPTY;
@@ -43,10 +48,10 @@ uvec2 visibility_surface(uint64_t w) {
 
 // The word's deformation residual, pixels (none for an empty pixel).
 vec2 visibility_residual(uint64_t w) {
-    uint low = uint(w);
-    if ((uint(w >> 22) & VISIBILITY_ID_EMPTY) == VISIBILITY_ID_EMPTY) {
+    if (visibility_empty(w)) {
         return vec2(0.0);
     }
+    uint low = uint(w);
     return (vec2(ivec2((low >> 11) & 0x7FFu, low & 0x7FFu)) - 1024.0) / VISIBILITY_RESIDUAL_STEPS;
 }
 #endif
