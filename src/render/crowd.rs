@@ -10,8 +10,7 @@ use ash::vk;
 use glam::Mat4;
 
 use super::shared::{
-    CHARACTER_DEFORMING, CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2,
-    TextureBinding,
+    CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, TextureBinding,
 };
 use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::bake::{BakedHairMesh, MeshInfo};
@@ -123,7 +122,7 @@ impl CharacterTextures {
             .as_ref()
             .filter(|d| d.alternate_current())
             .and_then(|d| d.alternate(binding))
-            .unwrap_or(&self.images[binding as usize])
+            .unwrap_or(self.own_image(binding))
     }
 }
 
@@ -385,7 +384,7 @@ impl Crowd {
         for (binding, _) in TextureBinding::ALL {
             let image = state
                 .alternate(binding)
-                .unwrap_or(&c.textures.images[binding as usize]);
+                .unwrap_or(c.textures.own_image(binding));
             self.texture_set
                 .write_image(binding as u32, other, image, &self.sampler)?;
         }
@@ -624,34 +623,36 @@ impl Crowd {
     }
 
     /// The character records of every slot (empty slots are invisible, with no bundles);
-    /// those in `deforming` (their pose changed this frame) flagged, with the previous pose's
-    /// texture set.
+    /// those in `deforming` (their pose changed this frame) with the previous pose's texture
+    /// set.
     pub fn records(&self, deforming: &[usize]) -> Vec<CharacterRecord> {
         let mut records: Vec<CharacterRecord> = self
             .slots
             .iter()
             .enumerate()
             .map(|(slot, c)| match c {
-                Some(c) => CharacterRecord {
-                    model: c.model.to_cols_array_2d(),
-                    mesh: c.info,
-                    style: c.style,
-                    texture_slot: self.texture_element(slot, c, false),
-                    first_bundle: c.first_bundle,
-                    bundle_count: c.bundles.len() as u32,
-                    strands_per_bundle: c.params.strands_per_bundle,
-                    verts_log2: c.params.verts_log2,
-                    flags: if c.visible { CHARACTER_VISIBLE } else { 0 },
-                    model_scale: model_scale(&c.model),
-                    prev_texture_slot: self.texture_element(slot, c, false),
-                    clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
-                },
+                Some(c) => {
+                    let texture_slot = self.texture_element(slot, c, false);
+                    CharacterRecord {
+                        model: c.model.to_cols_array_2d(),
+                        mesh: c.info,
+                        style: c.style,
+                        texture_slot,
+                        first_bundle: c.first_bundle,
+                        bundle_count: c.bundles.len() as u32,
+                        strands_per_bundle: c.params.strands_per_bundle,
+                        verts_log2: c.params.verts_log2,
+                        flags: if c.visible { CHARACTER_VISIBLE } else { 0 },
+                        model_scale: model_scale(&c.model),
+                        prev_texture_slot: texture_slot,
+                        clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
+                    }
+                }
                 None => bytemuck::Zeroable::zeroed(),
             })
             .collect();
         for &slot in deforming {
             if let (Some(r), Some(Some(c))) = (records.get_mut(slot), self.slots.get(slot)) {
-                r.flags |= CHARACTER_DEFORMING;
                 r.prev_texture_slot = self.texture_element(slot, c, true);
             }
         }

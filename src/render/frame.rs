@@ -131,8 +131,8 @@ impl Renderer {
         Ok(FrameTicket(self.frame_number - 1))
     }
 
-    /// The character records of this frame: those in `pose_updates` marked deforming (with
-    /// their previous pose's textures), with their motion where the frame has motion vectors.
+    /// The character records of this frame: those in `pose_updates` with their previous
+    /// pose's textures, all with their motion where the frame has motion vectors.
     fn frame_records(
         &self,
         pose_updates: &[usize],

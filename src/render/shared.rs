@@ -28,9 +28,6 @@ pub const SCAN_BLOCK: u32 = 1024;
 pub const DISPATCH_ROW: u32 = 65535;
 /// `CharacterRecord::flags`: the character is drawn this frame.
 pub const CHARACTER_VISIBLE: u32 = 1;
-/// `CharacterRecord::flags`: the character's hair mesh changed pose this frame (its hair moves
-/// relative to its head; `prev_texture_slot` holds the previous pose).
-pub const CHARACTER_DEFORMING: u32 = 2;
 
 pub use crate::shade::lut::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE};
 
@@ -502,12 +499,13 @@ pub struct CharacterRecord {
     pub strands_per_bundle: u32,
     /// Full-detail vertex level `e` (`2^e` segments).
     pub verts_log2: u32,
-    /// [`CHARACTER_VISIBLE`], [`CHARACTER_DEFORMING`].
+    /// [`CHARACTER_VISIBLE`].
     pub flags: u32,
     /// Uniform scale of `model` (widths and styling margins).
     pub model_scale: f32,
-    /// Element of the textures of the previous frame's pose: `texture_slot` unless the pose
-    /// changed this frame (the generators evaluate both for exact motion vectors).
+    /// Element of the textures of the previous frame's pose: `texture_slot` unless the hair
+    /// mesh changed pose this frame (the generators then evaluate both for exact motion
+    /// vectors).
     pub prev_texture_slot: u32,
     /// This frame's unjittered clip space to the previous frame's, for this character's
     /// surfaces (hair and scalp): the camera's motion and the character's own.
@@ -821,7 +819,6 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         layout("DEFORM_GROUP_SIZE", DEFORM_GROUP_SIZE),
         layout("LHS_GROUP_SIZE", LHS_GROUP_SIZE),
         uint("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
-        uint("CHARACTER_DEFORMING", CHARACTER_DEFORMING),
         uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
         uint("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
         layout("SET_FRAME", SET_FRAME),
