@@ -316,13 +316,10 @@ fn bench_lod(
         }
     }
     if let Some(p) = picture {
-        let mut strip = image::RgbaImage::new(width * 3, height);
-        for (i, out) in pics.iter().enumerate() {
-            let rgba = out.rgba.clone().context("no image")?;
-            let img = image::RgbaImage::from_raw(width, height, rgba).context("size")?;
-            image::imageops::replace(&mut strip, &img, (i as u32 * width) as i64, 0);
-        }
-        write_png(&p, strip.into_raw(), width * 3, height)?;
+        let images = pics.iter().map(|out| out.rgba.clone().context("no image"));
+        let strip = side_by_side(&[images.collect::<Result<_>>()?], (width, height))?;
+        let (w, h) = strip.dimensions();
+        write_png(&p, strip.into_raw(), w, h)?;
     }
     Ok(())
 }
@@ -589,6 +586,20 @@ fn median_passes<'a>(first: &'a FrameReport, reports: &[FrameReport]) -> Vec<(&'
             (*name, median(ms))
         })
         .collect()
+}
+
+/// RGBA images of `size` laid out side by side, one row of the picture per row given.
+fn side_by_side(rows: &[Vec<Vec<u8>>], (w, h): (u32, u32)) -> Result<image::RgbaImage> {
+    let cols = rows.iter().map(Vec::len).max().unwrap_or(0) as u32;
+    let mut out = image::RgbaImage::new(w * cols, h * rows.len() as u32);
+    for (r, row) in rows.iter().enumerate() {
+        for (c, rgba) in row.iter().enumerate() {
+            let img = image::RgbaImage::from_raw(w, h, rgba.clone()).context("image size")?;
+            let (x, y) = (c as u32 * w, r as u32 * h);
+            image::imageops::replace(&mut out, &img, x as i64, y as i64);
+        }
+    }
+    Ok(out)
 }
 
 /// Write RGBA pixels as a PNG by the output policy.

@@ -209,21 +209,12 @@ fn run_frames(herd: &mut Herd, a: &AnimateArgs, strip: bool) -> Result<Timings> 
     Ok(t)
 }
 
-fn write_strip(out: &OutputPath, images: Vec<Vec<u8>>, (w, h): (u32, u32)) -> Result<()> {
-    let n = images.len() as u32;
-    let mut img = image::RgbaImage::new(w * n, h);
-    for (k, rgba) in images.into_iter().enumerate() {
-        let frame = image::RgbaImage::from_raw(w, h, rgba)
-            .ok_or_else(|| anyhow::anyhow!("frame {k}: wrong size"))?;
-        image::imageops::replace(&mut img, &frame, k as i64 * w as i64, 0);
-    }
+fn write_strip(out: &OutputPath, images: Vec<Vec<u8>>, size: (u32, u32)) -> Result<()> {
+    let n = images.len();
+    let img = super::side_by_side(&[images], size)?;
+    let (w, h) = img.dimensions();
     let path = out.path().display().to_string();
-    out.write(&hairmesh::fsutil::encode_png(
-        &path,
-        w * n,
-        h,
-        img.into_raw(),
-    )?)?;
+    out.write(&hairmesh::fsutil::encode_png(&path, w, h, img.into_raw())?)?;
     outln!("wrote {n} frames side by side")?;
     Ok(())
 }

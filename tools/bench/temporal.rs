@@ -52,23 +52,6 @@ pub struct TemporalArgs {
     strip: Option<std::path::PathBuf>,
 }
 
-/// Rows of side-by-side images of `size` into one RGBA image.
-fn compose(rows: &[Vec<Vec<u8>>], (w, h): (u32, u32)) -> (Vec<u8>, u32, u32) {
-    let cols = rows.iter().map(Vec::len).max().unwrap_or(0) as u32;
-    let (width, height) = (w * cols, h * rows.len() as u32);
-    let mut out = vec![0u8; (width * height * 4) as usize];
-    for (r, row) in rows.iter().enumerate() {
-        for (c, img) in row.iter().enumerate() {
-            for y in 0..h as usize {
-                let src = &img[y * w as usize * 4..(y + 1) * w as usize * 4];
-                let at = ((r * h as usize + y) * width as usize + c * w as usize) * 4;
-                out[at..at + src.len()].copy_from_slice(src);
-            }
-        }
-    }
-    (out, width, height)
-}
-
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     hairmesh::render::scene::parse_size(s)
 }
@@ -348,8 +331,9 @@ pub fn bench_temporal(a: TemporalArgs) -> Result<()> {
         rows.push(row);
     }
     if let Some(out) = strip {
-        let (rgba, w, h) = compose(&rows, a.size);
-        super::write_png(&out, rgba, w, h)?;
+        let picture = super::side_by_side(&rows, a.size)?;
+        let (w, h) = picture.dimensions();
+        super::write_png(&out, picture.into_raw(), w, h)?;
     }
     Ok(())
 }
