@@ -9,6 +9,7 @@ pub mod animate;
 pub mod bake;
 pub mod budget;
 pub mod characters;
+pub mod dynamics;
 pub mod error;
 pub mod fit;
 pub mod fsutil;

@@ -3,15 +3,15 @@
 //! rebuilds their textures on the GPU. Characters small on screen simulate less often: by the
 //! height in pixels of their hair (the projected size eq. 7 of paper 003 uses), every frame
 //! above 96 px, every 2nd above 48, every 4th above 24, else every 8th frame, with the time
-//! they skipped (up to [`MAX_FRAME_STEP`](super::dynamics::MAX_FRAME_STEP)) in one step.
+//! they skipped (up to [`MAX_FRAME_STEP`](crate::dynamics::MAX_FRAME_STEP)) in one step.
 //! Characters due in a frame are simulated in parallel on all cores.
 
 use std::time::Instant;
 
 use glam::Vec3;
 
-use super::dynamics::{Collider, DynamicsSettings, HairDynamics, Wind};
 use super::motion::CharacterMotion;
+use crate::dynamics::{Collider, DynamicsSettings, HairDynamics, Wind};
 use crate::model::hair_mesh::HairMesh;
 use crate::render::{Camera, CharacterId, Renderer};
 use crate::vk::GpuResult;
@@ -53,6 +53,16 @@ pub struct CrowdAnimation {
     pub wind: Wind,
     /// What the last frame did.
     pub stats: AnimationStats,
+}
+
+/// Where hair meshes are simulated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DynamicsPath {
+    /// On the GPU (`glsl/hair_dynamics.comp`): the pose never leaves the device.
+    #[default]
+    Gpu,
+    /// On the CPU (`dynamics::HairDynamics`, all cores), the pose uploaded each frame.
+    Cpu,
 }
 
 /// Hair pixels above which a character simulates every frame (halving per step down).

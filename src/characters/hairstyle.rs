@@ -19,8 +19,8 @@ use glam::{Vec2, Vec3};
 
 use super::human::direction;
 use super::person::{PersonShape, PlacedHead};
-use crate::animate::Collider;
 use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
+use crate::dynamics::Collider;
 use crate::error::Result;
 use crate::model::hair_mesh::{ExtrudeDesc, Face, HairMesh, extrude};
 use crate::model::style::HairStyle;
@@ -560,7 +560,7 @@ impl Settle<'_> {
             body: person
                 .colliders()?
                 .into_iter()
-                .filter(|c| !matches!(c, Collider::Human { .. }))
+                .filter(|c| !matches!(c, Collider::Head { .. }))
                 .collect(),
             face: Collider::Ellipsoid {
                 centre: place.transform_point3(c),

@@ -13,6 +13,7 @@ use std::sync::OnceLock;
 
 use glam::Vec3;
 
+use crate::dynamics::RadialMap;
 use crate::error::{HairError, Result};
 use crate::render::shared::PropVertex;
 
@@ -53,11 +54,7 @@ pub fn direction(theta: f32, phi: f32) -> Vec3 {
 }
 
 /// Polar angle and azimuth (in `0..2pi`) of unit direction `d` (inverse of [`direction`]).
-pub fn angles(d: Vec3) -> (f32, f32) {
-    let theta = d.y.clamp(-1.0, 1.0).acos();
-    let phi = d.z.atan2(d.x).rem_euclid(std::f32::consts::TAU);
-    (theta, phi)
-}
+pub use crate::dynamics::angles;
 
 /// The canonical head: its triangles and radial map.
 pub struct HumanHead {
@@ -65,10 +62,10 @@ pub struct HumanHead {
     pub triangles: Vec<[Vec3; 3]>,
     /// Centre of the cranium (origin of the radial map).
     pub centre: Vec3,
-    /// `radius[row * MAP_COLS + col]`: distance of the surface from the centre.
-    radius: Vec<f32>,
+    /// The head's surface about [`Self::centre`]: what hair dynamics collide with.
+    pub map: RadialMap,
     /// The same map without the ears ([`opened`]).
-    cranium: Vec<f32>,
+    cranium: RadialMap,
 }
 
 static HEAD: OnceLock<std::result::Result<HumanHead, String>> = OnceLock::new();
@@ -113,11 +110,17 @@ impl HumanHead {
         fill_missing(&mut radius).ok_or_else(|| {
             HairError::invalid(name, "the head mesh does not surround its centre")
         })?;
-        let cranium = opened(&radius, EAR_WINDOW);
+        let map = |radius| RadialMap {
+            centre,
+            rows: MAP_ROWS,
+            cols: MAP_COLS,
+            radius,
+        };
+        let cranium = map(opened(&radius, EAR_WINDOW));
         Ok(HumanHead {
             triangles,
             centre,
-            radius,
+            map: map(radius),
             cranium,
         })
     }
@@ -125,23 +128,13 @@ impl HumanHead {
     /// Distance of the head surface from [`Self::centre`] in unit direction `d` (bilinear in
     /// the map).
     pub fn radius(&self, d: Vec3) -> f32 {
-        sample_map(&self.radius, d)
+        self.map.sample(d)
     }
 
     /// [`Self::radial_gap`] to the head without its ears: what hair lying between two columns
     /// over an ear must clear (it passes beside the ear, not over its far side).
     pub fn cranium_gap(&self, p: Vec3) -> f32 {
-        self.gap_to(&self.cranium, p)
-    }
-
-    /// Signed radial distance of `p` outside the surface of radial map `map`.
-    fn gap_to(&self, map: &[f32], p: Vec3) -> f32 {
-        let r = p - self.centre;
-        let l = r.length();
-        if l < 1e-9 {
-            return -sample_map(map, Vec3::Y);
-        }
-        l - sample_map(map, r / l)
+        self.cranium.gap(p)
     }
 
     /// Head surface point at polar angle `theta`, azimuth `phi` about the centre.
@@ -152,16 +145,12 @@ impl HumanHead {
 
     /// Signed radial distance of `p` outside the head (negative inside), metres.
     pub fn radial_gap(&self, p: Vec3) -> f32 {
-        self.gap_to(&self.radius, p)
+        self.map.gap(p)
     }
 
     /// `p` moved radially to at least `margin` outside the head (unchanged if already there).
     pub fn push_out(&self, p: Vec3, margin: f32) -> Vec3 {
-        let r = p - self.centre;
-        let l = r.length();
-        let d = if l < 1e-9 { Vec3::Y } else { r / l };
-        let min = self.radius(d) + margin;
-        if l < min { self.centre + d * min } else { p }
+        self.map.push_out(p, margin)
     }
 
     /// The bust as a prop mesh (triangle list, normals averaged over shared positions).
@@ -195,20 +184,6 @@ fn opened(map: &[f32], w: usize) -> Vec<f32> {
         out
     };
     filter(&filter(map, f32::min), f32::max)
-}
-
-/// Bilinear sample of a radial map in unit direction `d`.
-fn sample_map(map: &[f32], d: Vec3) -> f32 {
-    let (theta, phi) = angles(d);
-    let y = theta / std::f32::consts::PI * (MAP_ROWS - 1) as f32;
-    let x = phi / std::f32::consts::TAU * MAP_COLS as f32;
-    let (r0, fy) = ((y.floor() as usize).min(MAP_ROWS - 2), y.fract());
-    let (c0, fx) = (x.floor() as usize % MAP_COLS, x.fract());
-    let c1 = (c0 + 1) % MAP_COLS;
-    let at = |r: usize, c: usize| map[r * MAP_COLS + c];
-    let top = at(r0, c0) * (1.0 - fx) + at(r0, c1) * fx;
-    let bottom = at(r0 + 1, c0) * (1.0 - fx) + at(r0 + 1, c1) * fx;
-    top * (1.0 - fy) + bottom * fy
 }
 
 /// Direction of radial map cell `(row, col)`.
@@ -260,15 +235,6 @@ pub fn smooth_prop_mesh(triangles: &[[Vec3; 3]]) -> Vec<PropVertex> {
             })
         })
         .collect()
-}
-
-/// `p` (canonical frame) pushed radially out of the human head to `margin` metres outside it
-/// (unchanged when outside, or when the head cannot be loaded): the dynamics' head collider.
-pub fn push_out_of_head(p: Vec3, margin: f32) -> Vec3 {
-    match human_head() {
-        Ok(head) => head.push_out(p, margin),
-        Err(_) => p,
-    }
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@
 use glam::{Mat4, Vec3};
 
 use super::human::{HumanHead, direction, human_head, smooth_prop_mesh};
-use crate::animate::Collider;
+use crate::dynamics::Collider;
 use crate::error::Result;
 use crate::render::shared::PropVertex;
 use crate::rng::Pcg32;
@@ -104,8 +104,8 @@ impl PersonShape {
             })
             .collect();
         // The head last: where the neck capsule and the jaw disagree, the head wins.
-        out.push(Collider::human(
-            super::human::push_out_of_head,
+        out.push(Collider::head(
+            &super::human::human_head()?.map,
             self.head_transform()?,
             0.005,
         ));
