@@ -89,7 +89,7 @@ pub struct DynamicsSettings {
     /// Velocity damping per second (fraction lost is `1 - exp(-damping dt)`).
     pub damping: f32,
     /// Stiffness of the pull toward the authored shape at the roots (per unit mass, 1/s^2);
-    /// it falls to 30% at the tips.
+    /// it falls by [`SHAPE_TIP_LOSS`] of it at the tips.
     pub shape_stiffness: f32,
     /// Compliance of the spacing between neighbouring columns.
     pub spacing_compliance: f32,
@@ -176,6 +176,12 @@ pub struct HairTopology {
     /// Colour `c` is `spacing[spacing_colours[c]..spacing_colours[c + 1]]`.
     pub spacing_colours: Vec<u32>,
 }
+
+/// The shape pull falls by this fraction of its root stiffness from the roots to the tips.
+pub const SHAPE_TIP_LOSS: f32 = 0.7;
+
+/// Rounds of push-out and edge-length projection per vertex in follow-the-leader.
+pub const COLLISION_ROUNDS: u32 = 16;
 
 /// Colours of the bending constraints: the constraint of layer `k` (to layer `k - 2`) has
 /// colour `(k / 2) % 2`, so no two of a colour share a vertex.
@@ -386,7 +392,7 @@ impl HairDynamics {
         }
         for k in 1..layers {
             let along = k as f32 / (layers - 1) as f32;
-            let stiffness = s.shape_stiffness * (1.0 - 0.7 * along);
+            let stiffness = s.shape_stiffness * (1.0 - SHAPE_TIP_LOSS * along);
             for i in 0..n {
                 let j = k * n + i;
                 let acc = s.gravity + s.wind.acceleration(self.state.x[j], sub.time, along);
@@ -459,11 +465,11 @@ impl HairDynamics {
                     base + dir * t.edge[j]
                 };
                 let mut q = on_edge(self.collide(p[j], placement));
-                // Alternate until the push-out no longer moves it (at most 16 rounds; a point
-                // outside every collider costs one). Where they never agree (hair squeezed
-                // between two colliders) the colliders win over the exact edge length.
+                // Alternate until the push-out no longer moves it (at most COLLISION_ROUNDS; a
+                // point outside every collider costs one). Where they never agree (hair
+                // squeezed between two colliders) the colliders win over the exact edge length.
                 let mut settled = false;
-                for _ in 0..16 {
+                for _ in 0..COLLISION_ROUNDS {
                     let out = self.collide(q, placement);
                     if out == q {
                         settled = true;

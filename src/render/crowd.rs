@@ -9,8 +9,9 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Mat4;
 
+use super::deform::PoseUpdate;
 use super::shared::{
-    CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, TextureBinding,
+    CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, SimJob, TextureBinding,
 };
 use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::bake::{BakedHairMesh, MeshInfo};
@@ -102,6 +103,15 @@ fn model_scale(model: &Mat4) -> f32 {
     model.x_axis.truncate().length()
 }
 
+/// What [`Crowd::write_pending_poses`] found for a frame.
+#[derive(Default)]
+pub struct PoseUpdates {
+    /// Character slots whose textures are rebuilt.
+    pub updated: Vec<usize>,
+    /// Character slots simulated on the GPU first, with their steps.
+    pub simulated: Vec<(usize, SimJob)>,
+}
+
 /// The GPU resources of one character: its five textures and, when its hair mesh moves, the
 /// update state (with the other set of position, u and v textures).
 pub struct CharacterTextures {
@@ -167,6 +177,8 @@ pub struct Crowd {
     /// Bumped when the strands that exist change (characters added, removed, shown, hidden or
     /// restyled), not when they move: stored LHS strands are valid for one structure.
     structure_version: u64,
+    /// Radial maps of GPU-simulated heads.
+    head_maps: super::dynamics::HeadMaps,
 }
 
 impl Crowd {
@@ -213,6 +225,7 @@ impl Crowd {
             dirty: false,
             version: 0,
             structure_version: 0,
+            head_maps: Default::default(),
         })
     }
 
@@ -314,6 +327,14 @@ impl Crowd {
         })
     }
 
+    fn get(&self, id: CharacterId) -> GpuResult<&Character> {
+        self.slots
+            .get(id.slot as usize)
+            .and_then(|c| c.as_ref())
+            .filter(|c| c.generation == id.generation)
+            .ok_or_else(|| GpuError::Unsupported(format!("no character {id:?}")))
+    }
+
     fn get_mut(&mut self, id: CharacterId) -> GpuResult<&mut Character> {
         self.slots
             .get_mut(id.slot as usize)
@@ -403,18 +424,82 @@ impl Crowd {
         }
     }
 
-    /// Write every pending pose into frame slot `frame`'s buffers; the character slots that
-    /// have an update this frame.
-    pub fn write_pending_poses(&mut self, frame: usize) -> GpuResult<Vec<usize>> {
-        let mut updated = Vec::new();
+    /// Write every pending pose into frame slot `frame`'s buffers and take the pending GPU
+    /// steps: the character slots that have an update this frame, and the steps (with their
+    /// slots) the hair dynamics pass runs before the updates.
+    pub fn write_pending_poses(&mut self, frame: usize) -> GpuResult<PoseUpdates> {
+        let mut out = PoseUpdates::default();
         for (slot, c) in self.slots.iter_mut().enumerate() {
-            if let Some(d) = c.as_mut().and_then(|c| c.textures.deform.as_mut())
-                && d.write_pending(frame)?
-            {
-                updated.push(slot);
+            let Some(d) = c.as_mut().and_then(|c| c.textures.deform.as_mut()) else {
+                continue;
+            };
+            match d.write_pending(frame)? {
+                Some(PoseUpdate::Uploaded) => out.updated.push(slot),
+                Some(PoseUpdate::Simulated(job)) => {
+                    out.updated.push(slot);
+                    out.simulated.push((slot, job));
+                }
+                None => {}
             }
         }
-        Ok(updated)
+        Ok(out)
+    }
+
+    /// The deform state of character `id`, which must be deformable.
+    fn deform_mut(&mut self, id: CharacterId) -> GpuResult<&mut super::deform::DeformState> {
+        self.get_mut(id)?.textures.deform.as_mut().ok_or_else(|| {
+            GpuError::Unsupported(format!("character {id:?} was not made deformable"))
+        })
+    }
+
+    /// Simulate character `id`'s hair on the GPU from `sim`'s state (it must have been made
+    /// deformable); an earlier GPU simulation of it is returned for retiring.
+    pub fn simulate(
+        &mut self,
+        id: CharacterId,
+        sim: &crate::dynamics::HairDynamics,
+        layout: &Arc<DescriptorSetLayout>,
+    ) -> GpuResult<Option<super::deform::SimulatedPose>> {
+        let ctx = self.ctx.clone();
+        let mut maps = std::mem::take(&mut self.head_maps);
+        let result = self
+            .deform_mut(id)
+            .and_then(|d| d.simulate(&ctx, layout, sim, &mut maps));
+        self.head_maps = maps;
+        result
+    }
+
+    /// Step character `id`'s GPU hair dynamics (see `DeformState::step_simulation`).
+    pub fn step_simulation(
+        &mut self,
+        id: CharacterId,
+        dt: f32,
+        model: Mat4,
+        settings: &crate::dynamics::DynamicsSettings,
+    ) -> GpuResult<()> {
+        self.version += 1;
+        self.deform_mut(id)?.step_simulation(dt, model, settings)
+    }
+
+    /// Character `id`'s GPU simulation, if started.
+    pub fn simulation(&self, id: CharacterId) -> GpuResult<&super::deform::SimulatedPose> {
+        self.get(id)?
+            .textures
+            .deform
+            .as_ref()
+            .and_then(|d| d.simulation())
+            .ok_or_else(|| {
+                GpuError::Unsupported(format!("character {id:?} has no GPU hair dynamics"))
+            })
+    }
+
+    /// The state and pose buffers of the simulated characters in `slots` (this frame's).
+    pub fn simulated_buffers(&self, slots: &[usize]) -> Vec<(&Buffer, &Buffer)> {
+        slots
+            .iter()
+            .filter_map(|&s| self.slots.get(s)?.as_ref()?.textures.deform.as_ref())
+            .filter_map(|d| d.simulated_buffers())
+            .collect()
     }
 
     /// The update jobs of character slots `updated` for frame slot `frame`.

@@ -21,6 +21,32 @@ fn readback(ctx: &std::sync::Arc<crate::vk::Context>, name: &str, bytes: u64) ->
     )
 }
 
+/// The first `bytes` of device-local `buffer` (it needs `TRANSFER_SRC` usage), copied to the
+/// host; the caller has waited for the frames that write it.
+pub(super) fn read_device_buffer(
+    ctx: &std::sync::Arc<crate::vk::Context>,
+    buffer: &Buffer,
+    bytes: u64,
+) -> GpuResult<Vec<u8>> {
+    let bytes = bytes.min(buffer.size);
+    let mut out = readback(ctx, "buffer readback", bytes)?;
+    ctx.submit_and_wait(|rec| {
+        let mut g = FrameGraph::new(false);
+        let src = g.import_buffer("read buffer", buffer);
+        let dst = g.import_buffer("buffer readback", &out);
+        g.pass("copy buffer")
+            .read(src, Access::TransferRead)
+            .discard(dst, Access::TransferWrite)
+            .record(|rec, _| {
+                rec.copy_buffer(buffer, 0, &out, 0, bytes);
+                Ok(())
+            });
+        g.pass("host reads").read(dst, Access::HostRead).done();
+        g.run_untimed(rec).map(|_| ())
+    })??;
+    out.read()
+}
+
 impl Renderer {
     /// Draw `segments` (screen space and shaded, as generation appends them) with the
     /// software rasterizer alone, over a black image with nothing in front, keeping `k`
@@ -147,22 +173,9 @@ impl Renderer {
         if bytes == 0 {
             return Ok(Vec::new());
         }
-        let mut out = readback(&self.ctx, "vertex readback", bytes)?;
-        self.ctx.submit_and_wait(|rec| {
-            let mut g = FrameGraph::new(false);
-            let src = g.import_buffer("vertex pool", pool);
-            let dst = g.import_buffer("vertex readback", &out);
-            g.pass("copy vertices")
-                .read(src, Access::TransferRead)
-                .discard(dst, Access::TransferWrite)
-                .record(|rec, _| {
-                    rec.copy_buffer(pool, 0, &out, 0, bytes);
-                    Ok(())
-                });
-            g.pass("host reads").read(dst, Access::HostRead).done();
-            g.run_untimed(rec).map(|_| ())
-        })??;
-        Ok(bytemuck::pod_collect_to_vec(&out.read()?))
+        Ok(bytemuck::pod_collect_to_vec(&read_device_buffer(
+            &self.ctx, pool, bytes,
+        )?))
     }
 
     /// Read back character `id`'s texture `binding` (tightly packed texels, as in the bake).

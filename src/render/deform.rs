@@ -3,7 +3,9 @@
 //! buffer per frame in flight, and the packed texels `glsl/hair_mesh_update.comp` writes before
 //! `passes::hair_mesh_update` copies them into the character's textures. Its position, u and
 //! v textures exist twice: each pose update writes the set the last frame did not read, so
-//! the previous pose stays for the motion vectors (`render::temporal`).
+//! the previous pose stays for the motion vectors (`render::temporal`). A character whose hair
+//! is simulated on the GPU (`render::dynamics`) also has a device-local pose buffer, which the
+//! solver writes and the rebuild reads in the same frame.
 
 use std::sync::Arc;
 
@@ -11,6 +13,8 @@ use ash::vk;
 use glam::Vec3;
 
 use super::crowd::CharacterTextures;
+use super::dynamics::{HairSimulation, HeadMaps};
+use super::shared::SimJob;
 use super::shared::TextureBinding;
 use super::shared::{DeformBinding, DeformParams};
 use super::slots::FRAMES_IN_FLIGHT;
@@ -39,11 +43,31 @@ pub struct DeformState {
     alternates: [Image; 3],
     /// Whether the alternates hold the current pose (else the character's own images).
     alternate_current: bool,
-    _static: [Buffer; 4],
+    /// Decode box, texel -> vertex map, styling offsets and terms.
+    statics: [Buffer; 4],
     /// A pose given since the last frame, waiting for a frame slot.
     pending: Option<Vec<[f32; 4]>>,
     /// Bounds of the latest pose (character frame), for fitting the light's view.
     pose_bounds: Option<(Vec3, Vec3)>,
+    /// Hair dynamics on the GPU, when started.
+    simulation: Option<SimulatedPose>,
+    /// Whether this frame's update reads the simulated pose.
+    reads_simulation: bool,
+}
+
+/// GPU hair dynamics and the pose buffer it writes, with the update set that reads it.
+pub struct SimulatedPose {
+    sim: HairSimulation,
+    pose: Buffer,
+    set: DescriptorSet,
+}
+
+/// What a frame's update of one character rebuilds from.
+pub enum PoseUpdate {
+    /// A pose the CPU gave, uploaded.
+    Uploaded,
+    /// The GPU solver's pose after this step.
+    Simulated(SimJob),
 }
 
 fn storage(
@@ -76,6 +100,43 @@ fn alternates(ctx: &Arc<Context>, textures: &CharacterTextures) -> GpuResult<[Im
         alternate(POSED_TEXTURES[1])?,
         alternate(POSED_TEXTURES[2])?,
     ])
+}
+
+/// An update set reading `pose`.
+fn update_set(
+    ctx: &Arc<Context>,
+    layout: &Arc<DescriptorSetLayout>,
+    statics: &[Buffer; 4],
+    pose: &Buffer,
+    outputs: &[Buffer; 3],
+) -> GpuResult<DescriptorSet> {
+    let set = DescriptorSet::new(ctx, "hair mesh update", layout)?;
+    for (b, _) in DeformBinding::ALL {
+        let buffer = match b {
+            DeformBinding::Params => &statics[0],
+            DeformBinding::Positions => pose,
+            DeformBinding::TexelVertex => &statics[1],
+            DeformBinding::StylingOffsets => &statics[2],
+            DeformBinding::StylingTerms => &statics[3],
+            DeformBinding::PositionTexels => &outputs[0],
+            DeformBinding::UTexels => &outputs[1],
+            DeformBinding::VTexels => &outputs[2],
+        };
+        set.write_buffer(b as u32, buffer)?;
+    }
+    Ok(set)
+}
+
+impl SimulatedPose {
+    /// The solver's state.
+    pub fn sim(&self) -> &HairSimulation {
+        &self.sim
+    }
+
+    /// The pose buffer (`layers x vertices` vec4, character frame).
+    pub fn pose(&self) -> &Buffer {
+        &self.pose
+    }
 }
 
 impl DeformState {
@@ -137,20 +198,7 @@ impl DeformState {
                 )
                 .host_visible(),
             )?;
-            let set = DescriptorSet::new(ctx, "hair mesh update", layout)?;
-            for (b, _) in DeformBinding::ALL {
-                let buffer = match b {
-                    DeformBinding::Params => &statics[0],
-                    DeformBinding::Positions => &pose,
-                    DeformBinding::TexelVertex => &statics[1],
-                    DeformBinding::StylingOffsets => &statics[2],
-                    DeformBinding::StylingTerms => &statics[3],
-                    DeformBinding::PositionTexels => &outputs[0],
-                    DeformBinding::UTexels => &outputs[1],
-                    DeformBinding::VTexels => &outputs[2],
-                };
-                set.write_buffer(b as u32, buffer)?;
-            }
+            let set = update_set(ctx, layout, &statics, &pose, &outputs)?;
             poses.push((pose, set));
         }
         Ok(DeformState {
@@ -159,10 +207,65 @@ impl DeformState {
             outputs,
             alternates,
             alternate_current: false,
-            _static: statics,
+            statics,
             pending: None,
             pose_bounds: None,
+            simulation: None,
+            reads_simulation: false,
         })
+    }
+
+    /// Simulate the hair on the GPU from `sim`'s state (replacing an earlier GPU simulation,
+    /// which is returned for retiring); `layout`: the update pass's.
+    pub fn simulate(
+        &mut self,
+        ctx: &Arc<Context>,
+        layout: &Arc<DescriptorSetLayout>,
+        sim: &crate::dynamics::HairDynamics,
+        maps: &mut HeadMaps,
+    ) -> GpuResult<Option<SimulatedPose>> {
+        let n = self.basis.vertices as usize * self.basis.info.layers as usize;
+        if sim.vertex_count() != n {
+            return Err(GpuError::Unsupported(format!(
+                "hair dynamics of {} vertices for a hair mesh of {n}",
+                sim.vertex_count()
+            )));
+        }
+        let gpu = HairSimulation::new(ctx, sim, &self.basis.root_thinning, maps)?;
+        let pose = super::dynamics::pose_buffer(ctx, n as u64)?;
+        let set = update_set(ctx, layout, &self.statics, &pose, &self.outputs)?;
+        // The pose stays inside the decode box (the rebuild clamps to it).
+        let info = &self.basis.info;
+        let origin = Vec3::from_slice(&info.pos_origin[..3]);
+        self.pose_bounds = Some((origin, origin + Vec3::from_slice(&info.pos_extent[..3])));
+        Ok(self.simulation.replace(SimulatedPose {
+            sim: gpu,
+            pose,
+            set,
+        }))
+    }
+
+    /// The GPU simulation, if started.
+    pub fn simulation(&self) -> Option<&SimulatedPose> {
+        self.simulation.as_ref()
+    }
+
+    /// Step the GPU simulation by `dt` while the character moves to `model` (the next frame
+    /// runs it and rebuilds the textures from its pose; it replaces a pose given since).
+    pub fn step_simulation(
+        &mut self,
+        dt: f32,
+        model: glam::Mat4,
+        settings: &crate::dynamics::DynamicsSettings,
+    ) -> GpuResult<()> {
+        let Some(s) = self.simulation.as_mut() else {
+            return Err(GpuError::Unsupported(
+                "hair dynamics were not started on the GPU".into(),
+            ));
+        };
+        s.sim.step(dt, model, settings, &s.pose)?;
+        self.pending = None;
+        Ok(())
     }
 
     /// The other set's image of texture `binding` (`None`: uv and w, which poses keep).
@@ -210,6 +313,9 @@ impl DeformState {
                 .collect(),
         );
         self.pose_bounds = Some(crate::model::hair_mesh::bounds(positions.iter().copied()));
+        if let Some(s) = self.simulation.as_mut() {
+            s.sim.take_job();
+        }
         Ok(())
     }
 
@@ -218,21 +324,40 @@ impl DeformState {
         self.pose_bounds
     }
 
-    /// Write a pending pose into frame slot `slot`'s buffer (its earlier frame has completed)
-    /// and make the other texture set current (this frame's update writes it); whether there
-    /// was one.
-    pub fn write_pending(&mut self, slot: usize) -> GpuResult<bool> {
-        let Some(pose) = self.pending.take() else {
-            return Ok(false);
+    /// Write a pending pose into frame slot `slot`'s buffer (its earlier frame has completed),
+    /// or take the pending GPU step, and make the other texture set current (this frame's
+    /// update writes it); what this frame's update rebuilds from, if anything.
+    pub fn write_pending(&mut self, slot: usize) -> GpuResult<Option<PoseUpdate>> {
+        let job = self.simulation.as_mut().and_then(|s| s.sim.take_job());
+        let update = match (self.pending.take(), job) {
+            (Some(pose), _) => {
+                self.poses[slot].0.write(0, bytemuck::cast_slice(&pose))?;
+                PoseUpdate::Uploaded
+            }
+            (None, Some(job)) => PoseUpdate::Simulated(job),
+            (None, None) => {
+                self.reads_simulation = false;
+                return Ok(None);
+            }
         };
-        self.poses[slot].0.write(0, bytemuck::cast_slice(&pose))?;
+        self.reads_simulation = matches!(update, PoseUpdate::Simulated(_));
         self.alternate_current = !self.alternate_current;
-        Ok(true)
+        Ok(Some(update))
     }
 
     /// The set frame slot `slot` dispatches with, and the workgroup count.
     pub fn dispatch(&self, slot: usize) -> (&DescriptorSet, u32) {
         let invocations = self.basis.info.slice_texels() as u32 * self.basis.info.layers;
-        (&self.poses[slot].1, invocations.div_ceil(DEFORM_GROUP_SIZE))
+        let set = match (&self.simulation, self.reads_simulation) {
+            (Some(s), true) => &s.set,
+            _ => &self.poses[slot].1,
+        };
+        (set, invocations.div_ceil(DEFORM_GROUP_SIZE))
+    }
+
+    /// This frame's simulated state and pose buffers, when its update reads the simulation.
+    pub fn simulated_buffers(&self) -> Option<(&Buffer, &Buffer)> {
+        let s = self.simulation.as_ref().filter(|_| self.reads_simulation)?;
+        Some((s.sim.state_buffer(), &s.pose))
     }
 }

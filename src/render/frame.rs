@@ -2,6 +2,7 @@
 //! blocks, build the frame graph from the passes, run it, submit (the frames in flight are
 //! [`super::slots`]).
 
+use super::passes::hair_dynamics::SimulatedCharacter;
 use std::sync::Arc;
 
 use ash::vk;
@@ -45,6 +46,9 @@ pub(super) struct FrameWork<'a> {
     kbuffer_budget: u32,
     /// Character slots whose hair mesh pose changed (rebuilt this frame).
     pose_updates: Vec<usize>,
+    /// Character slots whose hair is simulated on the GPU this frame (their steps are in the
+    /// slot's job table, in this order).
+    simulated: Vec<usize>,
     /// Motion vectors and accumulation, when the frame has them.
     temporal: Option<TemporalWork>,
     /// The transient buffers and images the frame graph creates.
@@ -77,7 +81,9 @@ impl Renderer {
                 .push(Retired::Resource(Box::new(old)));
         }
         self.prepare_workspace(i, path)?;
-        let pose_updates = self.crowd.write_pending_poses(i)?;
+        let updates = self.crowd.write_pending_poses(i)?;
+        let simulated = self.write_sim_jobs(i, &updates.simulated)?;
+        let pose_updates = updates.updated;
         let (mut block, light_block) = self.frame_blocks(view, opts, (raster, kbuffer_budget));
         let motion = self.temporal_fields(&mut block, temporal);
         // Software light passes only where there is a light view this frame.
@@ -108,6 +114,7 @@ impl Renderer {
             light_raster,
             kbuffer_budget,
             pose_updates,
+            simulated,
             temporal,
             transients,
         };
@@ -129,6 +136,30 @@ impl Renderer {
         self.after_submit(path, raster);
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
         Ok(FrameTicket(self.frame_number - 1))
+    }
+
+    /// Write this frame's GPU hair dynamics steps into frame slot `i`'s job table (grown as
+    /// needed: its earlier frame has completed); their character slots, in table order.
+    fn write_sim_jobs(
+        &mut self,
+        i: usize,
+        steps: &[(usize, super::shared::SimJob)],
+    ) -> GpuResult<Vec<usize>> {
+        if steps.is_empty() {
+            return Ok(Vec::new());
+        }
+        let slot = &mut self.frames[i];
+        let bytes = std::mem::size_of_val(steps) as u64;
+        let table = match slot.sim_jobs.take() {
+            Some(t) if t.size >= bytes => t,
+            _ => {
+                super::passes::hair_dynamics::job_table(&self.ctx, steps.len().next_power_of_two())?
+            }
+        };
+        let jobs: Vec<super::shared::SimJob> = steps.iter().map(|(_, j)| *j).collect();
+        let table = slot.sim_jobs.insert(table);
+        table.write(0, bytemuck::cast_slice(&jobs))?;
+        Ok(steps.iter().map(|(s, _)| *s).collect())
     }
 
     /// The character records of this frame: those in `pose_updates` with their previous
@@ -390,6 +421,7 @@ impl Renderer {
             image_readback,
             motion_readback,
             retired,
+            sim_jobs,
             ..
         } = &mut self.frames[i];
         let mut rec = cmd.begin()?;
@@ -398,6 +430,12 @@ impl Renderer {
             q.reset(&mut rec);
         }
         let jobs = self.crowd.update_jobs(i, &work.pose_updates);
+        let simulated: Vec<SimulatedCharacter> = self
+            .crowd
+            .simulated_buffers(&work.simulated)
+            .into_iter()
+            .map(|(state, pose)| SimulatedCharacter { state, pose })
+            .collect();
         let size = self.targets.size();
         let mut g = FrameGraph::new(opts.describe_frame);
         if let Some((pass, resource, access)) = &self.desc.omit_use {
@@ -412,7 +450,8 @@ impl Renderer {
         let r = FrameRes::new(&mut g, sources, &work.transients);
         g.bind_transients(set);
         g.bind_transients(light_set);
-        self.passes.add_updates(&mut g, &r, &jobs);
+        let dynamics = sim_jobs.as_ref().map(|t| (t, simulated.as_slice()));
+        self.passes.add_updates(&mut g, &r, &jobs, dynamics);
         if work.path == RenderPath::Lhs
             && let Some((_, lhs)) = self.lhs.as_mut()
         {

@@ -7,6 +7,7 @@ pub mod camera;
 pub mod crowd;
 pub mod debug;
 pub mod deform;
+pub mod dynamics;
 pub mod frame;
 pub mod graph;
 pub mod passes;

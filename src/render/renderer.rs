@@ -249,6 +249,66 @@ impl Renderer {
         self.crowd.set_pose(id, positions)
     }
 
+    /// Simulate character `id`'s hair mesh on the GPU (`glsl/hair_dynamics.comp`), continuing
+    /// from `sim`'s state, clock, constraints and colliders (the character must have been made
+    /// deformable with the same mesh). Replaces an earlier GPU simulation of it. From then on
+    /// [`Self::step_hair`] advances it and each step's pose is rebuilt into its textures
+    /// without leaving the GPU.
+    pub fn simulate_hair(
+        &mut self,
+        id: CharacterId,
+        sim: &crate::dynamics::HairDynamics,
+    ) -> GpuResult<()> {
+        let layout = self.passes.deform_set_layout().clone();
+        if let Some(old) = self.crowd.simulate(id, sim, &layout)? {
+            self.retire(Retired::Resource(Box::new(old)));
+        }
+        Ok(())
+    }
+
+    /// Advance character `id`'s GPU hair dynamics by `dt` seconds while it moves to `model`,
+    /// with `settings` (the next frame runs the step, then rebuilds the textures from its
+    /// pose). One step per frame: a second call before the frame replaces the first's step
+    /// (its time is skipped). A pose given with [`Self::set_hair_mesh_pose`] after this call
+    /// wins over the step, and the other way round.
+    pub fn step_hair(
+        &mut self,
+        id: CharacterId,
+        dt: f32,
+        model: glam::Mat4,
+        settings: &crate::dynamics::DynamicsSettings,
+    ) -> GpuResult<()> {
+        self.crowd.step_simulation(id, dt, model, settings)
+    }
+
+    /// Character `id`'s GPU hair dynamics state (world positions and velocities) and clock,
+    /// read back after the frames in flight (tests, and switching to the CPU solver).
+    pub fn read_hair_state(
+        &mut self,
+        id: CharacterId,
+    ) -> GpuResult<(crate::dynamics::HairState, crate::dynamics::StepClock)> {
+        self.finish()?;
+        let sim = self.crowd.simulation(id)?.sim();
+        let bytes =
+            super::debug::read_device_buffer(&self.ctx, sim.state_buffer(), sim.state_bytes())?;
+        Ok((super::dynamics::hair_state(&bytes), *sim.clock()))
+    }
+
+    /// The pose character `id`'s GPU hair dynamics last wrote (`layers x vertices`,
+    /// character frame), read back after the frames in flight.
+    pub fn read_hair_pose(&mut self, id: CharacterId) -> GpuResult<Vec<glam::Vec3>> {
+        self.finish()?;
+        let s = self.crowd.simulation(id)?;
+        let bytes = super::debug::read_device_buffer(&self.ctx, s.pose(), s.pose().size)?;
+        let poses: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+        let n = (s.sim().state_bytes() / size_of::<super::shared::SimState>() as u64) as usize;
+        Ok(poses
+            .iter()
+            .take(n)
+            .map(|p| glam::Vec3::from_slice(&p[..3]))
+            .collect())
+    }
+
     /// Store the strands of the last compute-path frame for the LHS baseline (`RenderPath::Lhs`):
     /// its first `vertices` pool vertices (`FrameStats::vertex_slots_written` of that frame,
     /// rendered with LoD off), `verts_per_strand` each, with `fraction` of them as guides

@@ -43,6 +43,15 @@ pub const SOFT_BIN_GROUP: u32 = 256;
 pub const LOD_SOFT: u32 = 256;
 /// Invocations of one `hair_mesh_update.comp` workgroup.
 pub const DEFORM_GROUP_SIZE: u32 = 64;
+/// Invocations of one `hair_dynamics.comp` workgroup (one workgroup simulates one character).
+pub const DYNAMICS_GROUP_SIZE: u32 = 128;
+/// `SimCollider::shape.x`: an ellipsoid (`a`: centre, `b`: radii).
+pub const COLLIDER_ELLIPSOID: u32 = 0;
+/// `SimCollider::shape.x`: a capsule (`a`, `b`: axis ends; `a.w`: radius).
+pub const COLLIDER_CAPSULE: u32 = 1;
+/// `SimCollider::shape.x`: a radial-map head (`a.w`: margin; `b`: map centre; the job's head
+/// map).
+pub const COLLIDER_HEAD: u32 = 2;
 /// Largest k-buffer budget (nodes per pixel).
 pub const MAX_OIT_BUDGET: u32 = 16;
 /// Opacity of one full-detail strand over the part of a pixel it covers.
@@ -729,6 +738,120 @@ pub struct StructInfo {
     /// Rust `size_of`.
     pub rust_size: usize,
 }
+/// One simulated hair mesh vertex at rest (`glsl/hair_dynamics.comp`, `dynamics::HairTopology`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SimVertex {
+    /// xyz: authored position, character frame; w: the pose's w (the root thinning's cube root
+    /// on the scalp layer, as `DeformState::set_pose` writes it; 0 above).
+    pub rest: [f32; 4],
+    /// x: rest distance to the vertex below; y: to the vertex two layers below; zw unused.
+    pub lengths: [f32; 4],
+}
+
+/// One spacing constraint between two vertices of a layer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SimConstraint {
+    /// First vertex.
+    pub a: u32,
+    /// Second vertex.
+    pub b: u32,
+    /// Rest distance.
+    pub rest: f32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// A collider in the character's frame ([`COLLIDER_ELLIPSOID`], [`COLLIDER_CAPSULE`],
+/// [`COLLIDER_HEAD`]).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SimCollider {
+    /// x: the kind; yzw unused.
+    pub shape: [u32; 4],
+    /// Per kind (see the kinds).
+    pub a: [f32; 4],
+    /// Per kind.
+    pub b: [f32; 4],
+    /// Head: character frame to the map's canonical frame.
+    pub to_canonical: [[f32; 4]; 4],
+    /// Head: the map's canonical frame to the character's.
+    pub to_person: [[f32; 4]; 4],
+}
+
+/// One simulated vertex's state, world frame (w unused).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SimState {
+    /// Position.
+    pub x: [f32; 4],
+    /// Velocity.
+    pub v: [f32; 4],
+    /// The substep's positions being solved.
+    pub p: [f32; 4],
+    /// The follow-the-leader displacement.
+    pub correction: [f32; 4],
+}
+
+/// One character's step this frame: where its buffers are (device addresses, low word first)
+/// and its `dynamics::StepPlan` and settings.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SimJob {
+    /// `SimVertex[]`.
+    pub vertices: [u32; 2],
+    /// `SimConstraint[]`, grouped by colour.
+    pub spacing: [u32; 2],
+    /// `uint[]`: first constraint of each colour, then the total.
+    pub spacing_colours: [u32; 2],
+    /// `SimCollider[]`.
+    pub colliders: [u32; 2],
+    /// `SimState[]`.
+    pub state: [u32; 2],
+    /// `vec4[]`: the pose the texture rebuild reads (character frame).
+    pub pose: [u32; 2],
+    /// `float[]`: the head collider's radial map (rows x columns), if any.
+    pub head_map: [u32; 2],
+    /// Padding.
+    pub _pad: [u32; 2],
+    /// Vertices per layer, layers, substeps (0: only the pose), colliders.
+    pub counts: [u32; 4],
+    /// Spacing colours, head map rows, head map columns, unused.
+    pub colours: [u32; 4],
+    /// Rotation (quaternion xyzw) at the step's start.
+    pub from_rotation: [f32; 4],
+    /// Rotation at its end.
+    pub to_rotation: [f32; 4],
+    /// xyz: translation at the start; w: simulation time at the start.
+    pub from_translation: [f32; 4],
+    /// xyz: translation at the end; w: seconds per substep.
+    pub to_translation: [f32; 4],
+    /// xyz: scale at the start; w: velocity kept per substep (damping).
+    pub from_scale: [f32; 4],
+    /// xyz: scale at the end; w unused.
+    pub to_scale: [f32; 4],
+    /// xyz: gravity, m/s^2; w: wind gustiness.
+    pub gravity: [f32; 4],
+    /// xyz: unit wind direction; w: wind strength.
+    pub wind: [f32; 4],
+    /// Shape stiffness, spacing compliance, bend compliance, follow-the-leader damping.
+    pub stiffness: [f32; 4],
+}
+
+gpu_struct!(SimVertex as "SimVertex" { rest: "vec4", lengths: "vec4" });
+gpu_struct!(SimConstraint as "SimConstraint" { a: "uint", b: "uint", rest: "float", _pad: "uint" });
+gpu_struct!(SimCollider as "SimCollider" {
+    shape: "uvec4", a: "vec4", b: "vec4", to_canonical: "mat4", to_person: "mat4",
+});
+gpu_struct!(SimState as "SimState" { x: "vec4", v: "vec4", p: "vec4", correction: "vec4" });
+gpu_struct!(SimJob as "SimJob" {
+    vertices: "uvec2", spacing: "uvec2", spacing_colours: "uvec2", colliders: "uvec2",
+    state: "uvec2", pose: "uvec2", head_map: "uvec2", _pad: "uvec2", counts: "uvec4",
+    colours: "uvec4", from_rotation: "vec4", to_rotation: "vec4", from_translation: "vec4",
+    to_translation: "vec4", from_scale: "vec4", to_scale: "vec4", gravity: "vec4", wind: "vec4",
+    stiffness: "vec4",
+});
 gpu_struct!(LhsWeights as "LhsWeights" { guides: "uvec4", weights: "vec4" });
 gpu_struct!(DeformParams as "DeformParams" { origin: "vec4", extent: "vec4", counts: "uvec4" });
 gpu_struct!(crate::bake::deform::StylingTerm as "StylingTerm" {
@@ -762,6 +885,11 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<DeformParams>(),
         info::<LhsWeights>(),
         info::<crate::bake::deform::StylingTerm>(),
+        info::<SimVertex>(),
+        info::<SimConstraint>(),
+        info::<SimCollider>(),
+        info::<SimState>(),
+        info::<SimJob>(),
     ]
 }
 
@@ -818,6 +946,12 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("DISPATCH_ROW", DISPATCH_ROW),
         layout("DEFORM_GROUP_SIZE", DEFORM_GROUP_SIZE),
         layout("LHS_GROUP_SIZE", LHS_GROUP_SIZE),
+        layout("DYNAMICS_GROUP_SIZE", DYNAMICS_GROUP_SIZE),
+        uint("COLLIDER_ELLIPSOID", COLLIDER_ELLIPSOID),
+        uint("COLLIDER_CAPSULE", COLLIDER_CAPSULE),
+        uint("COLLIDER_HEAD", COLLIDER_HEAD),
+        uint("BEND_COLOURS", crate::dynamics::BEND_COLOURS as u32),
+        uint("COLLISION_ROUNDS", crate::dynamics::COLLISION_ROUNDS),
         uint("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
         uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
         uint("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
@@ -861,6 +995,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
 fn float_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("STRAND_OPACITY", STRAND_OPACITY),
+        ("SHAPE_TIP_LOSS", crate::dynamics::SHAPE_TIP_LOSS),
         ("VISIBILITY_RESIDUAL_STEPS", VISIBILITY_RESIDUAL_STEPS),
         ("TEMPORAL_SOLID_MOVING_WEIGHT", TEMPORAL_SOLID_MOVING_WEIGHT),
         ("TEMPORAL_SOLID_MOTION", TEMPORAL_SOLID_MOTION),

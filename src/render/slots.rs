@@ -94,6 +94,8 @@ pub(crate) struct FrameSlot {
     pub light_set: DescriptorSet,
     pub retired: Vec<Retired>,
     pub pending: Option<Pending>,
+    /// The GPU hair dynamics' job table (host-visible, read by address), once needed.
+    pub sim_jobs: Option<Buffer>,
 }
 
 impl FrameSlot {
@@ -122,6 +124,7 @@ impl FrameSlot {
             light_set: DescriptorSet::new(ctx, "light frame set", layout)?,
             retired: Vec::new(),
             pending: None,
+            sim_jobs: None,
         })
     }
 }

@@ -158,6 +158,15 @@ impl Buffer {
         self.raw
     }
 
+    /// The buffer's device address, as the `uvec2` a shader's `buffer_reference` takes (low
+    /// word, high word); the buffer needs `SHADER_DEVICE_ADDRESS` usage.
+    pub fn device_address(&self) -> [u32; 2] {
+        let info = vk::BufferDeviceAddressInfo::default().buffer(self.raw);
+        // SAFETY: valid buffer of this device; the device has bufferDeviceAddress enabled.
+        let address = unsafe { self.ctx.device.get_buffer_device_address(&info) };
+        [address as u32, (address >> 32) as u32]
+    }
+
     /// Read the contents of a host-visible buffer.
     pub fn read(&mut self) -> GpuResult<Vec<u8>> {
         self.read_range(0, self.size as usize)

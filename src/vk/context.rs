@@ -297,7 +297,7 @@ impl Context {
                 device: device.clone(),
                 physical_device: physical,
                 debug_settings: Default::default(),
-                buffer_device_address: false,
+                buffer_device_address: true,
                 allocation_sizes: Default::default(),
             });
             let allocator = match allocator {

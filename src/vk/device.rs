@@ -141,6 +141,8 @@ pub(super) fn query_features(
             "shaderSampledImageArrayNonUniformIndexing",
             f12.shader_sampled_image_array_non_uniform_indexing,
         ),
+        // The hair dynamics reach each character's buffers by address.
+        ("bufferDeviceAddress", f12.buffer_device_address),
     ];
     if let Some((missing, _)) = required.iter().find(|(_, on)| *on == 0) {
         return Err(GpuError::Unsupported(format!(
@@ -191,6 +193,7 @@ pub(super) fn create_logical(
         .descriptor_binding_sampled_image_update_after_bind(true)
         .descriptor_binding_update_unused_while_pending(true)
         .shader_sampled_image_array_non_uniform_indexing(true)
+        .buffer_device_address(true)
         .shader_buffer_int64_atomics(f.int64_atomics)
         .shader_shared_int64_atomics(f.int64_atomics);
     let mut enable_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default()

@@ -1,6 +1,7 @@
 //! Animated hair meshes: rebuild the hair mesh texture and the u/v textures of every character
 //! whose pose changed (`glsl/hair_mesh_update.comp`, the GPU twin of `bake::deform`), then copy
-//! the packed texels into its textures. Reads: the pose and static basis buffers. Writes: the
+//! the packed texels into its textures. Reads: the pose (uploaded, or written by
+//! `passes::hair_dynamics`) and static basis buffers. Writes: the
 //! characters' position, u and v textures (left sampled). Runs before anything reads them.
 
 use std::sync::Arc;
@@ -50,9 +51,16 @@ impl HairMeshUpdate {
         &self.set_layout
     }
 
-    /// Add the updates: the rebuild of every job's packed texels, their copies into the
-    /// textures, and the hand-back of the textures to sampling.
-    pub fn add<'a>(&'a self, g: &mut FrameGraph<'a>, r: &FrameRes, jobs: &'a [UpdateJob<'a>]) {
+    /// Add the updates: the rebuild of every job's packed texels (reading `simulated`, the
+    /// poses the GPU dynamics wrote this frame), their copies into the textures, and the
+    /// hand-back of the textures to sampling.
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes,
+        jobs: &'a [UpdateJob<'a>],
+        simulated: &[Res],
+    ) {
         if jobs.is_empty() {
             return;
         }
@@ -83,7 +91,8 @@ impl HairMeshUpdate {
         g.begin_scope("hair mesh update");
         let mut p = g
             .pass("hair mesh update")
-            .read(r.constants, Access::ComputeRead);
+            .read(r.constants, Access::ComputeRead)
+            .read_all(simulated, Access::ComputeRead);
         for o in outputs.iter().flatten() {
             p = p.discard(*o, Access::ComputeReadWrite);
         }

@@ -2,6 +2,7 @@
 //! `add`, declaring what it reads and writes; the graph derives the synchronisation.
 
 pub mod compute_generate;
+pub mod hair_dynamics;
 pub mod hair_mesh_update;
 pub mod lhs_skin;
 pub mod output;
@@ -522,6 +523,7 @@ pub struct FramePasses {
     /// Motion vectors and temporal accumulation, on devices with 64-bit buffer atomics.
     temporal: Option<temporal::TemporalPass>,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
+    hair_dynamics: hair_dynamics::HairDynamicsPass,
     lhs_skin: lhs_skin::LhsSkin,
 }
 
@@ -584,6 +586,7 @@ impl FramePasses {
                 false => None,
             },
             hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
+            hair_dynamics: hair_dynamics::HairDynamicsPass::new(ctx)?,
             lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
         })
     }
@@ -598,14 +601,20 @@ impl FramePasses {
         &self.lhs_skin
     }
 
-    /// Add this frame's hair mesh texture rebuilds (before [`Self::add`]).
+    /// Add this frame's hair dynamics (the steps in `table`, of the characters in
+    /// `simulated`) and hair mesh texture rebuilds (before [`Self::add`]).
     pub fn add_updates<'a>(
         &'a self,
         g: &mut FrameGraph<'a>,
         r: &FrameRes,
         jobs: &'a [hair_mesh_update::UpdateJob<'a>],
+        dynamics: Option<(&'a Buffer, &[hair_dynamics::SimulatedCharacter<'a>])>,
     ) {
-        self.hair_mesh_update.add(g, r, jobs);
+        let poses = match dynamics {
+            Some((table, simulated)) => self.hair_dynamics.add(g, table, simulated),
+            None => Vec::new(),
+        };
+        self.hair_mesh_update.add(g, r, jobs, &poses);
     }
 
     /// Add the LHS baseline's skinning for frame slot `slot` (before [`Self::add`]).

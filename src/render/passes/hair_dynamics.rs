@@ -1,0 +1,89 @@
+//! Hair dynamics on the GPU (`glsl/hair_dynamics.comp`, `render::dynamics`): one dispatch for
+//! every character simulated this frame, one workgroup each, reading the frame slot's job
+//! table by device address. Reads and writes: each character's state buffer. Writes: its pose
+//! buffer, which `passes::hair_mesh_update` reads next.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use crate::render::graph::{FrameGraph, Res};
+use crate::render::shared::SimJob;
+use crate::vk::{Access, Buffer, BufferDesc, Context, GpuResult, Pipeline, PipelineLayout};
+
+/// One simulated character's buffers this frame.
+pub struct SimulatedCharacter<'a> {
+    /// Positions, velocities and scratch.
+    pub state: &'a Buffer,
+    /// The pose the texture rebuild reads.
+    pub pose: &'a Buffer,
+}
+
+/// The solver's pipeline.
+pub struct HairDynamicsPass {
+    pipeline: Pipeline,
+}
+
+/// A host-visible job table with room for `jobs` steps (the solver reads it by address).
+pub fn job_table(ctx: &Arc<Context>, jobs: usize) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            "hair dynamics jobs",
+            (jobs.max(1) * size_of::<SimJob>()) as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+        )
+        .host_visible(),
+    )
+}
+
+impl HairDynamicsPass {
+    /// Compile the pass.
+    pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
+        let layout = PipelineLayout::new(ctx, &[])?;
+        let spirv = super::compile("hair_dynamics.comp", &super::shader_options(1))?;
+        Ok(HairDynamicsPass {
+            pipeline: Pipeline::compute(ctx, "hair dynamics", &layout, &spirv)?,
+        })
+    }
+
+    /// Add the step of every character in `simulated` (the jobs in `table`, in that order);
+    /// returns each character's pose in the graph, for the texture rebuild to read.
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        table: &'a Buffer,
+        simulated: &[SimulatedCharacter<'a>],
+    ) -> Vec<Res> {
+        if simulated.is_empty() {
+            return Vec::new();
+        }
+        let jobs = g.host_input("hair dynamics jobs");
+        let states: Vec<Res> = simulated
+            .iter()
+            .map(|s| g.import_buffer("hair state", s.state))
+            .collect();
+        let poses: Vec<Res> = simulated
+            .iter()
+            .map(|s| g.import_buffer("simulated pose", s.pose))
+            .collect();
+        let count = simulated.len() as u32;
+        let address = table.device_address();
+        g.begin_scope("hair dynamics");
+        let mut p = g.pass("hair dynamics").read(jobs, Access::ComputeRead);
+        for (s, pose) in states.iter().zip(&poses) {
+            p = p
+                .write(*s, Access::ComputeReadWrite)
+                .discard(*pose, Access::ComputeReadWrite);
+        }
+        p.record(move |rec, _| {
+            rec.bind(&self.pipeline, &[]);
+            rec.push_constants(&self.pipeline, &[address[0], address[1], count, 0]);
+            let (x, y) = super::dispatch_2d(count);
+            rec.dispatch(x, y, 1);
+            Ok(())
+        });
+        g.end_scope();
+        poses
+    }
+}
