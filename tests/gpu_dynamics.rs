@@ -209,3 +209,81 @@ fn gpu_equals_the_cpu_twin_for_a_person() {
     check_twins(&ctx, name, &hair.mesh, colliders, &turns, windy(12.0));
     assert_no_validation_errors(&ctx);
 }
+
+/// The CPU's stability bar (tests/dynamics.rs) on the GPU path: 600 frames of head jerks in
+/// strong wind at 60 Hz (every edge within 10% of its rest length, nothing NaN, nothing deep
+/// inside the head, the hair really moves), then 10 s still and calm: back at rest within
+/// 1% of the head radius. Roots follow the head exactly in every frame read.
+#[test]
+fn gpu_dynamics_are_stable_and_return_to_rest() {
+    let ctx = context();
+    let mesh = head_long();
+    let head = Collider::fit_scalp(&mesh);
+    let Collider::Ellipsoid { centre, radii } = head else {
+        unreachable!()
+    };
+    let radius = radii.x / 0.97;
+    let mut motion = CharacterMotion::idle(Mat4::IDENTITY, 3);
+    motion.jerk = 0.8;
+    let mut settings = windy(40.0);
+    let cpu = HairDynamics::new(&mesh, vec![head], settings, motion.model(0.0));
+    let topology = cpu.topology().clone();
+    let (mut r, id) = setup(&ctx, &mesh, motion.model(0.0));
+    r.simulate_hair(id, &cpu).unwrap();
+    let n = mesh.vertices_per_layer();
+    let (mut worst_strain, mut most_moved) = (0.0f32, 0.0f32);
+    let mut model = Mat4::IDENTITY;
+    for f in 1..=600 {
+        model = motion.model(f as f32 / 60.0);
+        r.set_model(id, model).unwrap();
+        r.step_hair(id, 1.0 / 60.0, model, &settings).unwrap();
+        frame(&mut r);
+        if f % 20 != 0 {
+            continue;
+        }
+        let (state, _) = r.read_hair_state(id).unwrap();
+        assert!(
+            state.x.iter().chain(&state.v).all(|p| p.is_finite()),
+            "frame {f}: NaN"
+        );
+        let strain = max_edge_strain(&topology, &state.x);
+        worst_strain = worst_strain.max(strain);
+        most_moved = most_moved.max(mean_offset(&state.x, &mesh, model));
+        let inv = model.inverse();
+        let inside = state
+            .x
+            .iter()
+            .map(|p| inv.transform_point3(*p).distance(centre))
+            .fold(f32::MAX, f32::min);
+        assert!(inside > radius * 0.85, "frame {f}: a vertex at {inside}");
+        // Roots: the pose's scalp layer is the authored one (up to the placement's rounding).
+        let pose = r.read_hair_pose(id).unwrap();
+        let root_error = pose[..n]
+            .iter()
+            .zip(&mesh.layers[0])
+            .map(|(p, q)| p.distance(*q))
+            .fold(0.0f32, f32::max);
+        assert!(
+            root_error < 1e-5,
+            "frame {f}: a root {root_error} m off the scalp"
+        );
+    }
+    println!("GPU: worst edge strain {worst_strain:.2e}, largest mean offset {most_moved:.3} m");
+    assert!(worst_strain < 0.1, "strain {worst_strain}");
+    assert!(most_moved > 0.05 * radius, "the wind did not move the hair");
+    settings.wind.strength = 0.0;
+    for _ in 0..600 {
+        r.step_hair(id, 1.0 / 60.0, model, &settings).unwrap();
+        frame(&mut r);
+    }
+    let (state, _) = r.read_hair_state(id).unwrap();
+    let settled = state
+        .x
+        .iter()
+        .zip(mesh.layers.iter().flatten())
+        .map(|(p, q)| p.distance(model.transform_point3(*q)))
+        .fold(0.0f32, f32::max);
+    println!("GPU: 10 s after stopping, {settled:.5} m from rest (head radius {radius:.3})");
+    assert!(settled < 0.01 * radius, "settled {settled}");
+    assert_no_validation_errors(&ctx);
+}

@@ -1,10 +1,13 @@
 //! A crowd in motion: every character follows its [`CharacterMotion`]; characters with a
-//! simulated hair mesh step their [`HairDynamics`] and hand the new pose to the renderer, which
-//! rebuilds their textures on the GPU. Characters small on screen simulate less often: by the
-//! height in pixels of their hair (the projected size eq. 7 of paper 003 uses), every frame
-//! above 96 px, every 2nd above 48, every 4th above 24, else every 8th frame, with the time
-//! they skipped (up to [`MAX_FRAME_STEP`](crate::dynamics::MAX_FRAME_STEP)) in one step.
-//! Characters due in a frame are simulated in parallel on all cores.
+//! simulated hair mesh step their hair dynamics every frame, on the GPU by default
+//! ([`DynamicsPath::Gpu`]: the renderer runs `glsl/hair_dynamics.comp` and rebuilds the
+//! textures from its pose without the pose leaving the device) or on the CPU
+//! ([`DynamicsPath::Cpu`]: [`HairDynamics`] on all cores, the pose uploaded). Switching path
+//! carries the state across. With the screen-size schedule on, characters small on screen
+//! simulate less often: by the height in pixels of their hair (the projected size eq. 7 of
+//! paper 003 uses), every frame above 96 px, every 2nd above 48, every 4th above 24, else
+//! every 8th frame, with the time they skipped (up to
+//! [`MAX_FRAME_STEP`](crate::dynamics::MAX_FRAME_STEP)) in one step.
 
 use std::time::Instant;
 
@@ -27,13 +30,17 @@ pub struct AnimatedCharacter {
     pending_dt: f32,
     /// Its hair roots as last handed to the renderer (character frame).
     roots: Vec<Vec3>,
+    /// Whether the renderer holds its hair dynamics' current state (GPU path).
+    on_gpu: bool,
 }
 
 /// What the last [`CrowdAnimation::advance`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AnimationStats {
-    /// CPU milliseconds simulating hair meshes.
+    /// CPU milliseconds simulating hair meshes (CPU path) or handing the GPU its steps.
     pub simulate_ms: f64,
+    /// Where they were simulated.
+    pub path: DynamicsPath,
     /// Characters whose hair was simulated (and textures rebuilt).
     pub simulated: usize,
     /// Hair mesh vertices simulated.
@@ -49,6 +56,11 @@ pub struct CrowdAnimation {
     pub moving: bool,
     /// Hair meshes are simulated (otherwise they stay at rest, moving rigidly).
     pub simulating: bool,
+    /// Where hair meshes are simulated (switch any time: the state is carried across).
+    pub path: DynamicsPath,
+    /// Simulate characters small on screen less often (see the module doc); off: every
+    /// character every frame.
+    pub schedule: bool,
     /// Wind, shared by every character.
     pub wind: Wind,
     /// What the last frame did.
@@ -63,6 +75,27 @@ pub enum DynamicsPath {
     Gpu,
     /// On the CPU (`dynamics::HairDynamics`, all cores), the pose uploaded each frame.
     Cpu,
+}
+
+impl std::str::FromStr for DynamicsPath {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "gpu" => Ok(DynamicsPath::Gpu),
+            "cpu" => Ok(DynamicsPath::Cpu),
+            _ => Err(format!("'{s}': expected gpu or cpu")),
+        }
+    }
+}
+
+impl std::fmt::Display for DynamicsPath {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            DynamicsPath::Gpu => "gpu",
+            DynamicsPath::Cpu => "cpu",
+        })
+    }
 }
 
 /// Hair pixels above which a character simulates every frame (halving per step down).
@@ -83,6 +116,8 @@ impl CrowdAnimation {
             frame: 0,
             moving: true,
             simulating: true,
+            path: DynamicsPath::default(),
+            schedule: false,
             wind: Wind::default(),
             stats: AnimationStats::default(),
         }
@@ -128,6 +163,7 @@ impl CrowdAnimation {
             bounds,
             pending_dt: 0.0,
             roots,
+            on_gpu: false,
         });
     }
 
@@ -178,41 +214,79 @@ impl CrowdAnimation {
             let centre = model.transform_point3(c.bounds.0);
             let scale = model.x_axis.truncate().length();
             let pixels = 2.0 * c.bounds.1 * scale * focal / camera.eye.distance(centre).max(1e-3);
-            if self.frame.is_multiple_of(update_interval(pixels)) {
+            if !self.schedule || self.frame.is_multiple_of(update_interval(pixels)) {
                 due.push((c, model));
             }
         }
-        // Characters are independent: simulate them on all cores.
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let chunk = due.len().div_ceil(threads).max(1);
         let wind = self.wind;
-        std::thread::scope(|scope| {
-            for part in due.chunks_mut(chunk) {
-                scope.spawn(move || {
-                    for (c, model) in part.iter_mut() {
-                        if let Some(d) = c.dynamics.as_mut() {
-                            d.settings.wind = wind;
-                            d.step(c.pending_dt, *model);
-                            c.pending_dt = 0.0;
-                        }
+        let settings = |d: &HairDynamics| DynamicsSettings { wind, ..d.settings };
+        match self.path {
+            DynamicsPath::Cpu => simulate_on_cpu(renderer, &mut due, wind, &mut stats)?,
+            DynamicsPath::Gpu => {
+                for (c, model) in due.iter_mut() {
+                    let Some(d) = c.dynamics.as_mut() else {
+                        continue;
+                    };
+                    if !c.on_gpu {
+                        renderer.simulate_hair(c.id, d)?;
+                        c.on_gpu = true;
                     }
-                });
-            }
-        });
-        for (c, _) in due.iter_mut() {
-            if let Some(d) = &c.dynamics {
-                let pose = d.pose();
-                renderer.set_hair_mesh_pose(c.id, &pose)?;
-                let n = c.roots.len();
-                c.roots.copy_from_slice(&pose[..n]);
-                stats.simulated += 1;
-                stats.vertices += d.vertex_count();
+                    renderer.step_hair(c.id, c.pending_dt, *model, &settings(d))?;
+                    c.pending_dt = 0.0;
+                    stats.simulated += 1;
+                    stats.vertices += d.vertex_count();
+                }
             }
         }
+        stats.path = self.path;
         stats.simulate_ms = start.elapsed().as_secs_f64() * 1e3;
         self.stats = stats;
         Ok(())
     }
+}
+
+/// Simulate the `due` characters on all cores (they are independent) and hand their poses to
+/// `renderer`; a character last simulated on the GPU continues from the GPU's state.
+fn simulate_on_cpu(
+    renderer: &mut Renderer,
+    due: &mut [(&mut AnimatedCharacter, glam::Mat4)],
+    wind: Wind,
+    stats: &mut AnimationStats,
+) -> GpuResult<()> {
+    for (c, _) in due.iter_mut() {
+        if let (true, Some(d)) = (c.on_gpu, c.dynamics.as_mut()) {
+            let (state, clock) = renderer.read_hair_state(c.id)?;
+            d.set_state(state, clock)
+                .map_err(crate::vk::GpuError::Unsupported)?;
+        }
+        c.on_gpu = false;
+    }
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let chunk = due.len().div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        for part in due.chunks_mut(chunk) {
+            scope.spawn(move || {
+                for (c, model) in part.iter_mut() {
+                    if let Some(d) = c.dynamics.as_mut() {
+                        d.settings.wind = wind;
+                        d.step(c.pending_dt, *model);
+                        c.pending_dt = 0.0;
+                    }
+                }
+            });
+        }
+    });
+    for (c, _) in due.iter_mut() {
+        if let Some(d) = &c.dynamics {
+            let pose = d.pose();
+            renderer.set_hair_mesh_pose(c.id, &pose)?;
+            let n = c.roots.len();
+            c.roots.copy_from_slice(&pose[..n]);
+            stats.simulated += 1;
+            stats.vertices += d.vertex_count();
+        }
+    }
+    Ok(())
 }
 
 /// Frames between hair updates for a character whose hair is `pixels` tall on screen.

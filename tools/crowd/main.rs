@@ -124,6 +124,14 @@ pub struct Args {
     /// balls; teapots move without hair dynamics).
     #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
     animate: bool,
+    /// Where hair dynamics run: gpu (one compute dispatch for every character; the pose never
+    /// leaves the GPU) or cpu (all cores; poses uploaded every frame).
+    #[arg(long, default_value = "gpu")]
+    dynamics: hairmesh::animate::DynamicsPath,
+    /// Simulate characters small on screen less often (every 2nd, 4th or 8th frame below 96,
+    /// 48 and 24 pixels of hair); off: every character every frame.
+    #[arg(long, default_value = "off", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
+    dynamics_schedule: bool,
     /// Wind strength on the hair tips, m/s^2 (0..=100; gusty).
     #[arg(long, default_value_t = 0.0)]
     wind: f32,
@@ -241,6 +249,8 @@ impl Scene {
         if !(0.0..=100.0).contains(&args.wind) {
             bail!("--wind {}: must be 0..=100", args.wind);
         }
+        anim.path = args.dynamics;
+        anim.schedule = args.dynamics_schedule;
         if !args.animate {
             anim.moving = false;
             anim.simulating = false;
@@ -488,13 +498,14 @@ fn run(args: Args) -> Result<()> {
             passes.join(" ")
         ));
         outln!(
-            "frame {f}: {:?} path, {} strands, {} triangles, GPU {:.1} ms ({}), record {:.3} ms, hair simulation {:.1} ms ({} characters), root gap {root_gap:.5} head radii",
+            "frame {f}: {:?} path, {} strands, {} triangles, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
             report.path,
             s.strands_drawn,
             s.triangles_drawn,
             report.gpu_ms(),
             passes.join(", "),
             report.record_ms,
+            animation.stats.path,
             animation.stats.simulate_ms,
             animation.stats.simulated
         )?;

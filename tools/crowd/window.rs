@@ -49,6 +49,8 @@ struct Controls {
     lod_appearance: bool,
     moving: bool,
     simulating: bool,
+    dynamics: hairmesh::animate::DynamicsPath,
+    schedule: bool,
     wind: hairmesh::animate::Wind,
     params: StrandParams,
     lod: LodSettings,
@@ -156,6 +158,13 @@ impl Controls {
                 ui.horizontal(|ui| {
                     ui.checkbox(&mut self.moving, "motion");
                     ui.checkbox(&mut self.simulating, "hair dynamics");
+                });
+                ui.horizontal(|ui| {
+                    use hairmesh::animate::DynamicsPath;
+                    ui.label("dynamics on");
+                    ui.radio_value(&mut self.dynamics, DynamicsPath::Gpu, "GPU");
+                    ui.radio_value(&mut self.dynamics, DynamicsPath::Cpu, "CPU");
+                    ui.checkbox(&mut self.schedule, "by screen size");
                 });
                 ui.add(egui::Slider::new(&mut self.wind.strength, 0.0..=60.0).text("wind m/s²"));
                 let mut angle = self
@@ -635,6 +644,8 @@ impl Running {
             lod_appearance: self.lod_appearance,
             moving: self.animation.moving,
             simulating: self.animation.simulating,
+            dynamics: self.animation.path,
+            schedule: self.animation.schedule,
             wind: self.animation.wind,
             params: self.params,
             lod: self.panel.lod,
@@ -720,6 +731,8 @@ impl Running {
         self.lod_appearance = c.lod_appearance;
         self.animation.moving = c.moving;
         self.animation.simulating = c.simulating;
+        self.animation.path = c.dynamics;
+        self.animation.schedule = c.schedule;
         self.animation.wind = c.wind;
         self.path = c.path;
         self.paused = c.paused || (c.fly && !self.camera.fly);
@@ -749,8 +762,8 @@ impl Running {
         );
         let a = &self.animation.stats;
         text.push_str(&format!(
-            "\nhair dynamics: {:.1} ms CPU, {} characters, {} vertices",
-            a.simulate_ms, a.simulated, a.vertices
+            "\nhair dynamics on the {}: {:.1} ms CPU, {} characters, {} vertices",
+            a.path, a.simulate_ms, a.simulated, a.vertices
         ));
         if r.path == RenderPath::Compute {
             text.push_str(&format!(
