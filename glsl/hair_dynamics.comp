@@ -38,6 +38,8 @@ const float TAU = 6.28318530717959;
 SimJob job;
 Vertices verts;
 States st;
+// The character's colliders, loaded once per dispatch.
+shared SimCollider colliders[MAX_SIM_COLLIDERS];
 
 // Workgroup barrier that also makes this workgroup's buffer writes visible to it.
 void sync() {
@@ -124,39 +126,42 @@ float map_sample(vec3 d) {
     return top * (1.0 - fy) + bottom * fy;
 }
 
-vec3 push_out(SimCollider c, vec3 p) {
-    if (c.shape.x == COLLIDER_ELLIPSOID) {
-        vec3 q = (p - c.a.xyz) / c.b.xyz;
+// `p` pushed out of collider `i` (reading only the fields its kind uses).
+vec3 push_out(uint i, vec3 p) {
+    uint kind = colliders[i].shape.x;
+    vec4 a = colliders[i].a;
+    vec3 b = colliders[i].b.xyz;
+    if (kind == COLLIDER_ELLIPSOID) {
+        vec3 q = (p - a.xyz) / b;
         float l = length(q);
-        return l >= 1e-9 && l < 1.0 ? c.a.xyz + q / l * c.b.xyz : p;
+        return l >= 1e-9 && l < 1.0 ? a.xyz + q / l * b : p;
     }
-    if (c.shape.x == COLLIDER_CAPSULE) {
-        vec3 ab = c.b.xyz - c.a.xyz;
-        float t = clamp(dot(p - c.a.xyz, ab) / max(dot(ab, ab), 1e-12), 0.0, 1.0);
-        vec3 centre = c.a.xyz + ab * t;
+    if (kind == COLLIDER_CAPSULE) {
+        vec3 ab = b - a.xyz;
+        float t = clamp(dot(p - a.xyz, ab) / max(dot(ab, ab), 1e-12), 0.0, 1.0);
+        vec3 centre = a.xyz + ab * t;
         vec3 d = p - centre;
         float l = length(d);
-        return l >= c.a.w || l < 1e-9 ? p : centre + d / l * c.a.w;
+        return l >= a.w || l < 1e-9 ? p : centre + d / l * a.w;
     }
-    // A radial-map head, in its canonical frame.
-    vec3 q = (c.to_canonical * vec4(p, 1.0)).xyz;
-    vec3 r = q - c.b.xyz;
+    // A radial-map head, in its canonical frame (b: the map's centre, a.w: the margin).
+    vec3 q = (colliders[i].to_canonical * vec4(p, 1.0)).xyz;
+    vec3 r = q - b;
     float l = length(r);
     vec3 d = l < 1e-9 ? vec3(0.0, 1.0, 0.0) : r / l;
-    float least = map_sample(d) + c.a.w;
+    float least = map_sample(d) + a.w;
     if (l >= least) {
         return p;
     }
-    return (c.to_person * vec4(c.b.xyz + d * least, 1.0)).xyz;
+    return (colliders[i].to_person * vec4(b + d * least, 1.0)).xyz;
 }
 
 // `p` pushed out of every collider at placement `pl` (bit-for-bit unchanged if outside).
 vec3 collide(vec3 p, Placement pl) {
-    Colliders cs = Colliders(job.colliders);
     vec3 local = unapply(pl, p);
     vec3 moved = local;
     for (uint i = 0u; i < job.counts.w; i++) {
-        moved = push_out(cs.colliders[i], moved);
+        moved = push_out(i, moved);
     }
     return moved == local ? p : apply(pl, moved);
 }
@@ -217,17 +222,19 @@ void spacing(float h) {
     }
 }
 
-// dynamics::bend_colour: the constraint of layer k has colour (k / 2) % BEND_COLOURS.
+// dynamics::bend_colour: the constraint of layer k has colour (k / 2) % 2, so colour c's
+// layers are pairs (k, k + 1) four apart from k = 4 (colour 0) or k = 2 (colour 1).
 void bending(float h) {
     uint n = job.counts.x;
     uint layers = job.counts.y;
     float alpha = job.stiffness.z / (h * h);
     for (uint colour = 0u; colour < BEND_COLOURS; colour++) {
-        for (uint j = 2u * n + gl_LocalInvocationID.x; j < n * layers; j += DYNAMICS_GROUP_SIZE) {
-            uint k = j / n;
-            if ((k / 2u) % BEND_COLOURS != colour) {
-                continue;
-            }
+        uint first = colour == 1u ? 2u : 4u;
+        uint count = layers > first ? ((layers - first) / 4u) * 2u + min((layers - first) % 4u, 2u) : 0u;
+        for (uint t = gl_LocalInvocationID.x; t < count * n; t += DYNAMICS_GROUP_SIZE) {
+            uint pair = t / n;
+            uint k = first + 4u * (pair / 2u) + pair % 2u;
+            uint j = k * n + t % n;
             // The scalp (layer 0) does not move: weight 0.
             float w_below = k == 2u ? 0.0 : 1.0;
             distance_constraint(j, 1.0, j - 2u * n, w_below, verts.vertices[j].lengths.y, alpha);
@@ -299,6 +306,10 @@ void main() {
     job = Jobs(push.jobs).jobs[index];
     verts = Vertices(job.vertices);
     st = States(job.state);
+    if (gl_LocalInvocationID.x < job.counts.w) {
+        colliders[gl_LocalInvocationID.x] = Colliders(job.colliders).colliders[gl_LocalInvocationID.x];
+    }
+    barrier();
     uint substeps = job.counts.z;
     float h = job.to_translation.w;
     for (uint s = 1u; s <= substeps; s++) {

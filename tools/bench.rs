@@ -20,9 +20,10 @@
 //! `bench temporal [--size 320x180] [--frames 16] [--scenarios orbit,dolly,crowd]`: the
 //! flicker measure with temporal accumulation off and on against a supersampled reference.
 //!
-//! `bench animate [--mesh M] [--wind 30] [--frames 90] [--strip out.png]`: one hair mesh in
-//! wind, simulated and re-textured every frame: CPU ms of the dynamics, GPU ms of the texture
-//! rebuild and of the frame (medians); optionally a strip of frames side by side.
+//! `bench animate [--mesh M] [--wind 30] [--frames 90] [--counts 1,100] [--dynamics gpu,cpu]
+//! [--strip out.png]`: copies of one hair mesh in wind, simulated (on the GPU, or the CPU on
+//! all cores) and re-textured every frame: CPU and GPU ms of the dynamics, GPU ms of the
+//! texture rebuild and of the frame (medians); optionally a strip of frames side by side.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -166,8 +167,8 @@ enum Cmd {
     /// reference's, FLIP against the reference, and the accumulation's GPU ms.
     Temporal(temporal::TemporalArgs),
     /// Copies of one hair mesh in wind, simulated and re-textured every frame (30 Hz), for
-    /// each character count: CPU ms of the dynamics (all cores), GPU ms of the texture rebuild
-    /// and of the frame; optionally a strip of frames.
+    /// each character count and dynamics path: CPU and GPU ms of the dynamics, GPU ms of the
+    /// texture rebuild and of the frame; optionally a strip of frames.
     Animate {
         /// Hair mesh OBJ (style: the .toml beside it).
         #[arg(long, default_value = "hairmeshes/head_long.obj")]
@@ -188,7 +189,11 @@ enum Cmd {
         /// frame on all cores).
         #[arg(long, value_delimiter = ',', default_value = "1")]
         counts: Vec<u32>,
-        /// Write frames (of the first count) side by side here.
+        /// Where the dynamics run, one run each: gpu (one dispatch for every character) and/or
+        /// cpu (all cores, poses uploaded).
+        #[arg(long, value_delimiter = ',', default_value = "gpu,cpu")]
+        dynamics: Vec<hairmesh::animate::DynamicsPath>,
+        /// Write frames (of the first count and path) side by side here.
         #[arg(long)]
         strip: Option<PathBuf>,
         /// Frames in the strip (evenly spaced).
@@ -656,6 +661,7 @@ fn run(args: Args) -> Result<()> {
             size,
             strands_per_bundle,
             counts,
+            dynamics,
             strip,
             strip_frames,
             device,
@@ -666,6 +672,7 @@ fn run(args: Args) -> Result<()> {
             size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
             strands_per_bundle,
             counts,
+            dynamics,
             strip,
             strip_frames,
             device,

@@ -18,6 +18,13 @@
 #define DISPATCH_ROW 65535u
 #define DEFORM_GROUP_SIZE 64
 #define LHS_GROUP_SIZE 64
+#define DYNAMICS_GROUP_SIZE 64
+#define MAX_SIM_COLLIDERS 16
+#define COLLIDER_ELLIPSOID 0u
+#define COLLIDER_CAPSULE 1u
+#define COLLIDER_HEAD 2u
+#define BEND_COLOURS 2u
+#define COLLISION_ROUNDS 16u
 #define CHARACTER_VISIBLE 1u
 #define MARSCHNER_LUT_PHI 256u
 #define MARSCHNER_LUT_D 64u
@@ -51,6 +58,7 @@
 #define TEMPORAL_GROUP 16u
 #define VISIBILITY_DEPTH_SHIFT 6u
 #define STRAND_OPACITY 0.7
+#define SHAPE_TIP_LOSS 0.7
 #define VISIBILITY_RESIDUAL_STEPS 8.0
 #define TEMPORAL_SOLID_MOVING_WEIGHT 0.5
 #define TEMPORAL_SOLID_MOTION 0.25
@@ -271,6 +279,55 @@ struct StylingTerm {
     uint i2;
     vec2 u;
     vec2 v;
+};
+
+struct SimVertex {
+    vec4 rest;
+    vec4 lengths;
+};
+
+struct SimConstraint {
+    uint a;
+    uint b;
+    float rest;
+    uint _pad;
+};
+
+struct SimCollider {
+    uvec4 shape;
+    vec4 a;
+    vec4 b;
+    mat4 to_canonical;
+    mat4 to_person;
+};
+
+struct SimState {
+    vec4 x;
+    vec4 v;
+    vec4 p;
+    vec4 correction;
+};
+
+struct SimJob {
+    uvec2 vertices;
+    uvec2 spacing;
+    uvec2 spacing_colours;
+    uvec2 colliders;
+    uvec2 state;
+    uvec2 pose;
+    uvec2 head_map;
+    uvec2 _pad;
+    uvec4 counts;
+    uvec4 colours;
+    vec4 from_rotation;
+    vec4 to_rotation;
+    vec4 from_translation;
+    vec4 to_translation;
+    vec4 from_scale;
+    vec4 to_scale;
+    vec4 gravity;
+    vec4 wind;
+    vec4 stiffness;
 };
 
 #endif

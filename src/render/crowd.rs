@@ -437,7 +437,7 @@ impl Crowd {
                 Some(PoseUpdate::Uploaded) => out.updated.push(slot),
                 Some(PoseUpdate::Simulated(job)) => {
                     out.updated.push(slot);
-                    out.simulated.push((slot, job));
+                    out.simulated.push((slot, *job));
                 }
                 None => {}
             }

@@ -67,7 +67,7 @@ pub enum PoseUpdate {
     /// A pose the CPU gave, uploaded.
     Uploaded,
     /// The GPU solver's pose after this step.
-    Simulated(SimJob),
+    Simulated(Box<SimJob>),
 }
 
 fn storage(
@@ -334,7 +334,7 @@ impl DeformState {
                 self.poses[slot].0.write(0, bytemuck::cast_slice(&pose))?;
                 PoseUpdate::Uploaded
             }
-            (None, Some(job)) => PoseUpdate::Simulated(job),
+            (None, Some(job)) => PoseUpdate::Simulated(Box::new(job)),
             (None, None) => {
                 self.reads_simulation = false;
                 return Ok(None);

@@ -11,8 +11,8 @@ use ash::vk;
 use glam::{Mat4, Vec3};
 
 use super::shared::{
-    COLLIDER_CAPSULE, COLLIDER_ELLIPSOID, COLLIDER_HEAD, SimCollider, SimConstraint, SimJob,
-    SimState, SimVertex,
+    COLLIDER_CAPSULE, COLLIDER_ELLIPSOID, COLLIDER_HEAD, MAX_SIM_COLLIDERS, SimCollider,
+    SimConstraint, SimJob, SimState, SimVertex,
 };
 use crate::dynamics::{
     Collider, DynamicsSettings, HairDynamics, HairState, RadialMap, StepClock, StepPlan,
@@ -168,6 +168,12 @@ impl HairSimulation {
             None => None,
         };
         let records: Vec<SimCollider> = colliders.iter().map(|(c, _)| *c).collect();
+        if records.len() > MAX_SIM_COLLIDERS as usize {
+            return Err(GpuError::Unsupported(format!(
+                "GPU hair dynamics: {} colliders; at most {MAX_SIM_COLLIDERS}",
+                records.len()
+            )));
+        }
         Ok(HairSimulation {
             vertices: upload(ctx, "sim vertices", bytemuck::cast_slice(&vertices))?,
             spacing: upload(ctx, "sim spacing", bytemuck::cast_slice(&spacing))?,

@@ -44,7 +44,9 @@ pub const LOD_SOFT: u32 = 256;
 /// Invocations of one `hair_mesh_update.comp` workgroup.
 pub const DEFORM_GROUP_SIZE: u32 = 64;
 /// Invocations of one `hair_dynamics.comp` workgroup (one workgroup simulates one character).
-pub const DYNAMICS_GROUP_SIZE: u32 = 128;
+pub const DYNAMICS_GROUP_SIZE: u32 = 64;
+/// Most colliders one simulated character may have (the solver keeps them in shared memory).
+pub const MAX_SIM_COLLIDERS: u32 = 16;
 /// `SimCollider::shape.x`: an ellipsoid (`a`: centre, `b`: radii).
 pub const COLLIDER_ELLIPSOID: u32 = 0;
 /// `SimCollider::shape.x`: a capsule (`a`, `b`: axis ends; `a.w`: radius).
@@ -947,6 +949,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         layout("DEFORM_GROUP_SIZE", DEFORM_GROUP_SIZE),
         layout("LHS_GROUP_SIZE", LHS_GROUP_SIZE),
         layout("DYNAMICS_GROUP_SIZE", DYNAMICS_GROUP_SIZE),
+        layout("MAX_SIM_COLLIDERS", MAX_SIM_COLLIDERS),
         uint("COLLIDER_ELLIPSOID", COLLIDER_ELLIPSOID),
         uint("COLLIDER_CAPSULE", COLLIDER_CAPSULE),
         uint("COLLIDER_HEAD", COLLIDER_HEAD),

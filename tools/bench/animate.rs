@@ -1,7 +1,8 @@
-//! `bench animate`: copies of one hair mesh in wind, each simulated (on all cores) and
-//! re-textured every frame: CPU ms of the hair dynamics, GPU ms of the texture rebuild, GPU ms
-//! of the frame, per frame (medians), for each character count; optionally a strip of frames
-//! of the first count side by side.
+//! `bench animate`: copies of one hair mesh in wind, each simulated and re-textured every
+//! frame, for each character count and dynamics path (GPU: `Renderer::step_hair`, one
+//! dispatch; CPU: `HairDynamics` on all cores, poses uploaded): CPU and GPU ms of the hair
+//! dynamics, GPU ms of the texture rebuild, GPU ms of the frame, per frame (medians);
+//! optionally a strip of frames of the first run side by side.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -9,7 +10,9 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use glam::{Mat4, Vec3};
-use hairmesh::animate::{CharacterMotion, Collider, DynamicsSettings, HairDynamics, Wind};
+use hairmesh::animate::{
+    CharacterMotion, Collider, DynamicsPath, DynamicsSettings, HairDynamics, Wind,
+};
 use hairmesh::bake::BakedHairMesh;
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::fsutil::OutputPath;
@@ -31,6 +34,7 @@ pub struct AnimateArgs {
     pub size: (u32, u32),
     pub strands_per_bundle: u32,
     pub counts: Vec<u32>,
+    pub dynamics: Vec<DynamicsPath>,
     pub strip: Option<PathBuf>,
     pub strip_frames: u32,
     pub device: Option<String>,
@@ -79,9 +83,17 @@ struct Herd {
     dynamics: Vec<HairDynamics>,
     motions: Vec<CharacterMotion>,
     camera: Camera,
+    path: DynamicsPath,
+    settings: DynamicsSettings,
 }
 
-fn herd(ctx: &Arc<Context>, s: &Sample, count: u32, a: &AnimateArgs) -> Result<Herd> {
+fn herd(
+    ctx: &Arc<Context>,
+    s: &Sample,
+    count: u32,
+    path: DynamicsPath,
+    a: &AnimateArgs,
+) -> Result<Herd> {
     let (w, h) = a.size;
     let mut renderer = Renderer::new(ctx, &RendererDesc::default().size(w, h))?;
     let params = StrandParams {
@@ -105,7 +117,11 @@ fn herd(ctx: &Arc<Context>, s: &Sample, count: u32, a: &AnimateArgs) -> Result<H
         let id = renderer.add_character(&s.baked, &s.style, params, home)?;
         renderer.make_deformable(id, DeformBasis::new(&s.mesh, &s.baked, s.options)?)?;
         let collider = vec![Collider::fit_scalp(&s.mesh)];
-        dynamics.push(HairDynamics::new(&s.mesh, collider, settings, home));
+        let sim = HairDynamics::new(&s.mesh, collider, settings, home);
+        if path == DynamicsPath::Gpu {
+            renderer.simulate_hair(id, &sim)?;
+        }
+        dynamics.push(sim);
         // Each turns on its own phase, so the herd is not in lockstep.
         motions.push(CharacterMotion {
             turn: 0.5,
@@ -128,6 +144,8 @@ fn herd(ctx: &Arc<Context>, s: &Sample, count: u32, a: &AnimateArgs) -> Result<H
         dynamics,
         motions,
         camera,
+        path,
+        settings,
     })
 }
 
@@ -158,6 +176,7 @@ fn step_all(dynamics: &mut [HairDynamics], models: &[Mat4], dt: f32) -> Vec<Vec<
 #[derive(Default)]
 struct Timings {
     sim_ms: Vec<f64>,
+    sim_gpu_ms: Vec<f64>,
     update_ms: Vec<f64>,
     gpu_ms: Vec<f64>,
     strip: Vec<Vec<u8>>,
@@ -170,11 +189,23 @@ fn run_frames(herd: &mut Herd, a: &AnimateArgs, strip: bool) -> Result<Timings> 
         let time = (f + 1) as f32 / 30.0;
         let models: Vec<Mat4> = herd.motions.iter().map(|m| m.model(time)).collect();
         let start = Instant::now();
-        let poses = step_all(&mut herd.dynamics, &models, 1.0 / 30.0);
+        match herd.path {
+            DynamicsPath::Cpu => {
+                let poses = step_all(&mut herd.dynamics, &models, 1.0 / 30.0);
+                for (id, pose) in herd.ids.iter().zip(&poses) {
+                    herd.renderer.set_hair_mesh_pose(*id, pose)?;
+                }
+            }
+            DynamicsPath::Gpu => {
+                for (id, model) in herd.ids.iter().zip(&models) {
+                    herd.renderer
+                        .step_hair(*id, 1.0 / 30.0, *model, &herd.settings)?;
+                }
+            }
+        }
         t.sim_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        for ((id, model), pose) in herd.ids.iter().zip(&models).zip(&poses) {
+        for (id, model) in herd.ids.iter().zip(&models) {
             herd.renderer.set_model(*id, *model)?;
-            herd.renderer.set_hair_mesh_pose(*id, pose)?;
         }
         let view = View {
             light_dir: Vec3::new(-0.6, 0.8, 0.4),
@@ -199,6 +230,15 @@ fn run_frames(herd: &mut Herd, a: &AnimateArgs, strip: bool) -> Result<Timings> 
             .iter()
             .filter(|(n, _)| *n == "hair mesh update");
         t.update_ms.push(update.map(|p| p.1).sum::<f64>());
+        let pass = |name: &str| {
+            report
+                .pass_ms
+                .iter()
+                .filter(|(n, _)| *n == name)
+                .map(|p| p.1)
+                .sum::<f64>()
+        };
+        t.sim_gpu_ms.push(pass("hair dynamics"));
         t.gpu_ms.push(report.gpu_ms());
         if let Some(rgba) = report.rgba
             && t.strip.len() < a.strip_frames as usize
@@ -247,17 +287,26 @@ pub fn bench_animate(a: AnimateArgs) -> Result<()> {
         ctx.info.name
     )?;
     outln!(
-        "| characters | dynamics ms CPU | per character ms | texture rebuild ms GPU | frame ms GPU |"
+        "| characters | dynamics | dynamics ms CPU | dynamics ms GPU | per character ms | texture rebuild ms GPU | frame ms GPU |"
     )?;
-    outln!("|---|---|---|---|---|")?;
+    outln!("|---|---|---|---|---|---|---|")?;
     let mut strip_images = Vec::new();
-    for (k, &count) in a.counts.iter().enumerate() {
-        let mut h = herd(&ctx, &sample, count, &a)?;
+    let runs = a
+        .counts
+        .iter()
+        .flat_map(|&c| a.dynamics.iter().map(move |&p| (c, p)));
+    for (k, (count, path)) in runs.enumerate() {
+        let mut h = herd(&ctx, &sample, count, path, &a)?;
         let t = run_frames(&mut h, &a, k == 0 && strip.is_some())?;
-        let sim = super::median(t.sim_ms);
+        let (cpu, gpu) = (super::median(t.sim_ms), super::median(t.sim_gpu_ms));
+        // What the dynamics cost: the CPU's wall time, or the GPU's pass.
+        let cost = match path {
+            DynamicsPath::Cpu => cpu,
+            DynamicsPath::Gpu => gpu,
+        };
         outln!(
-            "| {count} | {sim:.2} | {:.3} | {:.2} | {:.1} |",
-            sim / count as f64,
+            "| {count} | {path} | {cpu:.2} | {gpu:.2} | {:.3} | {:.2} | {:.1} |",
+            cost / count as f64,
             super::median(t.update_ms),
             super::median(t.gpu_ms)
         )?;
