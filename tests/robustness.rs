@@ -192,6 +192,7 @@ fn absurd_arguments_are_refused_before_allocating() {
         (vec!["crowd", "--counts", "0"], "--counts"),
         (vec!["animate", "--counts", "0"], "--counts"),
         (vec!["animate", "--counts", "1,5000"], "--counts"),
+        (vec!["animate", "--dynamics", "gpu,fpga"], "--dynamics"),
         (
             vec!["crowd", "--strands-per-bundle", "5000"],
             "--strands-per-bundle",

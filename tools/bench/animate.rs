@@ -304,8 +304,12 @@ pub fn bench_animate(a: AnimateArgs) -> Result<()> {
             DynamicsPath::Cpu => cpu,
             DynamicsPath::Gpu => gpu,
         };
+        let gpu_text = match path {
+            DynamicsPath::Gpu => format!("{gpu:.2}"),
+            DynamicsPath::Cpu => "-".into(),
+        };
         outln!(
-            "| {count} | {path} | {cpu:.2} | {gpu:.2} | {:.3} | {:.2} | {:.1} |",
+            "| {count} | {path} | {cpu:.2} | {gpu_text} | {:.3} | {:.2} | {:.1} |",
             cost / count as f64,
             super::median(t.update_ms),
             super::median(t.gpu_ms)
