@@ -234,10 +234,6 @@ impl DeformState {
         let gpu = HairSimulation::new(ctx, sim, &self.basis.root_thinning, maps)?;
         let pose = super::dynamics::pose_buffer(ctx, n as u64)?;
         let set = update_set(ctx, layout, &self.statics, &pose, &self.outputs)?;
-        // The pose stays inside the decode box (the rebuild clamps to it).
-        let info = &self.basis.info;
-        let origin = Vec3::from_slice(&info.pos_origin[..3]);
-        self.pose_bounds = Some((origin, origin + Vec3::from_slice(&info.pos_extent[..3])));
         Ok(self.simulation.replace(SimulatedPose {
             sim: gpu,
             pose,
@@ -265,6 +261,9 @@ impl DeformState {
         };
         s.sim.step(dt, model, settings, &s.pose)?;
         self.pending = None;
+        // The pose stays on the GPU: the light's view falls back to the decode box (the
+        // rebuild clamps every pose to it).
+        self.pose_bounds = None;
         Ok(())
     }
 
@@ -319,7 +318,8 @@ impl DeformState {
         Ok(())
     }
 
-    /// Bounds of the latest pose in the character's frame (`None` before the first pose).
+    /// Bounds of the latest pose in the character's frame (`None` before the first pose, and
+    /// while the pose comes from the GPU dynamics).
     pub fn pose_bounds(&self) -> Option<(Vec3, Vec3)> {
         self.pose_bounds
     }

@@ -287,9 +287,14 @@ impl HairSimulation {
         self.pending.take()
     }
 
+    /// Vertices simulated (all layers).
+    pub fn vertex_count(&self) -> usize {
+        self.counts[0] as usize * self.counts[1] as usize
+    }
+
     /// Bytes of the state buffer.
     pub fn state_bytes(&self) -> u64 {
-        self.counts[0] as u64 * self.counts[1] as u64 * size_of::<SimState>() as u64
+        (self.vertex_count() * size_of::<SimState>()) as u64
     }
 }
 

@@ -2,7 +2,6 @@
 //! blocks, build the frame graph from the passes, run it, submit (the frames in flight are
 //! [`super::slots`]).
 
-use super::passes::hair_dynamics::SimulatedCharacter;
 use std::sync::Arc;
 
 use ash::vk;
@@ -12,6 +11,7 @@ use std::time::Instant;
 use super::RenderPath;
 use super::camera::View;
 use super::graph::FrameGraph;
+use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::PropDraw;
 use super::passes::temporal::TemporalWork;

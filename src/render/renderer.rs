@@ -301,7 +301,7 @@ impl Renderer {
         let s = self.crowd.simulation(id)?;
         let bytes = super::debug::read_device_buffer(&self.ctx, s.pose(), s.pose().size)?;
         let poses: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
-        let n = (s.sim().state_bytes() / size_of::<super::shared::SimState>() as u64) as usize;
+        let n = s.sim().vertex_count();
         Ok(poses
             .iter()
             .take(n)
