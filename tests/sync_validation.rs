@@ -1,7 +1,8 @@
 //! Synchronization validation (`VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT`)
 //! over every frame the renderer can draw: each valid combination of generation path x strand
 //! raster x shadows x transparency x MSAA (as `FrameSettings::validate` decides), two frames in
-//! flight each on small images, then the static and LHS paths and an animated hair mesh. Any
+//! flight each on small images, then the static and LHS paths and an animated hair mesh (posed
+//! from the CPU, then simulated on the GPU). Any
 //! validation message fails. The frame graph derives every barrier from the passes' declared
 //! uses; the last test removes one declared read and shows validation catches it.
 
@@ -204,6 +205,30 @@ fn static_lhs_and_animated_frames_are_free_of_hazards() {
         };
         two_frames(&ctx, &mut r, &view, &opts, &format!("animated {path:?}"));
     }
+    // Its hair dynamics on the GPU: the solver writes the pose the rebuild reads, two frames
+    // in flight sharing the state buffer.
+    let settings = hairmesh::dynamics::DynamicsSettings::default();
+    let sim = hairmesh::dynamics::HairDynamics::new(&mesh, Vec::new(), settings, Mat4::IDENTITY);
+    r.simulate_hair(id, &sim).unwrap();
+    let opts = FrameOptions {
+        path: Some(RenderPath::Compute),
+        ..Default::default()
+    };
+    let mut tickets = Vec::new();
+    for f in 1..=2 {
+        let model = Mat4::from_rotation_y(0.2 * f as f32);
+        r.set_model(id, model).unwrap();
+        r.step_hair(id, 1.0 / 60.0, model, &settings).unwrap();
+        tickets.push(r.render_frame(&view, &opts).unwrap());
+    }
+    for t in tickets {
+        r.wait(t).unwrap();
+    }
+    assert!(
+        ctx.validation_errors() == 0,
+        "GPU dynamics: {:#?}",
+        ctx.validation_messages()
+    );
 }
 
 #[test]
