@@ -163,10 +163,6 @@ impl HairSimulation {
             }
             map = Some(m);
         }
-        let head_map = match map {
-            Some(m) => Some((maps.buffer(ctx, m)?, [m.rows as u32, m.cols as u32])),
-            None => None,
-        };
         let records: Vec<SimCollider> = colliders.iter().map(|(c, _)| *c).collect();
         if records.len() > MAX_SIM_COLLIDERS as usize {
             return Err(GpuError::Unsupported(format!(
@@ -174,6 +170,11 @@ impl HairSimulation {
                 records.len()
             )));
         }
+        // Checked: now upload, the shared head map first.
+        let head_map = match map {
+            Some(m) => Some((maps.buffer(ctx, m)?, [m.rows as u32, m.cols as u32])),
+            None => None,
+        };
         Ok(HairSimulation {
             vertices: upload(ctx, "sim vertices", bytemuck::cast_slice(&vertices))?,
             spacing: upload(ctx, "sim spacing", bytemuck::cast_slice(&spacing))?,
