@@ -40,6 +40,8 @@ Vertices verts;
 States st;
 // The character's colliders, loaded once per dispatch.
 shared SimCollider colliders[MAX_SIM_COLLIDERS];
+// The colliders' bounding spheres placed for the substep (xyz centre, w radius squared, padded).
+shared vec4 world_bounds[MAX_SIM_COLLIDERS];
 
 // Workgroup barrier that also makes this workgroup's buffer writes visible to it.
 void sync() {
@@ -156,8 +158,29 @@ vec3 push_out(uint i, vec3 p) {
     return (colliders[i].to_person * vec4(b + d * least, 1.0)).xyz;
 }
 
-// `p` pushed out of every collider at placement `pl` (bit-for-bit unchanged if outside).
+// dynamics::placed_bounds: thread i < colliders places collider i's bounding sphere for the
+// substep, padded against rounding, so a point outside every sphere is outside every collider.
+void place_bounds(Placement pl) {
+    uint i = gl_LocalInvocationID.x;
+    if (i < job.counts.w) {
+        vec4 b = colliders[i].bound;
+        vec3 s = abs(pl.scale);
+        float r = b.w * max(s.x, max(s.y, s.z)) * BOUND_SLACK + BOUND_PAD;
+        world_bounds[i] = vec4(apply(pl, b.xyz), r * r);
+    }
+}
+
+// `p` pushed out of every collider at placement `pl` (bit-for-bit unchanged if outside). A
+// point outside every bounding sphere skips the exact test, whose result would be `p` itself.
 vec3 collide(vec3 p, Placement pl) {
+    bool near = false;
+    for (uint i = 0u; i < job.counts.w; i++) {
+        vec3 d = p - world_bounds[i].xyz;
+        near = near || dot(d, d) <= world_bounds[i].w;
+    }
+    if (!near) {
+        return p;
+    }
     vec3 local = unapply(pl, p);
     vec3 moved = local;
     for (uint i = 0u; i < job.counts.w; i++) {
@@ -314,6 +337,7 @@ void main() {
     float h = job.to_translation.w;
     for (uint s = 1u; s <= substeps; s++) {
         Placement pl = placement_at(float(s) / float(substeps));
+        place_bounds(pl);
         predict(pl, h, job.from_translation.w + h * float(s));
         sync();
         spacing(h);

@@ -120,3 +120,40 @@ fn stable_with_long_steps() {
         );
     }
 }
+
+/// `Collider::bounding_sphere` (which lets the GPU solver skip the exact push-out): every point
+/// outside it is left bit-for-bit unchanged by the push-out, and it is tight enough to matter
+/// (points just inside it, toward the collider, do get pushed).
+#[test]
+fn collider_bounding_spheres_hold_every_push_out() {
+    let person = hairmesh::characters::person::PersonShape {
+        head: Vec3::new(1.05, 0.95, 1.02),
+        ..Default::default()
+    };
+    let mut colliders = person.colliders().unwrap();
+    colliders.push(Collider::Ellipsoid {
+        centre: Vec3::new(0.1, 1.6, -0.05),
+        radii: Vec3::new(0.09, 0.12, 0.1),
+    });
+    let mut state = 0x9e37_79b9u32;
+    let mut unit = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as f32 / u32::MAX as f32
+    };
+    for c in &colliders {
+        let (centre, radius) = c.bounding_sphere();
+        assert!(radius.is_finite() && radius > 0.0 && radius < 1.0, "{c:?}: {radius}");
+        let mut pushed_inside = 0;
+        for _ in 0..4000 {
+            let d = Vec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5).normalize_or(Vec3::Y);
+            // Just outside the sphere, and anywhere up to twice its radius out.
+            let outside = centre + d * radius * (1.0 + 1e-5 + unit());
+            assert_eq!(c.push_out(outside), outside, "{c:?} moved a point outside its bound");
+            let inside = centre + d * radius * unit() * 0.5;
+            pushed_inside += (c.push_out(inside) != inside) as usize;
+        }
+        assert!(pushed_inside > 100, "{c:?}: bound too loose ({pushed_inside} pushed)");
+    }
+}

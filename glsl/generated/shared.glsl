@@ -299,6 +299,7 @@ struct SimCollider {
     vec4 b;
     mat4 to_canonical;
     mat4 to_person;
+    vec4 bound;
 };
 
 struct SimState {

@@ -41,6 +41,11 @@ impl RadialMap {
         top * (1.0 - fy) + bottom * fy
     }
 
+    /// The largest radius of the surface.
+    pub fn max_radius(&self) -> f32 {
+        self.radius.iter().copied().fold(0.0, f32::max)
+    }
+
     /// Signed radial distance of `p` outside the surface (negative inside).
     pub fn gap(&self, p: Vec3) -> f32 {
         let r = p - self.centre;
@@ -144,6 +149,24 @@ impl Collider {
                 } else {
                     c + d / l * radius
                 }
+            }
+        }
+    }
+
+    /// A sphere (centre, radius) in the character's frame outside which [`Self::push_out`]
+    /// leaves every point unchanged: the GPU solver tests it before the exact push-out.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        match *self {
+            Collider::Ellipsoid { centre, radii } => (centre, radii.abs().max_element()),
+            Collider::Capsule { a, b, radius } => ((a + b) * 0.5, (b - a).length() * 0.5 + radius),
+            Collider::Head {
+                map, to_person, margin, ..
+            } => {
+                let stretch = (0..3)
+                    .map(|i| to_person.col(i).truncate().length())
+                    .fold(0.0, f32::max);
+                let r = (map.max_radius() + margin.max(0.0)) * stretch;
+                (to_person.transform_point3(map.centre), r)
             }
         }
     }

@@ -183,6 +183,26 @@ pub const SHAPE_TIP_LOSS: f32 = 0.7;
 /// Rounds of push-out and edge-length projection per vertex in follow-the-leader.
 pub const COLLISION_ROUNDS: u32 = 16;
 
+/// A collider's bounding sphere, placed for a substep, is widened by this factor and
+/// [`BOUND_PAD`] metres against rounding, so a point outside it is outside the collider.
+pub const BOUND_SLACK: f32 = 1.001;
+/// See [`BOUND_SLACK`].
+pub const BOUND_PAD: f32 = 1e-4;
+
+/// Colliders' bounding spheres placed for a substep: world centre and padded radius squared.
+/// A point outside all of them skips the exact push-out, whose result would be itself.
+pub fn placed_bounds(colliders: &[Collider], placement: &Placement) -> Vec<(Vec3, f32)> {
+    let stretch = placement.scale.abs().max_element();
+    colliders
+        .iter()
+        .map(|c| {
+            let (centre, radius) = c.bounding_sphere();
+            let r = radius * stretch * BOUND_SLACK + BOUND_PAD;
+            (placement.apply(centre), r * r)
+        })
+        .collect()
+}
+
 /// Colours of the bending constraints: the constraint of layer `k` (to layer `k - 2`) has
 /// colour `(k / 2) % 2`, so no two of a colour share a vertex.
 pub const BEND_COLOURS: usize = 2;
@@ -439,7 +459,10 @@ impl HairDynamics {
 
     /// `p` pushed out of every collider at `placement` (bit-for-bit unchanged if outside
     /// them all).
-    fn collide(&self, p: Vec3, placement: &Placement) -> Vec3 {
+    fn collide(&self, p: Vec3, placement: &Placement, bounds: &[(Vec3, f32)]) -> Vec3 {
+        if bounds.iter().all(|&(c, r2)| (p - c).length_squared() > r2) {
+            return p;
+        }
         let local = placement.unapply(p);
         let moved = self.colliders.iter().fold(local, |q, c| c.push_out(q));
         if moved == local {
@@ -456,6 +479,7 @@ impl HairDynamics {
         let t = &self.topology;
         let (n, layers) = (t.n, t.layers);
         let mut correction = vec![Vec3::ZERO; n * layers];
+        let bounds = placed_bounds(&self.colliders, placement);
         for i in 0..n {
             for k in 1..layers {
                 let (j, below) = (k * n + i, (k - 1) * n + i);
@@ -464,13 +488,13 @@ impl HairDynamics {
                     let dir = (q - base).try_normalize().unwrap_or(Vec3::Y);
                     base + dir * t.edge[j]
                 };
-                let mut q = on_edge(self.collide(p[j], placement));
+                let mut q = on_edge(self.collide(p[j], placement, &bounds));
                 // Alternate until the push-out no longer moves it (at most COLLISION_ROUNDS; a
                 // point outside every collider costs one). Where they never agree (hair
                 // squeezed between two colliders) the colliders win over the exact edge length.
                 let mut settled = false;
                 for _ in 0..COLLISION_ROUNDS {
-                    let out = self.collide(q, placement);
+                    let out = self.collide(q, placement, &bounds);
                     if out == q {
                         settled = true;
                         break;
@@ -478,7 +502,7 @@ impl HairDynamics {
                     q = on_edge(out);
                 }
                 if !settled {
-                    q = self.collide(q, placement);
+                    q = self.collide(q, placement, &bounds);
                 }
                 correction[j] = q - p[j];
                 p[j] = q;

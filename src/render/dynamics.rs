@@ -65,7 +65,11 @@ impl HeadMaps {
 /// A collider as the solver reads it, and the radial map it needs (if a head).
 fn sim_collider(c: &Collider) -> (SimCollider, Option<&'static RadialMap>) {
     let v4 = |v: Vec3, w: f32| v.extend(w).to_array();
-    let mut out = SimCollider::default();
+    let (centre, radius) = c.bounding_sphere();
+    let mut out = SimCollider {
+        bound: v4(centre, radius),
+        ..SimCollider::default()
+    };
     match *c {
         Collider::Ellipsoid { centre, radii } => {
             out.shape[0] = COLLIDER_ELLIPSOID;

@@ -780,6 +780,9 @@ pub struct SimCollider {
     pub to_canonical: [[f32; 4]; 4],
     /// Head: the map's canonical frame to the character's.
     pub to_person: [[f32; 4]; 4],
+    /// Character frame: a sphere (xyz centre, w radius) outside which the push-out is the
+    /// identity (`Collider::bounding_sphere`).
+    pub bound: [f32; 4],
 }
 
 /// One simulated vertex's state, world frame (w unused).
@@ -844,7 +847,7 @@ pub struct SimJob {
 gpu_struct!(SimVertex as "SimVertex" { rest: "vec4", lengths: "vec4" });
 gpu_struct!(SimConstraint as "SimConstraint" { a: "uint", b: "uint", rest: "float", _pad: "uint" });
 gpu_struct!(SimCollider as "SimCollider" {
-    shape: "uvec4", a: "vec4", b: "vec4", to_canonical: "mat4", to_person: "mat4",
+    shape: "uvec4", a: "vec4", b: "vec4", to_canonical: "mat4", to_person: "mat4", bound: "vec4",
 });
 gpu_struct!(SimState as "SimState" { x: "vec4", v: "vec4", p: "vec4", correction: "vec4" });
 gpu_struct!(SimJob as "SimJob" {
@@ -999,6 +1002,8 @@ fn float_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("STRAND_OPACITY", STRAND_OPACITY),
         ("SHAPE_TIP_LOSS", crate::dynamics::SHAPE_TIP_LOSS),
+        ("BOUND_SLACK", crate::dynamics::BOUND_SLACK),
+        ("BOUND_PAD", crate::dynamics::BOUND_PAD),
         ("VISIBILITY_RESIDUAL_STEPS", VISIBILITY_RESIDUAL_STEPS),
         ("TEMPORAL_SOLID_MOVING_WEIGHT", TEMPORAL_SOLID_MOVING_WEIGHT),
         ("TEMPORAL_SOLID_MOTION", TEMPORAL_SOLID_MOTION),
