@@ -191,29 +191,28 @@ vec3 collide(vec3 p, Placement pl) {
 
 // ---- Phases ----
 
+// A column per thread (no integer division on the way).
 void predict(Placement pl, float h, float t) {
     uint n = job.counts.x;
     uint layers = job.counts.y;
     float keep = job.from_scale.w;
-    for (uint j = gl_LocalInvocationID.x; j < n * layers; j += DYNAMICS_GROUP_SIZE) {
-        uint k = j / n;
-        vec3 rest = verts.vertices[j].rest.xyz;
-        if (k == 0u) {
-            st.states[j].p.xyz = apply(pl, rest);
-            continue;
+    for (uint i = gl_LocalInvocationID.x; i < n; i += DYNAMICS_GROUP_SIZE) {
+        st.states[i].p.xyz = apply(pl, verts.vertices[i].rest.xyz);
+        for (uint k = 1u; k < layers; k++) {
+            uint j = k * n + i;
+            float along = float(k) / float(layers - 1u);
+            float stiffness = job.stiffness.x * (1.0 - SHAPE_TIP_LOSS * along);
+            vec3 x = st.states[j].x.xyz;
+            vec3 acc = job.gravity.xyz + wind_acceleration(x, t, along);
+            vec3 v = (st.states[j].v.xyz + acc * h) * keep;
+            vec3 q = x + v * h;
+            if (stiffness > 0.0) {
+                float alpha = 1.0 / (stiffness * h * h);
+                vec3 target = apply(pl, verts.vertices[j].rest.xyz) - job.gravity.xyz / stiffness;
+                q -= (q - target) / (1.0 + alpha);
+            }
+            st.states[j].p.xyz = q;
         }
-        float along = float(k) / float(layers - 1u);
-        float stiffness = job.stiffness.x * (1.0 - SHAPE_TIP_LOSS * along);
-        vec3 x = st.states[j].x.xyz;
-        vec3 acc = job.gravity.xyz + wind_acceleration(x, t, along);
-        vec3 v = (st.states[j].v.xyz + acc * h) * keep;
-        vec3 q = x + v * h;
-        if (stiffness > 0.0) {
-            float alpha = 1.0 / (stiffness * h * h);
-            vec3 target = apply(pl, rest) - job.gravity.xyz / stiffness;
-            q -= (q - target) / (1.0 + alpha);
-        }
-        st.states[j].p.xyz = q;
     }
 }
 
@@ -245,22 +244,23 @@ void spacing(float h) {
     }
 }
 
-// dynamics::bend_colour: the constraint of layer k has colour (k / 2) % 2, so colour c's
-// layers are pairs (k, k + 1) four apart from k = 4 (colour 0) or k = 2 (colour 1).
+// dynamics::bend_colour: the constraint of layer k (to layer k - 2) has colour (k / 2) % 2. A
+// column per thread.
 void bending(float h) {
     uint n = job.counts.x;
     uint layers = job.counts.y;
     float alpha = job.stiffness.z / (h * h);
     for (uint colour = 0u; colour < BEND_COLOURS; colour++) {
-        uint first = colour == 1u ? 2u : 4u;
-        uint count = layers > first ? ((layers - first) / 4u) * 2u + min((layers - first) % 4u, 2u) : 0u;
-        for (uint t = gl_LocalInvocationID.x; t < count * n; t += DYNAMICS_GROUP_SIZE) {
-            uint pair = t / n;
-            uint k = first + 4u * (pair / 2u) + pair % 2u;
-            uint j = k * n + t % n;
-            // The scalp (layer 0) does not move: weight 0.
-            float w_below = k == 2u ? 0.0 : 1.0;
-            distance_constraint(j, 1.0, j - 2u * n, w_below, verts.vertices[j].lengths.y, alpha);
+        for (uint i = gl_LocalInvocationID.x; i < n; i += DYNAMICS_GROUP_SIZE) {
+            for (uint k = 2u; k < layers; k++) {
+                if ((k / 2u) % 2u != colour) {
+                    continue;
+                }
+                uint j = k * n + i;
+                // The scalp (layer 0) does not move: weight 0.
+                float w_below = k == 2u ? 0.0 : 1.0;
+                distance_constraint(j, 1.0, j - 2u * n, w_below, verts.vertices[j].lengths.y, alpha);
+            }
         }
         sync();
     }
@@ -274,11 +274,16 @@ vec3 on_edge(vec3 q, vec3 base, float edge) {
     return base + dir * edge;
 }
 
-void follow_the_leader(Placement pl) {
+// Follow-the-leader (phase 4) and the velocities (phase 5) of a column per thread: vertex k's
+// velocity needs the correction of vertex k + 1 of the same column, so it is finished one
+// vertex behind.
+void follow_the_leader(Placement pl, float h) {
     uint n = job.counts.x;
     uint layers = job.counts.y;
+    float ftl = job.stiffness.w;
     for (uint i = gl_LocalInvocationID.x; i < n; i += DYNAMICS_GROUP_SIZE) {
         vec3 base = st.states[i].p.xyz;
+        st.states[i].x.xyz = base;
         for (uint k = 1u; k < layers; k++) {
             uint j = k * n + i;
             float edge = verts.vertices[j].lengths.x;
@@ -296,28 +301,20 @@ void follow_the_leader(Placement pl) {
             if (!settled) {
                 q = collide(q, pl);
             }
-            st.states[j].correction.xyz = q - p;
-            st.states[j].p.xyz = q;
+            if (k >= 2u) {
+                // The vertex below: its velocity less this vertex's correction (eq. 9).
+                uint below = j - n;
+                vec3 v = (base - st.states[below].x.xyz) / h;
+                v -= (q - p) * (ftl / h);
+                st.states[below].v.xyz = v;
+                st.states[below].x.xyz = base;
+            }
+            if (k + 1u == layers) {
+                st.states[j].v.xyz = (q - st.states[j].x.xyz) / h;
+                st.states[j].x.xyz = q;
+            }
             base = q;
         }
-    }
-}
-
-void velocities(float h) {
-    uint n = job.counts.x;
-    uint layers = job.counts.y;
-    float ftl = job.stiffness.w;
-    for (uint j = gl_LocalInvocationID.x; j < n * layers; j += DYNAMICS_GROUP_SIZE) {
-        uint k = j / n;
-        vec3 p = st.states[j].p.xyz;
-        if (k >= 1u) {
-            vec3 v = (p - st.states[j].x.xyz) / h;
-            if (k + 1u < layers) {
-                v -= st.states[j + n].correction.xyz * (ftl / h);
-            }
-            st.states[j].v.xyz = v;
-        }
-        st.states[j].x.xyz = p;
     }
 }
 
@@ -342,9 +339,7 @@ void main() {
         sync();
         spacing(h);
         bending(h);
-        follow_the_leader(pl);
-        sync();
-        velocities(h);
+        follow_the_leader(pl, h);
         sync();
     }
     // The pose in the character's frame at the step's end.
