@@ -14,7 +14,8 @@
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_buffer_reference_uvec2 : require
 #include "shared.glsl"
-layout(local_size_x = DYNAMICS_GROUP_SIZE) in;
+// GROUP_SIZE: invocations per workgroup, chosen per device (shared::dynamics_group_size).
+layout(local_size_x = GROUP_SIZE) in;
 
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Jobs { SimJob jobs[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Vertices { SimVertex vertices[]; };
@@ -22,6 +23,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Sp
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Colours { uint first[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Colliders { SimCollider colliders[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) coherent buffer States { SimState states[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) coherent buffer Solve { vec4 p[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) writeonly buffer Poses { vec4 poses[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer HeadMap { float radius[]; };
 
@@ -38,6 +40,8 @@ const float TAU = 6.28318530717959;
 SimJob job;
 Vertices verts;
 States st;
+// The substep's positions being solved.
+Solve sol;
 // The character's colliders, loaded once per dispatch.
 shared SimCollider colliders[MAX_SIM_COLLIDERS];
 // The colliders' bounding spheres placed for the substep (xyz centre, w radius squared, padded).
@@ -196,8 +200,8 @@ void predict(Placement pl, float h, float t) {
     uint n = job.counts.x;
     uint layers = job.counts.y;
     float keep = job.from_scale.w;
-    for (uint i = gl_LocalInvocationID.x; i < n; i += DYNAMICS_GROUP_SIZE) {
-        st.states[i].p.xyz = apply(pl, verts.vertices[i].rest.xyz);
+    for (uint i = gl_LocalInvocationID.x; i < n; i += GROUP_SIZE) {
+        sol.p[i].xyz = apply(pl, verts.vertices[i].rest.xyz);
         for (uint k = 1u; k < layers; k++) {
             uint j = k * n + i;
             float along = float(k) / float(layers - 1u);
@@ -211,15 +215,15 @@ void predict(Placement pl, float h, float t) {
                 vec3 target = apply(pl, verts.vertices[j].rest.xyz) - job.gravity.xyz / stiffness;
                 q -= (q - target) / (1.0 + alpha);
             }
-            st.states[j].p.xyz = q;
+            sol.p[j].xyz = q;
         }
     }
 }
 
 // XPBD distance constraint between vertices a, b (inverse masses wa, wb).
 void distance_constraint(uint a, float wa, uint b, float wb, float rest, float alpha) {
-    vec3 pa = st.states[a].p.xyz;
-    vec3 pb = st.states[b].p.xyz;
+    vec3 pa = sol.p[a].xyz;
+    vec3 pb = sol.p[b].xyz;
     vec3 d = pa - pb;
     float l = length(d);
     if (l < 1e-9 || wa + wb <= 0.0) {
@@ -227,8 +231,8 @@ void distance_constraint(uint a, float wa, uint b, float wb, float rest, float a
     }
     float lambda = -(l - rest) / (wa + wb + alpha);
     vec3 corr = d / l * lambda;
-    st.states[a].p.xyz = pa + corr * wa;
-    st.states[b].p.xyz = pb - corr * wb;
+    sol.p[a].xyz = pa + corr * wa;
+    sol.p[b].xyz = pb - corr * wb;
 }
 
 void spacing(float h) {
@@ -236,7 +240,7 @@ void spacing(float h) {
     Colours colours = Colours(job.spacing_colours);
     float alpha = job.stiffness.y / (h * h);
     for (uint c = 0u; c < job.colours.x; c++) {
-        for (uint i = colours.first[c] + gl_LocalInvocationID.x; i < colours.first[c + 1u]; i += DYNAMICS_GROUP_SIZE) {
+        for (uint i = colours.first[c] + gl_LocalInvocationID.x; i < colours.first[c + 1u]; i += GROUP_SIZE) {
             SimConstraint con = sp.constraints[i];
             distance_constraint(con.a, 1.0, con.b, 1.0, con.rest, alpha);
         }
@@ -251,7 +255,7 @@ void bending(float h) {
     uint layers = job.counts.y;
     float alpha = job.stiffness.z / (h * h);
     for (uint colour = 0u; colour < BEND_COLOURS; colour++) {
-        for (uint i = gl_LocalInvocationID.x; i < n; i += DYNAMICS_GROUP_SIZE) {
+        for (uint i = gl_LocalInvocationID.x; i < n; i += GROUP_SIZE) {
             for (uint k = 2u; k < layers; k++) {
                 if ((k / 2u) % 2u != colour) {
                     continue;
@@ -281,13 +285,13 @@ void follow_the_leader(Placement pl, float h) {
     uint n = job.counts.x;
     uint layers = job.counts.y;
     float ftl = job.stiffness.w;
-    for (uint i = gl_LocalInvocationID.x; i < n; i += DYNAMICS_GROUP_SIZE) {
-        vec3 base = st.states[i].p.xyz;
+    for (uint i = gl_LocalInvocationID.x; i < n; i += GROUP_SIZE) {
+        vec3 base = sol.p[i].xyz;
         st.states[i].x.xyz = base;
         for (uint k = 1u; k < layers; k++) {
             uint j = k * n + i;
             float edge = verts.vertices[j].lengths.x;
-            vec3 p = st.states[j].p.xyz;
+            vec3 p = sol.p[j].xyz;
             vec3 q = on_edge(collide(p, pl), base, edge);
             bool settled = false;
             for (uint r = 0u; r < COLLISION_ROUNDS; r++) {
@@ -326,6 +330,7 @@ void main() {
     job = Jobs(push.jobs).jobs[index];
     verts = Vertices(job.vertices);
     st = States(job.state);
+    sol = Solve(job.solve);
     if (gl_LocalInvocationID.x < job.counts.w) {
         colliders[gl_LocalInvocationID.x] = Colliders(job.colliders).colliders[gl_LocalInvocationID.x];
     }
@@ -349,7 +354,7 @@ void main() {
     to.translation = job.to_translation.xyz;
     Poses poses = Poses(job.pose);
     uint total = job.counts.x * job.counts.y;
-    for (uint j = gl_LocalInvocationID.x; j < total; j += DYNAMICS_GROUP_SIZE) {
+    for (uint j = gl_LocalInvocationID.x; j < total; j += GROUP_SIZE) {
         poses.poses[j] = vec4(unapply(to, st.states[j].x.xyz), verts.vertices[j].rest.w);
     }
 }

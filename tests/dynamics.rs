@@ -144,16 +144,26 @@ fn collider_bounding_spheres_hold_every_push_out() {
     };
     for c in &colliders {
         let (centre, radius) = c.bounding_sphere();
-        assert!(radius.is_finite() && radius > 0.0 && radius < 1.0, "{c:?}: {radius}");
+        assert!(
+            radius.is_finite() && radius > 0.0 && radius < 1.0,
+            "{c:?}: {radius}"
+        );
         let mut pushed_inside = 0;
         for _ in 0..4000 {
             let d = Vec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5).normalize_or(Vec3::Y);
             // Just outside the sphere, and anywhere up to twice its radius out.
             let outside = centre + d * radius * (1.0 + 1e-5 + unit());
-            assert_eq!(c.push_out(outside), outside, "{c:?} moved a point outside its bound");
+            assert_eq!(
+                c.push_out(outside),
+                outside,
+                "{c:?} moved a point outside its bound"
+            );
             let inside = centre + d * radius * unit() * 0.5;
             pushed_inside += (c.push_out(inside) != inside) as usize;
         }
-        assert!(pushed_inside > 100, "{c:?}: bound too loose ({pushed_inside} pushed)");
+        assert!(
+            pushed_inside > 100,
+            "{c:?}: bound too loose ({pushed_inside} pushed)"
+        );
     }
 }

@@ -18,7 +18,7 @@
 #define DISPATCH_ROW 65535u
 #define DEFORM_GROUP_SIZE 64
 #define LHS_GROUP_SIZE 64
-#define DYNAMICS_GROUP_SIZE 64
+#define DYNAMICS_GROUP_SIZE 8
 #define MAX_SIM_COLLIDERS 16
 #define COLLIDER_ELLIPSOID 0u
 #define COLLIDER_CAPSULE 1u
@@ -307,8 +307,6 @@ struct SimCollider {
 struct SimState {
     vec4 x;
     vec4 v;
-    vec4 p;
-    vec4 correction;
 };
 
 struct SimJob {
@@ -319,7 +317,7 @@ struct SimJob {
     uvec2 state;
     uvec2 pose;
     uvec2 head_map;
-    uvec2 _pad;
+    uvec2 solve;
     uvec4 counts;
     uvec4 colours;
     vec4 from_rotation;

@@ -160,7 +160,10 @@ impl Collider {
             Collider::Ellipsoid { centre, radii } => (centre, radii.abs().max_element()),
             Collider::Capsule { a, b, radius } => ((a + b) * 0.5, (b - a).length() * 0.5 + radius),
             Collider::Head {
-                map, to_person, margin, ..
+                map,
+                to_person,
+                margin,
+                ..
             } => {
                 let stretch = (0..3)
                     .map(|i| to_person.col(i).truncate().length())

@@ -98,19 +98,22 @@ fn sim_collider(c: &Collider) -> (SimCollider, Option<&'static RadialMap>) {
     (out, None)
 }
 
-/// The state buffer's contents for `state`.
-fn sim_states(state: &HairState) -> Vec<SimState> {
-    state
+/// The state buffer's contents for `state`: a `SimState` per vertex, then room for the
+/// substep's positions (a `vec4` per vertex; kept apart so that the phases that solve them
+/// touch four vertices per cache line).
+fn sim_state_bytes(state: &HairState) -> Vec<u8> {
+    let states: Vec<SimState> = state
         .x
         .iter()
         .zip(&state.v)
         .map(|(x, v)| SimState {
             x: x.extend(0.0).to_array(),
             v: v.extend(0.0).to_array(),
-            p: x.extend(0.0).to_array(),
-            correction: [0.0; 4],
         })
-        .collect()
+        .collect();
+    let mut bytes = bytemuck::cast_slice(&states).to_vec();
+    bytes.resize(bytes.len() + state.x.len() * size_of::<[f32; 4]>(), 0);
+    bytes
 }
 
 /// One character's hair dynamics on the GPU.
@@ -184,11 +187,7 @@ impl HairSimulation {
             spacing: upload(ctx, "sim spacing", bytemuck::cast_slice(&spacing))?,
             colours: upload(ctx, "sim colours", bytemuck::cast_slice(&t.spacing_colours))?,
             colliders: upload(ctx, "sim colliders", bytemuck::cast_slice(&records))?,
-            state: upload(
-                ctx,
-                "sim state",
-                bytemuck::cast_slice(&sim_states(sim.state())),
-            )?,
+            state: upload(ctx, "sim state", &sim_state_bytes(sim.state()))?,
             head_map,
             counts: [
                 t.n as u32,
@@ -262,7 +261,7 @@ impl HairSimulation {
             state: self.state.device_address(),
             pose: pose.device_address(),
             head_map: map,
-            _pad: [0; 2],
+            solve: address_plus(self.state.device_address(), self.state_bytes()),
             counts: [
                 self.counts[0],
                 self.counts[1],
@@ -297,10 +296,16 @@ impl HairSimulation {
         self.counts[0] as usize * self.counts[1] as usize
     }
 
-    /// Bytes of the state buffer.
+    /// Bytes of the state buffer's first part, the state (then come the substep's positions).
     pub fn state_bytes(&self) -> u64 {
         (self.vertex_count() * size_of::<SimState>()) as u64
     }
+}
+
+/// `address` (low word first) advanced by `bytes`.
+fn address_plus(address: [u32; 2], bytes: u64) -> [u32; 2] {
+    let a = (address[0] as u64 | (address[1] as u64) << 32) + bytes;
+    [a as u32, (a >> 32) as u32]
 }
 
 /// Positions and velocities from the state buffer's bytes.

@@ -91,6 +91,8 @@ pub struct DeviceInfo {
     pub attachment_sample_counts: u32,
     /// Whether 64-bit integers and 64-bit storage-buffer atomics are enabled (k-buffer OIT).
     pub int64_atomics: bool,
+    /// Whether the device is a CPU (lavapipe): some passes pick other workgroup sizes.
+    pub cpu_device: bool,
 }
 
 /// GPU memory the allocator holds.

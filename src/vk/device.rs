@@ -239,6 +239,7 @@ pub(super) fn query_info(
     // SAFETY: property query with a chain living on this frame.
     unsafe { instance.get_physical_device_properties2(physical, &mut p2) };
     let limits = p2.properties.limits;
+    let cpu_device = p2.properties.device_type == vk::PhysicalDeviceType::CPU;
     let text = |s: Result<&std::ffi::CStr, _>| {
         s.map(|c| c.to_string_lossy().into_owned())
             .unwrap_or_default()
@@ -265,5 +266,6 @@ pub(super) fn query_info(
             & limits.framebuffer_depth_sample_counts)
             .as_raw(),
         int64_atomics: f.int64_atomics,
+        cpu_device,
     }
 }
