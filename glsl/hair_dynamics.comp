@@ -240,7 +240,9 @@ void spacing(float h) {
     Colours colours = Colours(job.spacing_colours);
     float alpha = job.stiffness.y / (h * h);
     for (uint c = 0u; c < job.colours.x; c++) {
-        for (uint i = colours.first[c] + gl_LocalInvocationID.x; i < colours.first[c + 1u]; i += GROUP_SIZE) {
+        // Read once: the stores through `sol` could alias the colour table for the compiler.
+        uint end = colours.first[c + 1u];
+        for (uint i = colours.first[c] + gl_LocalInvocationID.x; i < end; i += GROUP_SIZE) {
             SimConstraint con = sp.constraints[i];
             distance_constraint(con.a, 1.0, con.b, 1.0, con.rest, alpha);
         }
