@@ -8,7 +8,8 @@
 //   2. spacing, a colour of constraints at a time (Macklin et al. 2016, eq. 18 per constraint);
 //   3. bending, a colour at a time;
 //   4. follow-the-leader per column with the colliders' push-out (Mueller et al. 2012);
-//   5. velocities with the follow-the-leader correction (Mueller et al. 2012, eq. 9).
+//   5. velocities with the follow-the-leader correction (Mueller et al. 2012, eq. 9), in the
+//      same loop as 4 (a thread owns a column; per-vertex results equal the CPU's).
 // Then the pose in the character's frame, which glsl/hair_mesh_update.comp reads.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
