@@ -6,3 +6,4 @@ pub mod generate;
 pub mod lhs;
 pub mod lod;
 pub mod root_surface;
+pub mod volume;
