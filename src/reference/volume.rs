@@ -86,24 +86,29 @@ impl DensityVolume {
         ((c.z * self.dims.y + c.y) * self.dims.x + c.x) as usize
     }
 
-    /// Add strand length `length` at `p`, shared trilinearly among the 8 cell centres around
-    /// it (as density: divided by the cell's volume).
-    pub fn splat(&mut self, p: Vec3, length: f32) {
+    /// The 8 cell centres around `p` with their trilinear weights (`None`: outside the grid).
+    pub fn corners(&self, p: Vec3) -> [(Option<usize>, f32); 8] {
         let g = (p - self.origin) / self.cell - Vec3::splat(0.5);
         let base = g.floor();
         let f = g - base;
-        let per_volume = length / (self.cell.x * self.cell.y * self.cell.z);
-        for corner in 0..8u32 {
-            let o = UVec3::new(corner & 1, (corner >> 1) & 1, corner >> 2);
-            let w = Vec3::select(o.cmpeq(UVec3::ZERO).into(), Vec3::ONE - f, f);
-            let weight = w.x * w.y * w.z;
+        std::array::from_fn(|corner| {
+            let o = UVec3::new(corner as u32 & 1, (corner as u32 >> 1) & 1, corner as u32 >> 2);
+            let w = Vec3::select(o.cmpeq(UVec3::ZERO), Vec3::ONE - f, f);
             let c = base + o.as_vec3();
-            if c.cmplt(Vec3::ZERO).any() || c.cmpge(self.dims.as_vec3()).any() {
-                self.outside += length * weight;
-                continue;
+            let inside = c.cmpge(Vec3::ZERO).all() && c.cmplt(self.dims.as_vec3()).all();
+            (inside.then(|| self.index(c.as_uvec3())), w.x * w.y * w.z)
+        })
+    }
+
+    /// Add strand length `length` at `p`, shared trilinearly among the 8 cell centres around
+    /// it (as density: divided by the cell's volume).
+    pub fn splat(&mut self, p: Vec3, length: f32) {
+        let per_volume = length / (self.cell.x * self.cell.y * self.cell.z);
+        for (cell, weight) in self.corners(p) {
+            match cell {
+                Some(i) => self.density[i] += per_volume * weight,
+                None => self.outside += length * weight,
             }
-            let i = self.index(c.as_uvec3());
-            self.density[i] += per_volume * weight;
         }
     }
 
@@ -126,20 +131,10 @@ impl DensityVolume {
 
     /// Density at `p`, trilinear between cell centres (0 outside the grid).
     pub fn sample(&self, p: Vec3) -> f32 {
-        let g = (p - self.origin) / self.cell - Vec3::splat(0.5);
-        let base = g.floor();
-        let f = g - base;
-        let mut sum = 0.0;
-        for corner in 0..8u32 {
-            let o = UVec3::new(corner & 1, (corner >> 1) & 1, corner >> 2);
-            let c = base + o.as_vec3();
-            if c.cmplt(Vec3::ZERO).any() || c.cmpge(self.dims.as_vec3()).any() {
-                continue;
-            }
-            let w = Vec3::select(o.cmpeq(UVec3::ZERO).into(), Vec3::ONE - f, f);
-            sum += self.density[self.index(c.as_uvec3())] * w.x * w.y * w.z;
-        }
-        sum
+        self.corners(p)
+            .iter()
+            .filter_map(|&(cell, weight)| cell.map(|i| self.density[i] * weight))
+            .sum()
     }
 }
 
