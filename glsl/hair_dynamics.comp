@@ -15,7 +15,13 @@
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_buffer_reference_uvec2 : require
 #include "shared.glsl"
-// GROUP_SIZE: invocations per workgroup, chosen per device (shared::dynamics_group_size).
+// Invocations per workgroup, chosen per device (shared.rs): CPU_DEVICE is
+// defined on CPU devices (lavapipe).
+#ifdef CPU_DEVICE
+#define GROUP_SIZE DYNAMICS_GROUP_SIZE_CPU
+#else
+#define GROUP_SIZE DYNAMICS_GROUP_SIZE_GPU
+#endif
 layout(local_size_x = GROUP_SIZE) in;
 
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Jobs { SimJob jobs[]; };

@@ -4,6 +4,9 @@
 #define SHARED_GLSL
 
 #define STRAND_GROUP_SIZE 32
+#define VOLUME_GROUP_SIZE 32
+#define DYNAMICS_GROUP_SIZE_GPU 128
+#define DYNAMICS_GROUP_SIZE_CPU 16
 #define MAX_VERTS_LOG2 6u
 #define MAX_SEGMENTS 64u
 #define MESH_MAX_VERTICES 130
@@ -18,13 +21,13 @@
 #define DISPATCH_ROW 65535u
 #define DEFORM_GROUP_SIZE 64
 #define LHS_GROUP_SIZE 64
-#define DYNAMICS_GROUP_SIZE 8
 #define MAX_SIM_COLLIDERS 16
 #define COLLIDER_ELLIPSOID 0u
 #define COLLIDER_CAPSULE 1u
 #define COLLIDER_HEAD 2u
 #define BEND_COLOURS 2u
 #define COLLISION_ROUNDS 16u
+#define MAX_SPLAT_POINTS 64u
 #define CHARACTER_VISIBLE 1u
 #define MARSCHNER_LUT_PHI 256u
 #define MARSCHNER_LUT_D 64u
@@ -70,6 +73,8 @@
 #define KAJIYA_KAY_EXPONENT 80.0
 #define MARSCHNER_ENERGY_SCALE 0.9
 #define SHADOW_OPACITY_FIXED 4096.0
+#define VOLUME_FIXED 16384.0
+#define SPLAT_SPACING 0.5
 #define BINDING_FRAME 0
 #define BINDING_CHARACTERS 1
 #define BINDING_BUNDLES 2
@@ -329,6 +334,16 @@ struct SimJob {
     vec4 gravity;
     vec4 wind;
     vec4 stiffness;
+};
+
+struct DensityJob {
+    uvec2 cells;
+    uvec2 _pad;
+    vec4 origin;
+    vec4 cell;
+    uvec4 dims;
+    uvec4 bundles;
+    uvec4 strands;
 };
 
 #endif

@@ -61,11 +61,16 @@ pub fn volume_box(info: &MeshInfo) -> (Vec3, Vec3) {
     (lo - Vec3::splat(margin), lo + extent + Vec3::splat(margin))
 }
 
-/// Points per segment of length `length` so that they are at most half of the smallest
-/// cell apart (at least 1, at most 64).
+/// Splat points of a segment are at most this fraction of the smallest cell size apart.
+pub const SPLAT_SPACING: f32 = 0.5;
+/// Most splat points of one segment.
+pub const MAX_SPLAT_POINTS: u32 = 64;
+
+/// Points per segment of length `length`: at most [`SPLAT_SPACING`] of the smallest cell
+/// apart (at least 1, at most [`MAX_SPLAT_POINTS`]).
 pub fn splat_points(length: f32, cell: Vec3) -> u32 {
-    let step = 0.5 * cell.min_element();
-    ((length / step).ceil() as u32).clamp(1, 64)
+    let step = SPLAT_SPACING * cell.min_element();
+    ((length / step).ceil() as u32).clamp(1, MAX_SPLAT_POINTS)
 }
 
 impl DensityVolume {
@@ -92,7 +97,11 @@ impl DensityVolume {
         let base = g.floor();
         let f = g - base;
         std::array::from_fn(|corner| {
-            let o = UVec3::new(corner as u32 & 1, (corner as u32 >> 1) & 1, corner as u32 >> 2);
+            let o = UVec3::new(
+                corner as u32 & 1,
+                (corner as u32 >> 1) & 1,
+                corner as u32 >> 2,
+            );
             let w = Vec3::select(o.cmpeq(UVec3::ZERO), Vec3::ONE - f, f);
             let c = base + o.as_vec3();
             let inside = c.cmpge(Vec3::ZERO).all() && c.cmplt(self.dims.as_vec3()).all();

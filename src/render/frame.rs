@@ -49,6 +49,9 @@ pub(super) struct FrameWork<'a> {
     /// Character slots whose hair is simulated on the GPU this frame (their steps are in the
     /// slot's job table, in this order).
     simulated: Vec<usize>,
+    /// The density volumes built this frame (entries of `Renderer::volumes`, in the order of
+    /// the slot's job table) and the most bundles among their characters.
+    density: (Vec<usize>, u32),
     /// Motion vectors and accumulation, when the frame has them.
     temporal: Option<TemporalWork>,
     /// The transient buffers and images the frame graph creates.
@@ -101,6 +104,7 @@ impl Renderer {
         // Motion matrices only where the frame's temporal pass reads them.
         let moving = temporal.map(|_| &motion);
         let records = self.frame_records(&pose_updates, moving);
+        let density = self.write_density_jobs(i, &records)?;
         let blocks = (&block, light_block.as_ref());
         let prop_draws = self.write_slot(i, blocks, &records, moving, opts)?;
         let start = Instant::now();
@@ -115,6 +119,7 @@ impl Renderer {
             kbuffer_budget,
             pose_updates,
             simulated,
+            density,
             temporal,
             transients,
         };
@@ -160,6 +165,30 @@ impl Renderer {
         let table = slot.sim_jobs.insert(table);
         table.write(0, bytemuck::cast_slice(&jobs))?;
         Ok(steps.iter().map(|(s, _)| *s).collect())
+    }
+
+    /// Write the jobs of the density volumes waiting to be built into frame slot `i`'s job
+    /// table (grown as needed: its earlier frame has completed).
+    fn write_density_jobs(
+        &mut self,
+        i: usize,
+        records: &[super::shared::CharacterRecord],
+    ) -> GpuResult<(Vec<usize>, u32)> {
+        let (jobs, entries, most) = self.volumes.take_jobs(records);
+        if jobs.is_empty() {
+            return Ok((entries, most));
+        }
+        let slot = &mut self.frames[i];
+        let bytes = std::mem::size_of_val(jobs.as_slice()) as u64;
+        let table = match slot.density_jobs.take() {
+            Some(t) if t.size >= bytes => t,
+            _ => {
+                super::passes::density_volume::job_table(&self.ctx, jobs.len().next_power_of_two())?
+            }
+        };
+        let table = slot.density_jobs.insert(table);
+        table.write(0, bytemuck::cast_slice(&jobs))?;
+        Ok((entries, most))
     }
 
     /// The character records of this frame: those in `pose_updates` with their previous
@@ -422,6 +451,7 @@ impl Renderer {
             motion_readback,
             retired,
             sim_jobs,
+            density_jobs,
             ..
         } = &mut self.frames[i];
         let mut rec = cmd.begin()?;
@@ -470,6 +500,13 @@ impl Renderer {
                 textures,
             },
         );
+        if let Some(table) = density_jobs.as_ref()
+            && !work.density.0.is_empty()
+        {
+            let volumes = self.volumes.buffers(&work.density.0);
+            let build = (table, volumes.as_slice(), work.density.1);
+            self.passes.add_density_volumes(&mut g, &r, sets.0, build);
+        }
         let mut inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
         inputs.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
         self.passes.add(&mut g, &r, inputs)?;

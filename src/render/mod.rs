@@ -22,6 +22,7 @@ pub mod soft;
 pub mod targets;
 pub mod temporal;
 pub mod transparency;
+pub mod volume;
 pub mod workspace;
 
 pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};

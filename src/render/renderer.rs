@@ -76,6 +76,8 @@ pub struct Renderer {
     /// The previous frame's matrices and the temporal history.
     pub(super) temporal: super::temporal::TemporalState,
     pub(super) completed: VecDeque<FrameReport>,
+    /// Requested strand density volumes.
+    pub(super) volumes: super::volume::DensityVolumes,
     /// Background colour (linear RGB).
     pub background: [f32; 3],
 }
@@ -126,6 +128,7 @@ impl Renderer {
             work,
             temporal: Default::default(),
             completed: VecDeque::new(),
+            volumes: Default::default(),
             background: [0.6, 0.65, 0.7],
         })
     }
@@ -207,6 +210,9 @@ impl Renderer {
     pub fn remove_character(&mut self, id: CharacterId) -> GpuResult<()> {
         let removed = self.crowd.remove(id)?;
         self.props.attached.retain(|(c, ..)| *c != id);
+        if let Some(cells) = self.volumes.remove(id) {
+            self.retire(Retired::Resource(Box::new(cells)));
+        }
         self.retire(Retired::Resource(Box::new(removed.textures)));
         self.retire(Retired::CharacterSlot(removed.slot));
         Ok(())
@@ -292,6 +298,37 @@ impl Renderer {
         let bytes =
             super::debug::read_device_buffer(&self.ctx, sim.state_buffer(), sim.state_bytes())?;
         Ok((super::dynamics::hair_state(&bytes), *sim.clock()))
+    }
+
+    /// Build character `id`'s strand density volume (seed 002; `reference::volume` is its
+    /// twin) over its hair's box, sampled as `sampling`, in the next frame.
+    pub fn request_density_volume(
+        &mut self,
+        id: CharacterId,
+        sampling: crate::reference::volume::VolumeSampling,
+    ) -> GpuResult<()> {
+        if !self.crowd.contains(id) {
+            return Err(GpuError::Unsupported("no such character".into()));
+        }
+        if let Some(old) = self.volumes.request(&self.ctx, id, sampling)? {
+            self.retire(Retired::Resource(Box::new(old)));
+        }
+        Ok(())
+    }
+
+    /// Character `id`'s density volume as last built, read back after the frames in flight.
+    pub fn read_density_volume(
+        &mut self,
+        id: CharacterId,
+    ) -> GpuResult<crate::reference::volume::DensityVolume> {
+        self.finish()?;
+        let record = self
+            .crowd
+            .records(&[])
+            .get(id.slot() as usize)
+            .copied()
+            .ok_or_else(|| GpuError::Unsupported("no such character".into()))?;
+        self.volumes.read(&self.ctx, id, &record)
     }
 
     /// The pose character `id`'s GPU hair dynamics last wrote (`layers x vertices`,

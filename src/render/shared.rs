@@ -51,14 +51,11 @@ pub const DYNAMICS_GROUP_SIZE_GPU: u32 = 128;
 /// CPU solver's time, 64 threads 1.23x).
 pub const DYNAMICS_GROUP_SIZE_CPU: u32 = 16;
 
-/// Invocations of one `hair_dynamics.comp` workgroup on a device (`GROUP_SIZE` in the shader).
-pub fn dynamics_group_size(cpu_device: bool) -> u32 {
-    if cpu_device {
-        DYNAMICS_GROUP_SIZE_CPU
-    } else {
-        DYNAMICS_GROUP_SIZE_GPU
-    }
-}
+/// Fixed-point scale of the density volume's cells: a cell adds `round(length * VOLUME_FIXED)`
+/// for strand length `length` (object units).
+pub const VOLUME_FIXED: f32 = 16384.0;
+/// Invocations of one `density_volume.comp` workgroup (one bundle; a strand each).
+pub const VOLUME_GROUP_SIZE: u32 = 32;
 /// Most colliders one simulated character may have (the solver keeps them in shared memory).
 pub const MAX_SIM_COLLIDERS: u32 = 16;
 /// `SimCollider::shape.x`: an ellipsoid (`a`: centre, `b`: radii).
@@ -810,6 +807,29 @@ pub struct SimState {
     pub v: [f32; 4],
 }
 
+/// One character's strand density volume to build this frame (`glsl/density_volume.comp`,
+/// the twin of `reference::volume::density_volume`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DensityJob {
+    /// `uint[]`: the cells (x fastest) in units of 1 / [`VOLUME_FIXED`] strand length, then
+    /// one more for the length that fell outside.
+    pub cells: [u32; 2],
+    /// Padding.
+    pub _pad: [u32; 2],
+    /// xyz: corner of cell (0, 0, 0), object units; w unused.
+    pub origin: [f32; 4],
+    /// xyz: size of a cell; w unused.
+    pub cell: [f32; 4],
+    /// xyz: cells along x, y, z; w: the character's slot.
+    pub dims: [u32; 4],
+    /// First bundle in the crowd's table, bundles, strands generated per bundle at most,
+    /// segments per strand (log2).
+    pub bundles: [u32; 4],
+    /// x: strands per average bundle the volume stands for; yzw unused.
+    pub strands: [u32; 4],
+}
+
 /// One character's step this frame: where its buffers are (device addresses, low word first)
 /// and its `dynamics::StepPlan` and settings.
 #[repr(C)]
@@ -861,6 +881,10 @@ gpu_struct!(SimCollider as "SimCollider" {
     shape: "uvec4", a: "vec4", b: "vec4", to_canonical: "mat4", to_person: "mat4", bound: "vec4",
 });
 gpu_struct!(SimState as "SimState" { x: "vec4", v: "vec4" });
+gpu_struct!(DensityJob as "DensityJob" {
+    cells: "uvec2", _pad: "uvec2", origin: "vec4", cell: "vec4", dims: "uvec4", bundles: "uvec4",
+    strands: "uvec4",
+});
 gpu_struct!(SimJob as "SimJob" {
     vertices: "uvec2", spacing: "uvec2", spacing_colours: "uvec2", colliders: "uvec2",
     state: "uvec2", pose: "uvec2", head_map: "uvec2", solve: "uvec2", counts: "uvec4",
@@ -906,6 +930,7 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<SimCollider>(),
         info::<SimState>(),
         info::<SimJob>(),
+        info::<DensityJob>(),
     ]
 }
 
@@ -946,6 +971,9 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
     let uint = |n, v| (n, v, false);
     vec![
         layout("STRAND_GROUP_SIZE", STRAND_GROUP_SIZE),
+        layout("VOLUME_GROUP_SIZE", VOLUME_GROUP_SIZE),
+        layout("DYNAMICS_GROUP_SIZE_GPU", DYNAMICS_GROUP_SIZE_GPU),
+        layout("DYNAMICS_GROUP_SIZE_CPU", DYNAMICS_GROUP_SIZE_CPU),
         uint("MAX_VERTS_LOG2", MAX_VERTS_LOG2),
         uint("MAX_SEGMENTS", MAX_SEGMENTS),
         // The mesh shader's outputs: two vertices per strand vertex, two triangles per
@@ -968,6 +996,10 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("COLLIDER_HEAD", COLLIDER_HEAD),
         uint("BEND_COLOURS", crate::dynamics::BEND_COLOURS as u32),
         uint("COLLISION_ROUNDS", crate::dynamics::COLLISION_ROUNDS),
+        uint(
+            "MAX_SPLAT_POINTS",
+            crate::reference::volume::MAX_SPLAT_POINTS,
+        ),
         uint("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
         uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
         uint("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
@@ -1026,6 +1058,8 @@ fn float_constants() -> Vec<(&'static str, f32)> {
         ("KAJIYA_KAY_EXPONENT", crate::shade::KAJIYA_KAY_EXPONENT),
         ("MARSCHNER_ENERGY_SCALE", crate::shade::ENERGY_SCALE),
         ("SHADOW_OPACITY_FIXED", SHADOW_OPACITY_FIXED),
+        ("VOLUME_FIXED", VOLUME_FIXED),
+        ("SPLAT_SPACING", crate::reference::volume::SPLAT_SPACING),
     ]
 }
 

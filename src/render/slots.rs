@@ -96,6 +96,8 @@ pub(crate) struct FrameSlot {
     pub pending: Option<Pending>,
     /// The GPU hair dynamics' job table (host-visible, read by address), once needed.
     pub sim_jobs: Option<Buffer>,
+    /// The density volume builds' job table (grown as needed).
+    pub density_jobs: Option<Buffer>,
 }
 
 impl FrameSlot {
@@ -125,6 +127,7 @@ impl FrameSlot {
             retired: Vec::new(),
             pending: None,
             sim_jobs: None,
+            density_jobs: None,
         })
     }
 }

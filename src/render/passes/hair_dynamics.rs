@@ -41,8 +41,10 @@ impl HairDynamicsPass {
     /// Compile the pass.
     pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
         let layout = PipelineLayout::new(ctx, &[])?;
-        let group = crate::render::shared::dynamics_group_size(ctx.info.cpu_device);
-        let options = super::shader_options(1).define("GROUP_SIZE", group);
+        let options = match ctx.info.cpu_device {
+            true => super::shader_options(1).define("CPU_DEVICE", 1),
+            false => super::shader_options(1),
+        };
         let spirv = super::compile("hair_dynamics.comp", &options)?;
         Ok(HairDynamicsPass {
             pipeline: Pipeline::compute(ctx, "hair dynamics", &layout, &spirv)?,

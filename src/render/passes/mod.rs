@@ -2,6 +2,7 @@
 //! `add`, declaring what it reads and writes; the graph derives the synchronisation.
 
 pub mod compute_generate;
+pub mod density_volume;
 pub mod hair_dynamics;
 pub mod hair_mesh_update;
 pub mod lhs_skin;
@@ -525,6 +526,7 @@ pub struct FramePasses {
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
     hair_dynamics: hair_dynamics::HairDynamicsPass,
     lhs_skin: lhs_skin::LhsSkin,
+    density_volume: density_volume::DensityVolumePass,
 }
 
 /// The software rasterizer's passes (they need 64-bit shared and buffer atomics).
@@ -588,6 +590,7 @@ impl FramePasses {
             hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
             hair_dynamics: hair_dynamics::HairDynamicsPass::new(ctx)?,
             lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
+            density_volume: density_volume::DensityVolumePass::new(ctx, layout)?,
         })
     }
 
@@ -615,6 +618,19 @@ impl FramePasses {
             None => Vec::new(),
         };
         self.hair_mesh_update.add(g, r, jobs, &poses);
+    }
+
+    /// Add the builds of this frame's requested density volumes (after the updates, before
+    /// [`Self::add`]): `volumes` are their cells, in the order of the jobs in `table`.
+    pub fn add_density_volumes<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes,
+        sets: PassSets<'a>,
+        (table, volumes, most_bundles): (&'a Buffer, &[&'a Buffer], u32),
+    ) {
+        self.density_volume
+            .add(g, r, sets, table, volumes, most_bundles);
     }
 
     /// Add the LHS baseline's skinning for frame slot `slot` (before [`Self::add`]).

@@ -1,0 +1,80 @@
+#version 460
+// Strand density volumes (seed 002, vkhr): the twin of src/reference/volume.rs. One workgroup
+// per (bundle, job): each invocation generates a strand of the bundle's first `sampled` ones
+// with the generator's own evaluation (strand_eval.glsl) and splats every segment's length,
+// weighted by the strands it stands for, trilinearly into the job's cells at points no more
+// than SPLAT_SPACING of a cell apart. Cells hold fixed-point strand length (VOLUME_FIXED per
+// object unit); the one after the grid gathers what fell outside.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
+#include "bindings.glsl"
+layout(local_size_x = VOLUME_GROUP_SIZE) in;
+#include "common.glsl"
+#include "strand_eval.glsl"
+
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer DensityJobs { DensityJob jobs[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer Cells { uint cells[]; };
+
+DensityJob job;
+Cells cells;
+
+// volume::DensityVolume::splat, in fixed point.
+void splat(vec3 p, float length) {
+    uvec3 dims = job.dims.xyz;
+    vec3 g = (p - job.origin.xyz) / job.cell.xyz - vec3(0.5);
+    vec3 base = floor(g);
+    vec3 f = g - base;
+    for (uint corner = 0u; corner < 8u; corner++) {
+        uvec3 o = uvec3(corner & 1u, (corner >> 1u) & 1u, corner >> 2u);
+        vec3 w = mix(vec3(1.0) - f, f, vec3(o));
+        uint add = uint(round(length * w.x * w.y * w.z * VOLUME_FIXED));
+        vec3 c = base + vec3(o);
+        uint index = dims.x * dims.y * dims.z;
+        if (all(greaterThanEqual(c, vec3(0.0))) && all(lessThan(c, vec3(dims)))) {
+            uvec3 u = uvec3(c);
+            index = (u.z * dims.y + u.y) * dims.x + u.x;
+        }
+        if (add != 0u) {
+            atomicAdd(cells.cells[index], add);
+        }
+    }
+}
+
+// volume::DensityVolume::splat_segment.
+void splat_segment(vec3 a, vec3 b, float weight) {
+    float length = distance(a, b);
+    float step = SPLAT_SPACING * min(job.cell.x, min(job.cell.y, job.cell.z));
+    uint n = clamp(uint(ceil(length / step)), 1u, MAX_SPLAT_POINTS);
+    for (uint i = 0u; i < n; i++) {
+        float t = (float(i) + 0.5) / float(n);
+        splat(a + (b - a) * t, length * weight / float(n));
+    }
+}
+
+void main() {
+    job = DensityJobs(push.params.xy).jobs[gl_WorkGroupID.y];
+    uint local = gl_WorkGroupID.x;
+    if (local >= job.bundles.y) {
+        return;
+    }
+    uint g = job.bundles.x + local;
+    bind_character(job.dims.w);
+    cells = Cells(job.cells);
+    // generate::strands_in_bundle (as bundle_lod.glsl).
+    uint n = job.strands.x;
+    uint strands = style.density_by_area != 0u ? uint(round(float(n) * bundles[g].density)) : n;
+    strands = clamp(strands, 1u, MAX_STRANDS_PER_BUNDLE);
+    uint sampled = min(strands, max(job.bundles.z, 1u));
+    float weight = float(strands) / float(sampled);
+    uint segments = 1u << job.bundles.w;
+    for (uint strand = gl_LocalInvocationID.x; strand < sampled; strand += VOLUME_GROUP_SIZE) {
+        StrandInfo si = strand_info(g, strand);
+        vec3 a = strand_vertex(si, 0u, segments);
+        for (uint k = 1u; k <= segments; k++) {
+            vec3 b = strand_vertex(si, k, segments);
+            splat_segment(a, b, weight);
+            a = b;
+        }
+    }
+}

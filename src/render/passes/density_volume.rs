@@ -1,0 +1,90 @@
+//! Strand density volumes (`glsl/density_volume.comp`, the twin of
+//! `reference::volume::density_volume`): one dispatch for every volume requested this frame,
+//! a workgroup per (bundle, volume), reading the frame slot's job table by device address.
+//! Reads: the frame's records, bundle table and the characters' textures (after this frame's
+//! texture rebuilds). Writes: each requested volume's cells, cleared first.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{FrameRes, PassSets};
+use crate::render::graph::FrameGraph;
+use crate::render::shared::DensityJob;
+use crate::vk::shader::compile;
+use crate::vk::{Access, Buffer, BufferDesc, Context, GpuResult, Pipeline, PipelineLayout};
+
+/// The density build's pipeline.
+pub struct DensityVolumePass {
+    pipeline: Pipeline,
+}
+
+/// A host-visible job table with room for `jobs` volumes (the shader reads it by address).
+pub fn job_table(ctx: &Arc<Context>, jobs: usize) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            "density volume jobs",
+            (jobs.max(1) * size_of::<DensityJob>()) as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+        )
+        .host_visible(),
+    )
+}
+
+impl DensityVolumePass {
+    /// Compile the pass.
+    pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
+        let spirv = compile("density_volume.comp", &super::shader_options(1))?;
+        Ok(DensityVolumePass {
+            pipeline: Pipeline::compute(ctx, "density volume", layout, &spirv)?,
+        })
+    }
+
+    /// Add the builds of `volumes` (the cells buffers of the jobs in `table`, in that order;
+    /// `most_bundles`: the largest bundle count among them).
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes,
+        sets: PassSets<'a>,
+        table: &'a Buffer,
+        volumes: &[&'a Buffer],
+        most_bundles: u32,
+    ) {
+        if volumes.is_empty() || most_bundles == 0 {
+            return;
+        }
+        let jobs = g.host_input("density volume jobs");
+        let cells: Vec<_> = volumes
+            .iter()
+            .map(|v| (g.import_buffer("density volume", v), *v))
+            .collect();
+        g.begin_scope("density volume");
+        for (res, buffer) in &cells {
+            let buffer: &'a Buffer = buffer;
+            g.pass("density clear")
+                .discard(*res, Access::TransferWrite)
+                .record(move |rec, _| {
+                    rec.fill_buffer(buffer, 0, buffer.size, 0);
+                    Ok(())
+                });
+        }
+        let mut p = g
+            .pass("density volume")
+            .read(jobs, Access::ComputeRead)
+            .read_all(&[r.constants, r.textures], Access::ComputeRead);
+        for (res, _) in &cells {
+            p = p.write(*res, Access::ComputeReadWrite);
+        }
+        let address = table.device_address();
+        let count = volumes.len() as u32;
+        p.record(move |rec, _| {
+            rec.bind(&self.pipeline, &sets.both());
+            rec.push_constants(&self.pipeline, &[address[0], address[1], count, 0]);
+            rec.dispatch(most_bundles, count, 1);
+            Ok(())
+        });
+        g.end_scope();
+    }
+}
