@@ -6,13 +6,11 @@
 
 use std::sync::Arc;
 
-use ash::vk;
-
 use super::{FrameRes, PassSets};
 use crate::render::graph::FrameGraph;
 use crate::render::shared::DensityJob;
 use crate::vk::shader::compile;
-use crate::vk::{Access, Buffer, BufferDesc, Context, GpuResult, Pipeline, PipelineLayout};
+use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// The density build's pipeline.
 pub struct DensityVolumePass {
@@ -21,15 +19,8 @@ pub struct DensityVolumePass {
 
 /// A host-visible job table with room for `jobs` volumes (the shader reads it by address).
 pub fn job_table(ctx: &Arc<Context>, jobs: usize) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(
-            "density volume jobs",
-            (jobs.max(1) * size_of::<DensityJob>()) as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
-        )
-        .host_visible(),
-    )
+    let bytes = (jobs.max(1) * size_of::<DensityJob>()) as u64;
+    super::address_table(ctx, "density volume jobs", bytes)
 }
 
 impl DensityVolumePass {

@@ -5,15 +5,13 @@
 
 use std::sync::Arc;
 
-use ash::vk;
-
 use crate::render::graph::{FrameGraph, Res};
 use crate::render::shared::SimJob;
-use crate::vk::{Access, Buffer, BufferDesc, Context, GpuResult, Pipeline, PipelineLayout};
+use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One simulated character's buffers this frame.
 pub struct SimulatedCharacter<'a> {
-    /// Positions, velocities and scratch.
+    /// Positions and velocities, then the substep positions.
     pub state: &'a Buffer,
     /// The pose the texture rebuild reads.
     pub pose: &'a Buffer,
@@ -26,15 +24,8 @@ pub struct HairDynamicsPass {
 
 /// A host-visible job table with room for `jobs` steps (the solver reads it by address).
 pub fn job_table(ctx: &Arc<Context>, jobs: usize) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(
-            "hair dynamics jobs",
-            (jobs.max(1) * size_of::<SimJob>()) as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
-        )
-        .host_visible(),
-    )
+    let bytes = (jobs.max(1) * size_of::<SimJob>()) as u64;
+    super::address_table(ctx, "hair dynamics jobs", bytes)
 }
 
 impl HairDynamicsPass {

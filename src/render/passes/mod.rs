@@ -539,6 +539,17 @@ struct SoftPasses {
     pool: pool_segments::PoolSegments,
 }
 
+/// A host-visible table of `bytes` bytes that shaders read by device address (the job tables
+/// of the hair dynamics and the density volumes).
+pub fn address_table(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
+    let usage = ash::vk::BufferUsageFlags::STORAGE_BUFFER
+        | ash::vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
+    Buffer::new(
+        ctx,
+        &crate::vk::BufferDesc::new(name, bytes, usage).host_visible(),
+    )
+}
+
 /// Add the pass that zeroes `args` (indirect arguments and statistics).
 pub(crate) fn add_clear_args<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
     let args = r.args_buffer;
