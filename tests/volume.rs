@@ -114,3 +114,33 @@ fn gpu_density_volume_equals_the_cpu_twin() {
     }
     common::assert_no_validation_errors(&ctx);
 }
+
+/// Absurd samplings are refused with an error that says what is wrong, before anything is
+/// allocated; so is a character that does not exist.
+#[test]
+fn bad_density_volume_requests_are_errors() {
+    let ctx = common::context();
+    let mut r = common::renderer(&ctx, 32);
+    let (baked, style) = common::sample("small_patch.obj");
+    let id = common::upload(&mut r, &baked, &style, 4, 2);
+    let bad = [
+        (UVec3::new(0, 8, 8), 16, 4, "cells"),
+        (UVec3::splat(1024), 16, 4, "cells"),
+        (UVec3::splat(8), 0, 4, "strands"),
+        (UVec3::splat(8), 16, 20, "segments"),
+    ];
+    for (dims, strands_sampled, segments_log2, word) in bad {
+        let sampling = VolumeSampling {
+            dims,
+            strands_sampled,
+            segments_log2,
+            ..Default::default()
+        };
+        let e = r.request_density_volume(id, sampling).unwrap_err().to_string();
+        assert!(e.contains(word), "{dims} {strands_sampled} {segments_log2}: {e}");
+    }
+    assert!(r.read_density_volume(id).is_err(), "nothing was requested");
+    r.remove_character(id).unwrap();
+    assert!(r.request_density_volume(id, VolumeSampling::default()).is_err());
+    common::assert_no_validation_errors(&ctx);
+}

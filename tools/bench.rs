@@ -21,9 +21,10 @@
 //! flicker measure with temporal accumulation off and on against a supersampled reference.
 //!
 //! `bench animate [--mesh M] [--wind 30] [--frames 90] [--counts 1,100] [--dynamics gpu,cpu]
-//! [--strip out.png]`: copies of one hair mesh in wind, simulated (on the GPU, or the CPU on
+//! [--strip out.png] [--volumes]`: copies of one hair mesh in wind, simulated (on the GPU, or the CPU on
 //! all cores) and re-textured every frame: CPU and GPU ms of the dynamics, GPU ms of the
-//! texture rebuild and of the frame (medians); optionally a strip of frames side by side.
+//! texture rebuild and of the frame (medians), and with `--volumes` of rebuilding every
+//! character's density volume every frame; optionally a strip of frames side by side.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -202,6 +203,10 @@ enum Cmd {
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
+        /// Also rebuild every character's strand density volume (32^3 cells, 16 strands per
+        /// bundle) every frame, and report its GPU ms.
+        #[arg(long)]
+        volumes: bool,
     },
     /// A crowd of mixed sample meshes on a ground plane seen from human height: GPU ms per
     /// pass, CPU ms to record a frame, peak RSS and GPU memory, for N characters, LoD on/off,
@@ -665,6 +670,7 @@ fn run(args: Args) -> Result<()> {
             strip,
             strip_frames,
             device,
+            volumes,
         } => animate::bench_animate(animate::AnimateArgs {
             mesh,
             frames,
@@ -676,6 +682,7 @@ fn run(args: Args) -> Result<()> {
             strip,
             strip_frames,
             device,
+            volumes,
         })?,
         Cmd::Temporal(args) => temporal::bench_temporal(args)?,
         Cmd::Fuzz { iterations, seed } => {

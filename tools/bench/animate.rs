@@ -19,6 +19,7 @@ use hairmesh::fsutil::OutputPath;
 use hairmesh::model::hair_mesh::HairMesh;
 use hairmesh::model::obj_io::load_hair_mesh_obj;
 use hairmesh::outln;
+use hairmesh::reference::volume::VolumeSampling;
 use hairmesh::render::{
     Camera, CharacterId, FrameOptions, LodSettings, Renderer, RendererDesc, ShadowMode,
     StrandParams, Transparency, View,
@@ -38,6 +39,8 @@ pub struct AnimateArgs {
     pub strip: Option<PathBuf>,
     pub strip_frames: u32,
     pub device: Option<String>,
+    /// Rebuild every character's strand density volume every frame (`--volumes`).
+    pub volumes: bool,
 }
 
 /// Most characters one run animates (the renderer's default room).
@@ -179,6 +182,7 @@ struct Timings {
     sim_gpu_ms: Vec<f64>,
     update_ms: Vec<f64>,
     gpu_ms: Vec<f64>,
+    volume_ms: Vec<f64>,
     strip: Vec<Vec<u8>>,
 }
 
@@ -206,6 +210,10 @@ fn run_frames(herd: &mut Herd, a: &AnimateArgs, strip: bool) -> Result<Timings> 
         t.sim_ms.push(start.elapsed().as_secs_f64() * 1e3);
         for (id, model) in herd.ids.iter().zip(&models) {
             herd.renderer.set_model(*id, *model)?;
+            if a.volumes {
+                herd.renderer
+                    .request_density_volume(*id, VolumeSampling::default())?;
+            }
         }
         let view = View {
             light_dir: Vec3::new(-0.6, 0.8, 0.4),
@@ -239,6 +247,7 @@ fn run_frames(herd: &mut Herd, a: &AnimateArgs, strip: bool) -> Result<Timings> 
                 .sum::<f64>()
         };
         t.sim_gpu_ms.push(pass("hair dynamics"));
+        t.volume_ms.push(pass("density volume"));
         t.gpu_ms.push(report.gpu_ms());
         if let Some(rgba) = report.rgba
             && t.strip.len() < a.strip_frames as usize
@@ -286,10 +295,15 @@ pub fn bench_animate(a: AnimateArgs) -> Result<()> {
         a.wind,
         ctx.info.name
     )?;
+    let volume_column = match a.volumes {
+        true => (" density volumes ms GPU |", "---|"),
+        false => ("", ""),
+    };
     outln!(
-        "| characters | dynamics | dynamics ms CPU | dynamics ms GPU | per character ms | texture rebuild ms GPU | frame ms GPU |"
+        "| characters | dynamics | dynamics ms CPU | dynamics ms GPU | per character ms | texture rebuild ms GPU | frame ms GPU |{}",
+        volume_column.0
     )?;
-    outln!("|---|---|---|---|---|---|---|")?;
+    outln!("|---|---|---|---|---|---|---|{}", volume_column.1)?;
     let mut strip_images = Vec::new();
     let runs = a
         .counts
@@ -308,8 +322,12 @@ pub fn bench_animate(a: AnimateArgs) -> Result<()> {
             DynamicsPath::Gpu => format!("{gpu:.2}"),
             DynamicsPath::Cpu => "-".into(),
         };
+        let volumes = match a.volumes {
+            true => format!(" {:.2} |", super::median(t.volume_ms)),
+            false => String::new(),
+        };
         outln!(
-            "| {count} | {path} | {cpu:.2} | {gpu_text} | {:.3} | {:.2} | {:.1} |",
+            "| {count} | {path} | {cpu:.2} | {gpu_text} | {:.3} | {:.2} | {:.1} |{volumes}",
             cost / count as f64,
             super::median(t.update_ms),
             super::median(t.gpu_ms)
