@@ -136,11 +136,20 @@ fn bad_density_volume_requests_are_errors() {
             segments_log2,
             ..Default::default()
         };
-        let e = r.request_density_volume(id, sampling).unwrap_err().to_string();
-        assert!(e.contains(word), "{dims} {strands_sampled} {segments_log2}: {e}");
+        let e = r
+            .request_density_volume(id, sampling)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(word),
+            "{dims} {strands_sampled} {segments_log2}: {e}"
+        );
     }
     assert!(r.read_density_volume(id).is_err(), "nothing was requested");
     r.remove_character(id).unwrap();
-    assert!(r.request_density_volume(id, VolumeSampling::default()).is_err());
+    assert!(
+        r.request_density_volume(id, VolumeSampling::default())
+            .is_err()
+    );
     common::assert_no_validation_errors(&ctx);
 }

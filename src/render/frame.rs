@@ -15,6 +15,7 @@ use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::PropDraw;
 use super::passes::temporal::TemporalWork;
+use super::passes::write_address_table;
 use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets};
 use super::renderer::{PresentTarget, Renderer};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
@@ -153,17 +154,10 @@ impl Renderer {
         if steps.is_empty() {
             return Ok(Vec::new());
         }
-        let slot = &mut self.frames[i];
-        let bytes = std::mem::size_of_val(steps) as u64;
-        let table = match slot.sim_jobs.take() {
-            Some(t) if t.size >= bytes => t,
-            _ => {
-                super::passes::hair_dynamics::job_table(&self.ctx, steps.len().next_power_of_two())?
-            }
-        };
         let jobs: Vec<super::shared::SimJob> = steps.iter().map(|(_, j)| *j).collect();
-        let table = slot.sim_jobs.insert(table);
-        table.write(0, bytemuck::cast_slice(&jobs))?;
+        let bytes = bytemuck::cast_slice(&jobs);
+        let table = &mut self.frames[i].sim_jobs;
+        write_address_table(&self.ctx, table, "hair dynamics jobs", bytes)?;
         Ok(steps.iter().map(|(s, _)| *s).collect())
     }
 
@@ -178,16 +172,9 @@ impl Renderer {
         if jobs.is_empty() {
             return Ok((entries, most));
         }
-        let slot = &mut self.frames[i];
-        let bytes = std::mem::size_of_val(jobs.as_slice()) as u64;
-        let table = match slot.density_jobs.take() {
-            Some(t) if t.size >= bytes => t,
-            _ => {
-                super::passes::density_volume::job_table(&self.ctx, jobs.len().next_power_of_two())?
-            }
-        };
-        let table = slot.density_jobs.insert(table);
-        table.write(0, bytemuck::cast_slice(&jobs))?;
+        let bytes = bytemuck::cast_slice(&jobs);
+        let table = &mut self.frames[i].density_jobs;
+        write_address_table(&self.ctx, table, "density volume jobs", bytes)?;
         Ok((entries, most))
     }
 

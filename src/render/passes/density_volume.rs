@@ -8,19 +8,12 @@ use std::sync::Arc;
 
 use super::{FrameRes, PassSets};
 use crate::render::graph::FrameGraph;
-use crate::render::shared::DensityJob;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// The density build's pipeline.
 pub struct DensityVolumePass {
     pipeline: Pipeline,
-}
-
-/// A host-visible job table with room for `jobs` volumes (the shader reads it by address).
-pub fn job_table(ctx: &Arc<Context>, jobs: usize) -> GpuResult<Buffer> {
-    let bytes = (jobs.max(1) * size_of::<DensityJob>()) as u64;
-    super::address_table(ctx, "density volume jobs", bytes)
 }
 
 impl DensityVolumePass {

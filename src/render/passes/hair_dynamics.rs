@@ -6,7 +6,6 @@
 use std::sync::Arc;
 
 use crate::render::graph::{FrameGraph, Res};
-use crate::render::shared::SimJob;
 use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One simulated character's buffers this frame.
@@ -20,12 +19,6 @@ pub struct SimulatedCharacter<'a> {
 /// The solver's pipeline.
 pub struct HairDynamicsPass {
     pipeline: Pipeline,
-}
-
-/// A host-visible job table with room for `jobs` steps (the solver reads it by address).
-pub fn job_table(ctx: &Arc<Context>, jobs: usize) -> GpuResult<Buffer> {
-    let bytes = (jobs.max(1) * size_of::<SimJob>()) as u64;
-    super::address_table(ctx, "hair dynamics jobs", bytes)
 }
 
 impl HairDynamicsPass {

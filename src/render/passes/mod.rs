@@ -539,15 +539,29 @@ struct SoftPasses {
     pool: pool_segments::PoolSegments,
 }
 
-/// A host-visible table of `bytes` bytes that shaders read by device address (the job tables
-/// of the hair dynamics and the density volumes).
-pub fn address_table(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
-    let usage = ash::vk::BufferUsageFlags::STORAGE_BUFFER
-        | ash::vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
-    Buffer::new(
-        ctx,
-        &crate::vk::BufferDesc::new(name, bytes, usage).host_visible(),
-    )
+/// Write `bytes` into `table`, a host-visible table that shaders read by device address (the
+/// job tables of the hair dynamics and the density volumes), first replacing it with one of
+/// the next power-of-two size when it is missing or too small. The caller owns a frame slot
+/// whose earlier frame has completed, so the old table is free.
+pub fn write_address_table<'t>(
+    ctx: &Arc<Context>,
+    table: &'t mut Option<Buffer>,
+    name: &str,
+    bytes: &[u8],
+) -> GpuResult<&'t Buffer> {
+    let size = bytes.len().max(1) as u64;
+    let buffer = match table.take() {
+        Some(t) if t.size >= size => t,
+        _ => {
+            let usage = ash::vk::BufferUsageFlags::STORAGE_BUFFER
+                | ash::vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
+            let desc = crate::vk::BufferDesc::new(name, size.next_power_of_two(), usage);
+            Buffer::new(ctx, &desc.host_visible())?
+        }
+    };
+    let buffer = table.insert(buffer);
+    buffer.write(0, bytes)?;
+    Ok(buffer)
 }
 
 /// Add the pass that zeroes `args` (indirect arguments and statistics).
