@@ -73,13 +73,18 @@ pub fn splat_points(length: f32, cell: Vec3) -> u32 {
     ((length / step).ceil() as u32).clamp(1, MAX_SPLAT_POINTS)
 }
 
+/// Size of one of `dims` cells over `lo..hi`.
+pub fn cell_size(lo: Vec3, hi: Vec3, dims: UVec3) -> Vec3 {
+    (hi - lo) / dims.max(UVec3::ONE).as_vec3()
+}
+
 impl DensityVolume {
     /// An empty grid of `dims` cells over `lo..hi`.
     pub fn empty(lo: Vec3, hi: Vec3, dims: UVec3) -> Self {
         let dims = dims.max(UVec3::ONE);
         DensityVolume {
             origin: lo,
-            cell: (hi - lo) / dims.as_vec3(),
+            cell: cell_size(lo, hi, dims),
             dims,
             density: vec![0.0; (dims.x * dims.y * dims.z) as usize],
             outside: 0.0,

@@ -322,13 +322,7 @@ impl Renderer {
         id: CharacterId,
     ) -> GpuResult<crate::reference::volume::DensityVolume> {
         self.finish()?;
-        let record = self
-            .crowd
-            .records(&[])
-            .get(id.slot() as usize)
-            .copied()
-            .ok_or_else(|| GpuError::Unsupported("no such character".into()))?;
-        self.volumes.read(&self.ctx, id, &record)
+        self.volumes.read(&self.ctx, id)
     }
 
     /// The pose character `id`'s GPU hair dynamics last wrote (`layers x vertices`,

@@ -9,18 +9,20 @@ use glam::Vec3;
 
 use super::crowd::CharacterId;
 use super::shared::{CharacterRecord, DensityJob, VOLUME_FIXED};
-use crate::reference::volume::{DensityVolume, VolumeSampling, volume_box};
+use crate::reference::volume::{DensityVolume, VolumeSampling, cell_size, volume_box};
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
 
 /// Most cells one density volume may have (128^3).
 pub const MAX_VOLUME_CELLS: u32 = 1 << 21;
 
-/// One character's volume: its sampling and cells, and whether a frame has yet to build it.
+/// One character's volume: its sampling and cells, whether a frame has yet to build it, and
+/// the box (object units) of its last build.
 struct VolumeEntry {
     id: CharacterId,
     sampling: VolumeSampling,
     cells: Buffer,
     pending: bool,
+    built: Option<(Vec3, Vec3)>,
 }
 
 /// Every requested density volume.
@@ -72,6 +74,7 @@ impl DensityVolumes {
             sampling,
             cells,
             pending: true,
+            built: None,
         });
         Ok(old)
     }
@@ -93,7 +96,9 @@ impl DensityVolumes {
                 continue;
             };
             e.pending = false;
-            jobs.push(job(e, r));
+            let grid = volume_box(&r.mesh);
+            e.built = Some(grid);
+            jobs.push(job(e, r, grid));
             entries.push(i);
             most = most.max(r.bundle_count);
         }
@@ -105,27 +110,20 @@ impl DensityVolumes {
         entries.iter().map(|&i| &self.entries[i].cells).collect()
     }
 
-    /// `id`'s volume as last built (call after its frame completed), for a character with
-    /// position decode box of `record`.
-    pub fn read(
-        &self,
-        ctx: &Arc<Context>,
-        id: CharacterId,
-        record: &CharacterRecord,
-    ) -> GpuResult<DensityVolume> {
+    /// `id`'s volume as last built (call after its frame completed).
+    pub fn read(&self, ctx: &Arc<Context>, id: CharacterId) -> GpuResult<DensityVolume> {
         let e = self
             .entries
             .iter()
             .find(|e| e.id == id)
             .ok_or_else(|| GpuError::Unsupported("no density volume was requested".into()))?;
-        if e.pending {
+        let Some((lo, hi)) = e.built.filter(|_| !e.pending) else {
             return Err(GpuError::Unsupported(
                 "the density volume has not been built yet (render a frame first)".into(),
             ));
-        }
+        };
         let bytes = super::debug::read_device_buffer(ctx, &e.cells, e.cells.size)?;
         let fixed: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        let (lo, hi) = volume_box(&record.mesh);
         let mut volume = DensityVolume::empty(lo, hi, e.sampling.dims);
         let cell_volume = volume.cell.x * volume.cell.y * volume.cell.z;
         let n = volume.density.len();
@@ -137,11 +135,10 @@ impl DensityVolumes {
     }
 }
 
-/// The job of `e` for the character of `r`.
-fn job(e: &VolumeEntry, r: &CharacterRecord) -> DensityJob {
-    let (lo, hi) = volume_box(&r.mesh);
+/// The job of `e` for the character of `r`, over the box `lo..hi`.
+fn job(e: &VolumeEntry, r: &CharacterRecord, (lo, hi): (Vec3, Vec3)) -> DensityJob {
     let dims = e.sampling.dims;
-    let cell = (hi - lo) / dims.as_vec3();
+    let cell = cell_size(lo, hi, dims);
     let v4 = |v: Vec3| v.extend(0.0).to_array();
     DensityJob {
         cells: e.cells.device_address(),
