@@ -61,8 +61,8 @@ void main() {
     uint g = job.bundles.x + local;
     bind_character(job.dims.w);
     cells = Cells(job.cells);
-    // generate::strands_in_bundle (as bundle_lod.glsl).
-    uint n = job.strands.x;
+    // generate::strands_in_bundle (as bundle_lod.glsl), for the character's own N.
+    uint n = ch_strands;
     uint strands = style.density_by_area != 0u ? uint(round(float(n) * bundles[g].density)) : n;
     strands = clamp(strands, 1u, MAX_STRANDS_PER_BUNDLE);
     uint sampled = min(strands, max(job.bundles.z, 1u));

@@ -18,7 +18,8 @@ fn density_volume_keeps_the_strand_length_and_sits_on_the_hair() {
             dims: UVec3::new(24, 20, 16),
             ..Default::default()
         };
-        let volume = density_volume(&generator, &baked.info, &sampling);
+        let n = 64;
+        let volume = density_volume(&generator, &baked.info, n, &sampling);
         // The length the sampled strands stand for, summed directly.
         let segments = 1u32 << sampling.segments_log2;
         let verts = segments as usize + 1;
@@ -30,7 +31,7 @@ fn density_volume_keeps_the_strand_length_and_sits_on_the_hair() {
         let mut expected = 0.0f64;
         let mut roots = Vec::new();
         for (bundle, b) in generator.tex.bundles.iter().enumerate() {
-            let strands = strands_in_bundle(b, &style, sampling.strands_per_bundle);
+            let strands = strands_in_bundle(b, &style, n);
             let sampled = strands.min(sampling.strands_sampled);
             for strand in 0..sampled {
                 generator.strand(bundle as u32, strand, segments, &mut p, &mut t, &mut w);
@@ -80,14 +81,13 @@ fn gpu_density_volume_equals_the_cpu_twin() {
     };
     for name in ["head_long.obj", "sphere_fur.obj"] {
         let (baked, style) = common::sample(name);
-        let id = common::upload(&mut r, &baked, &style, 8, 3);
+        // 64 strands per bundle, 16 of them sampled: each stands for 4.
+        let n = 64;
+        let id = common::upload(&mut r, &baked, &style, n, 3);
         r.request_density_volume(id, sampling).unwrap();
         ids.push(id);
-        twins.push(density_volume(
-            &CpuGenerator::new(&baked, style),
-            &baked.info,
-            &sampling,
-        ));
+        let generator = CpuGenerator::new(&baked, style);
+        twins.push(density_volume(&generator, &baked.info, n, &sampling));
     }
     let (baked, _) = common::sample("head_long.obj");
     common::render(&mut r, &common::framing(&baked), &common::compute_full());
@@ -134,7 +134,6 @@ fn bad_density_volume_requests_are_errors() {
             dims,
             strands_sampled,
             segments_log2,
-            ..Default::default()
         };
         let e = r
             .request_density_volume(id, sampling)

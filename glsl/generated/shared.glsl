@@ -343,7 +343,6 @@ struct DensityJob {
     vec4 cell;
     uvec4 dims;
     uvec4 bundles;
-    uvec4 strands;
 };
 
 #endif

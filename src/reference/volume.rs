@@ -17,8 +17,6 @@ use crate::reference::generate::{CpuGenerator, strands_in_bundle};
 pub struct VolumeSampling {
     /// Cells along x, y and z.
     pub dims: UVec3,
-    /// Strands per average bundle of the hair (`N` of eq. 8): what the volume stands for.
-    pub strands_per_bundle: u32,
     /// At most this many strands of each bundle are generated; each stands for
     /// `strands / generated` strands.
     pub strands_sampled: u32,
@@ -30,7 +28,6 @@ impl Default for VolumeSampling {
     fn default() -> Self {
         VolumeSampling {
             dims: UVec3::splat(32),
-            strands_per_bundle: 64,
             strands_sampled: 16,
             segments_log2: 4,
         }
@@ -152,11 +149,13 @@ impl DensityVolume {
     }
 }
 
-/// The density volume of `generator`'s hair over [`volume_box`] of `info`, sampled as
-/// `sampling` says.
+/// The density volume of `generator`'s hair with `n` strands per average bundle (`N` of eq. 8:
+/// the character's own, so the volume stands for the strands it draws) over [`volume_box`] of
+/// `info`, sampled as `sampling` says.
 pub fn density_volume(
     generator: &CpuGenerator,
     info: &MeshInfo,
+    n: u32,
     sampling: &VolumeSampling,
 ) -> DensityVolume {
     let (lo, hi) = volume_box(info);
@@ -169,7 +168,7 @@ pub fn density_volume(
         vec![0.0; verts],
     );
     for (bundle, b) in generator.tex.bundles.iter().enumerate() {
-        let strands = strands_in_bundle(b, &generator.style, sampling.strands_per_bundle);
+        let strands = strands_in_bundle(b, &generator.style, n);
         let sampled = strands.min(sampling.strands_sampled.max(1));
         if sampled == 0 {
             continue;

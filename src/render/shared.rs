@@ -824,10 +824,9 @@ pub struct DensityJob {
     /// xyz: cells along x, y, z; w: the character's slot.
     pub dims: [u32; 4],
     /// First bundle in the crowd's table, bundles, strands generated per bundle at most,
-    /// segments per strand (log2).
+    /// segments per strand (log2). The volume stands for the character's own strands per
+    /// bundle (`CharacterRecord::strands_per_bundle`).
     pub bundles: [u32; 4],
-    /// x: strands per average bundle the volume stands for; yzw unused.
-    pub strands: [u32; 4],
 }
 
 /// One character's step this frame: where its buffers are (device addresses, low word first)
@@ -883,7 +882,6 @@ gpu_struct!(SimCollider as "SimCollider" {
 gpu_struct!(SimState as "SimState" { x: "vec4", v: "vec4" });
 gpu_struct!(DensityJob as "DensityJob" {
     cells: "uvec2", _pad: "uvec2", origin: "vec4", cell: "vec4", dims: "uvec4", bundles: "uvec4",
-    strands: "uvec4",
 });
 gpu_struct!(SimJob as "SimJob" {
     vertices: "uvec2", spacing: "uvec2", spacing_colours: "uvec2", colliders: "uvec2",

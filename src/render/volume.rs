@@ -152,6 +152,5 @@ fn job(e: &VolumeEntry, r: &CharacterRecord, (lo, hi): (Vec3, Vec3)) -> DensityJ
             e.sampling.strands_sampled,
             e.sampling.segments_log2,
         ],
-        strands: [e.sampling.strands_per_bundle, 0, 0, 0],
     }
 }
