@@ -39,6 +39,7 @@ uint ch_prev_slot;  // texture slot of the previous frame's pose (tex_slot unles
 uint ch_strands;    // N of eq. 8
 uint ch_emax;       // full-detail vertex level e
 bool ch_visible;
+bool ch_volume_only;  // drawn as its density volume alone: no strands
 
 void bind_character(uint c) {
     mesh = characters[c].mesh;
@@ -50,6 +51,7 @@ void bind_character(uint c) {
     ch_strands = characters[c].strands_per_bundle;
     ch_emax = characters[c].verts_log2;
     ch_visible = (characters[c].flags & CHARACTER_VISIBLE) != 0u;
+    ch_volume_only = (characters[c].flags & CHARACTER_VOLUME_ONLY) != 0u;
 }
 
 // The hair mesh texture is read where neighbouring invocations belong to different characters

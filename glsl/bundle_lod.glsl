@@ -81,7 +81,9 @@ BundleLod bundle_lod(uint g) {
     // Curved roots leave the hull by at most the root cell's bulge bound; the LoD distance
     // below stays that of the hull (src/reference/root_surface.rs).
     float bulge = scale * root_bulge_bound(root_cell(desc.origin));
-    if (!ch_visible || !box_visible(lo - bulge, hi + bulge)) {
+    // Hair drawn as its density volume alone (the volume tier's far characters) has no
+    // strands in any view.
+    if (!ch_visible || ch_volume_only || !box_visible(lo - bulge, hi + bulge)) {
         r.strands = 0u;
         return r;
     }

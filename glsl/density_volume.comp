@@ -3,8 +3,9 @@
 // per (bundle, job): each invocation generates a strand of the bundle's first `sampled` ones
 // with the generator's own evaluation (strand_eval.glsl) and splats every segment's length,
 // weighted by the strands it stands for, trilinearly into the job's cells at points no more
-// than SPLAT_SPACING of a cell apart. Cells hold fixed-point strand length (VOLUME_FIXED per
-// object unit); the one after the grid gathers what fell outside.
+// than SPLAT_SPACING of a cell apart. Cells (VolumeCell) hold fixed-point strand length and
+// flow (VOLUME_FIXED per object unit; the flow's components as two's complement); the one
+// after the grid gathers the length that fell outside.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_buffer_reference_uvec2 : require
@@ -14,13 +15,13 @@ layout(local_size_x = VOLUME_GROUP_SIZE) in;
 #include "strand_eval.glsl"
 
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer DensityJobs { DensityJob jobs[]; };
-layout(buffer_reference, std430, buffer_reference_align = 4) buffer Cells { uint cells[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Cells { VolumeCell cells[]; };
 
 DensityJob job;
 Cells cells;
 
 // volume::DensityVolume::splat, in fixed point.
-void splat(vec3 p, float length) {
+void splat(vec3 p, float length, vec3 along) {
     uvec3 dims = job.dims.xyz;
     vec3 g = (p - job.origin.xyz) / job.cell.xyz - vec3(0.5);
     vec3 base = floor(g);
@@ -28,15 +29,27 @@ void splat(vec3 p, float length) {
     for (uint corner = 0u; corner < 8u; corner++) {
         uvec3 o = uvec3(corner & 1u, (corner >> 1u) & 1u, corner >> 2u);
         vec3 w = mix(vec3(1.0) - f, f, vec3(o));
-        uint add = uint(round(length * w.x * w.y * w.z * VOLUME_FIXED));
+        float weight = w.x * w.y * w.z;
+        uint add = uint(round(length * weight * VOLUME_FIXED));
         vec3 c = base + vec3(o);
-        uint index = dims.x * dims.y * dims.z;
         if (all(greaterThanEqual(c, vec3(0.0))) && all(lessThan(c, vec3(dims)))) {
             uvec3 u = uvec3(c);
-            index = (u.z * dims.y + u.y) * dims.x + u.x;
-        }
-        if (add != 0u) {
-            atomicAdd(cells.cells[index], add);
+            uint index = (u.z * dims.y + u.y) * dims.x + u.x;
+            uvec3 flow = uvec3(ivec3(round(along * (weight * VOLUME_FIXED))));
+            if (add != 0u) {
+                atomicAdd(cells.cells[index].len, add);
+            }
+            if (flow.x != 0u) {
+                atomicAdd(cells.cells[index].flow[0], flow.x);
+            }
+            if (flow.y != 0u) {
+                atomicAdd(cells.cells[index].flow[1], flow.y);
+            }
+            if (flow.z != 0u) {
+                atomicAdd(cells.cells[index].flow[2], flow.z);
+            }
+        } else if (add != 0u) {
+            atomicAdd(cells.cells[dims.x * dims.y * dims.z].len, add);
         }
     }
 }
@@ -46,9 +59,10 @@ void splat_segment(vec3 a, vec3 b, float weight) {
     float length = distance(a, b);
     float step = SPLAT_SPACING * min(job.cell.x, min(job.cell.y, job.cell.z));
     uint n = clamp(uint(ceil(length / step)), 1u, MAX_SPLAT_POINTS);
+    float share = weight / float(n);
     for (uint i = 0u; i < n; i++) {
         float t = (float(i) + 0.5) / float(n);
-        splat(a + (b - a) * t, length * weight / float(n));
+        splat(a + (b - a) * t, length * share, (b - a) * share);
     }
 }
 

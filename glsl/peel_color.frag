@@ -10,6 +10,9 @@
 layout(early_fragment_tests) in;
 
 void main() {
+    if (shown_as_volume()) {
+        return;
+    }
     note_fragment(in_character, in_residual);
     uint p = peel_pixel();
     float a = strand_alpha();

@@ -4,11 +4,16 @@
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 #include "peel.glsl"
+#include "volume_shading.glsl"
+
+// The strand's character (strands.vert, strands.mesh): pixels showing its density volume
+// drop its strands (peel_color.frag drops the same ones).
+layout(location = 4) flat in uint in_character;
 
 void main() {
     uint p = peel_pixel();
     float z = gl_FragCoord.z;
-    if (z <= peel_depth[p] || z >= peel_depth[peel_pixels() + p]) {
+    if (z <= peel_depth[p] || z >= peel_depth[peel_pixels() + p] || volume_covers(uvec2(gl_FragCoord.xy), in_character)) {
         discard;
     }
 }

@@ -7,6 +7,7 @@
 #define STRAND_RADIANCE_GLSL
 #include "hair_shading.glsl"
 #include "shadow_lookup.glsl"
+#include "volume_shading.glsl"
 
 // Irradiance of the directional light, and an ambient term that stands in for multiple
 // scattering (dual scattering is not implemented) in the physically based models.
@@ -14,32 +15,39 @@
 #define AMBIENT 0.25
 
 // Radiance toward the eye at world point `pos` of a strand with unit-ish tangent `tangent`,
-// parameter `s` along it, base colour `base`, of character `character`.
-vec3 strand_radiance(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character) {
+// parameter `s` along it, base colour `base`, of character `character`, given the direct
+// light's transmittance `lit` and the ambient light's `ambient` there.
+vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character, float lit, float ambient) {
     vec3 t = normalize(tangent);
     vec3 l = normalize(frame.light_dir.xyz);
     vec3 e = normalize(frame.camera_pos.xyz - pos);
-    // Direct light reaching this point through the hair and bodies in front of it.
-    float lit = light_transmittance(pos, 0.0);
     float root_shadow = mix(0.55, 1.0, smoothstep(0.0, 0.3, s_param));
     vec3 c;
     if (frame.shading.x == SHADING_KAJIYA_KAY) {
         vec2 kk = kajiya_kay(t, l, e);
-        c = (base * (AMBIENT + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
+        c = (base * (AMBIENT * ambient + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
     } else if (frame.shading.x == SHADING_MARSCHNER) {
         HairStyle s = characters[character].style;
         vec3 sc = marschner(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees));
         float cos_i = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));
-        c = (sc * (LIGHT_IRRADIANCE * cos_i * lit) + base * AMBIENT) * root_shadow;
+        c = (sc * (LIGHT_IRRADIANCE * cos_i * lit) + base * (AMBIENT * ambient)) * root_shadow;
     } else {
         float tl = dot(t, l);
         float diffuse = sqrt(max(1.0 - tl * tl, 0.0));
         vec3 h = normalize(l + e);
         float th = dot(t, h);
         float spec = pow(sqrt(max(1.0 - th * th, 0.0)), 80.0);
-        c = base * (0.25 + 0.75 * diffuse * lit) * root_shadow + vec3(0.25) * (spec * lit) * root_shadow;
+        c = base * (0.25 * ambient + 0.75 * diffuse * lit) * root_shadow + vec3(0.25) * (spec * lit) * root_shadow;
     }
     return c;
+}
+
+// strand_radiance_lit with the light through the light's maps (hair and bodies in front of
+// the point) and the ambient light through the character's density volume (volumetric
+// ambient occlusion, where on).
+vec3 strand_radiance(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character) {
+    float lit = light_transmittance(pos, 0.0);
+    return strand_radiance_lit(tangent, s_param, pos, base, character, lit, volume_ambient(character, pos));
 }
 
 #endif

@@ -29,6 +29,10 @@
 #define COLLISION_ROUNDS 16u
 #define MAX_SPLAT_POINTS 64u
 #define CHARACTER_VISIBLE 1u
+#define CHARACTER_VOLUME_ONLY 2u
+#define VOLUME_BUILT 1u
+#define VOLUME_OCCLUSION 2u
+#define VOLUME_DIMS_BITS 10u
 #define MARSCHNER_LUT_PHI 256u
 #define MARSCHNER_LUT_D 64u
 #define SET_FRAME 0
@@ -75,6 +79,10 @@
 #define SHADOW_OPACITY_FIXED 4096.0
 #define VOLUME_FIXED 16384.0
 #define SPLAT_SPACING 0.5
+#define AO_RADIUS_CELLS 2.0
+#define MARCH_STEP_CELLS 0.5
+#define MARCH_MIN_TRANSMITTANCE 0.01
+#define STRAND_SHADOW_OPACITY 0.5
 #define BINDING_FRAME 0
 #define BINDING_CHARACTERS 1
 #define BINDING_BUNDLES 2
@@ -205,6 +213,9 @@ struct CharacterRecord {
     float model_scale;
     uint prev_texture_slot;
     mat4 clip_to_prev;
+    mat4 world_to_volume;
+    uvec4 volume;
+    vec4 volume_shading;
 };
 
 struct GpuBundle {
@@ -343,6 +354,11 @@ struct DensityJob {
     vec4 cell;
     uvec4 dims;
     uvec4 bundles;
+};
+
+struct VolumeCell {
+    uint len;
+    uint flow[3];
 };
 
 #endif

@@ -45,6 +45,10 @@ pub struct DensityVolume {
     pub dims: UVec3,
     /// Strand length per volume at each cell's centre, x fastest.
     pub density: Vec<f32>,
+    /// Strand flow at each cell's centre: the sum of the strands' root-to-tip directions
+    /// weighted by their length, per volume (its direction is the cell's mean tangent; its
+    /// length over `density` says how aligned the strands are).
+    pub flow: Vec<Vec3>,
     /// Strand length splatted outside the grid (lost).
     pub outside: f32,
 }
@@ -84,6 +88,7 @@ impl DensityVolume {
             cell: cell_size(lo, hi, dims),
             dims,
             density: vec![0.0; (dims.x * dims.y * dims.z) as usize],
+            flow: vec![Vec3::ZERO; (dims.x * dims.y * dims.z) as usize],
             outside: 0.0,
         }
     }
@@ -111,13 +116,17 @@ impl DensityVolume {
         })
     }
 
-    /// Add strand length `length` at `p`, shared trilinearly among the 8 cell centres around
-    /// it (as density: divided by the cell's volume).
-    pub fn splat(&mut self, p: Vec3, length: f32) {
-        let per_volume = length / (self.cell.x * self.cell.y * self.cell.z);
+    /// Add strand length `length` running along `along` (its direction times its length) at
+    /// `p`, shared trilinearly among the 8 cell centres around it (as density: divided by the
+    /// cell's volume).
+    pub fn splat(&mut self, p: Vec3, length: f32, along: Vec3) {
+        let per_volume = 1.0 / (self.cell.x * self.cell.y * self.cell.z);
         for (cell, weight) in self.corners(p) {
             match cell {
-                Some(i) => self.density[i] += per_volume * weight,
+                Some(i) => {
+                    self.density[i] += length * per_volume * weight;
+                    self.flow[i] += along * (per_volume * weight);
+                }
                 None => self.outside += length * weight,
             }
         }
@@ -128,9 +137,10 @@ impl DensityVolume {
     pub fn splat_segment(&mut self, a: Vec3, b: Vec3, weight: f32) {
         let length = (b - a).length();
         let n = splat_points(length, self.cell);
+        let share = weight / n as f32;
         for i in 0..n {
             let t = (i as f32 + 0.5) / n as f32;
-            self.splat(a + (b - a) * t, length * weight / n as f32);
+            self.splat(a + (b - a) * t, length * share, (b - a) * share);
         }
     }
 
@@ -146,6 +156,19 @@ impl DensityVolume {
             .iter()
             .filter_map(|&(cell, weight)| cell.map(|i| self.density[i] * weight))
             .sum()
+    }
+
+    /// Flow at `p`, trilinear between cell centres (0 outside the grid).
+    pub fn sample_flow(&self, p: Vec3) -> Vec3 {
+        self.corners(p)
+            .iter()
+            .filter_map(|&(cell, weight)| cell.map(|i| self.flow[i] * weight))
+            .sum()
+    }
+
+    /// Mean size of a cell's sides.
+    pub fn mean_cell(&self) -> f32 {
+        (self.cell.x + self.cell.y + self.cell.z) / 3.0
     }
 }
 

@@ -222,11 +222,14 @@ pub struct View {
     pub lod_appearance: bool,
     /// Temporal accumulation (jitter, motion vectors, history).
     pub temporal: super::temporal::Temporal,
+    /// The volume tier: far hair drawn from density volumes, volumetric ambient occlusion.
+    pub volumes: super::volume::VolumeTier,
 }
 
 impl View {
     /// `camera` with the defaults: light from above and in front (`DEFAULT_LIGHT_DIR`), LoD
-    /// on, the placeholder look, no shadows, opaque strands, seed 000's LoD appearance on.
+    /// on, the placeholder look, no shadows, opaque strands, seed 000's LoD appearance on, the
+    /// volume tier off.
     /// Change fields with struct update syntax: `View { shadows, ..View::new(camera) }`.
     pub fn new(camera: Camera) -> View {
         View {
@@ -238,6 +241,7 @@ impl View {
             transparency: Default::default(),
             lod_appearance: true,
             temporal: Default::default(),
+            volumes: super::volume::VolumeTier::OFF,
         }
     }
 
@@ -253,6 +257,7 @@ impl View {
             ));
         }
         validate_light(self.light_dir)?;
+        self.volumes.validate()?;
         self.lod.validate()
     }
 

@@ -731,6 +731,10 @@ impl Crowd {
                         model_scale: model_scale(&c.model),
                         prev_texture_slot: texture_slot,
                         clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
+                        // Filled in by the frame for characters with a density volume.
+                        world_to_volume: Mat4::IDENTITY.to_cols_array_2d(),
+                        volume: [0; 4],
+                        volume_shading: [0.0; 4],
                     }
                 }
                 None => bytemuck::Zeroable::zeroed(),

@@ -50,11 +50,13 @@ pub(super) struct FrameWork<'a> {
     /// Character slots whose hair is simulated on the GPU this frame (their steps are in the
     /// slot's job table, in this order).
     simulated: Vec<usize>,
-    /// The density volumes built this frame (entries of `Renderer::volumes`, in the order of
-    /// the slot's job table) and the most bundles among their characters.
+    /// The density volumes built this frame (character slots, in the order of the slot's job
+    /// table) and the most bundles among their characters.
     density: (Vec<usize>, u32),
     /// Motion vectors and accumulation, when the frame has them.
     temporal: Option<TemporalWork>,
+    /// Character slots whose hair may be drawn from their density volume (0: none).
+    volume_slots: u32,
     /// The transient buffers and images the frame graph creates.
     transients: FrameTransients,
 }
@@ -104,8 +106,9 @@ impl Renderer {
         )?;
         // Motion matrices only where the frame's temporal pass reads them.
         let moving = temporal.map(|_| &motion);
-        let records = self.frame_records(&pose_updates, moving);
-        let density = self.write_density_jobs(i, &records)?;
+        let mut records = self.frame_records(&pose_updates, moving);
+        let density =
+            self.write_density_jobs(i, &mut records, (&view.volumes, &block), &pose_updates)?;
         let blocks = (&block, light_block.as_ref());
         let prop_draws = self.write_slot(i, blocks, &records, moving, opts)?;
         let start = Instant::now();
@@ -122,6 +125,7 @@ impl Renderer {
             simulated,
             density,
             temporal,
+            volume_slots: volume_slots(&records),
             transients,
         };
         let frame_graph = self.record(i, work, opts, present.as_mut())?;
@@ -161,21 +165,48 @@ impl Renderer {
         Ok(steps.iter().map(|(s, _)| *s).collect())
     }
 
-    /// Write the jobs of the density volumes waiting to be built into frame slot `i`'s job
-    /// table (grown as needed: its earlier frame has completed).
+    /// The density volumes of this frame: request those the view's volume `tier` needs, mark
+    /// those of the characters in `pose_updates` stale, write the jobs of the volumes built
+    /// this frame into frame slot `i`'s job table (grown as needed: its earlier frame has
+    /// completed), and fill the volume fields of `records`. Returns the built volumes' slots
+    /// and the most bundles among them.
     fn write_density_jobs(
         &mut self,
         i: usize,
-        records: &[super::shared::CharacterRecord],
+        records: &mut [super::shared::CharacterRecord],
+        (tier, block): (&super::volume::VolumeTier, &FrameBlock),
+        pose_updates: &[usize],
     ) -> GpuResult<(Vec<usize>, u32)> {
-        let (jobs, entries, most) = self.volumes.take_jobs(records);
+        if tier.enabled() {
+            for id in self.crowd.ids() {
+                let r = &records[id.slot() as usize];
+                let visible = r.flags & super::shared::CHARACTER_VISIBLE != 0;
+                let needed =
+                    tier.occlusion || tier.weight(super::volume::hair_pixels(r, block)) > 0.0;
+                if visible
+                    && needed
+                    && let Some(old) = self.volumes.ensure(&self.ctx, id, tier.sampling)?
+                {
+                    self.frames[i]
+                        .retired
+                        .push(Retired::Resource(Box::new(old)));
+                }
+            }
+        }
+        for &slot in pose_updates {
+            self.volumes.mark_stale(slot);
+        }
+        let (jobs, slots, most) =
+            self.volumes
+                .take_jobs(records, tier.rebuilds_per_frame, self.frame_number);
+        self.volumes.fill_records(records, tier, block);
         if jobs.is_empty() {
-            return Ok((entries, most));
+            return Ok((slots, most));
         }
         let bytes = bytemuck::cast_slice(&jobs);
         let table = &mut self.frames[i].density_jobs;
         write_address_table(&self.ctx, table, "density volume jobs", bytes)?;
-        Ok((entries, most))
+        Ok((slots, most))
     }
 
     /// The character records of this frame: those in `pose_updates` with their previous
@@ -619,6 +650,19 @@ impl Renderer {
     }
 }
 
+/// The character slots up to the last whose hair has a share of volume this frame (the volume
+/// tier's far hair; 0: none).
+fn volume_slots(records: &[super::shared::CharacterRecord]) -> u32 {
+    records
+        .iter()
+        .rposition(|r| {
+            r.volume[3] & super::shared::VOLUME_BUILT != 0
+                && r.volume_shading[2] > 0.0
+                && r.flags & super::shared::CHARACTER_VISIBLE != 0
+        })
+        .map_or(0, |last| last as u32 + 1)
+}
+
 /// Make `readback` a buffer of `bytes` when the frame `wants` it and it is not one already.
 fn size_readback(
     ctx: &Arc<Context>,
@@ -664,5 +708,6 @@ fn frame_inputs<'a>(
         mesh_query,
         temporal: work.temporal,
         motion_readback: None,
+        volume_slots: work.volume_slots,
     }
 }

@@ -38,3 +38,4 @@ pub use slots::{FRAMES_IN_FLIGHT, FrameReport};
 pub use soft::StrandRaster;
 pub use temporal::Temporal;
 pub use transparency::Transparency;
+pub use volume::VolumeTier;

@@ -28,6 +28,14 @@ pub const SCAN_BLOCK: u32 = 1024;
 pub const DISPATCH_ROW: u32 = 65535;
 /// `CharacterRecord::flags`: the character is drawn this frame.
 pub const CHARACTER_VISIBLE: u32 = 1;
+/// `CharacterRecord::flags`: the character's hair is drawn as its density volume only (the
+/// volume tier's far characters): no strands in any view.
+pub const CHARACTER_VOLUME_ONLY: u32 = 2;
+/// `CharacterRecord::volume.w` bit: the record's density volume fields are valid.
+pub const VOLUME_BUILT: u32 = 1;
+/// `CharacterRecord::volume.w` bit: the ambient term of this character's strands is
+/// occluded by its density volume (`shade::volume::ambient_visibility`).
+pub const VOLUME_OCCLUSION: u32 = 2;
 
 pub use crate::shade::lut::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE};
 
@@ -52,8 +60,10 @@ pub const DYNAMICS_GROUP_SIZE_GPU: u32 = 128;
 pub const DYNAMICS_GROUP_SIZE_CPU: u32 = 16;
 
 /// Fixed-point scale of the density volume's cells: a cell adds `round(length * VOLUME_FIXED)`
-/// for strand length `length` (object units).
+/// for strand length `length` (object units), and the same for each component of its flow.
 pub const VOLUME_FIXED: f32 = 16384.0;
+/// Bits per axis of `CharacterRecord::volume.z` (the volume's cell counts, packed).
+pub const VOLUME_DIMS_BITS: u32 = 10;
 /// Invocations of one `density_volume.comp` workgroup (one bundle; a strand each).
 pub const VOLUME_GROUP_SIZE: u32 = 32;
 /// Most colliders one simulated character may have (the solver keeps them in shared memory).
@@ -532,13 +542,38 @@ pub struct CharacterRecord {
     /// This frame's unjittered clip space to the previous frame's, for this character's
     /// surfaces (hair and scalp): the camera's motion and the character's own.
     pub clip_to_prev: [[f32; 4]; 4],
+    /// World to the density volume's grid (cell `i` spans `[i, i + 1)` on each axis).
+    pub world_to_volume: [[f32; 4]; 4],
+    /// Density volume: xy its cells' device address ([`VolumeCell`]s, x fastest), z its cell
+    /// counts packed ([`VOLUME_DIMS_BITS`] per axis, x lowest), w [`VOLUME_BUILT`] |
+    /// [`VOLUME_OCCLUSION`].
+    pub volume: [u32; 4],
+    /// Density volume shading: x strand width over a cell's volume and [`VOLUME_FIXED`]
+    /// (a cell's fixed-point length times x is density times width, object units), y mean
+    /// cell side (object units), z the volume tier's weight (0: strands only, 1: the volume
+    /// only; between, a screen-door blend), w unused.
+    pub volume_shading: [f32; 4],
 }
 
 gpu_struct!(CharacterRecord as "CharacterRecord" {
     model: "mat4", mesh: "MeshInfo", style: "HairStyle", texture_slot: "uint",
     first_bundle: "uint", bundle_count: "uint", strands_per_bundle: "uint", verts_log2: "uint",
     flags: "uint", model_scale: "float", prev_texture_slot: "uint", clip_to_prev: "mat4",
+    world_to_volume: "mat4", volume: "uvec4", volume_shading: "vec4",
 });
+
+/// One cell of a density volume: x strand length, yzw flow (two's complement), all in units
+/// of 1 / [`VOLUME_FIXED`] (object units); `reference::volume::DensityVolume`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct VolumeCell {
+    /// Strand length.
+    pub len: u32,
+    /// Flow (`DensityVolume::flow` times the cell's volume), as `i32` bits.
+    pub flow: [u32; 3],
+}
+
+gpu_struct!(VolumeCell as "VolumeCell" { len: "uint", flow: "uint"[3] });
 
 /// One bundle of the crowd's bundle table: the baked [`BundleDesc`] plus its owner.
 #[repr(C)]
@@ -812,8 +847,8 @@ pub struct SimState {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DensityJob {
-    /// `uint[]`: the cells (x fastest) in units of 1 / [`VOLUME_FIXED`] strand length, then
-    /// one more for the length that fell outside.
+    /// [`VolumeCell`]`[]`: the cells (x fastest), then one more whose length is what fell
+    /// outside.
     pub cells: [u32; 2],
     /// Padding.
     pub _pad: [u32; 2],
@@ -929,6 +964,7 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<SimState>(),
         info::<SimJob>(),
         info::<DensityJob>(),
+        info::<VolumeCell>(),
     ]
 }
 
@@ -999,6 +1035,10 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
             crate::reference::volume::MAX_SPLAT_POINTS,
         ),
         uint("CHARACTER_VISIBLE", CHARACTER_VISIBLE),
+        uint("CHARACTER_VOLUME_ONLY", CHARACTER_VOLUME_ONLY),
+        uint("VOLUME_BUILT", VOLUME_BUILT),
+        uint("VOLUME_OCCLUSION", VOLUME_OCCLUSION),
+        uint("VOLUME_DIMS_BITS", VOLUME_DIMS_BITS),
         uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
         uint("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
         layout("SET_FRAME", SET_FRAME),
@@ -1058,6 +1098,16 @@ fn float_constants() -> Vec<(&'static str, f32)> {
         ("SHADOW_OPACITY_FIXED", SHADOW_OPACITY_FIXED),
         ("VOLUME_FIXED", VOLUME_FIXED),
         ("SPLAT_SPACING", crate::reference::volume::SPLAT_SPACING),
+        ("AO_RADIUS_CELLS", crate::shade::volume::AO_RADIUS_CELLS),
+        ("MARCH_STEP_CELLS", crate::shade::volume::MARCH_STEP_CELLS),
+        (
+            "MARCH_MIN_TRANSMITTANCE",
+            crate::shade::volume::MARCH_MIN_TRANSMITTANCE,
+        ),
+        (
+            "STRAND_SHADOW_OPACITY",
+            super::shadow::STRAND_SHADOW_OPACITY,
+        ),
     ]
 }
 

@@ -14,6 +14,7 @@ use glam::Vec3;
 
 pub mod lod_appearance;
 pub mod lut;
+pub mod volume;
 
 /// Which model shades the strands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

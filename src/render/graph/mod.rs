@@ -45,6 +45,9 @@ pub enum ImageState<'a> {
 enum Object<'a> {
     /// Buffers are ordered with global memory dependencies.
     Buffer(&'a Buffer),
+    /// A set of buffers that shaders reach by device address (no binding names them), ordered
+    /// as one buffer: passes declare their uses of the whole set.
+    AddressBuffers,
     Image(&'a Image),
     Swapchain(&'a SwapchainImage),
     /// Created when the graph runs.
@@ -310,7 +313,7 @@ impl<'a> FrameGraph<'a> {
         };
         let tracker = match object {
             // Earlier frames' uses are unknown: the first use waits for any of them.
-            Object::Buffer(_) | Object::TransientBuffer(_) => Tracker {
+            Object::Buffer(_) | Object::AddressBuffers | Object::TransientBuffer(_) => Tracker {
                 writes: Uses::any_buffer_use(),
                 visible: Uses::default(),
                 reads: Uses::any_buffer_use(),
@@ -337,6 +340,12 @@ impl<'a> FrameGraph<'a> {
     /// A buffer the GPU may have used in earlier frames.
     pub fn import_buffer(&mut self, name: &'static str, buffer: &'a Buffer) -> Res {
         self.push(name, Object::Buffer(buffer), None)
+    }
+
+    /// Buffers the GPU may have used in earlier frames that shaders reach by device address,
+    /// as one resource (passes name their objects themselves).
+    pub fn import_address_buffers(&mut self, name: &'static str) -> Res {
+        self.push(name, Object::AddressBuffers, None)
     }
 
     /// A buffer the graph takes from its pool when it runs (see [`transient`]); earlier
@@ -595,7 +604,7 @@ impl<'a> FrameGraph<'a> {
             r.touched = true;
             match r.object {
                 Object::Host => {}
-                Object::Buffer(_) | Object::TransientBuffer(_) => {
+                Object::Buffer(_) | Object::AddressBuffers | Object::TransientBuffer(_) => {
                     plan_buffer(&mut plan, res, &mut r.tracker, &mine)
                 }
                 Object::Image(_) | Object::Swapchain(_) | Object::TransientImage(_) => {
@@ -703,7 +712,7 @@ fn bind<'r>(
             Object::Buffer(b) => Bound::Buffer(b),
             Object::Image(i) => Bound::Image(i),
             Object::Swapchain(s) => Bound::Swapchain(s),
-            Object::Host => Bound::None,
+            Object::Host | Object::AddressBuffers => Bound::None,
             Object::TransientBuffer(_) => from_pool(taken, false),
             Object::TransientImage(_) => from_pool(taken, true),
         })

@@ -115,9 +115,7 @@ impl ComputeGenerate {
         if view != GenerateView::Light {
             // Software bundles are shaded here (shadow lookups included; the light's view
             // shades nothing, but the pipeline binds the maps).
-            p = p
-                .write(r.soft_segments, rw)
-                .read_all(&r.shadow, Access::SampledRead);
+            p = r.shading_uses(p.write(r.soft_segments, rw), Access::ComputeRead);
         }
         if view == GenerateView::Camera {
             // Frames with motion vectors: the vertices' and segments' deformation residuals.

@@ -2,7 +2,8 @@
 //! `reference::volume::density_volume`): one dispatch for every volume requested this frame,
 //! a workgroup per (bundle, volume), reading the frame slot's job table by device address.
 //! Reads: the frame's records, bundle table and the characters' textures (after this frame's
-//! texture rebuilds). Writes: each requested volume's cells, cleared first.
+//! texture rebuilds). Writes: each requested volume's cells, cleared first (the frame's
+//! density volumes, one resource of the graph: shaders reach them by device address).
 
 use std::sync::Arc;
 
@@ -40,27 +41,21 @@ impl DensityVolumePass {
             return;
         }
         let jobs = g.host_input("density volume jobs");
-        let cells: Vec<_> = volumes
-            .iter()
-            .map(|v| (g.import_buffer("density volume", v), *v))
-            .collect();
         g.begin_scope("density volume");
-        for (res, buffer) in &cells {
-            let buffer: &'a Buffer = buffer;
-            g.pass("density clear")
-                .discard(*res, Access::TransferWrite)
-                .record(move |rec, _| {
+        let clear: Vec<&'a Buffer> = volumes.to_vec();
+        g.pass("density clear")
+            .write(r.volumes, Access::TransferWrite)
+            .record(move |rec, _| {
+                for buffer in clear {
                     rec.fill_buffer(buffer, 0, buffer.size, 0);
-                    Ok(())
-                });
-        }
-        let mut p = g
+                }
+                Ok(())
+            });
+        let p = g
             .pass("density volume")
             .read(jobs, Access::ComputeRead)
-            .read_all(&[r.constants, r.textures], Access::ComputeRead);
-        for (res, _) in &cells {
-            p = p.write(*res, Access::ComputeReadWrite);
-        }
+            .read_all(&[r.constants, r.textures], Access::ComputeRead)
+            .write(r.volumes, Access::ComputeReadWrite);
         let address = table.device_address();
         let count = volumes.len() as u32;
         p.record(move |rec, _| {

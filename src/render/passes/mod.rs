@@ -16,6 +16,7 @@ pub mod soft_shadow;
 pub mod strands;
 pub mod temporal;
 pub mod transparency;
+pub mod volume_hair;
 
 use std::sync::Arc;
 
@@ -221,6 +222,8 @@ pub struct FrameRes<'a> {
     pub output: Res,
     /// Shadow maps: hair depth, prop depth, opacity layers.
     pub shadow: [Res; 3],
+    /// The characters' density volumes (read by device address).
+    pub volumes: Res,
     /// K-buffer nodes.
     pub oit_nodes: Res,
     /// K-buffer tails.
@@ -444,6 +447,7 @@ impl<'a> FrameRes<'a> {
                 g.import_image("shadow prop depth", prop_depth, Tracked(a1)),
                 g.import_image("shadow layers", layers, Tracked(a2)),
             ],
+            volumes: g.import_address_buffers("density volumes"),
             oit_nodes,
             oit_tail,
             peel_depth,
@@ -469,6 +473,20 @@ impl<'a> FrameRes<'a> {
                 shadow: [&*hair_depth, &*prop_depth, &*layers],
             },
         }
+    }
+}
+
+impl FrameRes<'_> {
+    /// The uses of a pass that shades strands (`strand_radiance.glsl`) in the shader stage of
+    /// `read` (a storage read): the light's maps, sampled, and the density volumes, read by
+    /// device address.
+    pub fn shading_uses<'g, 'a>(
+        &self,
+        p: crate::render::graph::PassBuilder<'g, 'a>,
+        read: Access,
+    ) -> crate::render::graph::PassBuilder<'g, 'a> {
+        p.read_all(&self.shadow, Access::SampledRead)
+            .read(self.volumes, read)
     }
 }
 
@@ -505,6 +523,9 @@ pub struct FrameInputs<'a> {
     pub temporal: Option<temporal::TemporalWork>,
     /// Where the motion vectors are copied for the host, when asked for.
     pub motion_readback: Option<&'a Buffer>,
+    /// Character slots whose hair may be drawn from their density volume this frame (the
+    /// volume tier; 0: none).
+    pub volume_slots: u32,
 }
 
 /// The pipelines of every pass of a frame; [`FramePasses::add`] adds them to the frame graph
@@ -527,6 +548,7 @@ pub struct FramePasses {
     hair_dynamics: hair_dynamics::HairDynamicsPass,
     lhs_skin: lhs_skin::LhsSkin,
     density_volume: density_volume::DensityVolumePass,
+    volume_hair: volume_hair::VolumeHairDraw,
 }
 
 /// The software rasterizer's passes (they need 64-bit shared and buffer atomics).
@@ -616,6 +638,7 @@ impl FramePasses {
             hair_dynamics: hair_dynamics::HairDynamicsPass::new(ctx)?,
             lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
             density_volume: density_volume::DensityVolumePass::new(ctx, layout)?,
+            volume_hair: volume_hair::VolumeHairDraw::new(ctx, layout, targets)?,
         })
     }
 
@@ -896,6 +919,10 @@ impl FramePasses {
         if strands {
             p = strands::strand_uses(p, r, inp.path, strands::StrandUse::CameraShaded);
         }
+        let volume_slots = inp.volume_slots;
+        if volume_slots > 0 {
+            p = r.shading_uses(p, Access::FragmentRead);
+        }
         let (mut query, rest) = match strands && mesh {
             true => (query, None),
             false => (None, query),
@@ -930,6 +957,9 @@ impl FramePasses {
                 }
             } else if strands {
                 self.strands.record_pulled(rec, sets, args);
+            }
+            if volume_slots > 0 {
+                self.volume_hair.record(rec, sets, volume_slots);
             }
             rec.end_rendering();
             result

@@ -43,14 +43,15 @@ impl PoolSegments {
             });
         let rw = Access::ComputeReadWrite;
         g.begin_scope("soft segments");
-        g.pass("pool segments")
+        let p = g
+            .pass("pool segments")
             .read_all(&[r.constants, r.textures], Access::ComputeRead)
             .read_all(&[r.pool, r.lods, r.offsets], Access::ComputeRead)
             .read(r.args, Access::IndirectRead)
             .write(r.args, rw)
             .write(r.soft_segments, rw)
-            .write_some(TemporalRes::segment_motion(r.temporal), rw)
-            .read_all(&r.shadow, Access::SampledRead)
+            .write_some(TemporalRes::segment_motion(r.temporal), rw);
+        r.shading_uses(p, Access::ComputeRead)
             .record(move |rec, _| {
                 rec.bind(&self.pipeline, &sets.both());
                 rec.dispatch_indirect(args, GenerateArgs::DISPATCH_OFFSET);

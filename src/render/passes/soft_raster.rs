@@ -88,7 +88,8 @@ impl SoftRasterPass {
         let task_bundles = self.task_bundles;
         let pipeline = self.mesh_segments.as_ref();
         g.begin_scope(scope);
-        g.pass("soft segments (mesh)")
+        let p = g
+            .pass("soft segments (mesh)")
             .read_all(&[r.constants, r.textures], Access::TaskRead)
             .read(r.textures, Access::MeshRead)
             .write(r.args, Access::TaskReadWrite)
@@ -97,19 +98,18 @@ impl SoftRasterPass {
             .write_some(
                 TemporalRes::segment_motion(r.temporal),
                 Access::MeshReadWrite,
-            )
-            .read_all(&r.shadow, Access::SampledRead)
-            .record(move |rec, _| {
-                let p = pipeline.ok_or_else(|| {
-                    crate::vk::GpuError::Unsupported("no usable VK_EXT_mesh_shader".into())
-                })?;
-                rec.begin_rendering_empty(size.0, size.1);
-                rec.bind(p, &sets.both());
-                let (x, y) = dispatch_2d(bundles.div_ceil(task_bundles));
-                let result = rec.draw_mesh_tasks(x, y, 1);
-                rec.end_rendering();
-                result
-            });
+            );
+        r.shading_uses(p, Access::MeshRead).record(move |rec, _| {
+            let p = pipeline.ok_or_else(|| {
+                crate::vk::GpuError::Unsupported("no usable VK_EXT_mesh_shader".into())
+            })?;
+            rec.begin_rendering_empty(size.0, size.1);
+            rec.bind(p, &sets.both());
+            let (x, y) = dispatch_2d(bundles.div_ceil(task_bundles));
+            let result = rec.draw_mesh_tasks(x, y, 1);
+            rec.end_rendering();
+            result
+        });
         g.end_scope();
     }
 

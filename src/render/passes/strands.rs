@@ -180,7 +180,7 @@ pub fn strand_uses<'g, 'a>(
             .write(r.args, Access::TaskReadWrite)
     };
     if used == StrandUse::CameraShaded {
-        p.read_all(&r.shadow, Access::SampledRead)
+        r.shading_uses(p, Access::FragmentRead)
     } else {
         p
     }

@@ -1,0 +1,92 @@
+#version 460
+// The volume tier's far hair (seed 002, vkhr sec. 4; CPU twin of the march:
+// src/shade/volume.rs march): the view ray through the fragment is marched front to back
+// through the character's density volume (strands of the frame's opacity, Poisson placed:
+// each step absorbs 1 - exp(-sigma ds) of what is left), and the strands are shaded once, at
+// the absorption-weighted mean point with the mean flow as tangent, lit through the light's
+// maps and, when the character has no strands in them (volume alone), through its own volume.
+// Written premultiplied over the target with the mean point's depth. Pixels the volume tier's
+// screen door gives the strands are dropped.
+#extension GL_GOOGLE_include_directive : require
+#include "bindings.glsl"
+#include "strand_radiance.glsl"
+#include "temporal.glsl"
+
+layout(location = 0) in vec3 in_world;
+layout(location = 1) flat in uint in_character;
+layout(location = 0) out vec4 out_color;
+
+// Most march steps of one pixel.
+#define MAX_MARCH_STEPS 512u
+
+void main() {
+    uint c = in_character;
+    if (!volume_covers(uvec2(gl_FragCoord.xy), c)) {
+        discard;
+    }
+    vec3 eye = frame.camera_pos.xyz;
+    vec3 dir = normalize(in_world - eye);
+    mat4 to_grid = characters[c].world_to_volume;
+    vec3 g0 = (to_grid * vec4(eye, 1.0)).xyz;
+    vec3 gd = (to_grid * vec4(dir, 0.0)).xyz;
+    vec3 inv = sign(gd + 1e-20) / max(abs(gd), vec3(1e-20));
+    vec3 ta = (vec3(0.0) - g0) * inv;
+    vec3 tb = (vec3(volume_dims(c)) - g0) * inv;
+    vec3 lo = min(ta, tb);
+    vec3 hi = max(ta, tb);
+    float t_enter = max(lo.x, max(lo.y, lo.z));
+    float t_exit = min(hi.x, min(hi.y, hi.z));
+    // Two-sided boxes: keep the face the ray enters by (the far one with the eye inside).
+    float t_frag = distance(in_world, eye);
+    bool front = abs(t_frag - t_enter) <= abs(t_frag - t_exit);
+    if (t_exit <= max(t_enter, 0.0) || front != (t_enter > 0.0)) {
+        discard;
+    }
+    float scale = characters[c].model_scale;
+    float step = MARCH_STEP_CELLS * characters[c].volume_shading.y * scale;
+    // The frame's opacity of one strand: opaque frames draw whole strands.
+    float alpha = frame.transparency.x == TRANSPARENCY_OPAQUE ? 1.0 : STRAND_OPACITY;
+    float t0 = max(t_enter, 0.0);
+    uint steps = min(uint(ceil((t_exit - t0) / step)), MAX_MARCH_STEPS);
+    float transmittance = 1.0;
+    vec3 point = vec3(0.0);
+    vec3 flow = vec3(0.0);
+    for (uint i = 0u; i < steps; i++) {
+        float ds = min(step, t_exit - t0 - float(i) * step);
+        float t = t0 + float(i) * step + 0.5 * ds;
+        vec4 s = volume_sample(c, g0 + gd * t);
+        if (s.x <= 0.0) {
+            continue;
+        }
+        // s.x is density times width in object units: the world step over the scale.
+        float a = transmittance * (1.0 - exp(-alpha * s.x * ds / scale));
+        point += (eye + dir * t) * a;
+        flow += s.yzw * a;
+        transmittance -= a;
+        if (transmittance < MARCH_MIN_TRANSMITTANCE) {
+            break;
+        }
+    }
+    float absorbed = 1.0 - transmittance;
+    if (absorbed < 0.5 / 255.0) {
+        discard;
+    }
+    point /= absorbed;
+    vec3 tangent = mat3(characters[c].model) * flow;
+    if (dot(tangent, tangent) < 1e-20) {
+        tangent = vec3(0.0, -1.0, 0.0);
+    }
+    vec3 l = normalize(frame.light_dir.xyz);
+    float lit = light_transmittance(point, 0.0);
+    if ((characters[c].flags & CHARACTER_VOLUME_ONLY) != 0u) {
+        lit *= volume_light(c, point, l);
+    }
+    HairStyle style = characters[c].style;
+    vec3 base = vec3(style.color[0], style.color[1], style.color[2]);
+    vec3 radiance = strand_radiance_lit(tangent, 1.0, point, base, c, lit, volume_ambient(c, point));
+    vec4 clip = frame.view_proj * vec4(point, 1.0);
+    float depth = clamp(clip.z / clip.w, 0.0, 1.0);
+    gl_FragDepth = depth;
+    note_visible(uvec2(gl_FragCoord.xy), depth, c, vec2(0.0));
+    out_color = vec4(radiance * absorbed, absorbed);
+}

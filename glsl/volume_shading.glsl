@@ -1,0 +1,103 @@
+// Shading from a character's strand density volume (seed 002, vkhr; CPU twins in
+// src/shade/volume.rs): its ambient occlusion of strands, the light's transmittance through
+// it, and the volume tier's screen-door blend with the strands. The volume is read by device
+// address (CharacterRecord::volume); passes that include this declare the frame's density
+// volumes as read (FrameRes::shading_uses). Requires bindings.glsl.
+#ifndef VOLUME_SHADING_GLSL
+#define VOLUME_SHADING_GLSL
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
+
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer VolumeCells { VolumeCell cells[]; };
+
+bool volume_built(uint c) {
+    return (characters[c].volume.w & VOLUME_BUILT) != 0u;
+}
+
+uvec3 volume_dims(uint c) {
+    uint packed = characters[c].volume.z;
+    uint mask = (1u << VOLUME_DIMS_BITS) - 1u;
+    return uvec3(packed & mask, (packed >> VOLUME_DIMS_BITS) & mask, packed >> (2u * VOLUME_DIMS_BITS));
+}
+
+// Grid coordinates (cell i spans [i, i + 1)) of world point p in character c's volume.
+vec3 volume_grid(uint c, vec3 p) {
+    return (characters[c].world_to_volume * vec4(p, 1.0)).xyz;
+}
+
+// Character c's cells at grid point g, trilinear between cell centres, 0 outside the grid:
+// x density times strand width (object units: the optical depth of opaque strands per unit
+// length), yzw the flow in the same units (reference::volume::DensityVolume::sample).
+vec4 volume_sample(uint c, vec3 g) {
+    uvec3 dims = volume_dims(c);
+    VolumeCells v = VolumeCells(characters[c].volume.xy);
+    vec3 q = g - vec3(0.5);
+    vec3 base = floor(q);
+    vec3 f = q - base;
+    vec4 sum = vec4(0.0);
+    for (uint corner = 0u; corner < 8u; corner++) {
+        uvec3 o = uvec3(corner & 1u, (corner >> 1u) & 1u, corner >> 2u);
+        vec3 cc = base + vec3(o);
+        if (any(lessThan(cc, vec3(0.0))) || any(greaterThanEqual(cc, vec3(dims)))) {
+            continue;
+        }
+        vec3 w = mix(vec3(1.0) - f, f, vec3(o));
+        uvec3 u = uvec3(cc);
+        VolumeCell cell = v.cells[(u.z * dims.y + u.y) * dims.x + u.x];
+        ivec3 flow = ivec3(int(cell.flow[0]), int(cell.flow[1]), int(cell.flow[2]));
+        sum += (w.x * w.y * w.z) * vec4(float(cell.len), vec3(flow));
+    }
+    return sum * characters[c].volume_shading.x;
+}
+
+// Ambient light reaching world point p of character c through its hair
+// (shade::volume::ambient_visibility): 1 without a volume or with occlusion off.
+float volume_ambient(uint c, vec3 p) {
+    if ((characters[c].volume.w & (VOLUME_BUILT | VOLUME_OCCLUSION)) != (VOLUME_BUILT | VOLUME_OCCLUSION)) {
+        return 1.0;
+    }
+    float radius = AO_RADIUS_CELLS * characters[c].volume_shading.y;
+    return exp(-STRAND_SHADOW_OPACITY * volume_sample(c, volume_grid(c, p)).x * radius);
+}
+
+// The volume tier's share of character c (0: strands only).
+float volume_weight(uint c) {
+    return volume_built(c) ? characters[c].volume_shading.z : 0.0;
+}
+
+// The 4x4 ordered-dither (Bayer) threshold of a pixel, in (0, 1).
+const uint BAYER_4X4[16] = uint[16](0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
+float screen_door(uvec2 pixel) {
+    return (float(BAYER_4X4[(pixel.y & 3u) * 4u + (pixel.x & 3u)]) + 0.5) / 16.0;
+}
+
+// Whether pixel `pixel` shows character c's volume rather than its strands: the volume
+// tier's screen-door blend (every pixel at weight 1, none at 0).
+bool volume_covers(uvec2 pixel, uint c) {
+    return screen_door(pixel) < volume_weight(c);
+}
+
+// Transmittance of the light from world point p through character c's own volume, toward
+// the unit direction l (shade::volume::march toward the light), strands STRAND_SHADOW_OPACITY
+// opaque: the self-shadow of hair drawn as a volume alone (its strands are in no light map).
+float volume_light(uint c, vec3 p, vec3 l) {
+    vec3 g = volume_grid(c, p);
+    vec3 gd = (characters[c].world_to_volume * vec4(l, 0.0)).xyz;
+    // Leave the grid: the exit along gd of the box [0, dims].
+    vec3 dims = vec3(volume_dims(c));
+    vec3 inv = 1.0 / (abs(gd) + 1e-12) * sign(gd + 1e-12);
+    vec3 t_exit = max((vec3(0.0) - g) * inv, (dims - g) * inv);
+    float world_length = max(min(t_exit.x, min(t_exit.y, t_exit.z)), 0.0);
+    float scale = characters[c].model_scale;
+    float step = MARCH_STEP_CELLS * characters[c].volume_shading.y * scale;
+    uint steps = min(uint(ceil(world_length / step)), 256u);
+    float depth = 0.0;
+    for (uint i = 0u; i < steps; i++) {
+        float t = (float(i) + 0.5) * step;
+        depth += volume_sample(c, g + gd * t).x;
+    }
+    // Object-unit optical depth: the world step over the model's scale.
+    return exp(-STRAND_SHADOW_OPACITY * depth * step / scale);
+}
+
+#endif
