@@ -56,7 +56,7 @@ impl VolumeTier {
         far: None,
         rebuilds_per_frame: 16,
         sampling: VolumeSampling {
-            dims: UVec3::new(20, 20, 20),
+            dims: UVec3::new(24, 24, 24),
             strands_sampled: 8,
             segments_log2: 3,
         },

@@ -117,6 +117,15 @@ pub struct Args {
     /// Seed 000's thick-strand appearance term under LoD.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     lod_appearance: bool,
+    /// The volume tier (seed 002): far characters' hair ray-marched through strand density
+    /// volumes, and volumetric ambient occlusion of every character's hair; off: strands
+    /// only, no occlusion.
+    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
+    volumes: bool,
+    /// The volume tier's switch band FAR,NEAR: hair boxes below FAR pixels across are drawn as
+    /// volumes alone, above NEAR as strands alone, blended between.
+    #[arg(long, default_value = "40,64")]
+    volume_band: String,
     /// Level of detail.
     #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
     lod: bool,
@@ -368,6 +377,32 @@ fn check_memory(args: &Args) -> Result<()> {
     Ok(())
 }
 
+impl Args {
+    /// The view's volume tier from `--volumes` and `--volume-band`.
+    fn volume_tier(&self) -> Result<hairmesh::render::VolumeTier> {
+        use hairmesh::render::VolumeTier;
+        if !self.volumes {
+            return Ok(VolumeTier::OFF);
+        }
+        let band = || -> Option<(f32, f32)> {
+            let (far, near) = self.volume_band.split_once(',')?;
+            Some((far.trim().parse().ok()?, near.trim().parse().ok()?))
+        };
+        let tier = VolumeTier {
+            far: Some(band().ok_or_else(|| {
+                anyhow::anyhow!(
+                    "--volume-band {}: expected FAR,NEAR pixels",
+                    self.volume_band
+                )
+            })?),
+            ..VolumeTier::on()
+        };
+        tier.validate()
+            .map_err(|why| anyhow::anyhow!("--volume-band {}: {why}", self.volume_band))?;
+        Ok(tier)
+    }
+}
+
 /// `--path`: the crowd generates its strands (mesh or compute).
 fn parse_generated_path(s: &str) -> Result<RenderPath, String> {
     match s.parse()? {
@@ -378,6 +413,7 @@ fn parse_generated_path(s: &str) -> Result<RenderPath, String> {
 
 fn run(args: Args) -> Result<()> {
     check_memory(&args)?;
+    let volumes = args.volume_tier()?;
     let scene = Scene::build(&args)?;
     if !args.headless {
         return window::run(args, scene);
@@ -458,6 +494,7 @@ fn run(args: Args) -> Result<()> {
             transparency: args.transparency,
             temporal: args.temporal,
             lod_appearance: args.lod_appearance,
+            volumes,
             ..View::new(camera)
         };
         let t = Instant::now();

@@ -47,6 +47,7 @@ struct Controls {
     temporal: Temporal,
     raster: StrandRaster,
     lod_appearance: bool,
+    volumes: hairmesh::render::VolumeTier,
     moving: bool,
     simulating: bool,
     dynamics: hairmesh::animate::DynamicsPath,
@@ -155,6 +156,15 @@ impl Controls {
                     }
                 });
                 ui.checkbox(&mut self.lod_appearance, "thick-strand appearance (LoD)");
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut self.volumes.occlusion, "volumetric AO");
+                    let mut far = self.volumes.far.is_some();
+                    ui.checkbox(&mut far, "far hair as volumes");
+                    self.volumes.far = match far {
+                        true => self.volumes.far.or(hairmesh::render::VolumeTier::on().far),
+                        false => None,
+                    };
+                });
                 ui.horizontal(|ui| {
                     ui.checkbox(&mut self.moving, "motion");
                     ui.checkbox(&mut self.simulating, "hair dynamics");
@@ -312,6 +322,7 @@ struct Running {
     /// The software rasterizer can draw this window's frames (device support, no MSAA).
     soft_ok: bool,
     lod_appearance: bool,
+    volumes: hairmesh::render::VolumeTier,
     animation: hairmesh::animate::CrowdAnimation,
     last_draw: Instant,
     paused: bool,
@@ -481,6 +492,7 @@ impl App {
             temporal: self.args.temporal,
             raster: chosen.raster,
             lod_appearance: self.args.lod_appearance,
+            volumes: self.args.volume_tier()?,
             animation,
             last_draw: Instant::now(),
             paused: false,
@@ -577,6 +589,7 @@ impl Running {
             transparency: self.transparency,
             temporal: self.temporal,
             lod_appearance: self.lod_appearance,
+            volumes: self.volumes,
             ..View::new(camera)
         };
         let (primitives, ppp, freed) = self.panel_frame(scene_len)?;
@@ -642,6 +655,7 @@ impl Running {
             temporal: self.temporal,
             raster: self.raster,
             lod_appearance: self.lod_appearance,
+            volumes: self.volumes,
             moving: self.animation.moving,
             simulating: self.animation.simulating,
             dynamics: self.animation.path,
@@ -729,6 +743,7 @@ impl Running {
         self.temporal = c.temporal;
         self.raster = c.raster;
         self.lod_appearance = c.lod_appearance;
+        self.volumes = c.volumes;
         self.animation.moving = c.moving;
         self.animation.simulating = c.simulating;
         self.animation.path = c.dynamics;
