@@ -56,6 +56,11 @@ float detail_level(float h, float d, float alpha) {
 
 // Culling and LoD of crowd bundle g (its character bound with bind_character).
 BundleLod bundle_lod(uint g) {
+    // Hidden characters, and hair drawn as its density volume alone (the volume tier's far
+    // characters), have no strands in any view: skip the texture reads.
+    if (!ch_visible || ch_volume_only) {
+        return BundleLod(0u, ch_emax, 0.0, 1.0, false, 1.0);
+    }
     GpuBundle desc = bundles[g];
     // World bounds: convex hull of the bundle's Bezier control points, grown by the styling.
     int depth = int(POSITION_DEPTH(mesh.layers));
@@ -81,9 +86,7 @@ BundleLod bundle_lod(uint g) {
     // Curved roots leave the hull by at most the root cell's bulge bound; the LoD distance
     // below stays that of the hull (src/reference/root_surface.rs).
     float bulge = scale * root_bulge_bound(root_cell(desc.origin));
-    // Hair drawn as its density volume alone (the volume tier's far characters) has no
-    // strands in any view.
-    if (!ch_visible || ch_volume_only || !box_visible(lo - bulge, hi + bulge)) {
+    if (!box_visible(lo - bulge, hi + bulge)) {
         r.strands = 0u;
         return r;
     }

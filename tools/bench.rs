@@ -11,7 +11,9 @@
 //! hair mesh (both paths) vs LHS vs static strands per model, crowd and distance LoD speedups,
 //! bytes per method.
 //!
-//! `bench crowd` takes `--draw hw|soft[:K]|auto[:K]` (the rasterizer of every frame).
+//! `bench crowd` takes `--draw hw|soft[:K]|auto[:K]` (the rasterizer of every frame);
+//! `bench crowd --volume-tier [--counts 100,1000]` measures the crowd's default look with the
+//! volume tier off and on instead.
 //!
 //! `bench raster [--size 1280x720] [--runs 5] [--crowd 100] [--strands 100000]`: the
 //! software rasterizer vs hardware strips (opaque and OIT) and the per-bundle split, for one
@@ -39,6 +41,8 @@ mod paper;
 mod raster;
 #[path = "bench/temporal.rs"]
 mod temporal;
+#[path = "bench/volume_tier.rs"]
+mod volume_tier;
 
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
@@ -244,6 +248,11 @@ enum Cmd {
         /// software light passes where supported), frame wall time and speed-up.
         #[arg(long)]
         compare_defaults: bool,
+        /// Instead: the crowd's default look with the volume tier (far hair from density
+        /// volumes, volumetric occlusion) off and on, and each one's cost of the largest
+        /// count over the smallest.
+        #[arg(long, conflicts_with = "compare_defaults")]
+        volume_tier: bool,
     },
 }
 
@@ -483,7 +492,7 @@ fn bench_crowd(
     runs: usize,
     device: Option<String>,
     picture: Option<PathBuf>,
-    (raster, compare_defaults): (hairmesh::render::StrandRaster, bool),
+    (raster, compare_defaults, volume_tier): (hairmesh::render::StrandRaster, bool, bool),
 ) -> Result<()> {
     if counts.is_empty() || counts.iter().any(|&c| c == 0 || c > 1024) {
         bail!("--counts: every count must be in 1..=1024");
@@ -519,6 +528,13 @@ fn bench_crowd(
         read_image: picture.is_some(),
         raster,
     };
+    if volume_tier {
+        let image = volume_tier::compare(&run, &counts, picture.is_some())?;
+        if let (Some(out), Some(rgba)) = (picture, image) {
+            write_png(&out, rgba, width, height)?;
+        }
+        return Ok(());
+    }
     if compare_defaults {
         outln!("| N | path | rasterizers | GPU ms | frame wall ms |\n|---|---|---|---|---|")?;
         for &count in &counts {
@@ -716,10 +732,12 @@ fn run(args: Args) -> Result<()> {
             picture,
             draw,
             compare_defaults,
+            volume_tier,
         } => bench_crowd(
-            counts.unwrap_or(match compare_defaults {
-                true => vec![100],
-                false => vec![1, 16, 64, 256],
+            counts.unwrap_or(match (compare_defaults, volume_tier) {
+                (true, _) => vec![100],
+                (_, true) => vec![100, 1000],
+                _ => vec![1, 16, 64, 256],
             }),
             width,
             height,
@@ -728,7 +746,7 @@ fn run(args: Args) -> Result<()> {
             runs as usize,
             device,
             picture,
-            (draw, compare_defaults),
+            (draw, compare_defaults, volume_tier),
         )?,
         Cmd::Lod {
             mesh,

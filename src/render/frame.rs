@@ -140,6 +140,7 @@ impl Renderer {
             read_image: opts.read_image,
             read_motion: opts.read_motion,
             frame_graph,
+            volume_characters: volume_characters(&records),
         };
         self.submit(i, pending, present.as_ref())?;
         self.remember_frame(&records, &motion, temporal);
@@ -661,6 +662,22 @@ fn volume_slots(records: &[super::shared::CharacterRecord]) -> u32 {
                 && r.flags & super::shared::CHARACTER_VISIBLE != 0
         })
         .map_or(0, |last| last as u32 + 1)
+}
+
+/// How many visible characters of `records` are drawn as their volume alone, and how many
+/// blend strands and volume.
+fn volume_characters(records: &[super::shared::CharacterRecord]) -> (u32, u32) {
+    use super::shared::{CHARACTER_VISIBLE, CHARACTER_VOLUME_ONLY, VOLUME_BUILT};
+    let drawn = records
+        .iter()
+        .filter(|r| r.flags & CHARACTER_VISIBLE != 0 && r.volume[3] & VOLUME_BUILT != 0);
+    drawn.fold((0, 0), |(only, blended), r| {
+        match (r.flags & CHARACTER_VOLUME_ONLY != 0, r.volume_shading[2] > 0.0) {
+            (true, _) => (only + 1, blended),
+            (false, true) => (only, blended + 1),
+            _ => (only, blended),
+        }
+    })
 }
 
 /// Make `readback` a buffer of `bytes` when the frame `wants` it and it is not one already.

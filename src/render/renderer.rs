@@ -496,6 +496,7 @@ impl Renderer {
                 rgba,
                 motion,
                 frame_graph: p.frame_graph,
+                volume_characters: p.volume_characters,
             });
             while self.completed.len() > 2 * FRAMES_IN_FLIGHT {
                 self.completed.pop_front();

@@ -53,6 +53,9 @@ pub struct FrameReport {
     /// The frame graph's passes, uses and derived dependencies, when
     /// [`super::FrameOptions::describe_frame`] was set.
     pub frame_graph: Option<String>,
+    /// The volume tier: characters drawn as their density volume alone, and those blended
+    /// between strands and volume.
+    pub volume_characters: (u32, u32),
 }
 
 impl FrameReport {
@@ -72,6 +75,8 @@ pub(crate) struct Pending {
     pub read_motion: bool,
     /// The frame graph's description, when asked for.
     pub frame_graph: Option<String>,
+    /// Volume-only and blended characters.
+    pub volume_characters: (u32, u32),
 }
 
 /// One frame in flight.

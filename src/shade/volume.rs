@@ -23,7 +23,7 @@ use crate::reference::volume::DensityVolume;
 /// Radius of the ambient occlusion neighbourhood, in mean cell sizes.
 pub const AO_RADIUS_CELLS: f32 = 2.0;
 /// Step of the view and light marches, in mean cell sizes.
-pub const MARCH_STEP_CELLS: f32 = 0.5;
+pub const MARCH_STEP_CELLS: f32 = 1.0;
 /// A march stops once less than this transmittance is left.
 pub const MARCH_MIN_TRANSMITTANCE: f32 = 0.01;
 

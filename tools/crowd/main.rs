@@ -535,10 +535,12 @@ fn run(args: Args) -> Result<()> {
             passes.join(" ")
         ));
         outln!(
-            "frame {f}: {:?} path, {} strands, {} triangles, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
+            "frame {f}: {:?} path, {} strands, {} triangles, volumes {} alone + {} blended, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
             report.path,
             s.strands_drawn,
             s.triangles_drawn,
+            report.volume_characters.0,
+            report.volume_characters.1,
             report.gpu_ms(),
             passes.join(", "),
             report.record_ms,

@@ -800,7 +800,15 @@ impl FramePasses {
             };
         let transparent = hardware && inp.transparency != super::Transparency::Opaque;
         let query = inp.mesh_query.take();
-        let query = self.add_opaque(g, r, &inp, hardware && !transparent, query);
+        // Far hair drawn from density volumes goes over the opaque pass, and then takes over
+        // its MSAA resolve.
+        let opaque_strands = hardware && !transparent;
+        let volumes = inp.volume_slots > 0;
+        let query = self.add_opaque(g, r, &inp, (opaque_strands, opaque_strands && !volumes), query);
+        if volumes {
+            self.volume_hair
+                .add(g, r, inp.sets, inp.volume_slots, opaque_strands);
+        }
         if transparent {
             let draw = TransparentDraw {
                 mode: inp.transparency,
@@ -883,15 +891,15 @@ impl FramePasses {
         Ok(())
     }
 
-    /// The opaque pass: props, scalps and, with `resolve`, the hardware-drawn strands (the
-    /// colour's MSAA resolve then ends here; MSAA frames draw no software strands). Returns
-    /// the mesh query when this pass did not use it.
+    /// The opaque pass: props, scalps and, with `strands`, the hardware-drawn strands; with
+    /// `resolve`, the colour's MSAA resolve ends here (MSAA frames draw no software strands).
+    /// Returns the mesh query when this pass did not use it.
     fn add_opaque<'a>(
         &'a self,
         g: &mut FrameGraph<'a>,
         r: &FrameRes<'a>,
         inp: &FrameInputs<'a>,
-        resolve: bool,
+        (strands, resolve): (bool, bool),
         query: Option<&'a mut MeshPrimitivesQuery>,
     ) -> Option<&'a mut MeshPrimitivesQuery> {
         let clear = inp.clear;
@@ -915,13 +923,9 @@ impl FramePasses {
             .read(r.textures, Access::VertexRead)
             .read_all(&r.shadow, Access::SampledRead)
             .write_some(r.visibility, Access::FragmentReadWrite);
-        let strands = inp.bundles > 0 && resolve;
+        let strands = inp.bundles > 0 && strands;
         if strands {
             p = strands::strand_uses(p, r, inp.path, strands::StrandUse::CameraShaded);
-        }
-        let volume_slots = inp.volume_slots;
-        if volume_slots > 0 {
-            p = r.shading_uses(p, Access::FragmentRead);
         }
         let (mut query, rest) = match strands && mesh {
             true => (query, None),
@@ -957,9 +961,6 @@ impl FramePasses {
                 }
             } else if strands {
                 self.strands.record_pulled(rec, sets, args);
-            }
-            if volume_slots > 0 {
-                self.volume_hair.record(rec, sets, volume_slots);
             }
             rec.end_rendering();
             result

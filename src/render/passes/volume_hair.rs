@@ -1,16 +1,17 @@
 //! The volume tier's far hair (seed 002, vkhr sec. 4; `glsl/volume_hair.vert`,
 //! `glsl/volume_hair.frag`): each character with a share of volume this frame draws its
 //! density volume's box, whose fragments march the view ray through the volume and write the
-//! shaded hair premultiplied over the target at the hair's mean depth. Drawn inside the
-//! opaque pass after the strands. Reads: frame block, character records, the light's maps,
-//! the density volumes (by device address). Writes: colour and depth (and the visibility
-//! words in frames with motion vectors).
+//! shaded hair premultiplied over the target at the hair's mean depth. Drawn after the opaque
+//! pass (whose MSAA resolve it then makes). Reads: frame block, character records, the
+//! light's maps, the density volumes (by device address). Writes: colour and depth (and the
+//! visibility words in frames with motion vectors).
 
 use std::sync::Arc;
 
-use super::{DrawTarget, PassSets, TargetFormats, device_shader_options};
+use super::{DrawTarget, FrameRes, PassSets, TargetFormats, device_shader_options};
+use crate::render::graph::FrameGraph;
 use crate::vk::shader::compile;
-use crate::vk::{BlendMode, CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout};
+use crate::vk::{Access, Attachment, BlendMode, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// Vertices of one character's box.
 const BOX_VERTICES: u32 = 36;
@@ -40,10 +41,49 @@ impl VolumeHairDraw {
         })
     }
 
-    /// Draw the volumes of the first `slots` character slots (inside rendering; characters
-    /// without a share of volume get no triangles).
-    pub fn record(&self, rec: &mut CommandRecorder, sets: PassSets, slots: u32) {
-        rec.bind(&self.pipeline, &sets.both());
-        rec.draw_instanced(BOX_VERTICES, slots, 0, 0);
+    /// Add the pass drawing the volumes of the first `slots` character slots (characters
+    /// without a share of volume get no triangles) over the colour and depth, ending with the
+    /// colour's MSAA resolve when `resolve`.
+    pub fn add<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        sets: PassSets<'a>,
+        slots: u32,
+        resolve: bool,
+    ) {
+        g.begin_scope("volume hair");
+        let mut p = g
+            .pass("volume hair")
+            .write(r.color, Access::ColorAttachment)
+            .write(r.depth, Access::DepthAttachment)
+            .read(r.constants, Access::VertexRead)
+            .read(r.constants, Access::FragmentRead)
+            .write_some(r.visibility, Access::FragmentReadWrite);
+        let resolve_into = r.images.resolved.filter(|_| resolve);
+        if let (Some(res), true) = (r.resolved, resolve) {
+            p = p.discard(res, Access::ColorAttachment);
+        }
+        let (color, depth) = (r.images.color, r.images.depth);
+        r.shading_uses(p, Access::FragmentRead)
+            .record(move |rec, _| {
+                rec.begin_rendering(
+                    Attachment {
+                        image: color,
+                        clear: None,
+                        resolve: resolve_into,
+                    },
+                    Attachment {
+                        image: depth,
+                        clear: None,
+                        resolve: None,
+                    },
+                );
+                rec.bind(&self.pipeline, &sets.both());
+                rec.draw_instanced(BOX_VERTICES, slots, 0, 0);
+                rec.end_rendering();
+                Ok(())
+            });
+        g.end_scope();
     }
 }

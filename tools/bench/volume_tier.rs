@@ -1,0 +1,85 @@
+//! `bench crowd --volume-tier`: the crowd with the look `crowd` shows by default (Marschner,
+//! deep opacity shadows, LoD on, the fastest rasterizers the device allows) with the volume
+//! tier off and on (`render::VolumeTier::on`), for every count, in one run: median GPU ms per
+//! pass and of the frame, characters drawn as volumes, and each setting's cost of the largest
+//! crowd over the smallest.
+
+use anyhow::Result;
+use glam::Vec3;
+use hairmesh::outln;
+use hairmesh::render::{
+    FrameOptions, FrameSettings, LightRaster, LodSettings, ShadowMode, StrandRaster, View,
+    VolumeTier,
+};
+
+/// Print a row per count and tier setting, then the ratio lines. With `picture`, returns the
+/// largest crowd's frame with the tier on.
+pub fn compare(
+    run: &super::CrowdRun,
+    counts: &[usize],
+    picture: bool,
+) -> Result<Option<Vec<u8>>> {
+    outln!(
+        "| N | volume tier | strands drawn | volumes alone + blended | GPU ms per pass | GPU ms | frame wall ms |\n|---|---|---|---|---|---|---|"
+    )?;
+    let mut gpu = [Vec::new(), Vec::new()];
+    let mut image = None;
+    for &count in counts {
+        let mut r = run.renderer(hairmesh::render::shared::TASK_PAYLOAD_BUNDLES)?;
+        run.add_crowd(&mut r, count)?;
+        let settings = FrameSettings {
+            path: r.default_path(),
+            raster: StrandRaster::Hardware,
+            transparency: Default::default(),
+            msaa: r.msaa(),
+            light_raster: LightRaster::Hardware,
+        }
+        .with_fastest((None, None), &r.caps());
+        let opts = FrameOptions {
+            path: Some(settings.path),
+            raster: settings.raster,
+            light_raster: settings.light_raster,
+            ..Default::default()
+        };
+        for (i, tier) in [VolumeTier::OFF, VolumeTier::on()].into_iter().enumerate() {
+            let view = View {
+                light_dir: Vec3::new(0.4, 1.0, 0.3),
+                lod: LodSettings::default(),
+                shading: hairmesh::shade::ShadingModel::Marschner,
+                shadows: ShadowMode::DeepOpacity,
+                volumes: tier,
+                ..View::new(run.camera)
+            };
+            // The first frame builds every volume; the timed ones rebuild stale ones only.
+            let read_image = picture && i == 1 && count == *counts.last().unwrap_or(&0);
+            let first = r.render_one(&view, &FrameOptions { read_image, ..opts })?;
+            let (reports, wall) = super::timed_frames(&mut r, &view, &opts, run.runs)?;
+            let passes: Vec<String> = super::median_passes(&first, &reports)
+                .iter()
+                .map(|(n, ms)| format!("{n} {ms:.1}"))
+                .collect();
+            let ms = super::median(reports.iter().map(|r| r.gpu_ms()).collect());
+            let (alone, blended) = reports.last().map_or((0, 0), |r| r.volume_characters);
+            outln!(
+                "| {count} | {} | {} | {alone} + {blended} | {} | {ms:.1} | {wall:.1} |",
+                if i == 1 { "on" } else { "off" },
+                reports.last().map_or(0, |r| r.stats.strands_drawn),
+                passes.join(", "),
+            )?;
+            gpu[i].push(ms);
+            if read_image {
+                image = first.rgba;
+            }
+        }
+    }
+    if let (Some(&small), Some(&large)) = (counts.first(), counts.last()) {
+        for (i, name) in ["off", "on"].iter().enumerate() {
+            let (a, b) = (gpu[i][0], gpu[i][counts.len() - 1]);
+            outln!(
+                "volume tier {name}: {large} characters cost {:.2}x the GPU time of {small} ({b:.1} / {a:.1} ms)",
+                b / a
+            )?;
+        }
+    }
+    Ok(image)
+}
