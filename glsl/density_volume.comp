@@ -2,7 +2,7 @@
 // Strand density volumes (seed 002, vkhr): the twin of src/reference/volume.rs. One workgroup
 // per (bundle, job): each invocation generates a strand of the bundle's first `sampled` ones
 // with the generator's own evaluation (strand_eval.glsl) and splats every segment's length,
-// weighted by the strands it stands for, into the job's cells that hold points no more
+// weighted by the strands it stands for, trilinearly into the job's cells at points no more
 // than SPLAT_SPACING of a cell apart. Cells (VolumeCell) hold fixed-point strand length and
 // flow (VOLUME_FIXED per object unit; the flow's components as two's complement); the one
 // after the grid gathers the length that fell outside.
@@ -23,26 +23,34 @@ Cells cells;
 // volume::DensityVolume::splat, in fixed point.
 void splat(vec3 p, float length, vec3 along) {
     uvec3 dims = job.dims.xyz;
-    vec3 c = floor((p - job.origin.xyz) / job.cell.xyz);
-    uint add = uint(round(length * VOLUME_FIXED));
-    if (all(greaterThanEqual(c, vec3(0.0))) && all(lessThan(c, vec3(dims)))) {
-        uvec3 u = uvec3(c);
-        uint index = (u.z * dims.y + u.y) * dims.x + u.x;
-        uvec3 flow = uvec3(ivec3(round(along * VOLUME_FIXED)));
-        if (add != 0u) {
-            atomicAdd(cells.cells[index].len, add);
+    vec3 g = (p - job.origin.xyz) / job.cell.xyz - vec3(0.5);
+    vec3 base = floor(g);
+    vec3 f = g - base;
+    for (uint corner = 0u; corner < 8u; corner++) {
+        uvec3 o = uvec3(corner & 1u, (corner >> 1u) & 1u, corner >> 2u);
+        vec3 w = mix(vec3(1.0) - f, f, vec3(o));
+        float weight = w.x * w.y * w.z;
+        uint add = uint(round(length * weight * VOLUME_FIXED));
+        vec3 c = base + vec3(o);
+        if (all(greaterThanEqual(c, vec3(0.0))) && all(lessThan(c, vec3(dims)))) {
+            uvec3 u = uvec3(c);
+            uint index = (u.z * dims.y + u.y) * dims.x + u.x;
+            uvec3 flow = uvec3(ivec3(round(along * (weight * VOLUME_FIXED))));
+            if (add != 0u) {
+                atomicAdd(cells.cells[index].len, add);
+            }
+            if (flow.x != 0u) {
+                atomicAdd(cells.cells[index].flow[0], flow.x);
+            }
+            if (flow.y != 0u) {
+                atomicAdd(cells.cells[index].flow[1], flow.y);
+            }
+            if (flow.z != 0u) {
+                atomicAdd(cells.cells[index].flow[2], flow.z);
+            }
+        } else if (add != 0u) {
+            atomicAdd(cells.cells[dims.x * dims.y * dims.z].len, add);
         }
-        if (flow.x != 0u) {
-            atomicAdd(cells.cells[index].flow[0], flow.x);
-        }
-        if (flow.y != 0u) {
-            atomicAdd(cells.cells[index].flow[1], flow.y);
-        }
-        if (flow.z != 0u) {
-            atomicAdd(cells.cells[index].flow[2], flow.z);
-        }
-    } else if (add != 0u) {
-        atomicAdd(cells.cells[dims.x * dims.y * dims.z].len, add);
     }
 }
 

@@ -67,8 +67,9 @@ fn density_volume_keeps_the_strand_length_and_sits_on_the_hair() {
 }
 
 /// The GPU build (`glsl/density_volume.comp`) against its CPU twin: the same strand length in
-/// total (within 0.1%), and cell by cell within 0.5% of the hair's length (fixed point and
-/// float rounding; measured 0.014% for head_long, 0.064% for sphere_fur). Validation on.
+/// total (within 0.1%), and cell by cell, length and flow, within 0.5% of the hair's length
+/// (fixed point and float rounding; measured 0.018% and 0.036% for head_long, 0.072% and
+/// 0.155% for sphere_fur). Validation on.
 #[test]
 fn gpu_density_volume_equals_the_cpu_twin() {
     let ctx = common::context();
@@ -109,8 +110,26 @@ fn gpu_density_volume_equals_the_cpu_twin() {
             .zip(&cpu.density)
             .map(|(a, b)| (a - b).abs() * volume)
             .sum();
-        eprintln!("GPU {g} m, CPU {c} m of strand; cells differ by {off} m");
+        let flow_off: f32 = gpu
+            .flow
+            .iter()
+            .zip(&cpu.flow)
+            .map(|(a, b)| (*a - *b).length() * volume)
+            .sum();
+        eprintln!("GPU {g} m, CPU {c} m of strand; cells differ by {off} m, flows by {flow_off} m");
         assert!(off <= 0.005 * c, "cells differ by {off} m of strand in {c}");
+        assert!(
+            flow_off <= 0.005 * c,
+            "flows differ by {flow_off} m of strand in {c}"
+        );
+        // The flow is the strands' direction: never longer than the length it sums.
+        let longer = cpu
+            .flow
+            .iter()
+            .zip(&cpu.density)
+            .filter(|(f, d)| f.length() > **d * 1.0001 + 1e-6)
+            .count();
+        assert_eq!(longer, 0, "{longer} cells flow more than their length");
     }
     common::assert_no_validation_errors(&ctx);
 }

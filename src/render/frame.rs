@@ -672,7 +672,10 @@ fn volume_characters(records: &[super::shared::CharacterRecord]) -> (u32, u32) {
         .iter()
         .filter(|r| r.flags & CHARACTER_VISIBLE != 0 && r.volume[3] & VOLUME_BUILT != 0);
     drawn.fold((0, 0), |(only, blended), r| {
-        match (r.flags & CHARACTER_VOLUME_ONLY != 0, r.volume_shading[2] > 0.0) {
+        match (
+            r.flags & CHARACTER_VOLUME_ONLY != 0,
+            r.volume_shading[2] > 0.0,
+        ) {
             (true, _) => (only + 1, blended),
             (false, true) => (only, blended + 1),
             _ => (only, blended),

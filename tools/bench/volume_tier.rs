@@ -14,11 +14,7 @@ use hairmesh::render::{
 
 /// Print a row per count and tier setting, then the ratio lines. With `picture`, returns the
 /// largest crowd's frame with the tier on.
-pub fn compare(
-    run: &super::CrowdRun,
-    counts: &[usize],
-    picture: bool,
-) -> Result<Option<Vec<u8>>> {
+pub fn compare(run: &super::CrowdRun, counts: &[usize], picture: bool) -> Result<Option<Vec<u8>>> {
     outln!(
         "| N | volume tier | strands drawn | volumes alone + blended | GPU ms per pass | GPU ms | frame wall ms |\n|---|---|---|---|---|---|---|"
     )?;

@@ -804,7 +804,13 @@ impl FramePasses {
         // its MSAA resolve.
         let opaque_strands = hardware && !transparent;
         let volumes = inp.volume_slots > 0;
-        let query = self.add_opaque(g, r, &inp, (opaque_strands, opaque_strands && !volumes), query);
+        let query = self.add_opaque(
+            g,
+            r,
+            &inp,
+            (opaque_strands, opaque_strands && !volumes),
+            query,
+        );
         if volumes {
             self.volume_hair
                 .add(g, r, inp.sets, inp.volume_slots, opaque_strands);
