@@ -253,6 +253,10 @@ enum Cmd {
         /// count over the smallest.
         #[arg(long, conflicts_with = "compare_defaults")]
         volume_tier: bool,
+        /// With --volume-tier: also write one character (head_long) shrinking across the
+        /// tier's switch band, tier on (top) and off (bottom), here.
+        #[arg(long, requires = "volume_tier")]
+        band_strip: Option<PathBuf>,
     },
 }
 
@@ -493,12 +497,16 @@ fn bench_crowd(
     device: Option<String>,
     picture: Option<PathBuf>,
     (raster, compare_defaults, volume_tier): (hairmesh::render::StrandRaster, bool, bool),
+    band_strip: Option<PathBuf>,
 ) -> Result<()> {
     if counts.is_empty() || counts.iter().any(|&c| c == 0 || c > 1024) {
         bail!("--counts: every count must be in 1..=1024");
     }
     let inputs: Vec<&std::path::Path> = CROWD_MESHES.iter().map(std::path::Path::new).collect();
     let picture = picture
+        .map(|p| OutputPath::check(&p, &inputs))
+        .transpose()?;
+    let band_strip = band_strip
         .map(|p| OutputPath::check(&p, &inputs))
         .transpose()?;
     let meshes = CROWD_MESHES
@@ -532,6 +540,10 @@ fn bench_crowd(
         let image = volume_tier::compare(&run, &counts, picture.is_some())?;
         if let (Some(out), Some(rgba)) = (picture, image) {
             write_png(&out, rgba, width, height)?;
+        }
+        if let Some(out) = band_strip {
+            let (rgba, (w, h)) = volume_tier::band_strip(&ctx, &meshes[0])?;
+            write_png(&out, rgba, w, h)?;
         }
         return Ok(());
     }
@@ -733,6 +745,7 @@ fn run(args: Args) -> Result<()> {
             draw,
             compare_defaults,
             volume_tier,
+            band_strip,
         } => bench_crowd(
             counts.unwrap_or(match (compare_defaults, volume_tier) {
                 (true, _) => vec![100],
@@ -747,6 +760,7 @@ fn run(args: Args) -> Result<()> {
             device,
             picture,
             (draw, compare_defaults, volume_tier),
+            band_strip,
         )?,
         Cmd::Lod {
             mesh,

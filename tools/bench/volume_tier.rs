@@ -79,3 +79,69 @@ pub fn compare(run: &super::CrowdRun, counts: &[usize], picture: bool) -> Result
     }
     Ok(image)
 }
+
+/// Hair-box sizes (pixels across) of the band strip's columns: above, inside and below the
+/// default band.
+const STRIP_PIXELS: [f32; 7] = [80.0, 64.0, 58.0, 52.0, 46.0, 40.0, 32.0];
+/// Side of one strip frame, and of the centre square each column shows (upscaled twice).
+const STRIP_FRAME: u32 = 128;
+const STRIP_CROP: u32 = 72;
+
+/// The band strip (`--band-strip`): one character (`mesh`) shrinking across the volume
+/// tier's default band, tier on (top row: strands, screen-door blend, volume) and off
+/// (bottom row: strands only), each column the centre of a frame at one size, twice enlarged.
+pub fn band_strip(
+    ctx: &std::sync::Arc<hairmesh::vk::Context>,
+    (baked, style): &(hairmesh::BakedHairMesh, hairmesh::HairStyle),
+) -> Result<(Vec<u8>, (u32, u32))> {
+    let lo = Vec3::from_slice(&baked.info.pos_origin[..3]);
+    let extent = Vec3::from_slice(&baked.info.pos_extent[..3]);
+    let (centre, radius, fov) = (lo + 0.5 * extent, 0.5 * extent.length(), 40.0f32);
+    let mut rows = Vec::new();
+    for tier in [VolumeTier::on(), VolumeTier::OFF] {
+        let mut row = Vec::new();
+        for pixels in STRIP_PIXELS {
+            let desc = hairmesh::render::RendererDesc::default()
+                .size(STRIP_FRAME, STRIP_FRAME)
+                .shadow_resolution(512);
+            let mut r = hairmesh::render::Renderer::new(ctx, &desc)?;
+            let params = hairmesh::render::StrandParams {
+                strands_per_bundle: 64,
+                verts_log2: 4,
+            };
+            r.add_character(baked, style, params, glam::Mat4::IDENTITY)?;
+            let distance = radius / (fov.to_radians() * 0.5).tan() * STRIP_FRAME as f32 / pixels;
+            let dir = hairmesh::render::DEFAULT_VIEW_DIR.normalize();
+            let camera = hairmesh::render::Camera::look_at(centre + dir * distance, centre, fov);
+            let view = View {
+                shading: hairmesh::shade::ShadingModel::Marschner,
+                shadows: ShadowMode::DeepOpacity,
+                volumes: tier,
+                ..View::new(camera)
+            };
+            let opts = FrameOptions {
+                read_image: true,
+                raster: StrandRaster::Auto { k: 8 },
+                light_raster: LightRaster::Software,
+                ..Default::default()
+            };
+            let rgba = r.render_one(&view, &opts)?.rgba.unwrap_or_default();
+            let full = image::RgbaImage::from_raw(STRIP_FRAME, STRIP_FRAME, rgba)
+                .ok_or_else(|| anyhow::anyhow!("frame size"))?;
+            let o = (STRIP_FRAME - STRIP_CROP) / 2;
+            let crop = image::imageops::crop_imm(&full, o, o, STRIP_CROP, STRIP_CROP).to_image();
+            let big = image::imageops::resize(
+                &crop,
+                2 * STRIP_CROP,
+                2 * STRIP_CROP,
+                image::imageops::FilterType::Nearest,
+            );
+            row.push(big.into_raw());
+        }
+        rows.push(row);
+    }
+    let tile = (2 * STRIP_CROP, 2 * STRIP_CROP);
+    let image = super::side_by_side(&rows, tile)?;
+    let size = (image.width(), image.height());
+    Ok((image.into_raw(), size))
+}
