@@ -524,6 +524,11 @@ fn crowd_outputs_are_checked_before_the_first_frame() {
         "4",
     ];
     assert_fails(&crowd(&soft_msaa), "--msaa 4");
+    for band in ["50,10", "nan,5", "5", "-1,4"] {
+        let flag = format!("--volume-band={band}");
+        let args = ["--count", "1", "--out", s(&new), flag.as_str()];
+        assert_fails(&crowd(&args), "--volume-band");
+    }
     assert!(!new.exists());
     let deep = dir.path().join("no/such/folder");
     assert_fails(

@@ -1,6 +1,7 @@
 //! Synchronization validation (`VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT`)
 //! over every frame the renderer can draw: each valid combination of generation path x strand
-//! raster x shadows x transparency x MSAA (as `FrameSettings::validate` decides), two frames in
+//! raster x shadows x transparency x MSAA (as `FrameSettings::validate` decides), with the
+//! volume tier off, occluding, blending and alone in turn, two frames in
 //! flight each on small images, then the static and LHS paths and an animated hair mesh (posed
 //! from the CPU, then simulated on the GPU). Any
 //! validation message fails. The frame graph derives every barrier from the passes' declared
@@ -15,7 +16,7 @@ use glam::{Mat4, Vec3};
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::render::{
     FrameOptions, FrameSettings, LightRaster, LodSettings, RenderPath, Renderer, RendererDesc,
-    ShadowMode, StrandParams, StrandRaster, Temporal, Transparency, View,
+    ShadowMode, StrandParams, StrandRaster, Temporal, Transparency, View, VolumeTier,
 };
 use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{Access, Context, ContextDesc};
@@ -113,10 +114,28 @@ fn every_pass_combination_is_free_of_hazards() {
                             0 => Temporal::Taa,
                             _ => Temporal::Off,
                         };
+                        // The volume tier in turn: off, occlusion only, most of the hair
+                        // blended toward the volume, the volume alone.
+                        let volumes = match valid % 4 {
+                            0 => VolumeTier::OFF,
+                            1 => VolumeTier {
+                                far: None,
+                                ..VolumeTier::on()
+                            },
+                            2 => VolumeTier {
+                                far: Some((0.0, 1e6)),
+                                ..VolumeTier::on()
+                            },
+                            _ => VolumeTier {
+                                far: Some((1e6, 1e6)),
+                                ..VolumeTier::on()
+                            },
+                        };
                         let view = View {
                             shadows,
                             transparency,
                             temporal,
+                            volumes,
                             ..base
                         };
                         let opts = FrameOptions {
@@ -128,7 +147,8 @@ fn every_pass_combination_is_free_of_hazards() {
                             ..Default::default()
                         };
                         let what = format!(
-                            "{path:?} {raster} {shadows:?} (light {light_raster}) {transparency} {msaa}x temporal {temporal}"
+                            "{path:?} {raster} {shadows:?} (light {light_raster}) {transparency} {msaa}x temporal {temporal} volumes {:?}",
+                            volumes.far
                         );
                         two_frames(&ctx, &mut r, &view, &opts, &what);
                     }
