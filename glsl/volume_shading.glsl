@@ -65,10 +65,14 @@ float volume_weight(uint c) {
     return volume_built(c) ? characters[c].volume_shading.z : 0.0;
 }
 
-// The 4x4 ordered-dither (Bayer) threshold of a pixel, in (0, 1).
+// The 4x4 ordered-dither (Bayer) threshold of a pixel, in (0, 1). With temporal accumulation
+// the pattern moves with the frame's sub-pixel jitter (a different offset each frame), so the
+// history averages the screen door into a blend.
 const uint BAYER_4X4[16] = uint[16](0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
 float screen_door(uvec2 pixel) {
-    return (float(BAYER_4X4[(pixel.y & 3u) * 4u + (pixel.x & 3u)]) + 0.5) / 16.0;
+    uvec2 shift = frame.temporal.y != 0u ? uvec2(ivec2(floor(frame.temporal_params.xy * 4.0 + 2.0))) : uvec2(0u);
+    uvec2 q = (pixel + shift) & 3u;
+    return (float(BAYER_4X4[q.y * 4u + q.x]) + 0.5) / 16.0;
 }
 
 // Whether pixel `pixel` shows character c's volume rather than its strands: the volume
@@ -78,7 +82,7 @@ bool volume_covers(uvec2 pixel, uint c) {
 }
 
 // Transmittance of the light from world point p through character c's own volume, toward
-// the unit direction l (shade::volume::march toward the light), strands STRAND_SHADOW_OPACITY
+// the unit direction l (shade::volume::light_transmittance), strands STRAND_SHADOW_OPACITY
 // opaque: the self-shadow of hair drawn as a volume alone (its strands are in no light map).
 float volume_light(uint c, vec3 p, vec3 l) {
     vec3 g = volume_grid(c, p);

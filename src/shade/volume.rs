@@ -14,7 +14,8 @@
 //! - **Ray marching** (vkhr sec. 4): a view ray is marched front to back in steps of
 //!   [`MARCH_STEP_CELLS`]; each step absorbs `1 - exp(-sigma ds)` of what is left. The march
 //!   returns the transmittance left and the opacity-weighted mean point and flow, where the
-//!   strands are shaded once ([`march`]).
+//!   strands are shaded once ([`march`]); toward the light, the transmittance through the
+//!   character's own hair ([`light_transmittance`]).
 
 use glam::Vec3;
 
@@ -92,6 +93,34 @@ pub fn march(
     }
 }
 
+/// Transmittance of the light from `p` through the volume toward the unit direction `dir`,
+/// up to the grid's edge, in whole steps of [`MARCH_STEP_CELLS`] (at most 256) sampled at their
+/// middles, through strands `width` wide and `opacity` opaque: `volume_light` in
+/// `volume_shading.glsl`, the self-shadow of hair drawn as its volume alone.
+pub fn light_transmittance(
+    volume: &DensityVolume,
+    p: Vec3,
+    dir: Vec3,
+    (width, opacity): (f32, f32),
+) -> f32 {
+    let hi = volume.origin + volume.cell * volume.dims.as_vec3();
+    let exit = |o: f32, d: f32, lo: f32, hi: f32| match d {
+        d if d > 0.0 => (hi - o) / d,
+        d if d < 0.0 => (lo - o) / d,
+        _ => f32::INFINITY,
+    };
+    let length = exit(p.x, dir.x, volume.origin.x, hi.x)
+        .min(exit(p.y, dir.y, volume.origin.y, hi.y))
+        .min(exit(p.z, dir.z, volume.origin.z, hi.z))
+        .max(0.0);
+    let step = MARCH_STEP_CELLS * volume.mean_cell();
+    let steps = ((length / step).ceil() as u32).min(256);
+    let depth: f32 = (0..steps)
+        .map(|i| volume.sample(p + dir * ((i as f32 + 0.5) * step)))
+        .sum();
+    (-extinction(depth * step, width, opacity)).exp()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,6 +159,21 @@ mod tests {
         // Nothing absorbed outside the hair.
         let miss = march(&slab(0.0), Vec3::ZERO, Vec3::Z, 1.0, (width, opacity));
         assert_eq!(miss.transmittance, 1.0);
+    }
+
+    #[test]
+    fn light_through_a_slab_falls_with_the_hair_it_crosses() {
+        let v = slab(100.0);
+        let (width, opacity) = (0.01, 0.5);
+        // From the slab's middle out through its far half (0.25 of hair), and from in front of
+        // the slab away from it (no hair).
+        let half = light_transmittance(&v, Vec3::new(0.5, 0.5, 0.5), Vec3::Z, (width, opacity));
+        let expected = (-extinction(100.0, width, opacity) * 0.25).exp();
+        assert!((half - expected).abs() < 0.02, "{half} vs {expected}");
+        let away = light_transmittance(&v, Vec3::new(0.5, 0.5, 0.1), -Vec3::Z, (width, opacity));
+        assert_eq!(away, 1.0);
+        let through = light_transmittance(&v, Vec3::new(0.5, 0.5, 0.05), Vec3::Z, (width, opacity));
+        assert!(through < half, "{through} {half}");
     }
 
     #[test]
