@@ -197,9 +197,13 @@ impl Renderer {
         for &slot in pose_updates {
             self.volumes.mark_stale(slot);
         }
-        let (jobs, slots, most) =
-            self.volumes
-                .take_jobs(records, tier.rebuilds_per_frame, self.frame_number);
+        // Stale volumes are rebuilt for the tier; with it off only requests are built.
+        let rebuilds = if tier.enabled() {
+            tier.rebuilds_per_frame
+        } else {
+            0
+        };
+        let (jobs, slots, most) = self.volumes.take_jobs(records, rebuilds, self.frame_number);
         self.volumes.fill_records(records, tier, block);
         if jobs.is_empty() {
             return Ok((slots, most));
