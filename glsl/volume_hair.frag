@@ -29,13 +29,9 @@ void main() {
     mat4 to_grid = characters[c].world_to_volume;
     vec3 g0 = (to_grid * vec4(eye, 1.0)).xyz;
     vec3 gd = (to_grid * vec4(dir, 0.0)).xyz;
-    vec3 inv = sign(gd + 1e-20) / max(abs(gd), vec3(1e-20));
-    vec3 ta = (vec3(0.0) - g0) * inv;
-    vec3 tb = (vec3(volume_dims(c)) - g0) * inv;
-    vec3 lo = min(ta, tb);
-    vec3 hi = max(ta, tb);
-    float t_enter = max(lo.x, max(lo.y, lo.z));
-    float t_exit = min(hi.x, min(hi.y, hi.z));
+    vec2 span = volume_span(c, g0, gd);
+    float t_enter = span.x;
+    float t_exit = span.y;
     // Two-sided boxes: keep the face the ray enters by (the far one with the eye inside).
     float t_frag = distance(in_world, eye);
     bool front = abs(t_frag - t_enter) <= abs(t_frag - t_exit);

@@ -81,17 +81,26 @@ bool volume_covers(uvec2 pixel, uint c) {
     return screen_door(pixel) < volume_weight(c);
 }
 
+// Where the ray g0 + t gd (grid coordinates; t in the units of gd's length) enters and
+// leaves character c's grid box [0, dims]: (t_enter, t_exit), no crossing when
+// t_exit <= t_enter.
+vec2 volume_span(uint c, vec3 g0, vec3 gd) {
+    vec3 inv = sign(gd + 1e-20) / max(abs(gd), vec3(1e-20));
+    vec3 ta = -g0 * inv;
+    vec3 tb = (vec3(volume_dims(c)) - g0) * inv;
+    vec3 lo = min(ta, tb);
+    vec3 hi = max(ta, tb);
+    return vec2(max(lo.x, max(lo.y, lo.z)), min(hi.x, min(hi.y, hi.z)));
+}
+
 // Transmittance of the light from world point p through character c's own volume, toward
 // the unit direction l (shade::volume::light_transmittance), strands STRAND_SHADOW_OPACITY
 // opaque: the self-shadow of hair drawn as a volume alone (its strands are in no light map).
 float volume_light(uint c, vec3 p, vec3 l) {
     vec3 g = volume_grid(c, p);
     vec3 gd = (characters[c].world_to_volume * vec4(l, 0.0)).xyz;
-    // Leave the grid: the exit along gd of the box [0, dims].
-    vec3 dims = vec3(volume_dims(c));
-    vec3 inv = 1.0 / (abs(gd) + 1e-12) * sign(gd + 1e-12);
-    vec3 t_exit = max((vec3(0.0) - g) * inv, (dims - g) * inv);
-    float world_length = max(min(t_exit.x, min(t_exit.y, t_exit.z)), 0.0);
+    // Up to where the ray leaves the grid.
+    float world_length = max(volume_span(c, g, gd).y, 0.0);
     float scale = characters[c].model_scale;
     float step = MARCH_STEP_CELLS * characters[c].volume_shading.y * scale;
     uint steps = min(uint(ceil(world_length / step)), 256u);

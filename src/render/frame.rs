@@ -30,6 +30,16 @@ use super::transparency::Transparency;
 use super::workspace::FrameBuffers;
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
 
+/// The density volumes of a frame.
+struct DensityWork {
+    /// The volumes built this frame: character slots, in the order of the slot's job table.
+    built: Vec<usize>,
+    /// The most bundles among their characters.
+    most_bundles: u32,
+    /// What the volume tier draws.
+    draw: super::volume::TierDraw,
+}
+
 /// What one frame draws (beyond the options the caller gave).
 pub(super) struct FrameWork<'a> {
     path: RenderPath,
@@ -50,13 +60,10 @@ pub(super) struct FrameWork<'a> {
     /// Character slots whose hair is simulated on the GPU this frame (their steps are in the
     /// slot's job table, in this order).
     simulated: Vec<usize>,
-    /// The density volumes built this frame (character slots, in the order of the slot's job
-    /// table) and the most bundles among their characters.
-    density: (Vec<usize>, u32),
+    /// The density volumes built and drawn this frame.
+    density: DensityWork,
     /// Motion vectors and accumulation, when the frame has them.
     temporal: Option<TemporalWork>,
-    /// Character slots whose hair may be drawn from their density volume (0: none).
-    volume_slots: u32,
     /// The transient buffers and images the frame graph creates.
     transients: FrameTransients,
 }
@@ -109,6 +116,7 @@ impl Renderer {
         let mut records = self.frame_records(&pose_updates, moving);
         let density =
             self.write_density_jobs(i, &mut records, (&view.volumes, &block), &pose_updates)?;
+        let work_draw = density.draw;
         let blocks = (&block, light_block.as_ref());
         let prop_draws = self.write_slot(i, blocks, &records, moving, opts)?;
         let start = Instant::now();
@@ -125,7 +133,6 @@ impl Renderer {
             simulated,
             density,
             temporal,
-            volume_slots: volume_slots(&records),
             transients,
         };
         let frame_graph = self.record(i, work, opts, present.as_mut())?;
@@ -140,7 +147,7 @@ impl Renderer {
             read_image: opts.read_image,
             read_motion: opts.read_motion,
             frame_graph,
-            volume_characters: volume_characters(&records),
+            volume_characters: (work_draw.alone, work_draw.blended),
         };
         self.submit(i, pending, present.as_ref())?;
         self.remember_frame(&records, &motion, temporal);
@@ -169,21 +176,27 @@ impl Renderer {
     /// The density volumes of this frame: request those the view's volume `tier` needs, mark
     /// those of the characters in `pose_updates` stale, write the jobs of the volumes built
     /// this frame into frame slot `i`'s job table (grown as needed: its earlier frame has
-    /// completed), and fill the volume fields of `records`. Returns the built volumes' slots
-    /// and the most bundles among them.
+    /// completed), and fill the volume fields of `records`.
     fn write_density_jobs(
         &mut self,
         i: usize,
         records: &mut [super::shared::CharacterRecord],
         (tier, block): (&super::volume::VolumeTier, &FrameBlock),
         pose_updates: &[usize],
-    ) -> GpuResult<(Vec<usize>, u32)> {
+    ) -> GpuResult<DensityWork> {
+        // Each character's share of volume, from its size on screen (0 with the far tier off).
+        let weights: Vec<f32> = records
+            .iter()
+            .map(|r| match tier.far {
+                Some(_) => tier.weight(super::volume::hair_pixels(r, block)),
+                None => 0.0,
+            })
+            .collect();
         if tier.enabled() {
             for id in self.crowd.ids() {
-                let r = &records[id.slot() as usize];
-                let visible = r.flags & super::shared::CHARACTER_VISIBLE != 0;
-                let needed =
-                    tier.occlusion || tier.weight(super::volume::hair_pixels(r, block)) > 0.0;
+                let slot = id.slot() as usize;
+                let visible = records[slot].flags & super::shared::CHARACTER_VISIBLE != 0;
+                let needed = tier.occlusion || weights[slot] > 0.0;
                 if visible
                     && needed
                     && let Some(old) = self.volumes.ensure(&self.ctx, id, tier.sampling)?
@@ -203,15 +216,19 @@ impl Renderer {
         } else {
             0
         };
-        let (jobs, slots, most) = self.volumes.take_jobs(records, rebuilds, self.frame_number);
-        self.volumes.fill_records(records, tier, block);
-        if jobs.is_empty() {
-            return Ok((slots, most));
+        let (jobs, built, most_bundles) =
+            self.volumes.take_jobs(records, rebuilds, self.frame_number);
+        let draw = self.volumes.fill_records(records, tier, &weights);
+        if !jobs.is_empty() {
+            let bytes = bytemuck::cast_slice(&jobs);
+            let table = &mut self.frames[i].density_jobs;
+            write_address_table(&self.ctx, table, "density volume jobs", bytes)?;
         }
-        let bytes = bytemuck::cast_slice(&jobs);
-        let table = &mut self.frames[i].density_jobs;
-        write_address_table(&self.ctx, table, "density volume jobs", bytes)?;
-        Ok((slots, most))
+        Ok(DensityWork {
+            built,
+            most_bundles,
+            draw,
+        })
     }
 
     /// The character records of this frame: those in `pose_updates` with their previous
@@ -524,10 +541,10 @@ impl Renderer {
             },
         );
         if let Some(table) = density_jobs.as_ref()
-            && !work.density.0.is_empty()
+            && !work.density.built.is_empty()
         {
-            let volumes = self.volumes.buffers(&work.density.0);
-            let build = (table, volumes.as_slice(), work.density.1);
+            let volumes = self.volumes.buffers(&work.density.built);
+            let build = (table, volumes.as_slice(), work.density.most_bundles);
             self.passes.add_density_volumes(&mut g, &r, sets.0, build);
         }
         let mut inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
@@ -655,38 +672,6 @@ impl Renderer {
     }
 }
 
-/// The character slots up to the last whose hair has a share of volume this frame (the volume
-/// tier's far hair; 0: none).
-fn volume_slots(records: &[super::shared::CharacterRecord]) -> u32 {
-    records
-        .iter()
-        .rposition(|r| {
-            r.volume[3] & super::shared::VOLUME_BUILT != 0
-                && r.volume_shading[2] > 0.0
-                && r.flags & super::shared::CHARACTER_VISIBLE != 0
-        })
-        .map_or(0, |last| last as u32 + 1)
-}
-
-/// How many visible characters of `records` are drawn as their volume alone, and how many
-/// blend strands and volume.
-fn volume_characters(records: &[super::shared::CharacterRecord]) -> (u32, u32) {
-    use super::shared::{CHARACTER_VISIBLE, CHARACTER_VOLUME_ONLY, VOLUME_BUILT};
-    let drawn = records
-        .iter()
-        .filter(|r| r.flags & CHARACTER_VISIBLE != 0 && r.volume[3] & VOLUME_BUILT != 0);
-    drawn.fold((0, 0), |(only, blended), r| {
-        match (
-            r.flags & CHARACTER_VOLUME_ONLY != 0,
-            r.volume_shading[2] > 0.0,
-        ) {
-            (true, _) => (only + 1, blended),
-            (false, true) => (only, blended + 1),
-            _ => (only, blended),
-        }
-    })
-}
-
 /// Make `readback` a buffer of `bytes` when the frame `wants` it and it is not one already.
 fn size_readback(
     ctx: &Arc<Context>,
@@ -732,6 +717,6 @@ fn frame_inputs<'a>(
         mesh_query,
         temporal: work.temporal,
         motion_readback: None,
-        volume_slots: work.volume_slots,
+        volume_slots: work.density.draw.slots,
     }
 }

@@ -16,8 +16,8 @@ use glam::{Mat4, UVec3, Vec3};
 
 use super::crowd::CharacterId;
 use super::shared::{
-    CHARACTER_VOLUME_ONLY, CharacterRecord, DensityJob, FrameBlock, VOLUME_BUILT, VOLUME_DIMS_BITS,
-    VOLUME_FIXED, VOLUME_OCCLUSION, VolumeCell,
+    CHARACTER_VISIBLE, CHARACTER_VOLUME_ONLY, CharacterRecord, DensityJob, FrameBlock,
+    VOLUME_BUILT, VOLUME_DIMS_BITS, VOLUME_FIXED, VOLUME_OCCLUSION, VolumeCell,
 };
 use crate::reference::volume::{DensityVolume, VolumeSampling, cell_size, volume_box};
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
@@ -94,6 +94,27 @@ impl VolumeTier {
             None => 0.0,
             Some((far, near)) if near > far => ((near - pixels) / (near - far)).clamp(0.0, 1.0),
             Some((far, _)) => (pixels < far) as u32 as f32,
+        }
+    }
+}
+
+/// What the volume tier draws in a frame: its visible characters with a share of volume.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TierDraw {
+    /// Character slots up to the last of them (0: none): the volume hair pass's instances.
+    pub slots: u32,
+    /// Drawn as their volume alone.
+    pub alone: u32,
+    /// Blended between strands and volume.
+    pub blended: u32,
+}
+
+impl TierDraw {
+    fn add(&mut self, slot: usize, alone: bool) {
+        self.slots = self.slots.max(slot as u32 + 1);
+        match alone {
+            true => self.alone += 1,
+            false => self.blended += 1,
         }
     }
 }
@@ -285,15 +306,16 @@ impl DensityVolumes {
     }
 
     /// Fill the volume fields of `records` (after [`Self::take_jobs`]): every character
-    /// whose volume is built gets its grid, occlusion where `tier` asks for it, and the
-    /// tier's weight from its size on the screen of `block` (volume-only below the band).
+    /// whose volume is built gets its grid, occlusion where `tier` asks for it, and its tier
+    /// weight from `weights` (by slot; volume-only at 1). Returns what the tier draws.
     pub fn fill_records(
         &self,
         records: &mut [CharacterRecord],
         tier: &VolumeTier,
-        block: &FrameBlock,
-    ) {
-        for (r, e) in records.iter_mut().zip(&self.entries) {
+        weights: &[f32],
+    ) -> TierDraw {
+        let mut draw = TierDraw::default();
+        for (slot, (r, e)) in records.iter_mut().zip(&self.entries).enumerate() {
             let Some((e, (lo, hi))) = e.as_ref().and_then(|e| Some((e, e.built?))) else {
                 continue;
             };
@@ -306,18 +328,22 @@ impl DensityVolumes {
             let packed = dims.x | dims.y << VOLUME_DIMS_BITS | dims.z << (2 * VOLUME_DIMS_BITS);
             let flags = VOLUME_BUILT | if tier.occlusion { VOLUME_OCCLUSION } else { 0 };
             r.volume = [address[0], address[1], packed, flags];
-            let weight = tier.weight(hair_pixels(r, block));
+            let weight = weights.get(slot).copied().unwrap_or(0.0);
             let width = mean_strand_width(&r.style);
             r.volume_shading = [
                 width / (VOLUME_FIXED * cell.x * cell.y * cell.z),
-                (cell.x + cell.y + cell.z) / 3.0,
+                cell.element_sum() / 3.0,
                 weight,
                 0.0,
             ];
             if weight >= 1.0 {
                 r.flags |= CHARACTER_VOLUME_ONLY;
             }
+            if weight > 0.0 && r.flags & CHARACTER_VISIBLE != 0 {
+                draw.add(slot, weight >= 1.0);
+            }
         }
+        draw
     }
 
     /// `id`'s volume as last built (call after its frame completed).
