@@ -54,14 +54,97 @@ vec3 marschner(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt) 
     float m_tt = 0.5 * hair_gaussian(0.5 * b, theta_h - 0.5 * a);
     float m_trt = 0.5 * hair_gaussian(2.0 * b, theta_h - 1.5 * a);
     float n_r = 0.25 * cos_half_phi * hair_fresnel(HAIR_ETA, sqrt(max(0.5 + 0.5 * dot(l, v), 0.0)));
-    // Texel centres sit at cos(phi) = -1 + 2 i / (PHI - 1), cos(theta_d) = j / (D - 1).
+    // Texel centres sit at cos(phi) = -1 + 2 i / (PHI - 1), cos(theta_d) = j / (D - 1), in
+    // the first rows of the shading lookup texture.
     vec2 size = vec2(MARSCHNER_LUT_PHI, MARSCHNER_LUT_D);
-    vec2 uv = (vec2(0.5 + 0.5 * cos_phi, cos_d) * (size - 1.0) + 0.5) / size;
+    vec2 uv = (vec2(0.5 + 0.5 * cos_phi, cos_d) * (size - 1.0) + 0.5)
+        / vec2(SHADING_LUT_WIDTH, SHADING_LUT_HEIGHT);
     vec3 az = textureLod(marschner_lut, uv, 0.0).rgb;
     vec3 base = max(color, vec3(1e-4));
     vec3 n_tt = pow(base, vec3(az.r / (2.0 * cos_d))) * az.g;
     vec3 n_trt = pow(base, vec3(0.8 / cos_d)) * (az.b / MARSCHNER_LUT_TRT_SCALE);
     return (vec3(m_r * n_r) + n_tt * m_tt + n_trt * m_trt) * (MARSCHNER_ENERGY_SCALE / (cos_d * cos_d));
+}
+
+// ---- Dual scattering (Zinke et al. 2008; seed 000 sec. 3.2, eqs. 3-4). CPU twin:
+// src/shade/scattering.rs, where the derivation is written out.
+
+// theta_h, cos(theta_d), cos(phi), cos(theta_i) (shade::scattering::hair_angles).
+vec4 hair_angles(vec3 t, vec3 l, vec3 v) {
+    float sin_i = clamp(dot(t, l), -1.0, 1.0);
+    float sin_o = clamp(dot(t, v), -1.0, 1.0);
+    float theta_i = asin(sin_i);
+    float theta_o = asin(sin_o);
+    vec3 lp = l - t * sin_i;
+    vec3 vp = v - t * sin_o;
+    float cos_phi = clamp(dot(lp, vp) / sqrt(dot(lp, lp) * dot(vp, vp) + 1e-8), -1.0, 1.0);
+    return vec4(0.5 * (theta_i + theta_o), max(cos(0.5 * (theta_o - theta_i)), 1e-3), cos_phi,
+                sqrt(max(1.0 - sin_i * sin_i, 0.0)));
+}
+
+// Energies of R, TT, TRT into the front (back = 0) or back (back = 1) half of azimuth for
+// colour channel c (shade::scattering::lobe_energies, tabulated in src/shade/lut.rs).
+vec3 lobe_energies(uint back, float cos_d, float c) {
+    float x = sqrt(clamp(c, 0.0, 1.0)) * float(SHADING_LUT_WIDTH - 1u) + 0.5;
+    float y = float(MARSCHNER_LUT_D + back * SCATTER_LUT_THETA)
+        + clamp(cos_d, 0.0, 1.0) * float(SCATTER_LUT_THETA - 1u) + 0.5;
+    return textureLod(marschner_lut, vec2(x, y) / vec2(SHADING_LUT_WIDTH, SHADING_LUT_HEIGHT), 0.0).rgb;
+}
+
+// Energy-weighted (total, mean shift, variance) of one half's lobes.
+vec3 half_moments(vec3 e, vec3 shifts, vec3 widths) {
+    float total = e.x + e.y + e.z;
+    float w = 1.0 / max(total, 1e-6);
+    return vec3(total, dot(e, shifts) * w, dot(e, widths * widths) * w);
+}
+
+// Local back-scattering A_b = A_1 + A_3 with its mean shift and variance
+// (shade::scattering::back_scattering).
+vec3 back_scattering(vec3 front, vec3 back) {
+    float af2 = front.x * front.x;
+    float q = max(1.0 - af2, 1e-4);
+    float a1 = back.x * af2 / q;
+    float a3 = back.x * back.x * back.x * af2 / (q * q * q);
+    float w = 1.0 / max(a1 + a3, 1e-8);
+    float shift = (a1 * (back.y + 2.0 * front.y) + a3 * (3.0 * back.y + 2.0 * front.y)) * w;
+    float var = (a1 * (back.z + 2.0 * front.z) + a3 * (3.0 * back.z + 2.0 * front.z)) * w;
+    float widen = 1.0 + BACKWARD_DENSITY * af2;
+    return vec3(a1 + a3, shift, var * widen * widen);
+}
+
+// Radiance per unit light irradiance (shade::scattering::dual_scattering): single scattering
+// of the direct light, plus with `multiple` Zinke's global and local multiple scattering per
+// channel. arrival: x direct fraction, y fraction not behind bodies, z expected strand hits.
+vec3 dual_scattering(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt, vec3 arrival, bool multiple) {
+    vec3 single = marschner(t, l, v, color, roughness, tilt);
+    vec4 ang = hair_angles(t, l, v);
+    if (!multiple) {
+        return single * (ang.w * arrival.x);
+    }
+    vec3 shifts = vec3(-tilt, 0.5 * tilt, 1.5 * tilt);
+    vec3 widths = vec3(roughness, 0.5 * roughness, 2.0 * roughness);
+    float inv_cos2 = 1.0 / (ang.y * ang.y);
+    float back_azimuth = (1.0 + ang.z) / 6.28318530718;
+    vec3 result;
+    for (int ch = 0; ch < 3; ch++) {
+        vec3 ef = lobe_energies(0u, ang.y, color[ch]);
+        vec3 eb = lobe_energies(1u, ang.y, color[ch]);
+        vec3 front = half_moments(ef, shifts, widths);
+        vec3 back = back_scattering(front, half_moments(eb, shifts, widths));
+        float scattered = max(arrival.y * exp(-arrival.z * (1.0 - front.x)) - arrival.x, 0.0);
+        float spread = max(arrival.z, 1.0) * front.z;
+        float back_direct = back.x * 0.5 * hair_gaussian(sqrt(back.z), ang.x - back.y) * back_azimuth;
+        float back_spread = back.x * 0.5 * hair_gaussian(sqrt(back.z + spread), ang.x - back.y) * back_azimuth;
+        vec3 energy = ef + eb;
+        vec3 g = vec3(hair_gaussian(sqrt(widths.x * widths.x + spread), ang.x - shifts.x),
+                      hair_gaussian(sqrt(widths.y * widths.y + spread), ang.x - shifts.y),
+                      hair_gaussian(sqrt(widths.z * widths.z + spread), ang.x - shifts.z));
+        float global = 0.5 * dot(g, energy) / 6.28318530718;
+        float direct = arrival.x * (single[ch] + BACKWARD_DENSITY * back_direct * inv_cos2);
+        float scatter = FORWARD_DENSITY * scattered * (global + BACKWARD_DENSITY * back_spread) * inv_cos2;
+        result[ch] = (direct + scatter) * ang.w;
+    }
+    return result;
 }
 
 #endif

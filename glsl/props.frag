@@ -14,8 +14,8 @@ layout(location = 3) flat in uint in_instance;
 layout(location = 0) out vec4 out_color;
 
 #define PROP_ROUGHNESS 0.55
-#define LIGHT_IRRADIANCE 2.5
-#define AMBIENT 0.3
+#define PROP_IRRADIANCE 2.5
+#define PROP_AMBIENT 0.3
 
 void main() {
     note_fragment(VISIBILITY_PROP | in_instance, vec2(0.0));
@@ -34,5 +34,5 @@ void main() {
     vec3 brdf = in_color / 3.14159265 + vec3(d * vis * f);
     // Lookups start a little toward the light, against self-shadowing of the surface.
     float lit = nl > 0.0 ? light_transmittance(in_pos, 2.0 * frame.shadow_params.w) : 0.0;
-    out_color = vec4(brdf * (LIGHT_IRRADIANCE * nl * lit) + in_color * AMBIENT, 1.0);
+    out_color = vec4(brdf * (PROP_IRRADIANCE * nl * lit) + in_color * PROP_AMBIENT, 1.0);
 }

@@ -1,8 +1,9 @@
 #version 460
 // Test probe (tests/shading_twin.rs): evaluates the GPU shading models at given directions so
-// they can be compared with their CPU twins in src/shade/mod.rs. Per sample, inputs are five
-// vec4 (tangent, to light, to eye, colour + roughness, tilt) and outputs two vec4 (Marschner
-// rgb; Kajiya-Kay diffuse, specular). Binding 2: the Marschner lookup texture.
+// they can be compared with their CPU twins in src/shade/mod.rs and src/shade/scattering.rs.
+// Per sample, inputs are five vec4 (tangent, to light, to eye, colour + roughness, tilt +
+// light arrival + multiple scattering flag) and outputs three vec4 (Marschner rgb;
+// Kajiya-Kay diffuse, specular; dual scattering rgb). Binding 2: the shading lookup texture.
 #extension GL_GOOGLE_include_directive : require
 #define SHADING_LUT_SET 0
 #define SHADING_LUT_BINDING 2
@@ -21,7 +22,11 @@ void main() {
     vec3 l = inputs[5u * i + 1u].xyz;
     vec3 v = inputs[5u * i + 2u].xyz;
     vec4 cr = inputs[5u * i + 3u];
-    float tilt = inputs[5u * i + 4u].x;
-    outputs[2u * i] = vec4(marschner(t, l, v, cr.rgb, cr.a, tilt), 0.0);
-    outputs[2u * i + 1u] = vec4(kajiya_kay(t, l, v), 0.0, 0.0);
+    vec4 extra = inputs[5u * i + 4u];
+    float tilt = extra.x;
+    // Arrival: direct = exp(-hits) * open (no map's filtering), open, hits.
+    vec3 arrival = vec3(extra.y * exp(-extra.z), extra.y, extra.z);
+    outputs[3u * i] = vec4(marschner(t, l, v, cr.rgb, cr.a, tilt), 0.0);
+    outputs[3u * i + 1u] = vec4(kajiya_kay(t, l, v), 0.0, 0.0);
+    outputs[3u * i + 2u] = vec4(dual_scattering(t, l, v, cr.rgb, cr.a, tilt, arrival, extra.w != 0.0), 0.0);
 }

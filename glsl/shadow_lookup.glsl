@@ -18,17 +18,20 @@ float deep_opacity(vec4 layers, float dz) {
         + layers.z * clamp(x - 2.0, 0.0, 1.0) + layers.w * clamp(x - 3.0, 0.0, 1.0);
 }
 
-// Transmittance of the light to `p` (1: fully lit). `offset` moves the lookup point toward
-// the light (world units) against self-shadowing of opaque surfaces.
-float light_transmittance(vec3 p, float offset) {
+// How the light reaches `p` (shade::scattering::LightArrival): x the fraction arriving
+// without crossing hair (1: fully lit), y the fraction not behind a body, z the expected
+// strand hits on the way where not behind a body (dual scattering's strand count). `offset`
+// moves the lookup point toward the light (world units) against self-shadowing of opaque
+// surfaces.
+vec3 light_arrival(vec3 p, float offset) {
     uint mode = frame.shadow.x;
     if (mode == SHADOW_OFF) {
-        return 1.0;
+        return vec3(1.0, 1.0, 0.0);
     }
     vec4 c = frame.light_view_proj * vec4(p, 1.0);
     vec2 uv = c.xy * 0.5 + 0.5;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || c.z < 0.0 || c.z > 1.0) {
-        return 1.0;
+        return vec3(1.0, 1.0, 0.0);
     }
     int res = int(frame.shadow.y);
     ivec2 centre = ivec2(uv * float(res));
@@ -37,9 +40,11 @@ float light_transmittance(vec3 p, float offset) {
     float bias = frame.shadow_params.w;
     float z = c.z * range - offset;
     // Per-strand transmittance 1 - alpha written as exp(-k alpha): opacity sums then give the
-    // product of strand transmittances.
+    // product of strand transmittances, and k * opacity is the expected hits.
     float k = -log(1.0 - alpha) / alpha;
     float sum = 0.0;
+    float open = 0.0;
+    float hits = 0.0;
     for (int dy = -1; dy <= 1; dy++) {
         for (int dx = -1; dx <= 1; dx++) {
             ivec2 t = clamp(centre + ivec2(dx, dy), ivec2(0), ivec2(res - 1));
@@ -57,9 +62,16 @@ float light_transmittance(vec3 p, float offset) {
                 opacity = alpha * (dz / frame.shadow_params.x);
             }
             sum += exp(-k * opacity);
+            open += 1.0;
+            hits += k * opacity;
         }
     }
-    return sum / 9.0;
+    return vec3(sum / 9.0, open / 9.0, hits / max(open, 1.0));
+}
+
+// Transmittance of the light to `p` (light_arrival's direct fraction).
+float light_transmittance(vec3 p, float offset) {
+    return light_arrival(p, offset).x;
 }
 
 #endif

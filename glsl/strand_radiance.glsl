@@ -9,15 +9,16 @@
 #include "shadow_lookup.glsl"
 #include "volume_shading.glsl"
 
-// Irradiance of the directional light, and an ambient term that stands in for multiple
-// scattering (dual scattering is not implemented) in the physically based models.
-#define LIGHT_IRRADIANCE 4.5
-#define AMBIENT 0.25
+// LIGHT_IRRADIANCE (the directional light) and AMBIENT (the sky) come from shared.glsl (Rust
+// twins in src/shade/mod.rs). With frame.shading.z on, Marschner adds dual scattering
+// (hair_shading.glsl) from the light; the ambient term is the sky in every model.
 
 // Radiance toward the eye at world point `pos` of a strand with unit-ish tangent `tangent`,
-// parameter `s` along it, base colour `base`, of character `character`, given the direct
-// light's transmittance `lit` and the ambient light's `ambient` there.
-vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character, float lit, float ambient) {
+// parameter `s` along it, base colour `base`, of character `character`, given how the light
+// arrives there (`arrival`: light_arrival's direct fraction, open fraction, strand hits) and
+// the ambient light's visibility `ambient`.
+vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character, vec3 arrival, float ambient) {
+    float lit = arrival.x;
     vec3 t = normalize(tangent);
     vec3 l = normalize(frame.light_dir.xyz);
     vec3 e = normalize(frame.camera_pos.xyz - pos);
@@ -28,9 +29,9 @@ vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint 
         c = (base * (AMBIENT * ambient + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
     } else if (frame.shading.x == SHADING_MARSCHNER) {
         HairStyle s = characters[character].style;
-        vec3 sc = marschner(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees));
-        float cos_i = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));
-        c = (sc * (LIGHT_IRRADIANCE * cos_i * lit) + base * (AMBIENT * ambient)) * root_shadow;
+        vec3 sc = dual_scattering(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees), arrival,
+                                  frame.shading.z != 0u);
+        c = (sc * LIGHT_IRRADIANCE + base * (AMBIENT * ambient)) * root_shadow;
     } else {
         float tl = dot(t, l);
         float diffuse = sqrt(max(1.0 - tl * tl, 0.0));
@@ -46,8 +47,8 @@ vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint 
 // the point) and the ambient light through the character's density volume (volumetric
 // ambient occlusion, where on).
 vec3 strand_radiance(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character) {
-    float lit = light_transmittance(pos, 0.0);
-    return strand_radiance_lit(tangent, s_param, pos, base, character, lit, volume_ambient(character, pos));
+    return strand_radiance_lit(tangent, s_param, pos, base, character, light_arrival(pos, 0.0),
+                               volume_ambient(character, pos));
 }
 
 #endif

@@ -73,13 +73,16 @@ void main() {
         tangent = vec3(0.0, -1.0, 0.0);
     }
     vec3 l = normalize(frame.light_dir.xyz);
-    float lit = light_transmittance(point, 0.0);
+    vec3 arrival = light_arrival(point, 0.0);
     if ((characters[c].flags & CHARACTER_VOLUME_ONLY) != 0u) {
-        lit *= volume_light(c, point, l);
+        // Through its own hair too: hits add, transmittances multiply.
+        float own = volume_light(c, point, l);
+        arrival.x *= own;
+        arrival.z += -log(max(own, 1e-6));
     }
     HairStyle style = characters[c].style;
     vec3 base = vec3(style.color[0], style.color[1], style.color[2]);
-    vec3 radiance = strand_radiance_lit(tangent, 1.0, point, base, c, lit, volume_ambient(c, point));
+    vec3 radiance = strand_radiance_lit(tangent, 1.0, point, base, c, arrival, volume_ambient(c, point));
     vec4 clip = frame.view_proj * vec4(point, 1.0);
     float depth = clamp(clip.z / clip.w, 0.0, 1.0);
     gl_FragDepth = depth;

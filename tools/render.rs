@@ -106,6 +106,11 @@ struct Args {
     /// `[look] lod_appearance`, else true.
     #[arg(long)]
     lod_appearance: Option<bool>,
+    /// Multiple scattering between strands under marschner (dual scattering: light hair
+    /// glows through itself) (true/false); default: the scene's `[look]
+    /// multiple_scattering`, else false.
+    #[arg(long)]
+    multiple_scattering: Option<bool>,
     /// Strand rasterization: hw (camera-facing strips through the hardware rasterizer),
     /// soft or soft:K (the compute software rasterizer keeping K fragments per pixel sorted,
     /// default 8), auto or auto:K (per bundle: strands drawn at most 4 pixels wide to
@@ -488,6 +493,10 @@ fn run(args: Args) -> Result<()> {
             .lod_appearance
             .or(inputs.look.lod_appearance)
             .unwrap_or(true),
+        multiple_scattering: args
+            .multiple_scattering
+            .or(inputs.look.multiple_scattering)
+            .unwrap_or(false),
         ..View::new(camera)
     };
     let second = args

@@ -220,6 +220,9 @@ pub struct View {
     /// Seed 000's aggregated appearance for LoD-thickened strands (opacity and multiple
     /// scattering scaled by the strands a thick strand stands for).
     pub lod_appearance: bool,
+    /// Multiple scattering between strands under the Marschner model: dual scattering
+    /// (`shade::scattering`; Zinke et al. 2008, seed 000 eqs. 3-4).
+    pub multiple_scattering: bool,
     /// Temporal accumulation (jitter, motion vectors, history).
     pub temporal: super::temporal::Temporal,
     /// The volume tier: far hair drawn from density volumes, volumetric ambient occlusion.
@@ -228,8 +231,8 @@ pub struct View {
 
 impl View {
     /// `camera` with the defaults: light from above and in front (`DEFAULT_LIGHT_DIR`), LoD
-    /// on, the placeholder look, no shadows, opaque strands, seed 000's LoD appearance on, the
-    /// volume tier off.
+    /// on, the placeholder look, no shadows, opaque strands, seed 000's LoD appearance on,
+    /// multiple scattering off, the volume tier off.
     /// Change fields with struct update syntax: `View { shadows, ..View::new(camera) }`.
     pub fn new(camera: Camera) -> View {
         View {
@@ -240,6 +243,7 @@ impl View {
             shadows: Default::default(),
             transparency: Default::default(),
             lod_appearance: true,
+            multiple_scattering: false,
             temporal: Default::default(),
             volumes: super::volume::VolumeTier::OFF,
         }
@@ -296,7 +300,12 @@ impl View {
             ],
             lod_ortho: [0.0; 4],
             counts: [bundles, characters, self.lod.enabled as u32, vertex_budget],
-            shading: [self.shading as u32, self.lod_appearance as u32, 0, 0],
+            shading: [
+                self.shading as u32,
+                self.lod_appearance as u32,
+                self.multiple_scattering as u32,
+                0,
+            ],
             // Filled in by the renderer once the light view is fitted.
             light_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
             shadow: [0; 4],

@@ -15,6 +15,7 @@
 //! transparency = "oit:8"           # opaque, oit[:K] (K-buffer), peel[:N] (depth peeling)
 //! temporal = "taa"                 # off, taa (temporal accumulation made for strands)
 //! lod_appearance = true            # seed 000's thick-strand term under LoD (default on)
+//! multiple_scattering = true       # dual scattering under marschner (default off)
 //! [[character]]
 //! mesh = "hairmeshes/head_long.obj" # .obj (baked on load) or .hmb; relative to this file
 //! style = "hairmeshes/head_long.toml" # optional: default is the style beside the mesh / baked in
@@ -80,6 +81,8 @@ pub struct LookDesc {
     pub transparency: Option<String>,
     /// Thick-strand appearance term under LoD.
     pub lod_appearance: Option<bool>,
+    /// Multiple scattering (dual scattering) under the Marschner model.
+    pub multiple_scattering: Option<bool>,
     /// Temporal accumulation (`render::Temporal`): `off` or `taa`.
     pub temporal: Option<String>,
 }

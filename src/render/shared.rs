@@ -37,7 +37,10 @@ pub const VOLUME_BUILT: u32 = 1;
 /// occluded by its density volume (`shade::volume::ambient_visibility`).
 pub const VOLUME_OCCLUSION: u32 = 2;
 
-pub use crate::shade::lut::{MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE};
+pub use crate::shade::lut::{
+    MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE, SCATTER_LUT_THETA,
+    SHADING_LUT_HEIGHT, SHADING_LUT_WIDTH,
+};
 
 /// Software rasterizer: side of a square screen tile in pixels (one raster workgroup).
 pub const SOFT_TILE: u32 = 16;
@@ -468,7 +471,7 @@ pub struct FrameBlock {
     /// (compute path, in `HairVertex` slots).
     pub counts: [u32; 4],
     /// x shading model (`shade::ShadingModel`), y thick-strand appearance term on (seed 000,
-    /// `lod_appearance.glsl`); zw reserved.
+    /// `lod_appearance.glsl`), z multiple scattering on (`shade::scattering`); w reserved.
     pub shading: [u32; 4],
     /// World to the light's clip space (the shadow maps; camera views only).
     pub light_view_proj: [[f32; 4]; 4],
@@ -1041,6 +1044,9 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("VOLUME_DIMS_BITS", VOLUME_DIMS_BITS),
         uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
         uint("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
+        uint("SCATTER_LUT_THETA", SCATTER_LUT_THETA),
+        uint("SHADING_LUT_WIDTH", SHADING_LUT_WIDTH),
+        uint("SHADING_LUT_HEIGHT", SHADING_LUT_HEIGHT),
         layout("SET_FRAME", SET_FRAME),
         layout("SET_TEXTURES", SET_TEXTURES),
         uint("SOFT_TILE", SOFT_TILE),
@@ -1095,6 +1101,13 @@ fn float_constants() -> Vec<(&'static str, f32)> {
         ("HAIR_ETA", crate::shade::HAIR_ETA),
         ("KAJIYA_KAY_EXPONENT", crate::shade::KAJIYA_KAY_EXPONENT),
         ("MARSCHNER_ENERGY_SCALE", crate::shade::ENERGY_SCALE),
+        ("LIGHT_IRRADIANCE", crate::shade::LIGHT_IRRADIANCE),
+        ("AMBIENT", crate::shade::AMBIENT),
+        ("FORWARD_DENSITY", crate::shade::scattering::FORWARD_DENSITY),
+        (
+            "BACKWARD_DENSITY",
+            crate::shade::scattering::BACKWARD_DENSITY,
+        ),
         ("SHADOW_OPACITY_FIXED", SHADOW_OPACITY_FIXED),
         ("VOLUME_FIXED", VOLUME_FIXED),
         ("SPLAT_SPACING", crate::reference::volume::SPLAT_SPACING),

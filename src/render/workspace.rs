@@ -11,7 +11,9 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec2;
 
-use super::shared::{FrameBinding, GenerateArgs, MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, SCAN_BLOCK};
+use super::shared::{
+    FrameBinding, GenerateArgs, SCAN_BLOCK, SHADING_LUT_HEIGHT, SHADING_LUT_WIDTH,
+};
 use crate::bake::blue_noise::{quad_samples, triangle_samples};
 use crate::vk::{Buffer, BufferDesc, Context, DescriptorSet, GpuResult, Image, ImageDesc, Sampler};
 
@@ -144,12 +146,12 @@ impl Workspace {
             shading_lut: Image::with_data(
                 ctx,
                 &ImageDesc::new_2d(
-                    "marschner lut",
+                    "shading lut",
                     vk::Format::R16G16B16A16_UNORM,
-                    MARSCHNER_LUT_PHI,
-                    MARSCHNER_LUT_D,
+                    SHADING_LUT_WIDTH,
+                    SHADING_LUT_HEIGHT,
                 ),
-                bytemuck::cast_slice(&crate::shade::lut::marschner_lut()),
+                bytemuck::cast_slice(crate::shade::lut::shading_lut()),
             )?,
             lut_sampler: Sampler::linear_clamp(ctx)?,
         })

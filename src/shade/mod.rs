@@ -14,6 +14,7 @@ use glam::Vec3;
 
 pub mod lod_appearance;
 pub mod lut;
+pub mod scattering;
 pub mod volume;
 
 /// Which model shades the strands.
@@ -59,6 +60,11 @@ pub fn melanin_color(eumelanin: f32, pheomelanin: f32) -> Vec3 {
     (-sigma).exp()
 }
 
+/// Irradiance of the directional light (perpendicular to it) in the physically based models.
+pub const LIGHT_IRRADIANCE: f32 = 4.5;
+/// Ambient (sky) radiance scale: strands add `colour * AMBIENT * ambient visibility`.
+pub const AMBIENT: f32 = 0.25;
+
 /// Refractive index of hair keratin.
 pub const HAIR_ETA: f32 = 1.55;
 /// Kajiya-Kay specular exponent.
@@ -84,7 +90,7 @@ pub fn fresnel(eta: f32, cos_theta: f32) -> f32 {
 }
 
 /// Normalised Gaussian of width `beta` at `x`.
-fn gaussian(beta: f32, x: f32) -> f32 {
+pub(crate) fn gaussian(beta: f32, x: f32) -> f32 {
     (-x * x / (2.0 * beta * beta)).exp() / ((2.0 * std::f32::consts::PI).sqrt() * beta)
 }
 
@@ -164,12 +170,12 @@ pub fn azimuthal_factors(cos_phi: f32, cos_d: f32) -> AzimuthalFactors {
 pub const ENERGY_SCALE: f32 = 0.9;
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// `integral over the sphere of S(omega_i, omega_o) cos(theta_o) d omega_o` for white hair
     /// (no absorption) and incidence `theta_i`, by midpoint quadrature in (theta_o, phi).
-    fn furnace(theta_i: f32, p: &MarschnerParams) -> f32 {
+    pub(crate) fn furnace(theta_i: f32, p: &MarschnerParams) -> f32 {
         let t = Vec3::Y;
         let l = Vec3::new(theta_i.cos(), theta_i.sin(), 0.0);
         let (nt, np) = (400, 400);

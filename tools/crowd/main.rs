@@ -117,6 +117,10 @@ pub struct Args {
     /// Seed 000's thick-strand appearance term under LoD.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     lod_appearance: bool,
+    /// Multiple scattering between strands under marschner (dual scattering, seed 000): light
+    /// hair glows through itself instead of going flat and grey.
+    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
+    multiple_scattering: bool,
     /// The volume tier (seed 002): far characters' hair ray-marched through strand density
     /// volumes, and volumetric ambient occlusion of every character's hair; off: strands
     /// only, no occlusion.
@@ -494,6 +498,7 @@ fn run(args: Args) -> Result<()> {
             transparency: args.transparency,
             temporal: args.temporal,
             lod_appearance: args.lod_appearance,
+            multiple_scattering: args.multiple_scattering,
             volumes,
             ..View::new(camera)
         };

@@ -47,6 +47,7 @@ struct Controls {
     temporal: Temporal,
     raster: StrandRaster,
     lod_appearance: bool,
+    multiple_scattering: bool,
     volumes: hairmesh::render::VolumeTier,
     moving: bool,
     simulating: bool,
@@ -156,6 +157,10 @@ impl Controls {
                     }
                 });
                 ui.checkbox(&mut self.lod_appearance, "thick-strand appearance (LoD)");
+                ui.checkbox(
+                    &mut self.multiple_scattering,
+                    "multiple scattering (Marschner)",
+                );
                 ui.horizontal(|ui| {
                     ui.checkbox(&mut self.volumes.occlusion, "volumetric AO");
                     let mut far = self.volumes.far.is_some();
@@ -322,6 +327,7 @@ struct Running {
     /// The software rasterizer can draw this window's frames (device support, no MSAA).
     soft_ok: bool,
     lod_appearance: bool,
+    multiple_scattering: bool,
     volumes: hairmesh::render::VolumeTier,
     animation: hairmesh::animate::CrowdAnimation,
     last_draw: Instant,
@@ -492,6 +498,7 @@ impl App {
             temporal: self.args.temporal,
             raster: chosen.raster,
             lod_appearance: self.args.lod_appearance,
+            multiple_scattering: self.args.multiple_scattering,
             volumes: self.args.volume_tier()?,
             animation,
             last_draw: Instant::now(),
@@ -589,6 +596,7 @@ impl Running {
             transparency: self.transparency,
             temporal: self.temporal,
             lod_appearance: self.lod_appearance,
+            multiple_scattering: self.multiple_scattering,
             volumes: self.volumes,
             ..View::new(camera)
         };
@@ -655,6 +663,7 @@ impl Running {
             temporal: self.temporal,
             raster: self.raster,
             lod_appearance: self.lod_appearance,
+            multiple_scattering: self.multiple_scattering,
             volumes: self.volumes,
             moving: self.animation.moving,
             simulating: self.animation.simulating,
@@ -743,6 +752,7 @@ impl Running {
         self.temporal = c.temporal;
         self.raster = c.raster;
         self.lod_appearance = c.lod_appearance;
+        self.multiple_scattering = c.multiple_scattering;
         self.volumes = c.volumes;
         self.animation.moving = c.moving;
         self.animation.simulating = c.simulating;
