@@ -98,24 +98,32 @@ vec3 half_moments(vec3 e, vec3 shifts, vec3 widths) {
     return vec3(total, dot(e, shifts) * w, dot(e, widths * widths) * w);
 }
 
-// Local back-scattering A_b = A_1 + A_3 with its mean shift and variance
-// (shade::scattering::back_scattering).
-vec3 back_scattering(vec3 front, vec3 back) {
+// Local back-scattering A_1 + A_3 (Zinke) + A_1+ (seed 000 eq. 10, a cluster crossed `cluster`
+// times) with its mean shift and variance (shade::scattering::back_scattering).
+vec3 back_scattering(vec3 front, vec3 back, float cluster) {
     float af2 = front.x * front.x;
     float q = max(1.0 - af2, 1e-4);
     float a1 = back.x * af2 / q;
     float a3 = back.x * back.x * back.x * af2 / (q * q * q);
-    float w = 1.0 / max(a1 + a3, 1e-8);
-    float shift = (a1 * (back.y + 2.0 * front.y) + a3 * (3.0 * back.y + 2.0 * front.y)) * w;
-    float var = (a1 * (back.z + 2.0 * front.z) + a3 * (3.0 * back.z + 2.0 * front.z)) * w;
+    float n = max(cluster, 1.0);
+    float gap = GAP_DENSITY * back.x * front.x * (1.0 - pow(af2, n)) / q;
+    float gap_forward = min((1.0 + af2) / q, 2.0 * n - 1.0);
+    float w = 1.0 / max(a1 + a3 + gap, 1e-8);
+    float shift = (a1 * (back.y + 2.0 * front.y) + a3 * (3.0 * back.y + 2.0 * front.y)
+        + gap * (back.y + gap_forward * front.y)) * w;
+    float var = (a1 * (back.z + 2.0 * front.z) + a3 * (3.0 * back.z + 2.0 * front.z)
+        + gap * (back.z + gap_forward * front.z)) * w;
     float widen = 1.0 + BACKWARD_DENSITY * af2;
-    return vec3(a1 + a3, shift, var * widen * widen);
+    return vec3(a1 + a3 + gap, shift, var * widen * widen);
 }
 
 // Radiance per unit light irradiance (shade::scattering::dual_scattering): single scattering
 // of the direct light, plus with `multiple` Zinke's global and local multiple scattering per
-// channel. arrival: x direct fraction, y fraction not behind bodies, z expected strand hits.
-vec3 dual_scattering(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt, vec3 arrival, bool multiple) {
+// channel and seed 000's aggregated model for a strand standing for a cluster whose strands a
+// ray crosses `cluster` times (1: one strand). arrival: x direct fraction, y fraction not
+// behind bodies, z expected strand hits.
+vec3 dual_scattering(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt, vec3 arrival, bool multiple,
+                     float cluster) {
     vec3 single = marschner(t, l, v, color, roughness, tilt);
     vec4 ang = hair_angles(t, l, v);
     if (!multiple) {
@@ -130,7 +138,9 @@ vec3 dual_scattering(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float 
         vec3 ef = lobe_energies(0u, ang.y, color[ch]);
         vec3 eb = lobe_energies(1u, ang.y, color[ch]);
         vec3 front = half_moments(ef, shifts, widths);
-        vec3 back = back_scattering(front, half_moments(eb, shifts, widths));
+        vec3 back = back_scattering(front, half_moments(eb, shifts, widths), cluster);
+        // Eq. 8: light leaving through the cluster's far side crossed its other strands.
+        float inherited = pow(max(front.x, 1e-6), (max(cluster, 1.0) - 1.0) * 0.5 * (1.0 - ang.z));
         float scattered = max(arrival.y * exp(-arrival.z * (1.0 - front.x)) - arrival.x, 0.0);
         float spread = max(arrival.z, 1.0) * front.z;
         float back_direct = back.x * 0.5 * hair_gaussian(sqrt(back.z), ang.x - back.y) * back_azimuth;
@@ -140,7 +150,7 @@ vec3 dual_scattering(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float 
                       hair_gaussian(sqrt(widths.y * widths.y + spread), ang.x - shifts.y),
                       hair_gaussian(sqrt(widths.z * widths.z + spread), ang.x - shifts.z));
         float global = 0.5 * dot(g, energy) / 6.28318530718;
-        float direct = arrival.x * (single[ch] + BACKWARD_DENSITY * back_direct * inv_cos2);
+        float direct = arrival.x * (single[ch] * inherited + BACKWARD_DENSITY * back_direct * inv_cos2);
         float scatter = FORWARD_DENSITY * scattered * (global + BACKWARD_DENSITY * back_spread) * inv_cos2;
         result[ch] = (direct + scatter) * ang.w;
     }

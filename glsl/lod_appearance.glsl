@@ -12,8 +12,9 @@
 //   (c = the strip's coverage, so about sqrt(k) strands along a ray, seed 000's n), and light
 //   through a point passes (1 - a1 c / k)^k rather than (1 - a1 c): exact at k = 1, the
 //   Poisson limit exp(-a1 c) for large k.
-// - Multiple scattering: our stand-in for it is the constant ambient term at every level of
-//   detail, so there is nothing to rescale (seed 000's B lobe would scale it with n).
+// - Multiple scattering (with frame.shading.z): seed 000's aggregated BCSDF (eqs. 7-11) in
+//   hair_shading.glsl's dual_scattering, with the strands a ray crosses in the cluster
+//   (cluster_crossings).
 #ifndef LOD_APPEARANCE_GLSL
 #define LOD_APPEARANCE_GLSL
 
@@ -24,6 +25,15 @@ float cluster_min_width(float pixel, float thickness, float cap) {
         return pixel;
     }
     return max(pixel, min(sqrt(max(thickness, 1.0)) * pixel, cap));
+}
+
+// Strands of a strip's cluster that a ray crosses: sqrt(k) at packing density 1 (seed 000's
+// n; 1 for a single strand or with the term off).
+float cluster_crossings(float thickness) {
+    if (frame.shading.y == 0u) {
+        return 1.0;
+    }
+    return sqrt(max(thickness, 1.0));
 }
 
 // Opacity of a strip of `thickness` strands whose single-strand opacity over the pixel is

@@ -2,7 +2,7 @@
 // Test probe (tests/shading_twin.rs): evaluates the GPU shading models at given directions so
 // they can be compared with their CPU twins in src/shade/mod.rs and src/shade/scattering.rs.
 // Per sample, inputs are five vec4 (tangent, to light, to eye, colour + roughness, tilt +
-// light arrival + multiple scattering flag) and outputs three vec4 (Marschner rgb;
+// light arrival + cluster crossings (0: multiple scattering off)) and outputs three vec4 (Marschner rgb;
 // Kajiya-Kay diffuse, specular; dual scattering rgb). Binding 2: the shading lookup texture.
 #extension GL_GOOGLE_include_directive : require
 #define SHADING_LUT_SET 0
@@ -28,5 +28,5 @@ void main() {
     vec3 arrival = vec3(extra.y * exp(-extra.z), extra.y, extra.z);
     outputs[3u * i] = vec4(marschner(t, l, v, cr.rgb, cr.a, tilt), 0.0);
     outputs[3u * i + 1u] = vec4(kajiya_kay(t, l, v), 0.0, 0.0);
-    outputs[3u * i + 2u] = vec4(dual_scattering(t, l, v, cr.rgb, cr.a, tilt, arrival, extra.w != 0.0), 0.0);
+    outputs[3u * i + 2u] = vec4(dual_scattering(t, l, v, cr.rgb, cr.a, tilt, arrival, extra.w != 0.0, max(extra.w, 1.0)), 0.0);
 }

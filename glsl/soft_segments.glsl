@@ -102,7 +102,7 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
         vec3 ndc = c.xyz / max(c.w, 1e-6);
         vec2 screen = (ndc.xy * 0.5 + 0.5) * frame.viewport.xy;
         sv_screen[idx] = vec4(screen, ndc.z, in_range ? drawn / pixel : -1.0);
-        vec3 radiance = frame.soft.x == RASTER_LIGHT ? vec3(0.0) : strand_radiance(st[idx], s, p, color, character);
+        vec3 radiance = frame.soft.x == RASTER_LIGHT ? vec3(0.0) : strand_radiance(st[idx], s, p, color, character, thickness);
         sv_color[idx] = pack_fragment(radiance, width / max(drawn, 1e-20));
 #if defined(VISIBILITY) && !defined(SOFT_POOL)
         sv_residual[idx] = entry_residual(idx, character);

@@ -26,7 +26,7 @@ bool shown_as_volume() {
 
 // Radiance toward the eye of this fragment's strand.
 vec3 shade_strand() {
-    return strand_radiance(in_tangent, in_s, in_pos, in_color, in_character);
+    return strand_radiance(in_tangent, in_s, in_pos, in_color, in_character, in_thickness);
 }
 
 // Opacity of this fragment over its pixel: one strand's opacity times the fraction of the

@@ -8,16 +8,19 @@
 #include "hair_shading.glsl"
 #include "shadow_lookup.glsl"
 #include "volume_shading.glsl"
+#include "lod_appearance.glsl"
 
 // LIGHT_IRRADIANCE (the directional light) and AMBIENT (the sky) come from shared.glsl (Rust
 // twins in src/shade/mod.rs). With frame.shading.z on, Marschner adds dual scattering
 // (hair_shading.glsl) from the light; the ambient term is the sky in every model.
 
 // Radiance toward the eye at world point `pos` of a strand with unit-ish tangent `tangent`,
-// parameter `s` along it, base colour `base`, of character `character`, given how the light
-// arrives there (`arrival`: light_arrival's direct fraction, open fraction, strand hits) and
-// the ambient light's visibility `ambient`.
-vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character, vec3 arrival, float ambient) {
+// parameter `s` along it, base colour `base`, of character `character`, standing for
+// `thickness` strands (strand LoD; 1 at full detail), given how the light arrives there
+// (`arrival`: light_arrival's direct fraction, open fraction, strand hits) and the ambient
+// light's visibility `ambient`.
+vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character, float thickness, vec3 arrival,
+                         float ambient) {
     float lit = arrival.x;
     vec3 t = normalize(tangent);
     vec3 l = normalize(frame.light_dir.xyz);
@@ -30,7 +33,7 @@ vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint 
     } else if (frame.shading.x == SHADING_MARSCHNER) {
         HairStyle s = characters[character].style;
         vec3 sc = dual_scattering(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees), arrival,
-                                  frame.shading.z != 0u);
+                                  frame.shading.z != 0u, cluster_crossings(thickness));
         c = (sc * LIGHT_IRRADIANCE + base * (AMBIENT * ambient)) * root_shadow;
     } else {
         float tl = dot(t, l);
@@ -46,8 +49,8 @@ vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint 
 // strand_radiance_lit with the light through the light's maps (hair and bodies in front of
 // the point) and the ambient light through the character's density volume (volumetric
 // ambient occlusion, where on).
-vec3 strand_radiance(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character) {
-    return strand_radiance_lit(tangent, s_param, pos, base, character, light_arrival(pos, 0.0),
+vec3 strand_radiance(vec3 tangent, float s_param, vec3 pos, vec3 base, uint character, float thickness) {
+    return strand_radiance_lit(tangent, s_param, pos, base, character, thickness, light_arrival(pos, 0.0),
                                volume_ambient(character, pos));
 }
 

@@ -82,7 +82,7 @@ void main() {
     }
     HairStyle style = characters[c].style;
     vec3 base = vec3(style.color[0], style.color[1], style.color[2]);
-    vec3 radiance = strand_radiance_lit(tangent, 1.0, point, base, c, arrival, volume_ambient(c, point));
+    vec3 radiance = strand_radiance_lit(tangent, 1.0, point, base, c, 1.0, arrival, volume_ambient(c, point));
     vec4 clip = frame.view_proj * vec4(point, 1.0);
     float depth = clamp(clip.z / clip.w, 0.0, 1.0);
     gl_FragDepth = depth;

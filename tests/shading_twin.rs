@@ -53,6 +53,8 @@ fn gpu_shading_equals_the_cpu_twin() {
             1.0
         };
         let multiple = rng.next_f32() < 0.75;
+        // Strands a ray crosses in the strand's cluster (strand LoD): one, or up to 8.
+        let cluster = if rng.next_f32() < 0.5 { 1.0 } else { 1.0 + 7.0 * rng.next_f32() };
         let arrival = LightArrival {
             direct: open * (-hits).exp(),
             open,
@@ -63,9 +65,9 @@ fn gpu_shading_equals_the_cpu_twin() {
             l.extend(0.0).to_array(),
             v.extend(0.0).to_array(),
             color.extend(p.roughness).to_array(),
-            [p.tilt, open, hits, multiple as u32 as f32],
+            [p.tilt, open, hits, if multiple { cluster } else { 0.0 }],
         ]);
-        cases.push((t, l, v, p, arrival, multiple));
+        cases.push((t, l, v, p, arrival, multiple, cluster));
     }
     let input = Buffer::with_data(
         &ctx,
@@ -125,7 +127,7 @@ fn gpu_shading_equals_the_cpu_twin() {
     // Relative to the larger of the value and 1e-3 (S spans many decades).
     let relative =
         |gpu: Vec3, cpu: Vec3| ((gpu - cpu).abs() / cpu.abs().max(Vec3::splat(1e-3))).max_element();
-    for (i, (t, l, v, p, arrival, multiple)) in cases.iter().enumerate() {
+    for (i, (t, l, v, p, arrival, multiple, cluster)) in cases.iter().enumerate() {
         let gpu = Vec3::from_slice(&out[3 * i][..3]);
         worst_m = worst_m.max(relative(gpu, marschner(*t, *l, *v, p)));
         let (d, s) = kajiya_kay(*t, *l, *v);
@@ -134,7 +136,7 @@ fn gpu_shading_equals_the_cpu_twin() {
         let gpu = Vec3::from_slice(&out[3 * i + 2][..3]);
         worst_d = worst_d.max(relative(
             gpu,
-            dual_scattering(*t, *l, *v, p, *arrival, *multiple),
+            dual_scattering(*t, *l, *v, p, *arrival, *multiple, *cluster),
         ));
     }
     println!(

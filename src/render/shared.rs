@@ -1108,6 +1108,7 @@ fn float_constants() -> Vec<(&'static str, f32)> {
             "BACKWARD_DENSITY",
             crate::shade::scattering::BACKWARD_DENSITY,
         ),
+        ("GAP_DENSITY", crate::shade::scattering::GAP_DENSITY),
         ("SHADOW_OPACITY_FIXED", SHADOW_OPACITY_FIXED),
         ("VOLUME_FIXED", VOLUME_FIXED),
         ("SPLAT_SPACING", crate::reference::volume::SPLAT_SPACING),

@@ -29,6 +29,10 @@ pub const FORWARD_DENSITY: f32 = 0.7;
 /// Zinke's backward density factor `d_b` (0.7 in the paper).
 pub const BACKWARD_DENSITY: f32 = 0.7;
 
+/// Seed 000's `d_1+` (eq. 10): the share of the gap paths that reach the strand (0.6 in the
+/// paper).
+pub const GAP_DENSITY: f32 = 0.6;
+
 /// Azimuthal samples of the half-circle in [`lobe_energies`].
 const AZIMUTH_SAMPLES: usize = 128;
 
@@ -133,25 +137,46 @@ fn half_moments(energies: &[f32; 3], shapes: &[(f32, f32); 3]) -> (f32, f32, f32
     (total, alpha, var)
 }
 
-/// Local back-scattering (Zinke 2008 sec. 4.2; seed 000 eq. 4's `A_B = A_1 + A_3`): its
-/// attenuation, mean longitudinal shift and variance, from one channel's forward and backward
-/// moments `(a, alpha, beta^2)`.
+/// Local back-scattering (Zinke 2008 sec. 4.2; seed 000 eqs. 4, 10, 11): its attenuation,
+/// mean longitudinal shift and variance, from one channel's forward and backward moments
+/// `(a, alpha, beta^2)`, for a strand standing for a cluster whose strands a ray crosses
+/// `cluster` times (1 for a single strand).
 ///
-/// `A_1 = a_b a_f^2 / (1 - a_f^2)` sums the paths into the hair through `k >= 1` strands, one
-/// backward scattering and out again (`a_f^2k a_b`); `A_3 = a_b^3 a_f^2 / (1 - a_f^2)^3` those
-/// with three. Each path's shift and variance add its lobes' (`2 forward + 1 or 3 back`); the
-/// result is their attenuation-weighted mean, widened by `(1 + d_b a_f^2)` as Zinke does.
-pub fn back_scattering(front: (f32, f32, f32), back: (f32, f32, f32)) -> (f32, f32, f32) {
+/// - `A_1 = a_b a_f^2 / (1 - a_f^2)` sums the paths into the hair through `k >= 1` strands, one
+///   backward scattering and out again (`a_f^2k a_b`); `A_3 = a_b^3 a_f^2 / (1 - a_f^2)^3`
+///   those with three (Zinke).
+/// - Seed 000's gap paths (eq. 10): light that reached strands behind through gaps and comes
+///   back, `A_1+ = d_1+ a_b sum_{i=1}^{n} a_f^(2i-1) = d_1+ a_b a_f (1 - a_f^2n) / (1 - a_f^2)`
+///   (closed form, so fractional `n` changes it smoothly). Its paths cross on average
+///   `(1 + a_f^2) / (1 - a_f^2)` forward lobes, at most `2n - 1`.
+///
+/// Each path's shift and variance add its lobes'; the result is their attenuation-weighted
+/// mean (eq. 11's "averaged accumulated variance"), widened by `(1 + d_b a_f^2)` as Zinke
+/// does.
+pub fn back_scattering(
+    front: (f32, f32, f32),
+    back: (f32, f32, f32),
+    cluster: f32,
+) -> (f32, f32, f32) {
     let (af, alpha_f, var_f) = front;
     let (ab, alpha_b, var_b) = back;
     let af2 = af * af;
     let q = (1.0 - af2).max(1e-4);
     let a1 = ab * af2 / q;
     let a3 = ab * ab * ab * af2 / (q * q * q);
-    let total = a1 + a3;
+    let n = cluster.max(1.0);
+    let gap = GAP_DENSITY * ab * af * (1.0 - af2.powf(n)) / q;
+    let gap_forward = ((1.0 + af2) / q).min(2.0 * n - 1.0);
+    let total = a1 + a3 + gap;
     let w = 1.0 / total.max(1e-8);
-    let shift = (a1 * (alpha_b + 2.0 * alpha_f) + a3 * (3.0 * alpha_b + 2.0 * alpha_f)) * w;
-    let var = (a1 * (var_b + 2.0 * var_f) + a3 * (3.0 * var_b + 2.0 * var_f)) * w;
+    let shift = (a1 * (alpha_b + 2.0 * alpha_f)
+        + a3 * (3.0 * alpha_b + 2.0 * alpha_f)
+        + gap * (alpha_b + gap_forward * alpha_f))
+        * w;
+    let var = (a1 * (var_b + 2.0 * var_f)
+        + a3 * (3.0 * var_b + 2.0 * var_f)
+        + gap * (var_b + gap_forward * var_f))
+        * w;
     let widen = 1.0 + BACKWARD_DENSITY * af2;
     (total, shift, var * widen * widen)
 }
@@ -185,6 +210,15 @@ pub fn hair_angles(t: Vec3, l: Vec3, v: Vec3) -> [f32; 4] {
 /// (light arrives from the whole front half, seed 000 eq. 3), and `f_back` is the local lobe of
 /// energy `A_b` with azimuthal distribution `(1 + cos(phi)) / 2 pi` (eq. 4's `I_B / pi`,
 /// smoothed so it has no seam at `phi = 90` degrees; same energy).
+///
+/// A strand standing for a cluster (strand LoD; a ray crosses `cluster` of its strands, 1 for
+/// a single strand) gets seed 000's aggregated model (eqs. 7-11) on top, continuous in
+/// `cluster`: the inherited single-scattering lobes lose `a_f^(n - 1)` where light leaves the
+/// cluster's far side (eq. 8; weighted by `(1 - cos(phi)) / 2` instead of the hemisphere
+/// indicator, so there is no seam; eq. 9's widening of their lobes is left out: it moves no
+/// energy), and the local lobe gains the gap paths `A_1+` (eq. 10, [`back_scattering`]).
+/// Clusters are drawn at packing density 1 (`lod_appearance.glsl`), where eq. 15's
+/// shadowing-masking term is 1.
 pub fn dual_scattering(
     t: Vec3,
     l: Vec3,
@@ -192,6 +226,7 @@ pub fn dual_scattering(
     p: &MarschnerParams,
     arrival: LightArrival,
     multiple: bool,
+    cluster: f32,
 ) -> Vec3 {
     let single = super::marschner(t, l, v, p);
     let [theta_h, cos_d, cos_phi, cos_i] = hair_angles(t, l, v);
@@ -205,7 +240,11 @@ pub fn dual_scattering(
         let e = lobe_energies(cos_d, c);
         let front = half_moments(&e.front, &shapes);
         let back = half_moments(&e.back, &shapes);
-        let (a_b, shift_b, var_b) = back_scattering(front, back);
+        let (a_b, shift_b, var_b) = back_scattering(front, back, cluster);
+        // Eq. 8: light leaving through the cluster's far side crossed its other strands.
+        let inherited = front
+            .0
+            .powf((cluster.max(1.0) - 1.0) * 0.5 * (1.0 - cos_phi));
         let back_lobe = |spread: f32| {
             a_b * 0.5 * gaussian((var_b + spread).sqrt(), theta_h - shift_b) * back_azimuth
         };
@@ -220,7 +259,8 @@ pub fn dual_scattering(
                     / std::f32::consts::TAU
             })
             .sum();
-        let direct = arrival.direct * (single + BACKWARD_DENSITY * back_lobe(0.0) * inv_cos2);
+        let direct = arrival.direct
+            * (single * inherited + BACKWARD_DENSITY * back_lobe(0.0) * inv_cos2);
         let multiple = FORWARD_DENSITY
             * scattered
             * (global + BACKWARD_DENSITY * back_lobe(spread))
@@ -288,8 +328,10 @@ mod tests {
                 let e = lobe_energies(deg.to_radians().cos(), c);
                 let front = half_moments(&e.front, &shapes);
                 let back = half_moments(&e.back, &shapes);
-                let (a_b, _, var) = back_scattering(front, back);
-                let sent_back = back.0 + BACKWARD_DENSITY * a_b;
+                let (a_b, _, var) = back_scattering(front, back, 1.0);
+                // With a cluster of any size the gap paths stay within the budget too.
+                let (a_big, _, _) = back_scattering(front, back, 1e4);
+                let sent_back = back.0 + BACKWARD_DENSITY * a_big;
                 assert!(
                     sent_back <= 1.0 && front.0 + back.0 <= 1.0 && var > 0.0,
                     "melanin {eumelanin}, {deg} deg: {sent_back} {front:?} {back:?}"
@@ -327,7 +369,7 @@ mod tests {
 
     /// With multiple scattering off the response is single scattering of the direct light;
     /// with it on, light hair gains much more than dark hair, both lit (local back-scattering:
-    /// blond +23%, black +0.3%) and behind three strand hits (global: blond 22x, black 1.3x).
+    /// blond +32%, black +3%) and behind three strand hits (global: blond 23x, black 1.3x).
     #[test]
     fn multiple_scattering_brightens_light_hair_more_than_dark() {
         let t = Vec3::Y;
@@ -336,11 +378,11 @@ mod tests {
         for arrival in [LightArrival::FULL, LightArrival::through(3.0)] {
             let gain = |eumelanin: f32| {
                 let p = params(melanin_color(eumelanin, 0.0));
-                let single = dual_scattering(t, l, v, &p, arrival, false);
+                let single = dual_scattering(t, l, v, &p, arrival, false, 1.0);
                 let off = crate::shade::marschner(t, l, v, &p)
                     * (hair_angles(t, l, v)[3] * arrival.direct);
                 assert!((single - off).abs().max_element() < 1e-6);
-                let on = dual_scattering(t, l, v, &p, arrival, true);
+                let on = dual_scattering(t, l, v, &p, arrival, true, 1.0);
                 assert!(on.cmpge(single).all(), "{on} < {single}");
                 on.y / single.y.max(1e-9)
             };
@@ -354,6 +396,29 @@ mod tests {
             let black_most = if arrival.hits == 0.0 { 1.05 } else { 1.5 };
             assert!(black < black_most, "black hair gains {black}");
             assert!(blond > 1.15, "blond hair gains only {blond}");
+        }
+    }
+
+    /// Seed 000's aggregated model is continuous in the cluster size (a cluster of one is a
+    /// strand), dims light leaving through a cluster's far side and adds back-scattering from
+    /// its gaps on the light's side, more for larger clusters.
+    #[test]
+    fn clusters_change_the_look_smoothly() {
+        let t = Vec3::Y;
+        let l = Vec3::new(0.3, 0.2, 1.0).normalize();
+        let p = params(melanin_color(0.3, 0.1));
+        let through = Vec3::new(-0.2, -0.1, -1.0).normalize();
+        let back = Vec3::new(0.5, -0.1, 1.0).normalize();
+        for v in [through, back] {
+            let at = |n: f32| dual_scattering(t, l, v, &p, LightArrival::FULL, true, n);
+            assert!((at(1.0) - at(1.0001)).abs().max_element() < 1e-4);
+            let (one, four, sixteen) = (at(1.0), at(2.0), at(4.0));
+            println!("{v}: cluster 1 {one}, 4 strands {four}, 16 strands {sixteen}");
+            if v == through {
+                assert!(four.y < one.y && sixteen.y < four.y, "{one} {four} {sixteen}");
+            } else {
+                assert!(four.y > one.y && sixteen.y > four.y, "{one} {four} {sixteen}");
+            }
         }
     }
 }
