@@ -218,7 +218,12 @@ fn aggregated_scattering_keeps_thick_strands_close_to_full_detail() {
         );
         if l_on.abs() > TOLERANCE || h_on.abs() > TOLERANCE {
             let dir = output_dir();
-            save_png(&dir.join(format!("lod_ms_{name}_full.png")), SIZE, SIZE, &full);
+            save_png(
+                &dir.join(format!("lod_ms_{name}_full.png")),
+                SIZE,
+                SIZE,
+                &full,
+            );
             save_png(&dir.join(format!("lod_ms_{name}_on.png")), SIZE, SIZE, &on);
             panic!("{name}: luminance {l_on:+.3}, hue {h_on:+.3} off full detail");
         }

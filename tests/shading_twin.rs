@@ -54,7 +54,11 @@ fn gpu_shading_equals_the_cpu_twin() {
         };
         let multiple = rng.next_f32() < 0.75;
         // Strands a ray crosses in the strand's cluster (strand LoD): one, or up to 8.
-        let cluster = if rng.next_f32() < 0.5 { 1.0 } else { 1.0 + 7.0 * rng.next_f32() };
+        let cluster = if rng.next_f32() < 0.5 {
+            1.0
+        } else {
+            1.0 + 7.0 * rng.next_f32()
+        };
         let arrival = LightArrival {
             direct: open * (-hits).exp(),
             open,

@@ -45,6 +45,7 @@ fn scene(ctx: &Arc<Context>, desc: RendererDesc) -> (Renderer, View) {
     }
     let view = View {
         shading: ShadingModel::Marschner,
+        multiple_scattering: true,
         ..View::new(framing(&baked))
     };
     (r, view)

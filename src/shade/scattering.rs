@@ -259,8 +259,8 @@ pub fn dual_scattering(
                     / std::f32::consts::TAU
             })
             .sum();
-        let direct = arrival.direct
-            * (single * inherited + BACKWARD_DENSITY * back_lobe(0.0) * inv_cos2);
+        let direct =
+            arrival.direct * (single * inherited + BACKWARD_DENSITY * back_lobe(0.0) * inv_cos2);
         let multiple = FORWARD_DENSITY
             * scattered
             * (global + BACKWARD_DENSITY * back_lobe(spread))
@@ -415,9 +415,15 @@ mod tests {
             let (one, four, sixteen) = (at(1.0), at(2.0), at(4.0));
             println!("{v}: cluster 1 {one}, 4 strands {four}, 16 strands {sixteen}");
             if v == through {
-                assert!(four.y < one.y && sixteen.y < four.y, "{one} {four} {sixteen}");
+                assert!(
+                    four.y < one.y && sixteen.y < four.y,
+                    "{one} {four} {sixteen}"
+                );
             } else {
-                assert!(four.y > one.y && sixteen.y > four.y, "{one} {four} {sixteen}");
+                assert!(
+                    four.y > one.y && sixteen.y > four.y,
+                    "{one} {four} {sixteen}"
+                );
             }
         }
     }
