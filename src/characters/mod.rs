@@ -3,6 +3,7 @@
 //! ([`hairstyle`]) and scene presets ([`preset`]) that give every character its own hair
 //! mesh, style and placement.
 
+pub mod far_mesh;
 pub mod hairstyle;
 pub mod head;
 pub mod human;

@@ -83,7 +83,19 @@ pub mod prop_mesh {
     pub const BALL: usize = 3;
     /// A teapot.
     pub const TEAPOT: usize = 4;
+    /// The far version of [`HEAD`] ([`super::prop_lods`]).
+    pub const FAR_HEAD: usize = 5;
+    /// The far version of [`BODY`].
+    pub const FAR_BODY: usize = 6;
 }
+
+/// Cell of the far head (vertex clustering, `far_mesh`), metres.
+pub const FAR_HEAD_CELL: f32 = 0.025;
+/// Cell of the far body, metres.
+pub const FAR_BODY_CELL: f32 = 0.04;
+/// Pixels a far mesh's cell spans where the switch to it happens: the far version is drawn
+/// once a cell is under two pixels.
+pub const FAR_CELL_PIXELS: f32 = 2.0;
 
 /// Most vertex level fur uses: 2^3 = 8 segments are plenty for strands a few centimetres long.
 pub const FUR_MAX_VERTS_LOG2: u32 = 3;
@@ -196,13 +208,37 @@ pub fn build_families(
 /// Prop meshes of crowds, indexed by [`prop_mesh`].
 pub fn prop_meshes() -> Result<Vec<Vec<PropVertex>>> {
     let ball = ball_head();
+    let head = super::person::head_mesh()?;
+    let body = super::person::body_mesh();
+    let far_head = super::far_mesh::far_mesh(&head, FAR_HEAD_CELL);
+    let far_body = super::far_mesh::far_mesh(&body, FAR_BODY_CELL);
     Ok(vec![
         ground_mesh(60.0),
-        super::person::head_mesh()?,
-        super::person::body_mesh(),
+        head,
+        body,
         super::head::sphere_mesh(ball.centre, ball.radii * 0.985),
         super::teapot::teapot_mesh(TEAPOT_HEIGHT),
+        far_head,
+        far_body,
     ])
+}
+
+/// The far versions of the crowd's prop meshes (people's heads and bodies), switched where
+/// their cells span [`FAR_CELL_PIXELS`]: give them to `Renderer::set_prop_lods` after
+/// [`prop_meshes`].
+pub fn prop_lods(meshes: &[Vec<PropVertex>]) -> Vec<crate::render::prop_table::PropLod> {
+    let lod = |mesh: usize, far_mesh: usize, cell: f32| {
+        let (_, radius) = crate::render::prop_table::bounding_sphere(&meshes[mesh]);
+        crate::render::prop_table::PropLod {
+            mesh,
+            far_mesh,
+            below_pixels: FAR_CELL_PIXELS * 2.0 * radius / cell,
+        }
+    };
+    vec![
+        lod(prop_mesh::HEAD, prop_mesh::FAR_HEAD, FAR_HEAD_CELL),
+        lod(prop_mesh::BODY, prop_mesh::FAR_BODY, FAR_BODY_CELL),
+    ]
 }
 
 /// The world props: the ground.

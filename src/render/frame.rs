@@ -444,7 +444,12 @@ impl Renderer {
             ))
         };
         let world = motion.map_or(still, FrameMotion::camera);
-        let (prop_instances, prop_draws) = self.props.frame_lists(moved, world);
+        let camera = super::prop_table::Projection {
+            eye: glam::Vec3::from_slice(&block.camera_pos[..3]),
+            height: block.camera_pos[3],
+            cot_half_fov: block.light_dir[3],
+        };
+        let (prop_instances, prop_draws) = self.props.frame_lists(moved, world, &camera);
         let (width, height) = self.targets.size();
         let slot = &mut self.frames[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;

@@ -4,31 +4,89 @@
 use std::sync::Arc;
 
 use ash::vk;
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 
 use super::crowd::CharacterId;
 use super::passes::props::PropDraw;
 use super::shared::{PropInstance, PropVertex};
 use crate::vk::{Buffer, Context, GpuError, GpuResult};
 
+/// A far version of a prop mesh: instances whose bounding sphere spans fewer than
+/// `below_pixels` pixels of the camera's image are drawn with `far_mesh` instead (in every
+/// view of the frame, so their shadows match).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PropLod {
+    /// The mesh that has a far version.
+    pub mesh: usize,
+    /// Its far version.
+    pub far_mesh: usize,
+    /// Bounding-sphere diameter in pixels below which the far version is drawn.
+    pub below_pixels: f32,
+}
+
+/// How many pixels a sphere spans in a perspective view: eye, image height and
+/// `1 / tan(fov_y / 2)` (from the frame block; 0 for orthographic views, which pick no far
+/// meshes).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Projection {
+    pub(super) eye: Vec3,
+    pub(super) height: f32,
+    pub(super) cot_half_fov: f32,
+}
+
+impl Projection {
+    /// Diameter in pixels of a sphere of `radius` at `centre` (infinite at the eye or in
+    /// orthographic views).
+    fn pixels(&self, centre: Vec3, radius: f32) -> f32 {
+        let d = centre.distance(self.eye);
+        if self.cot_half_fov <= 0.0 || d <= radius {
+            return f32::INFINITY;
+        }
+        radius * self.height * self.cot_half_fov / d
+    }
+}
+
 /// Prop meshes on the GPU and the instances placed for the next frames.
 #[derive(Default)]
 pub(super) struct Props {
     pub(super) vertices: Option<Buffer>,
     pub(super) meshes: Vec<(u32, u32)>,
+    /// Bounding sphere (centre, radius) of each mesh in its own frame.
+    bounds: Vec<(Vec3, f32)>,
+    /// Far version of each mesh, if any: `(far mesh, below pixels)`.
+    far: Vec<Option<(usize, f32)>>,
     pub(super) instances: Vec<(usize, PropInstance)>,
     /// Props that move with a character: `(character, mesh, instance in its frame)`.
     pub(super) attached: Vec<(CharacterId, usize, PropInstance)>,
 }
 
 impl Props {
+    /// The mesh an instance of `mesh` at `model` is drawn with: its far version where the
+    /// camera sees it small.
+    fn mesh_for(&self, mesh: usize, model: &Mat4, camera: &Projection) -> usize {
+        let Some((far, below)) = self.far[mesh] else {
+            return mesh;
+        };
+        let (centre, radius) = self.bounds[mesh];
+        let scale = model
+            .x_axis
+            .truncate()
+            .length()
+            .max(model.y_axis.truncate().length())
+            .max(model.z_axis.truncate().length());
+        let pixels = camera.pixels(model.transform_point3(centre), radius * scale);
+        if pixels < below { far } else { mesh }
+    }
+
     /// This frame's instance records (sorted by mesh) and one draw per mesh: the world props
     /// (their motion: `world_clip_to_prev`, the camera's) and, placed by `model_of` (model
-    /// and clip_to_prev; `None`: not drawn), the characters' own.
+    /// and clip_to_prev; `None`: not drawn), the characters' own; far versions where `camera`
+    /// sees a prop small.
     pub(super) fn frame_lists(
         &self,
         model_of: impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
         world_clip_to_prev: Mat4,
+        camera: &Projection,
     ) -> (Vec<PropInstance>, Vec<PropDraw>) {
         let mut all = self.instances.clone();
         for (_, inst) in &mut all {
@@ -46,6 +104,9 @@ impl Props {
                 },
             ))
         }));
+        for (mesh, inst) in &mut all {
+            *mesh = self.mesh_for(*mesh, &Mat4::from_cols_array_2d(&inst.model), camera);
+        }
         all.sort_by_key(|(m, _)| *m);
         let records = all.iter().map(|(_, i)| *i).collect();
         let mut draws: Vec<PropDraw> = Vec::new();
@@ -75,6 +136,7 @@ impl Props {
     ) -> GpuResult<Option<Buffer>> {
         let mut all = Vec::new();
         let mut ranges = Vec::new();
+        let mut bounds = Vec::new();
         for m in meshes {
             if m.len() % 3 != 0 || m.iter().any(|v| !v.position.iter().all(|x| x.is_finite())) {
                 return Err(GpuError::Unsupported(
@@ -82,6 +144,7 @@ impl Props {
                 ));
             }
             ranges.push((all.len() as u32, m.len() as u32));
+            bounds.push(bounding_sphere(m));
             all.extend_from_slice(m);
         }
         let vertices = if all.is_empty() {
@@ -95,6 +158,8 @@ impl Props {
             )?)
         };
         self.meshes = ranges;
+        self.far = vec![None; bounds.len()];
+        self.bounds = bounds;
         self.instances.clear();
         self.attached.clear();
         Ok(std::mem::replace(&mut self.vertices, vertices))
@@ -114,6 +179,38 @@ impl Props {
         };
         if !instances.iter().all(|(_, i)| finite(i)) {
             return Err(GpuError::Unsupported("prop transform is not finite".into()));
+        }
+        Ok(())
+    }
+
+    /// Give meshes far versions (replacing earlier ones); refuses unknown meshes, a mesh that
+    /// is its own far version, a far version with one of its own, and thresholds that are
+    /// not finite and non-negative.
+    pub(super) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
+        let n = self.meshes.len();
+        for l in lods {
+            let bad = if l.mesh >= n || l.far_mesh >= n {
+                Some(format!("no prop mesh {}", l.mesh.max(l.far_mesh)))
+            } else if l.mesh == l.far_mesh || lods.iter().any(|o| o.mesh == l.far_mesh) {
+                Some(format!(
+                    "prop mesh {} cannot be a far version and have one",
+                    l.far_mesh
+                ))
+            } else if !(l.below_pixels.is_finite() && l.below_pixels >= 0.0) {
+                Some(format!(
+                    "far prop threshold {} is not a finite pixel count",
+                    l.below_pixels
+                ))
+            } else {
+                None
+            };
+            if let Some(e) = bad {
+                return Err(GpuError::Unsupported(e));
+            }
+        }
+        self.far = vec![None; n];
+        for l in lods {
+            self.far[l.mesh] = Some((l.far_mesh, l.below_pixels));
         }
         Ok(())
     }
@@ -145,5 +242,112 @@ impl Props {
             .filter(|(c, ..)| *c == id)
             .map(|(_, _, i)| model * Mat4::from_cols_array_2d(&i.model))
             .collect()
+    }
+}
+
+/// A bounding sphere of a triangle list: the box's centre and the farthest vertex from it.
+pub fn bounding_sphere(vertices: &[PropVertex]) -> (Vec3, f32) {
+    let points = || vertices.iter().map(|v| Vec3::from_slice(&v.position[..3]));
+    let (lo, hi) = points().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    if vertices.is_empty() {
+        return (Vec3::ZERO, 0.0);
+    }
+    let centre = (lo + hi) * 0.5;
+    (
+        centre,
+        points().map(|p| p.distance(centre)).fold(0.0, f32::max),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn triangle(at: Vec3) -> Vec<PropVertex> {
+        [Vec3::ZERO, Vec3::X, Vec3::Y]
+            .map(|p| PropVertex {
+                position: (p + at).extend(1.0).to_array(),
+                normal: [0.0, 0.0, 1.0, 0.0],
+            })
+            .to_vec()
+    }
+
+    /// A prop is drawn with its far version exactly when its bounding sphere spans fewer
+    /// pixels than the threshold, and bad far versions are refused.
+    #[test]
+    fn far_versions_replace_small_props() {
+        let mut props = Props {
+            meshes: vec![(0, 3), (3, 3), (6, 3)],
+            bounds: [Vec3::ZERO; 3]
+                .map(|v| bounding_sphere(&triangle(v)))
+                .to_vec(),
+            far: vec![None; 3],
+            ..Default::default()
+        };
+        let (c, r) = props.bounds[0];
+        assert!((c - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6 && (r - 0.5f32.sqrt()).abs() < 1e-6);
+        props
+            .set_lods(&[PropLod {
+                mesh: 0,
+                far_mesh: 1,
+                below_pixels: 50.0,
+            }])
+            .unwrap();
+        // 60 degrees, 720 pixels: the sphere spans r * 720 * cot(30) / d pixels.
+        let camera = Projection {
+            eye: Vec3::new(0.5, 0.5, 0.0),
+            height: 720.0,
+            cot_half_fov: 1.0 / 30f32.to_radians().tan(),
+        };
+        let at = |d: f32| Mat4::from_translation(Vec3::new(0.0, 0.0, -d));
+        let d50 = r * 720.0 * camera.cot_half_fov / 50.0;
+        assert_eq!(props.mesh_for(0, &at(d50 * 0.99), &camera), 0);
+        assert_eq!(props.mesh_for(0, &at(d50 * 1.01), &camera), 1);
+        assert_eq!(props.mesh_for(2, &at(1e4), &camera), 2);
+        // Twice the scale, twice the distance.
+        let scaled = at(d50 * 1.9) * Mat4::from_scale(Vec3::splat(2.0));
+        assert_eq!(props.mesh_for(0, &scaled, &camera), 0);
+        let ortho = Projection {
+            cot_half_fov: 0.0,
+            ..camera
+        };
+        assert_eq!(props.mesh_for(0, &at(1e4), &ortho), 0);
+        for bad in [
+            PropLod {
+                mesh: 0,
+                far_mesh: 3,
+                below_pixels: 1.0,
+            },
+            PropLod {
+                mesh: 0,
+                far_mesh: 0,
+                below_pixels: 1.0,
+            },
+            PropLod {
+                mesh: 0,
+                far_mesh: 1,
+                below_pixels: f32::NAN,
+            },
+            PropLod {
+                mesh: 0,
+                far_mesh: 1,
+                below_pixels: -1.0,
+            },
+        ] {
+            assert!(props.set_lods(&[bad]).is_err(), "{bad:?}");
+        }
+        let chain = [
+            PropLod {
+                mesh: 0,
+                far_mesh: 1,
+                below_pixels: 1.0,
+            },
+            PropLod {
+                mesh: 1,
+                far_mesh: 2,
+                below_pixels: 1.0,
+            },
+        ];
+        assert!(props.set_lods(&chain).is_err());
     }
 }

@@ -398,6 +398,14 @@ impl Renderer {
         Ok(())
     }
 
+    /// Give prop meshes far versions: an instance whose bounding sphere spans fewer than
+    /// `below_pixels` of the camera's image is drawn with the far mesh in every view of the
+    /// frame (camera, light, motion). Replaces earlier far versions; cleared by
+    /// [`Self::set_prop_meshes`].
+    pub fn set_prop_lods(&mut self, lods: &[super::prop_table::PropLod]) -> GpuResult<()> {
+        self.props.set_lods(lods)
+    }
+
     /// Place world props for the next frames: `(mesh index, instance)`.
     pub fn set_prop_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
         self.props.set_instances(instances)

@@ -239,7 +239,9 @@ impl Scene {
             strands_per_bundle: args.strands_per_bundle,
             verts_log2: args.verts_log2,
         };
-        renderer.set_prop_meshes(&preset::prop_meshes()?)?;
+        let meshes = preset::prop_meshes()?;
+        renderer.set_prop_meshes(&meshes)?;
+        renderer.set_prop_lods(&preset::prop_lods(&meshes))?;
         renderer.set_prop_instances(&preset::world_props())?;
         for (c, b) in self.characters.iter().zip(&self.baked) {
             let id = renderer.add_character(b, &c.hair.style, c.strand_params(params), c.model)?;
