@@ -15,7 +15,9 @@ use super::device;
 use super::sync::{Fence, Semaphore};
 use super::{GpuError, GpuResult, VkContext};
 
-/// Raw handles of a window to present to (from winit through `raw-window-handle`).
+/// Raw handles of a window to present to (from winit through `raw-window-handle`; feature
+/// `window`).
+#[cfg(feature = "window")]
 #[derive(Clone, Copy, Debug)]
 pub struct WindowHandles {
     /// The display connection.
@@ -28,7 +30,8 @@ pub struct WindowHandles {
 #[derive(Clone, Debug, Default)]
 pub struct ContextDesc {
     /// Present to this window: creates its surface, requires a queue that can present to it
-    /// and enables `VK_KHR_swapchain`.
+    /// and enables `VK_KHR_swapchain` (feature `window`).
+    #[cfg(feature = "window")]
     pub window: Option<WindowHandles>,
     /// Enable `VK_LAYER_KHRONOS_validation`; validation errors are counted and printed.
     pub validation: bool,
@@ -61,6 +64,7 @@ impl ContextDesc {
     }
 
     /// Present to `window`.
+    #[cfg(feature = "window")]
     pub fn window(mut self, window: WindowHandles) -> Self {
         self.window = Some(window);
         self
@@ -160,6 +164,51 @@ pub struct Context {
     pub info: DeviceInfo,
 }
 
+/// The instance extensions `desc`'s window needs (none without one).
+#[cfg(feature = "window")]
+fn window_extensions(desc: &ContextDesc) -> GpuResult<&'static [*const std::ffi::c_char]> {
+    match &desc.window {
+        Some(w) => ash_window::enumerate_required_extensions(w.display)
+            .ctx("window surface extensions"),
+        None => Ok(&[]),
+    }
+}
+
+/// Without the `window` feature there are no windows.
+#[cfg(not(feature = "window"))]
+fn window_extensions(_desc: &ContextDesc) -> GpuResult<&'static [*const std::ffi::c_char]> {
+    Ok(&[])
+}
+
+/// The surface of `desc`'s window, if it has one.
+#[cfg(feature = "window")]
+fn window_surface(
+    entry: &ash::Entry,
+    instance: &ash::Instance,
+    desc: &ContextDesc,
+) -> Result<Option<Surface>, vk::Result> {
+    let Some(w) = &desc.window else {
+        return Ok(None);
+    };
+    // SAFETY: the handles come from a live window that outlives the context (the caller keeps
+    // the window until the context is dropped).
+    let raw = unsafe { ash_window::create_surface(entry, instance, w.display, w.window, None)? };
+    Ok(Some(Surface {
+        loader: ash::khr::surface::Instance::new(entry, instance),
+        raw,
+    }))
+}
+
+/// Without the `window` feature there are no windows.
+#[cfg(not(feature = "window"))]
+fn window_surface(
+    _entry: &ash::Entry,
+    _instance: &ash::Instance,
+    _desc: &ContextDesc,
+) -> Result<Option<Surface>, vk::Result> {
+    Ok(None)
+}
+
 /// A window surface and its instance-level functions.
 pub(crate) struct Surface {
     pub(crate) loader: ash::khr::surface::Instance,
@@ -199,11 +248,7 @@ impl Context {
         let enabled = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
         let mut features =
             vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled);
-        if let Some(w) = &desc.window {
-            let needed = ash_window::enumerate_required_extensions(w.display)
-                .ctx("window surface extensions")?;
-            extensions.extend_from_slice(needed);
-        }
+        extensions.extend_from_slice(window_extensions(desc)?);
         let debug_state = Arc::new(DebugState {
             errors: AtomicU32::new(0),
             messages: Mutex::new(Vec::new()),
@@ -260,28 +305,15 @@ impl Context {
         debug_state: Arc<DebugState>,
         desc: &ContextDesc,
     ) -> GpuResult<Self> {
-        let surface = match &desc.window {
-            Some(w) => {
-                // SAFETY: the handles come from a live window that outlives the context (the
-                // caller keeps the window until the context is dropped).
-                let raw = unsafe {
-                    ash_window::create_surface(&entry, &instance, w.display, w.window, None)
-                };
-                match raw {
-                    Ok(raw) => Some(Surface {
-                        loader: ash::khr::surface::Instance::new(&entry, &instance),
-                        raw,
-                    }),
-                    Err(result) => {
-                        destroy_instance(&instance, debug);
-                        return Err(GpuError::Vk {
-                            what: "create window surface",
-                            result,
-                        });
-                    }
-                }
+        let surface = match window_surface(&entry, &instance, desc) {
+            Ok(surface) => surface,
+            Err(result) => {
+                destroy_instance(&instance, debug);
+                return Err(GpuError::Vk {
+                    what: "create window surface",
+                    result,
+                });
             }
-            None => None,
         };
         let created = (|| {
             let (physical, name, queue_family) =
@@ -492,6 +524,7 @@ impl Context {
         self.physical
     }
 
+    #[cfg(feature = "window")]
     pub(crate) fn instance(&self) -> &ash::Instance {
         &self.instance
     }

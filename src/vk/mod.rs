@@ -13,18 +13,22 @@ pub mod profiler;
 pub mod shader;
 pub mod swapchain;
 pub mod sync;
+#[cfg(feature = "window")]
 pub mod ui;
 
 pub use access::Access;
 pub use buffer::{Buffer, BufferDesc};
 pub use command::{Attachment, BarrierImage, CommandBuffer, CommandRecorder, ImageBarrier};
-pub use context::{Context, ContextDesc, DeviceInfo, MemoryReport, WindowHandles};
+#[cfg(feature = "window")]
+pub use context::WindowHandles;
+pub use context::{Context, ContextDesc, DeviceInfo, MemoryReport};
 pub use descriptor::{BindingDesc, DescriptorKind, DescriptorSet, DescriptorSetLayout};
 pub use image::{Image, ImageDesc, Sampler};
 pub use pipeline::{BlendMode, CullMode, DepthMode, GraphicsDesc, Pipeline, PipelineLayout};
 pub use profiler::{MeshPrimitivesQuery, Profiler};
 pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainImage};
 pub use sync::{Fence, Semaphore};
+#[cfg(feature = "window")]
 pub use ui::UiRenderer;
 
 /// Errors of the GPU layer.
