@@ -160,16 +160,42 @@ pub struct Context {
     pub(crate) mesh_ext: Option<ash::ext::mesh_shader::Device>,
     pub(crate) surface: Option<Surface>,
     pub(crate) swapchain_ext: Option<ash::khr::swapchain::Device>,
+    /// Whether the instance and device are this context's (else a host's, never destroyed
+    /// here).
+    owns_device: bool,
     /// Capabilities of the device.
     pub info: DeviceInfo,
+}
+
+/// A Vulkan device an engine created and keeps: [`Context::from_host`] borrows it. Create the
+/// device with [`super::create_host_device`] (or enable at least what it enables) on an
+/// instance of Vulkan 1.3.
+pub struct HostDevice {
+    /// The loader the instance came from.
+    pub entry: ash::Entry,
+    /// The host's instance.
+    pub instance: ash::Instance,
+    /// The physical device of `device`.
+    pub physical: vk::PhysicalDevice,
+    /// The host's device.
+    pub device: ash::Device,
+    /// A queue family with graphics and compute.
+    pub queue_family: u32,
+    /// A queue of that family the renderer submits to (the host orders its own submissions
+    /// around the renderer's, or gives it a queue of its own).
+    pub queue: vk::Queue,
+    /// Count and print validation messages through a messenger of the renderer's own on the
+    /// host's instance (which must have `VK_EXT_debug_utils` and the validation layer).
+    pub validation: bool,
 }
 
 /// The instance extensions `desc`'s window needs (none without one).
 #[cfg(feature = "window")]
 fn window_extensions(desc: &ContextDesc) -> GpuResult<&'static [*const std::ffi::c_char]> {
     match &desc.window {
-        Some(w) => ash_window::enumerate_required_extensions(w.display)
-            .ctx("window surface extensions"),
+        Some(w) => {
+            ash_window::enumerate_required_extensions(w.display).ctx("window surface extensions")
+        }
         None => Ok(&[]),
     }
 }
@@ -253,18 +279,7 @@ impl Context {
             errors: AtomicU32::new(0),
             messages: Mutex::new(Vec::new()),
         });
-        let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-            .message_severity(
-                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
-                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
-            )
-            .message_type(
-                vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
-                    | vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
-                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
-            )
-            .pfn_user_callback(Some(debug_callback))
-            .user_data(Arc::as_ptr(&debug_state) as *mut c_void);
+        let mut messenger_info = messenger_info(&debug_state);
         let mut info = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_layer_names(&layers)
@@ -385,6 +400,90 @@ impl Context {
             mesh_ext,
             surface,
             swapchain_ext,
+            owns_device: true,
+            info,
+        })
+    }
+
+    /// A context on a host's device: it makes its own memory allocator and (with
+    /// `validation`) its own messenger on the device and instance, and destroys only those
+    /// when dropped; the host keeps the instance and device, and must keep them until then.
+    /// Fails when the device lacks a feature the renderer requires.
+    pub fn from_host(host: HostDevice) -> GpuResult<Self> {
+        let HostDevice {
+            entry,
+            instance,
+            physical,
+            device,
+            queue_family,
+            queue,
+            validation,
+        } = host;
+        // SAFETY: valid physical device of the host's instance.
+        let props = unsafe { instance.get_physical_device_properties(physical) };
+        let name = props
+            .device_name_as_c_str()
+            .map(|c| c.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let features = device::query_features(&instance, physical, &name)?;
+        let debug_state = Arc::new(DebugState {
+            errors: AtomicU32::new(0),
+            messages: Mutex::new(Vec::new()),
+        });
+        let debug = if validation {
+            let loader = debug_utils::Instance::new(&entry, &instance);
+            let info = messenger_info(&debug_state);
+            // SAFETY: messenger info is valid; the DebugState outlives the messenger.
+            let messenger = unsafe { loader.create_debug_utils_messenger(&info, None) }
+                .ctx("create messenger on the host's instance")?;
+            Some((loader, messenger))
+        } else {
+            None
+        };
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: true,
+            allocation_sizes: Default::default(),
+        });
+        let allocator = match allocator {
+            Ok(a) => a,
+            Err(error) => {
+                if let Some((loader, messenger)) = debug {
+                    // SAFETY: the messenger was created above and is used by nothing.
+                    unsafe { loader.destroy_debug_utils_messenger(messenger, None) };
+                }
+                return Err(GpuError::Alloc {
+                    name: "the allocator".into(),
+                    size: 0,
+                    error,
+                });
+            }
+        };
+        let info = device::query_info(&instance, physical, name, &features);
+        let debug_device = debug
+            .as_ref()
+            .map(|_| debug_utils::Device::new(&instance, &device));
+        let mesh_ext = info
+            .mesh_shader
+            .then(|| ash::ext::mesh_shader::Device::new(&instance, &device));
+        Ok(Context {
+            _entry: entry,
+            instance,
+            debug,
+            debug_device,
+            debug_state,
+            physical,
+            device,
+            queue,
+            queue_family,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            mesh_ext,
+            surface: None,
+            swapchain_ext: None,
+            owns_device: false,
             info,
         })
     }
@@ -550,6 +649,22 @@ impl Context {
 }
 
 /// Destroy an instance (and its messenger) when device creation fails half-way.
+/// The messenger that counts errors into `state` and prints errors and warnings.
+fn messenger_info(state: &Arc<DebugState>) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
+    vk::DebugUtilsMessengerCreateInfoEXT::default()
+        .message_severity(
+            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+        )
+        .message_type(
+            vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                | vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+        )
+        .pfn_user_callback(Some(debug_callback))
+        .user_data(Arc::as_ptr(state) as *mut c_void)
+}
+
 fn destroy_instance(
     instance: &ash::Instance,
     debug: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
@@ -567,17 +682,22 @@ impl Drop for Context {
     fn drop(&mut self) {
         // SAFETY: tear down in reverse creation order after the device is idle; every object
         // created from this context must already be destroyed (they borrow it).
+        // A host's instance and device stay: only what the context made on them goes.
         unsafe {
             let _ = self.device.device_wait_idle();
             ManuallyDrop::drop(&mut self.allocator);
-            self.device.destroy_device(None);
+            if self.owns_device {
+                self.device.destroy_device(None);
+            }
             if let Some(s) = self.surface.take() {
                 s.loader.destroy_surface(s.raw, None);
             }
             if let Some((loader, messenger)) = self.debug.take() {
                 loader.destroy_debug_utils_messenger(messenger, None);
             }
-            self.instance.destroy_instance(None);
+            if self.owns_device {
+                self.instance.destroy_instance(None);
+            }
         }
     }
 }

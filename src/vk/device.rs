@@ -171,16 +171,29 @@ pub(super) fn create_logical(
     f: &DeviceFeatures,
     swapchain: bool,
 ) -> GpuResult<ash::Device> {
+    let extensions: &[&std::ffi::CStr] = if swapchain {
+        &[ash::khr::swapchain::NAME]
+    } else {
+        &[]
+    };
+    create_device(instance, physical, queue_family, f, extensions)
+}
+
+/// The device with features `f` and the `extra` extensions.
+fn create_device(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    queue_family: u32,
+    f: &DeviceFeatures,
+    extra: &[&std::ffi::CStr],
+) -> GpuResult<ash::Device> {
     let priorities = [1.0f32];
     let queue_info = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(queue_family)
         .queue_priorities(&priorities)];
-    let mut ext_names = Vec::new();
-    if f.mesh {
+    let mut ext_names: Vec<*const std::ffi::c_char> = extra.iter().map(|e| e.as_ptr()).collect();
+    if f.mesh && !extra.contains(&ash::ext::mesh_shader::NAME) {
         ext_names.push(ash::ext::mesh_shader::NAME.as_ptr());
-    }
-    if swapchain {
-        ext_names.push(ash::khr::swapchain::NAME.as_ptr());
     }
     let mut enable13 = vk::PhysicalDeviceVulkan13Features::default()
         .dynamic_rendering(true)
@@ -218,6 +231,27 @@ pub(super) fn create_logical(
         what: "create device",
         result,
     })
+}
+
+/// Create a device for a host ([`super::HostDevice`]) on `physical` with one queue of
+/// `queue_family`: the extensions and features the renderer uses where the device has them,
+/// plus the host's `extensions` (e.g. `VK_KHR_swapchain`). The host owns the device and
+/// destroys it after every renderer on it is dropped. Fails with the name of a missing
+/// required feature.
+pub fn create_host_device(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    queue_family: u32,
+    extensions: &[&std::ffi::CStr],
+) -> GpuResult<ash::Device> {
+    // SAFETY: valid physical device of `instance`.
+    let props = unsafe { instance.get_physical_device_properties(physical) };
+    let name = props
+        .device_name_as_c_str()
+        .map(|c| c.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let features = query_features(instance, physical, &name)?;
+    create_device(instance, physical, queue_family, &features, extensions)
 }
 
 /// What the device can do, for the features enabled.

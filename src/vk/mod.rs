@@ -21,8 +21,9 @@ pub use buffer::{Buffer, BufferDesc};
 pub use command::{Attachment, BarrierImage, CommandBuffer, CommandRecorder, ImageBarrier};
 #[cfg(feature = "window")]
 pub use context::WindowHandles;
-pub use context::{Context, ContextDesc, DeviceInfo, MemoryReport};
+pub use context::{Context, ContextDesc, DeviceInfo, HostDevice, MemoryReport};
 pub use descriptor::{BindingDesc, DescriptorKind, DescriptorSet, DescriptorSetLayout};
+pub use device::create_host_device;
 pub use image::{Image, ImageDesc, Sampler};
 pub use pipeline::{BlendMode, CullMode, DepthMode, GraphicsDesc, Pipeline, PipelineLayout};
 pub use profiler::{MeshPrimitivesQuery, Profiler};
