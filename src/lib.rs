@@ -5,6 +5,8 @@
 //! [`reference`] (CPU oracle of strand generation and LoD) | [`render`] (GPU generation,
 //! shading, image) on the thin Vulkan layer [`vk`].
 
+#![warn(missing_docs)]
+
 pub mod animate;
 pub mod bake;
 pub mod budget;
