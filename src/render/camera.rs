@@ -202,6 +202,9 @@ pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
 /// Direction toward the light of [`View::new`] (normalised by the frame).
 pub const DEFAULT_LIGHT_DIR: Vec3 = Vec3::new(0.4, 1.0, 0.6);
 
+/// Direction toward the light of the crowd's look ([`View::crowd_look`]).
+pub const CROWD_LIGHT_DIR: Vec3 = Vec3::new(0.4, 1.0, 0.3);
+
 /// Everything per-view a frame needs: camera, light, image size and LoD settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
@@ -246,6 +249,21 @@ impl View {
             multiple_scattering: false,
             temporal: Default::default(),
             volumes: super::volume::VolumeTier::OFF,
+        }
+    }
+
+    /// The look `crowd` shows by default, for every tool and test that means it: light from
+    /// [`CROWD_LIGHT_DIR`], LoD on with the thick-strand term, Marschner with multiple
+    /// scattering, deep opacity shadows, opaque strands, the volume tier on, no temporal
+    /// accumulation.
+    pub fn crowd_look(camera: Camera) -> View {
+        View {
+            light_dir: CROWD_LIGHT_DIR,
+            shading: crate::shade::ShadingModel::Marschner,
+            shadows: super::settings::ShadowMode::DeepOpacity,
+            multiple_scattering: true,
+            volumes: super::volume::VolumeTier::on(),
+            ..View::new(camera)
         }
     }
 

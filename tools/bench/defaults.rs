@@ -5,24 +5,15 @@
 //! run: median frame wall time of each and the speed-up.
 
 use anyhow::Result;
-use glam::Vec3;
 use hairmesh::outln;
-use hairmesh::render::{
-    FrameOptions, FrameSettings, LightRaster, LodSettings, ShadowMode, StrandRaster, View,
-};
+use hairmesh::render::{FrameOptions, FrameSettings, LightRaster, StrandRaster, View};
 
 /// Print the two rows and the speed-up line for `count` characters of `run`'s crowd (its
 /// meshes, size, camera and timed frames).
 pub fn compare(run: &super::CrowdRun, count: usize) -> Result<()> {
     let mut r = run.renderer(hairmesh::render::shared::TASK_PAYLOAD_BUNDLES)?;
     run.add_crowd(&mut r, count)?;
-    let view = View {
-        light_dir: Vec3::new(0.4, 1.0, 0.3),
-        lod: LodSettings::default(),
-        shading: hairmesh::shade::ShadingModel::Marschner,
-        shadows: ShadowMode::DeepOpacity,
-        ..View::new(run.camera)
-    };
+    let view = View::crowd_look(run.camera);
     let old = FrameSettings {
         path: r.default_path(),
         raster: StrandRaster::Hardware,

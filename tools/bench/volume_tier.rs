@@ -8,8 +8,7 @@ use anyhow::Result;
 use glam::Vec3;
 use hairmesh::outln;
 use hairmesh::render::{
-    FrameOptions, FrameSettings, LightRaster, LodSettings, ShadowMode, StrandRaster, View,
-    VolumeTier,
+    FrameOptions, FrameSettings, LightRaster, ShadowMode, StrandRaster, View, VolumeTier,
 };
 
 /// Print a row per count and tier setting, then the ratio lines. With `picture`, returns the
@@ -39,12 +38,8 @@ pub fn compare(run: &super::CrowdRun, counts: &[usize], picture: bool) -> Result
         };
         for (i, tier) in [VolumeTier::OFF, VolumeTier::on()].into_iter().enumerate() {
             let view = View {
-                light_dir: Vec3::new(0.4, 1.0, 0.3),
-                lod: LodSettings::default(),
-                shading: hairmesh::shade::ShadingModel::Marschner,
-                shadows: ShadowMode::DeepOpacity,
                 volumes: tier,
-                ..View::new(run.camera)
+                ..View::crowd_look(run.camera)
             };
             // The first frame builds every volume; the timed ones rebuild stale ones only.
             let read_image = picture && i == 1 && count == *counts.last().unwrap_or(&0);

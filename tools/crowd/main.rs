@@ -493,7 +493,7 @@ fn run(args: Args) -> Result<()> {
         // Headless frames are 1/30 s apart in animation time.
         animation.advance(&mut renderer, 1.0 / 30.0, &camera, height)?;
         let view = View {
-            light_dir: Vec3::new(0.4, 1.0, 0.3),
+            light_dir: hairmesh::render::camera::CROWD_LIGHT_DIR,
             lod,
             shading: args.shading,
             shadows: args.shadows,

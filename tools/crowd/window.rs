@@ -589,7 +589,7 @@ impl Running {
         let camera = self.camera.camera();
         self.animation.advance(&mut self.renderer, dt, &camera, h)?;
         let view = View {
-            light_dir: Vec3::new(0.4, 1.0, 0.3),
+            light_dir: hairmesh::render::camera::CROWD_LIGHT_DIR,
             lod: self.panel.lod,
             shading: self.shading,
             shadows: self.shadows,
