@@ -15,15 +15,6 @@ use hairmesh::shade::ShadingModel;
 
 const SIZE: u32 = 160;
 
-fn srgb_to_linear(c: u8) -> f64 {
-    let c = c as f64 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// Mean linear colour of `img` over the pixels where `a` or `b` is not background.
 fn region_mean(img: &[u8], a: &[u8], b: &[u8]) -> [f64; 3] {
     let bg = &a[..4];

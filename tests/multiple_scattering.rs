@@ -18,15 +18,6 @@ use hairmesh::shade::{ShadingModel, melanin_color};
 
 const SIZE: u32 = 192;
 
-fn srgb_to_linear(c: u8) -> f64 {
-    let c = c as f64 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// The hairs of the gallery: name, eumelanin, pheomelanin.
 const HAIRS: [(&str, f32, f32); 4] = [
     ("grey", 0.12, 0.0),

@@ -19,15 +19,6 @@ const PARAMS: StrandParams = StrandParams {
     verts_log2: 4,
 };
 
-fn srgb_to_linear(v: u8) -> f64 {
-    let c = v as f64 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// One straight white strand of width `w` < 1 pixel across the image, as a single segment
 /// (no joints): the coverage the image holds adds up to the strand's area, and every pixel
 /// matches the CPU twin, at several angles and sub-pixel offsets.

@@ -341,15 +341,7 @@ impl Context {
                 &features,
                 surface.is_some(),
             )?;
-            let allocator = Allocator::new(&AllocatorCreateDesc {
-                instance: instance.clone(),
-                device: device.clone(),
-                physical_device: physical,
-                debug_settings: Default::default(),
-                buffer_device_address: true,
-                allocation_sizes: Default::default(),
-            });
-            let allocator = match allocator {
+            let allocator = match new_allocator(&instance, &device, physical) {
                 Ok(a) => a,
                 Err(e) => {
                     // SAFETY: nothing was created on the device yet.
@@ -377,32 +369,20 @@ impl Context {
         };
         // SAFETY: the queue family/index were requested at device creation.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        let debug_device = debug
-            .as_ref()
-            .map(|_| debug_utils::Device::new(&instance, &device));
-        let mesh_ext = info
-            .mesh_shader
-            .then(|| ash::ext::mesh_shader::Device::new(&instance, &device));
-        let swapchain_ext = surface
-            .as_ref()
-            .map(|_| ash::khr::swapchain::Device::new(&instance, &device));
-        Ok(Context {
-            _entry: entry,
+        Ok(Self::assemble(Parts {
+            entry,
             instance,
             debug,
-            debug_device,
             debug_state,
             physical,
             device,
             queue,
             queue_family,
-            allocator: ManuallyDrop::new(Mutex::new(allocator)),
-            mesh_ext,
+            allocator,
             surface,
-            swapchain_ext,
             owns_device: true,
             info,
-        })
+        }))
     }
 
     /// A context on a host's device: it makes its own memory allocator and (with
@@ -440,15 +420,7 @@ impl Context {
         } else {
             None
         };
-        let allocator = Allocator::new(&AllocatorCreateDesc {
-            instance: instance.clone(),
-            device: device.clone(),
-            physical_device: physical,
-            debug_settings: Default::default(),
-            buffer_device_address: true,
-            allocation_sizes: Default::default(),
-        });
-        let allocator = match allocator {
+        let allocator = match new_allocator(&instance, &device, physical) {
             Ok(a) => a,
             Err(error) => {
                 if let Some((loader, messenger)) = debug {
@@ -463,29 +435,53 @@ impl Context {
             }
         };
         let info = device::query_info(&instance, physical, name, &features);
-        let debug_device = debug
-            .as_ref()
-            .map(|_| debug_utils::Device::new(&instance, &device));
-        let mesh_ext = info
-            .mesh_shader
-            .then(|| ash::ext::mesh_shader::Device::new(&instance, &device));
-        Ok(Context {
-            _entry: entry,
+        Ok(Self::assemble(Parts {
+            entry,
             instance,
             debug,
-            debug_device,
             debug_state,
             physical,
             device,
             queue,
             queue_family,
-            allocator: ManuallyDrop::new(Mutex::new(allocator)),
-            mesh_ext,
+            allocator,
             surface: None,
-            swapchain_ext: None,
             owns_device: false,
             info,
-        })
+        }))
+    }
+
+    /// The context of `p`, with the device-level function tables it needs.
+    fn assemble(p: Parts) -> Self {
+        let debug_device = p
+            .debug
+            .as_ref()
+            .map(|_| debug_utils::Device::new(&p.instance, &p.device));
+        let mesh_ext = p
+            .info
+            .mesh_shader
+            .then(|| ash::ext::mesh_shader::Device::new(&p.instance, &p.device));
+        let swapchain_ext = p
+            .surface
+            .as_ref()
+            .map(|_| ash::khr::swapchain::Device::new(&p.instance, &p.device));
+        Context {
+            _entry: p.entry,
+            instance: p.instance,
+            debug: p.debug,
+            debug_device,
+            debug_state: p.debug_state,
+            physical: p.physical,
+            device: p.device,
+            queue: p.queue,
+            queue_family: p.queue_family,
+            allocator: ManuallyDrop::new(Mutex::new(p.allocator)),
+            mesh_ext,
+            surface: p.surface,
+            swapchain_ext,
+            owns_device: p.owns_device,
+            info: p.info,
+        }
     }
 
     pub(crate) fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
@@ -649,6 +645,38 @@ impl Context {
 }
 
 /// Destroy an instance (and its messenger) when device creation fails half-way.
+/// What a context is made of, before its device-level function tables.
+struct Parts {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    debug: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    debug_state: Arc<DebugState>,
+    physical: vk::PhysicalDevice,
+    device: ash::Device,
+    queue: vk::Queue,
+    queue_family: u32,
+    allocator: Allocator,
+    surface: Option<Surface>,
+    owns_device: bool,
+    info: DeviceInfo,
+}
+
+/// A memory allocator on `device` (buffer device addresses on).
+fn new_allocator(
+    instance: &ash::Instance,
+    device: &ash::Device,
+    physical: vk::PhysicalDevice,
+) -> Result<Allocator, gpu_allocator::AllocationError> {
+    Allocator::new(&AllocatorCreateDesc {
+        instance: instance.clone(),
+        device: device.clone(),
+        physical_device: physical,
+        debug_settings: Default::default(),
+        buffer_device_address: true,
+        allocation_sizes: Default::default(),
+    })
+}
+
 /// The messenger that counts errors into `state` and prints errors and warnings.
 fn messenger_info(state: &Arc<DebugState>) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
     vk::DebugUtilsMessengerCreateInfoEXT::default()

@@ -110,6 +110,16 @@ pub fn framing(baked: &BakedHairMesh) -> Camera {
     Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0)
 }
 
+/// An 8-bit sRGB value in linear light.
+pub fn srgb_to_linear(c: u8) -> f64 {
+    let c = c as f64 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// Mean absolute difference of two equally sized 8-bit images, in [0, 1].
 pub fn mean_abs_diff(a: &[u8], b: &[u8]) -> f64 {
     assert_eq!(a.len(), b.len(), "images of different sizes");
