@@ -56,10 +56,25 @@ pub fn direction(theta: f32, phi: f32) -> Vec3 {
 /// Polar angle and azimuth (in `0..2pi`) of unit direction `d` (inverse of [`direction`]).
 pub use crate::dynamics::angles;
 
+/// An eyeball in a socket of the bust (canonical frame): a sphere that fills the socket's
+/// opening, set back so that it bulges at most a third of its radius out of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Eye {
+    /// Centre of the sphere.
+    pub centre: Vec3,
+    /// Radius of the sphere.
+    pub radius: f32,
+}
+
 /// The canonical head: its triangles and radial map.
 pub struct HumanHead {
     /// Triangles, canonical character frame, metres.
     pub triangles: Vec<[Vec3; 3]>,
+    /// Triangles closing the mouth's opening (a fan from its centre), drawn with the bust.
+    pub mouth: Vec<[Vec3; 3]>,
+    /// The eyeballs in the two eye sockets (the bust's openings above the mouth), left then
+    /// right.
+    pub eyes: [Eye; 2],
     /// Centre of the cranium (origin of the radial map).
     pub centre: Vec3,
     /// The head's surface about [`Self::centre`]: what hair dynamics collide with.
@@ -117,8 +132,11 @@ impl HumanHead {
             radius,
         };
         let cranium = map(opened(&radius, EAR_WINDOW));
+        let (eyes, mouth) = face_openings(name, &triangles, centre)?;
         Ok(HumanHead {
             triangles,
+            mouth,
+            eyes,
             centre,
             map: map(radius),
             cranium,
@@ -153,10 +171,109 @@ impl HumanHead {
         self.map.push_out(p, margin)
     }
 
-    /// The bust as a prop mesh (triangle list, normals averaged over shared positions).
+    /// The bust with its mouth closed as a prop mesh (triangle list, normals averaged over
+    /// shared positions).
     pub fn prop_mesh(&self) -> Vec<PropVertex> {
-        smooth_prop_mesh(&self.triangles)
+        let mut all = self.triangles.clone();
+        all.extend_from_slice(&self.mouth);
+        smooth_prop_mesh(&all)
     }
+}
+
+/// Boundary loops of a triangle soup (edges used by one triangle), as ordered rings of
+/// positions.
+fn boundary_loops(triangles: &[[Vec3; 3]]) -> Vec<Vec<Vec3>> {
+    let key = |p: Vec3| (p * 1e5).round().as_ivec3().to_array();
+    let mut count: std::collections::HashMap<([i32; 3], [i32; 3]), i32> = Default::default();
+    let mut at: std::collections::HashMap<[i32; 3], Vec3> = Default::default();
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (key(t[k]), key(t[(k + 1) % 3]));
+            at.insert(a, t[k]);
+            // Directed edge a -> b; a boundary edge has no b -> a.
+            *count.entry((a, b)).or_default() += 1;
+        }
+    }
+    let mut next: std::collections::HashMap<[i32; 3], [i32; 3]> = Default::default();
+    for (&(a, b), _) in count
+        .iter()
+        .filter(|(e, _)| !count.contains_key(&(e.1, e.0)))
+    {
+        next.insert(b, a);
+    }
+    let mut loops = Vec::new();
+    let mut starts: Vec<[i32; 3]> = next.keys().copied().collect();
+    starts.sort();
+    let mut used = std::collections::HashSet::new();
+    for start in starts {
+        let mut ring = Vec::new();
+        let mut v = start;
+        while used.insert(v) {
+            ring.push(at[&v]);
+            match next.get(&v) {
+                Some(&n) => v = n,
+                None => break,
+            }
+        }
+        if ring.len() >= 3 {
+            loops.push(ring);
+        }
+    }
+    loops
+}
+
+/// The eyeballs and the mouth's cap from the bust's openings: the three small openings in
+/// front of the centre, the lowest being the mouth.
+fn face_openings(
+    name: &str,
+    triangles: &[[Vec3; 3]],
+    centre: Vec3,
+) -> Result<([Eye; 2], Vec<[Vec3; 3]>)> {
+    let mut face: Vec<(Vec3, f32, Vec<Vec3>)> = boundary_loops(triangles)
+        .into_iter()
+        .map(|ring| {
+            let c = ring.iter().copied().sum::<Vec3>() / ring.len() as f32;
+            let r = ring.iter().map(|p| p.distance(c)).fold(0.0, f32::max);
+            (c, r, ring)
+        })
+        .filter(|(c, r, _)| c.z > centre.z && *r < 0.04 && c.distance(centre) < RADIAL_REACH)
+        .collect();
+    if face.len() != 3 {
+        return Err(HairError::invalid(
+            name,
+            format!(
+                "expected two eye openings and a mouth, found {} openings",
+                face.len()
+            ),
+        ));
+    }
+    face.sort_by(|a, b| a.0.y.total_cmp(&b.0.y));
+    let (mouth_centre, _, mouth_ring) = &face[0];
+    // Each ring runs against the mesh's boundary edges, so the fan turns like its neighbours.
+    let mouth = (0..mouth_ring.len())
+        .map(|k| {
+            [
+                *mouth_centre,
+                mouth_ring[k],
+                mouth_ring[(k + 1) % mouth_ring.len()],
+            ]
+        })
+        .collect();
+    // The sphere's section in the opening's plane has the opening's radius r: with the centre
+    // set back by 0.6 R, that section is 0.8 R, so R = 1.25 r and it bulges 0.4 R.
+    let eye = |(c, r, _): &(Vec3, f32, Vec<Vec3>)| {
+        let radius = 1.25 * r;
+        Eye {
+            centre: *c - (*c - centre).normalize_or(Vec3::Z) * 0.6 * radius,
+            radius,
+        }
+    };
+    let (a, b) = (eye(&face[1]), eye(&face[2]));
+    Ok(if a.centre.x < b.centre.x {
+        ([a, b], mouth)
+    } else {
+        ([b, a], mouth)
+    })
 }
 
 /// Half-width, in map cells (2.5 degrees each), of the window that removes the ears from the
@@ -241,6 +358,45 @@ pub fn smooth_prop_mesh(triangles: &[[Vec3; 3]]) -> Vec<PropVertex> {
 mod tests {
     use super::*;
 
+    /// The eyeballs fill their sockets (every rim point within the sphere) without standing
+    /// far out of them, sit left and right of the face's middle at the same height; the mouth's
+    /// cap faces forward like the face around it.
+    #[test]
+    fn the_eyes_fill_their_sockets_and_the_mouth_is_closed() {
+        let head = human_head().unwrap();
+        let loops = boundary_loops(&head.triangles);
+        for eye in head.eyes {
+            let rim = loops
+                .iter()
+                .find(|ring| {
+                    ring.iter()
+                        .all(|p| p.distance(eye.centre) < 2.0 * eye.radius)
+                })
+                .expect("the eye's socket");
+            let c = rim.iter().copied().sum::<Vec3>() / rim.len() as f32;
+            let worst = rim
+                .iter()
+                .map(|p| p.distance(eye.centre) / eye.radius)
+                .fold(0.0, f32::max);
+            let bulge = eye.radius - eye.centre.distance(c);
+            println!(
+                "eye at {}, radius {:.4}: rim within {worst:.3} radii",
+                eye.centre, eye.radius
+            );
+            assert!(worst <= 1.02, "the rim reaches {worst} radii");
+            assert!(bulge < 0.5 * eye.radius && eye.radius < 0.04, "{eye:?}");
+        }
+        let [l, r] = head.eyes;
+        assert!(l.centre.x < -0.01 && r.centre.x > 0.01 && (l.centre.y - r.centre.y).abs() < 1e-3);
+        assert!(!head.mouth.is_empty());
+        let forward = head
+            .mouth
+            .iter()
+            .map(|t| (t[1] - t[0]).cross(t[2] - t[0]))
+            .sum::<Vec3>();
+        assert!(forward.z > 0.0, "the mouth's cap faces {forward}");
+    }
+
     #[test]
     fn the_radial_map_follows_the_mesh() {
         let head = human_head().unwrap();
@@ -267,6 +423,9 @@ mod tests {
         assert!(
             head.radial_gap(head.push_out(head.centre + (p - head.centre) * 0.9, 0.01)) > 0.0099
         );
-        assert_eq!(head.prop_mesh().len(), head.triangles.len() * 3);
+        assert_eq!(
+            head.prop_mesh().len(),
+            (head.triangles.len() + head.mouth.len()) * 3
+        );
     }
 }

@@ -87,7 +87,32 @@ pub mod prop_mesh {
     pub const FAR_HEAD: usize = 5;
     /// The far version of [`BODY`].
     pub const FAR_BODY: usize = 6;
+    /// An eyeball or an iris (unit sphere, placed by [`super::character_props`]).
+    pub const EYE: usize = 7;
+    /// The far version of [`EYE`].
+    pub const FAR_EYE: usize = 8;
 }
+
+/// An eye sphere's far version is drawn once it spans fewer pixels than this.
+pub const FAR_EYE_PIXELS: f32 = 12.0;
+
+/// A unit sphere of `rings x segments` quads: the eyes' meshes.
+fn eye_mesh(rings: usize, segments: usize) -> Vec<PropVertex> {
+    let mut tris = Vec::new();
+    super::person::ellipsoid(&mut tris, Vec3::ZERO, Vec3::ONE, rings, segments);
+    super::human::smooth_prop_mesh(&tris)
+}
+
+/// Colour of the whites of the eyes.
+pub const SCLERA_COLOR: [f32; 4] = [0.64, 0.6, 0.56, 1.0];
+/// Colour of the irises (dark brown; the pupil is not drawn apart).
+pub const IRIS_COLOR: [f32; 4] = [0.1, 0.065, 0.04, 1.0];
+/// An iris is a sphere of this fraction of its eyeball's radius, its centre this far in front
+/// of the eyeball's (same unit), looking along +Z: the part outside the eyeball is a disc of
+/// 0.4 eyeball radii, half the socket's opening, as an iris is about half the eye's.
+pub const IRIS_RADIUS: f32 = 0.42;
+/// See [`IRIS_RADIUS`].
+pub const IRIS_OFFSET: f32 = 0.78;
 
 /// Cell of the far head (vertex clustering, `far_mesh`), metres.
 pub const FAR_HEAD_CELL: f32 = 0.025;
@@ -220,11 +245,13 @@ pub fn prop_meshes() -> Result<Vec<Vec<PropVertex>>> {
         super::teapot::teapot_mesh(TEAPOT_HEIGHT),
         far_head,
         far_body,
+        eye_mesh(10, 16),
+        eye_mesh(4, 6),
     ])
 }
 
-/// The far versions of the crowd's prop meshes (people's heads and bodies), switched where
-/// their cells span [`FAR_CELL_PIXELS`]: give them to `Renderer::set_prop_lods` after
+/// The far versions of the crowd's prop meshes (people's heads and bodies, switched where
+/// their cells span [`FAR_CELL_PIXELS`]; eyes below [`FAR_EYE_PIXELS`]): give them to `Renderer::set_prop_lods` after
 /// [`prop_meshes`].
 pub fn prop_lods(meshes: &[Vec<PropVertex>]) -> Vec<crate::render::prop_table::PropLod> {
     let lod = |mesh: usize, far_mesh: usize, cell: f32| {
@@ -238,6 +265,11 @@ pub fn prop_lods(meshes: &[Vec<PropVertex>]) -> Vec<crate::render::prop_table::P
     vec![
         lod(prop_mesh::HEAD, prop_mesh::FAR_HEAD, FAR_HEAD_CELL),
         lod(prop_mesh::BODY, prop_mesh::FAR_BODY, FAR_BODY_CELL),
+        crate::render::prop_table::PropLod {
+            mesh: prop_mesh::EYE,
+            far_mesh: prop_mesh::FAR_EYE,
+            below_pixels: FAR_EYE_PIXELS,
+        },
     ]
 }
 
@@ -268,10 +300,28 @@ pub fn character_props(c: &CrowdCharacter) -> Result<Vec<(usize, PropInstance)>>
         )
     };
     Ok(match c.body {
-        Body::Person(p) => vec![
-            at(prop_mesh::HEAD, p.head_transform()?),
-            at(prop_mesh::BODY, p.body_transform()),
-        ],
+        Body::Person(p) => {
+            let head = p.head_transform()?;
+            let mut props = vec![
+                at(prop_mesh::HEAD, head),
+                at(prop_mesh::BODY, p.body_transform()),
+            ];
+            for eye in super::human::human_head()?.eyes {
+                let iris = eye.centre + Vec3::Z * (IRIS_OFFSET * eye.radius);
+                for (centre, radius, color) in [
+                    (eye.centre, eye.radius, SCLERA_COLOR),
+                    (iris, IRIS_RADIUS * eye.radius, IRIS_COLOR),
+                ] {
+                    let model = head
+                        * Mat4::from_translation(centre)
+                        * Mat4::from_scale(Vec3::splat(radius));
+                    let (_, mut inst) = at(prop_mesh::EYE, model);
+                    inst.color = color;
+                    props.push((prop_mesh::EYE, inst));
+                }
+            }
+            props
+        }
         Body::Ball => vec![at(prop_mesh::BALL, Mat4::IDENTITY)],
         Body::Teapot => vec![at(prop_mesh::TEAPOT, Mat4::IDENTITY)],
     })
