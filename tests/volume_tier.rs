@@ -7,12 +7,7 @@
 mod common;
 
 use common::*;
-use glam::Vec3;
-use hairmesh::render::{
-    Camera, FrameOptions, LightRaster, LodSettings, Renderer, RendererDesc, ShadowMode,
-    StrandRaster, View, VolumeTier,
-};
-use hairmesh::shade::ShadingModel;
+use hairmesh::render::{Camera, LodSettings, Renderer, RendererDesc, View, VolumeTier};
 
 /// Side of the test frames.
 const SIZE: u32 = 128;
@@ -21,14 +16,7 @@ const SIZE: u32 = 128;
 /// of a `SIZE`-pixel frame (`render::volume::hair_pixels`).
 fn camera_at(name: &str, pixels: f32) -> Camera {
     let (baked, _) = sample(name);
-    let lo = Vec3::from_slice(&baked.info.pos_origin[..3]);
-    let extent = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    let centre = lo + 0.5 * extent;
-    let radius = 0.5 * extent.length();
-    let fov: f32 = 40.0;
-    let distance = radius / (fov.to_radians() * 0.5).tan() * SIZE as f32 / pixels;
-    let dir = hairmesh::render::DEFAULT_VIEW_DIR.normalize();
-    Camera::look_at(centre + dir * distance, centre, fov)
+    hairmesh::render::volume::camera_spanning(&baked.info, pixels, SIZE)
 }
 
 /// One frame of `name` (64 strands per bundle, 16 segments) seen by `camera`, with `tier`.
@@ -47,19 +35,8 @@ fn frame(
     )
     .unwrap();
     upload(&mut r, &baked, &style, 64, 4);
-    let view = View {
-        shading: ShadingModel::Marschner,
-        shadows: ShadowMode::DeepOpacity,
-        lod,
-        volumes: tier,
-        ..View::new(camera)
-    };
-    let opts = FrameOptions {
-        read_image: true,
-        raster: StrandRaster::Auto { k: 8 },
-        light_raster: LightRaster::Software,
-        ..Default::default()
-    };
+    let (view, opts) = hairmesh::render::volume::switch_look(camera, tier);
+    let view = View { lod, ..view };
     let rgba = r.render_one(&view, &opts).unwrap().rgba.unwrap();
     assert_no_validation_errors(ctx);
     rgba

@@ -139,6 +139,38 @@ pub fn hair_pixels(r: &CharacterRecord, block: &FrameBlock) -> f32 {
     radius * inv_tan * height / distance
 }
 
+/// The camera from [`super::DEFAULT_VIEW_DIR`] (vertical field of view 40 degrees) at which
+/// the bounding sphere of the hair box of `info` spans `pixels` pixels of a frame `height`
+/// pixels tall: the inverse of [`hair_pixels`] for a character at the origin, where the switch
+/// is measured (tests/volume_tier.rs) and shown (`bench crowd --band-strip`).
+pub fn camera_spanning(info: &crate::bake::MeshInfo, pixels: f32, height: u32) -> super::Camera {
+    let lo = Vec3::from_slice(&info.pos_origin[..3]);
+    let extent = Vec3::from_slice(&info.pos_extent[..3]);
+    let (centre, radius, fov) = (lo + 0.5 * extent, 0.5 * extent.length(), 40.0f32);
+    let distance = radius / (fov.to_radians() * 0.5).tan() * height as f32 / pixels;
+    let dir = super::DEFAULT_VIEW_DIR.normalize();
+    super::Camera::look_at(centre + dir * distance, centre, fov)
+}
+
+/// The look the switch between strands and volume is measured and shown with, for `camera`
+/// and `tier`: Marschner, deep opacity shadows, software strands (`auto:8`) and light passes,
+/// the image read back.
+pub fn switch_look(camera: super::Camera, tier: VolumeTier) -> (super::View, super::FrameOptions) {
+    let view = super::View {
+        shading: crate::shade::ShadingModel::Marschner,
+        shadows: super::ShadowMode::DeepOpacity,
+        volumes: tier,
+        ..super::View::new(camera)
+    };
+    let opts = super::FrameOptions {
+        read_image: true,
+        raster: super::StrandRaster::Auto { k: 8 },
+        light_raster: super::LightRaster::Software,
+        ..Default::default()
+    };
+    (view, opts)
+}
+
 /// Refuse a sampling the GPU build cannot hold.
 fn check_sampling(sampling: &VolumeSampling) -> GpuResult<()> {
     let d = sampling.dims;

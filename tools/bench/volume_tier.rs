@@ -5,11 +5,8 @@
 //! crowd over the smallest.
 
 use anyhow::Result;
-use glam::Vec3;
 use hairmesh::outln;
-use hairmesh::render::{
-    FrameOptions, FrameSettings, LightRaster, ShadowMode, StrandRaster, View, VolumeTier,
-};
+use hairmesh::render::{FrameOptions, FrameSettings, LightRaster, StrandRaster, View, VolumeTier};
 
 /// Print a row per count and tier setting, then the ratio lines. With `picture`, returns the
 /// largest crowd's frame with the tier on.
@@ -89,9 +86,6 @@ pub fn band_strip(
     ctx: &std::sync::Arc<hairmesh::vk::Context>,
     (baked, style): &(hairmesh::BakedHairMesh, hairmesh::HairStyle),
 ) -> Result<(Vec<u8>, (u32, u32))> {
-    let lo = Vec3::from_slice(&baked.info.pos_origin[..3]);
-    let extent = Vec3::from_slice(&baked.info.pos_extent[..3]);
-    let (centre, radius, fov) = (lo + 0.5 * extent, 0.5 * extent.length(), 40.0f32);
     let mut rows = Vec::new();
     for tier in [VolumeTier::on(), VolumeTier::OFF] {
         let mut row = Vec::new();
@@ -105,21 +99,9 @@ pub fn band_strip(
                 verts_log2: 4,
             };
             r.add_character(baked, style, params, glam::Mat4::IDENTITY)?;
-            let distance = radius / (fov.to_radians() * 0.5).tan() * STRIP_FRAME as f32 / pixels;
-            let dir = hairmesh::render::DEFAULT_VIEW_DIR.normalize();
-            let camera = hairmesh::render::Camera::look_at(centre + dir * distance, centre, fov);
-            let view = View {
-                shading: hairmesh::shade::ShadingModel::Marschner,
-                shadows: ShadowMode::DeepOpacity,
-                volumes: tier,
-                ..View::new(camera)
-            };
-            let opts = FrameOptions {
-                read_image: true,
-                raster: StrandRaster::Auto { k: 8 },
-                light_raster: LightRaster::Software,
-                ..Default::default()
-            };
+            let camera =
+                hairmesh::render::volume::camera_spanning(&baked.info, pixels, STRIP_FRAME);
+            let (view, opts) = hairmesh::render::volume::switch_look(camera, tier);
             let rgba = r.render_one(&view, &opts)?.rgba.unwrap_or_default();
             let full = image::RgbaImage::from_raw(STRIP_FRAME, STRIP_FRAME, rgba)
                 .ok_or_else(|| anyhow::anyhow!("frame size"))?;
