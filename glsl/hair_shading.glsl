@@ -36,24 +36,32 @@ float hair_gaussian(float beta, float x) {
     return exp(-x * x / (2.0 * beta * beta)) / (2.50662827463 * beta);
 }
 
-// S(omega_i, omega_o) per channel; radiance = S * E * cos(theta_i).
-vec3 marschner(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt) {
+// theta_h, cos(theta_d), cos(phi), cos(theta_i) (shade::hair_angles).
+vec4 hair_angles(vec3 t, vec3 l, vec3 v) {
     float sin_i = clamp(dot(t, l), -1.0, 1.0);
     float sin_o = clamp(dot(t, v), -1.0, 1.0);
     float theta_i = asin(sin_i);
     float theta_o = asin(sin_o);
-    float theta_h = 0.5 * (theta_i + theta_o);
-    float cos_d = max(cos(0.5 * (theta_o - theta_i)), 1e-3);
     vec3 lp = l - t * sin_i;
     vec3 vp = v - t * sin_o;
     float cos_phi = clamp(dot(lp, vp) / sqrt(dot(lp, lp) * dot(vp, vp) + 1e-8), -1.0, 1.0);
+    return vec4(0.5 * (theta_i + theta_o), max(cos(0.5 * (theta_o - theta_i)), 1e-3), cos_phi,
+                sqrt(max(1.0 - sin_i * sin_i, 0.0)));
+}
+
+// S(omega_i, omega_o) per channel at the angles `ang` (hair_angles) with `lv` = dot(l, v);
+// radiance = S * E * cos(theta_i).
+vec3 marschner_at(vec4 ang, float lv, vec3 color, float roughness, float tilt) {
+    float theta_h = ang.x;
+    float cos_d = ang.y;
+    float cos_phi = ang.z;
     float cos_half_phi = sqrt(0.5 + 0.5 * cos_phi);
     float a = tilt;
     float b = roughness;
     float m_r = 0.5 * hair_gaussian(b, theta_h + a);
     float m_tt = 0.5 * hair_gaussian(0.5 * b, theta_h - 0.5 * a);
     float m_trt = 0.5 * hair_gaussian(2.0 * b, theta_h - 1.5 * a);
-    float n_r = 0.25 * cos_half_phi * hair_fresnel(HAIR_ETA, sqrt(max(0.5 + 0.5 * dot(l, v), 0.0)));
+    float n_r = 0.25 * cos_half_phi * hair_fresnel(HAIR_ETA, sqrt(max(0.5 + 0.5 * lv, 0.0)));
     // Texel centres sit at cos(phi) = -1 + 2 i / (PHI - 1), cos(theta_d) = j / (D - 1), in
     // the first rows of the shading lookup texture.
     vec2 size = vec2(MARSCHNER_LUT_PHI, MARSCHNER_LUT_D);
@@ -66,21 +74,13 @@ vec3 marschner(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt) 
     return (vec3(m_r * n_r) + n_tt * m_tt + n_trt * m_trt) * (MARSCHNER_ENERGY_SCALE / (cos_d * cos_d));
 }
 
+// S(omega_i, omega_o) per channel for unit tangent t, to-light l and to-eye v.
+vec3 marschner(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt) {
+    return marschner_at(hair_angles(t, l, v), dot(l, v), color, roughness, tilt);
+}
+
 // ---- Dual scattering (Zinke et al. 2008; seed 000 sec. 3.2, eqs. 3-4). CPU twin:
 // src/shade/scattering.rs, where the derivation is written out.
-
-// theta_h, cos(theta_d), cos(phi), cos(theta_i) (shade::scattering::hair_angles).
-vec4 hair_angles(vec3 t, vec3 l, vec3 v) {
-    float sin_i = clamp(dot(t, l), -1.0, 1.0);
-    float sin_o = clamp(dot(t, v), -1.0, 1.0);
-    float theta_i = asin(sin_i);
-    float theta_o = asin(sin_o);
-    vec3 lp = l - t * sin_i;
-    vec3 vp = v - t * sin_o;
-    float cos_phi = clamp(dot(lp, vp) / sqrt(dot(lp, lp) * dot(vp, vp) + 1e-8), -1.0, 1.0);
-    return vec4(0.5 * (theta_i + theta_o), max(cos(0.5 * (theta_o - theta_i)), 1e-3), cos_phi,
-                sqrt(max(1.0 - sin_i * sin_i, 0.0)));
-}
 
 // Energies of R, TT, TRT into the front (back = 0) or back (back = 1) half of azimuth for
 // colour channel c (shade::scattering::lobe_energies, tabulated in src/shade/lut.rs).
@@ -124,8 +124,8 @@ vec3 back_scattering(vec3 front, vec3 back, float cluster) {
 // behind bodies, z expected strand hits.
 vec3 dual_scattering(vec3 t, vec3 l, vec3 v, vec3 color, float roughness, float tilt, vec3 arrival, bool multiple,
                      float cluster) {
-    vec3 single = marschner(t, l, v, color, roughness, tilt);
     vec4 ang = hair_angles(t, l, v);
+    vec3 single = marschner_at(ang, dot(l, v), color, roughness, tilt);
     if (!multiple) {
         return single * (ang.w * arrival.x);
     }

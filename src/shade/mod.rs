@@ -109,15 +109,30 @@ pub struct MarschnerParams {
 /// `t`, direction to the light `l` and to the eye `v`. Outgoing radiance from a directional
 /// light of irradiance `E` (perpendicular to the light) is `S * E * cos(theta_i)`.
 pub fn marschner(t: Vec3, l: Vec3, v: Vec3, p: &MarschnerParams) -> Vec3 {
+    marschner_at(hair_angles(t, l, v), l.dot(v), p)
+}
+
+/// The angles the hair models need for unit tangent `t`, direction to the light `l` and to
+/// the eye `v`: `theta_h`, `cos(theta_d)`, `cos(phi)`, `cos(theta_i)`.
+pub fn hair_angles(t: Vec3, l: Vec3, v: Vec3) -> [f32; 4] {
     let sin_i = t.dot(l).clamp(-1.0, 1.0);
     let sin_o = t.dot(v).clamp(-1.0, 1.0);
     let (theta_i, theta_o) = (sin_i.asin(), sin_o.asin());
-    let theta_h = 0.5 * (theta_i + theta_o);
-    let cos_d = (0.5 * (theta_o - theta_i)).cos().max(1e-3);
     let lp = l - t * sin_i;
     let vp = v - t * sin_o;
     let cos_phi =
         (lp.dot(vp) / (lp.length_squared() * vp.length_squared() + 1e-8).sqrt()).clamp(-1.0, 1.0);
+    [
+        0.5 * (theta_i + theta_o),
+        (0.5 * (theta_o - theta_i)).cos().max(1e-3),
+        cos_phi,
+        (1.0 - sin_i * sin_i).max(0.0).sqrt(),
+    ]
+}
+
+/// [`marschner`] at the angles `[theta_h, cos_d, cos_phi, _]` of [`hair_angles`], with
+/// `lv = l . v`.
+pub fn marschner_at([theta_h, cos_d, cos_phi, _]: [f32; 4], lv: f32, p: &MarschnerParams) -> Vec3 {
     let cos_half_phi = (0.5 + 0.5 * cos_phi).sqrt();
     // Longitudinal: shifts -a, a/2, 3a/2 and widths b, b/2, 2b (Marschner 2003), normalised
     // over theta_o (d theta_o = 2 d theta_h).
@@ -126,7 +141,7 @@ pub fn marschner(t: Vec3, l: Vec3, v: Vec3, p: &MarschnerParams) -> Vec3 {
     let m_tt = 0.5 * gaussian(0.5 * b, theta_h - 0.5 * a);
     let m_trt = 0.5 * gaussian(2.0 * b, theta_h - 1.5 * a);
     // Azimuthal (Karis 2016).
-    let n_r = 0.25 * cos_half_phi * fresnel(HAIR_ETA, (0.5 + 0.5 * l.dot(v)).max(0.0).sqrt());
+    let n_r = 0.25 * cos_half_phi * fresnel(HAIR_ETA, (0.5 + 0.5 * lv).max(0.0).sqrt());
     let az = azimuthal_factors(cos_phi, cos_d);
     let absorb = |path: f32| p.color.max(Vec3::splat(1e-4)).powf(path);
     let n_tt = absorb(az.tt_path / (2.0 * cos_d)) * az.tt;

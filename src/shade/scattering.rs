@@ -21,7 +21,9 @@
 
 use glam::Vec3;
 
-use super::{ENERGY_SCALE, HAIR_ETA, MarschnerParams, azimuthal_factors, fresnel, gaussian};
+use super::{
+    ENERGY_SCALE, HAIR_ETA, MarschnerParams, azimuthal_factors, fresnel, gaussian, hair_angles,
+};
 
 /// Zinke's forward density factor `d_f`: the share of the global path that hair of finite
 /// density lets through (0.7 in the paper).
@@ -181,24 +183,6 @@ pub fn back_scattering(
     (total, shift, var * widen * widen)
 }
 
-/// The angles the scattering terms need: `theta_h`, `cos(theta_d)`, `cos(phi)`,
-/// `cos(theta_i)`.
-pub fn hair_angles(t: Vec3, l: Vec3, v: Vec3) -> [f32; 4] {
-    let sin_i = t.dot(l).clamp(-1.0, 1.0);
-    let sin_o = t.dot(v).clamp(-1.0, 1.0);
-    let (theta_i, theta_o) = (sin_i.asin(), sin_o.asin());
-    let lp = l - t * sin_i;
-    let vp = v - t * sin_o;
-    let cos_phi =
-        (lp.dot(vp) / (lp.length_squared() * vp.length_squared() + 1e-8).sqrt()).clamp(-1.0, 1.0);
-    [
-        0.5 * (theta_i + theta_o),
-        (0.5 * (theta_o - theta_i)).cos().max(1e-3),
-        cos_phi,
-        (1.0 - sin_i * sin_i).max(0.0).sqrt(),
-    ]
-}
-
 /// Radiance toward `v` per unit irradiance of a directional light toward `l` (so multiply by
 /// the light's irradiance), for a strand of tangent `t` and style `p` that the light reaches
 /// as `arrival`: single scattering of the direct light, plus with `multiple` on, Zinke's dual
@@ -228,8 +212,9 @@ pub fn dual_scattering(
     multiple: bool,
     cluster: f32,
 ) -> Vec3 {
-    let single = super::marschner(t, l, v, p);
-    let [theta_h, cos_d, cos_phi, cos_i] = hair_angles(t, l, v);
+    let angles = hair_angles(t, l, v);
+    let single = super::marschner_at(angles, l.dot(v), p);
+    let [theta_h, cos_d, cos_phi, cos_i] = angles;
     if !multiple {
         return single * (cos_i * arrival.direct);
     }
