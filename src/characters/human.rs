@@ -180,10 +180,15 @@ impl HumanHead {
     }
 }
 
+/// A position to 10 micrometres, as the key that welds a triangle soup's shared corners.
+fn position_key(p: Vec3) -> [i32; 3] {
+    (p * 1e5).round().as_ivec3().to_array()
+}
+
 /// Boundary loops of a triangle soup (edges used by one triangle), as ordered rings of
 /// positions.
 fn boundary_loops(triangles: &[[Vec3; 3]]) -> Vec<Vec<Vec3>> {
-    let key = |p: Vec3| (p * 1e5).round().as_ivec3().to_array();
+    let key = position_key;
     let mut count: std::collections::HashMap<([i32; 3], [i32; 3]), i32> = Default::default();
     let mut at: std::collections::HashMap<[i32; 3], Vec3> = Default::default();
     for t in triangles {
@@ -331,7 +336,7 @@ fn fill_missing(radius: &mut [f32]) -> Option<()> {
 /// A triangle list with normals averaged over the triangles sharing each position (area
 /// weighted), so a faceted mesh shades smoothly.
 pub fn smooth_prop_mesh(triangles: &[[Vec3; 3]]) -> Vec<PropVertex> {
-    let key = |p: Vec3| (p * 1e5).round().as_ivec3().to_array();
+    let key = position_key;
     let mut normals: std::collections::HashMap<[i32; 3], Vec3> = Default::default();
     for t in triangles {
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
