@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The library as an engine embeds it: built without the default `window` feature, with no
-# windowing toolkit or UI crate in its dependency tree (issue 27). Run by .ci/run after the
+# windowing toolkit or UI crate in its dependency tree (issue 27). Run by tools/test.sh after the
 # tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
