@@ -34,6 +34,7 @@ fn round_trip(name: &str, per: u32) -> (Fidelity, usize, usize) {
     let (baked, style) = sample(name);
     let input = strands_of(&baked, style, per);
     let model = StrandModel {
+        widths: None,
         name: name.into(),
         strands: input.clone(),
         file_bytes: 0,
@@ -235,6 +236,7 @@ fn a_model_with_fewer_strands_than_bundles_fits() {
         })
         .collect();
     let model = StrandModel {
+        widths: None,
         name: "sparse.hair".into(),
         strands,
         file_bytes: 0,

@@ -284,6 +284,21 @@ fn percentile(v: &mut [f32], q: f32) -> f32 {
     v[((v.len() - 1) as f32 * q).round() as usize]
 }
 
+/// The root width and tip-to-root ratio of the style from the model's widths (medians over the
+/// strands; `None` without widths or when they are all zero).
+fn fit_widths(model: &StrandModel) -> Option<(f32, f32)> {
+    let widths = model.widths.as_ref()?;
+    let root = median(widths.iter().filter_map(|w| w.first().copied()).collect());
+    let ratio = median(
+        widths
+            .iter()
+            .filter(|w| w.first().is_some_and(|r| *r > 0.0))
+            .map(|w| w[w.len() - 1] / w[0])
+            .collect(),
+    );
+    (root > 0.0 && root.is_finite()).then_some((root, ratio.clamp(0.0, 1.0)))
+}
+
 /// Fit a hair mesh and style to `model`; `head` (triangles) places the scalp on its surface.
 pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -> Result<Fitted> {
     let bad = |what: String| HairError::invalid(&model.name, what);
@@ -460,8 +475,10 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
         Some(_) => 0.25 * residual,
         None => residual,
     };
+    let (strand_width, tip_width_ratio) = fit_widths(model).unwrap_or((diag * 0.0015, 0.3));
     let style = HairStyle {
-        strand_width: diag * 0.0015,
+        strand_width,
+        tip_width_ratio,
         length_variation,
         clump_strength,
         frizz_amplitude,

@@ -31,12 +31,15 @@ pub struct StrandModel {
     pub name: String,
     /// Strands, root first; every one has at least two points.
     pub strands: Vec<Vec<Vec3>>,
+    /// Per-point widths (object units), when the file has them (Alembic curves); the same
+    /// shape as `strands`.
+    pub widths: Option<Vec<Vec<f32>>>,
     /// Size of the file it was read from, bytes.
     pub file_bytes: u64,
 }
 
 impl StrandModel {
-    /// Read a `.tfx` or `.hair` file (chosen by extension).
+    /// Read a `.tfx`, `.hair` or Alembic `.abc` file (chosen by extension).
     pub fn load(path: &Path) -> Result<Self> {
         let bytes = crate::fsutil::read_input(path, crate::fsutil::MAX_MESH_FILE_BYTES)?;
         let name = path.display().to_string();
@@ -45,9 +48,12 @@ impl StrandModel {
             Some(e) if e.eq_ignore_ascii_case("hair") => {
                 Self::from_hair(&name, &HairFile::parse(&name, &bytes)?, bytes.len() as u64)
             }
+            Some(e) if e.eq_ignore_ascii_case("abc") => {
+                super::alembic::strand_model(&name, &bytes)
+            }
             _ => Err(HairError::invalid(
                 name,
-                "unknown strand file type (expected .tfx or .hair)",
+                "unknown strand file type (expected .tfx, .hair or .abc)",
             )),
         }
     }
@@ -115,12 +121,17 @@ impl StrandModel {
             }
             out.push(strand);
         }
-        Self::checked(name, out, bytes.len() as u64)
+        Self::checked(name, out, None, bytes.len() as u64)
     }
 
     /// The hairs of a `.hair` model.
     pub fn from_hair(name: &str, hair: &HairFile, file_bytes: u64) -> Result<Self> {
         let mut out = Vec::with_capacity(hair.hair_count as usize);
+        let thickness = hair
+            .thickness
+            .as_ref()
+            .filter(|t| t.len() == hair.points.len());
+        let mut widths = thickness.map(|_| Vec::with_capacity(hair.hair_count as usize));
         let mut o = 0usize;
         for i in 0..hair.hair_count as usize {
             let n = hair.hair_segments(i) as usize + 1;
@@ -130,17 +141,31 @@ impl StrandModel {
                     .map(|p| Vec3::from_array(*p))
                     .collect(),
             );
+            if let (Some(w), Some(t)) = (widths.as_mut(), thickness) {
+                w.push(t[o..o + n].to_vec());
+            }
             o += n;
         }
-        Self::checked(name, out, file_bytes)
+        Self::checked(name, out, widths, file_bytes)
     }
 
-    /// Strands with at least two points and non-zero length; errors when none is left.
-    fn checked(name: &str, strands: Vec<Vec<Vec3>>, file_bytes: u64) -> Result<Self> {
-        let strands: Vec<Vec<Vec3>> = strands
-            .into_iter()
-            .filter(|s| s.len() >= 2 && polyline_length(s) > 0.0)
-            .collect();
+    /// Strands with at least two points and non-zero length (with their `widths`, one per
+    /// point, when given); errors when none is left.
+    pub(crate) fn checked(
+        name: &str,
+        strands: Vec<Vec<Vec3>>,
+        widths: Option<Vec<Vec<f32>>>,
+        file_bytes: u64,
+    ) -> Result<Self> {
+        let keep = |s: &Vec<Vec3>| s.len() >= 2 && polyline_length(s) > 0.0;
+        let widths = widths.map(|w| {
+            w.into_iter()
+                .zip(&strands)
+                .filter(|(_, s)| keep(s))
+                .map(|(w, _)| w)
+                .collect()
+        });
+        let strands: Vec<Vec<Vec3>> = strands.into_iter().filter(keep).collect();
         if strands.is_empty() {
             return Err(HairError::invalid(
                 name,
@@ -150,6 +175,7 @@ impl StrandModel {
         Ok(StrandModel {
             name: name.into(),
             strands,
+            widths,
             file_bytes,
         })
     }
