@@ -7,12 +7,12 @@ mod common;
 
 use glam::Vec3;
 use hairmesh::fit::metric::compare;
-use hairmesh::reference::generate::strands_per_bundle_for;
-use hairmesh::{BakeOptions, CpuGenerator, bake};
 use hairmesh::fit::{FitOptions, fit};
 use hairmesh::model::alembic::read_curves;
 use hairmesh::model::hair_file::HairFile;
 use hairmesh::model::strands::StrandModel;
+use hairmesh::reference::generate::strands_per_bundle_for;
+use hairmesh::{BakeOptions, CpuGenerator, bake};
 
 fn sample_bytes() -> Vec<u8> {
     std::fs::read(common::root().join("hairmeshes/sintel_hair.abc")).unwrap()
@@ -40,7 +40,10 @@ fn sample_round_trips_against_hair() {
     let names: Vec<&str> = objects.iter().map(|o| o.name.as_str()).collect();
     // Two curve objects, one below a moved, turned and scaled transform.
     assert_eq!(names.len(), 2, "{names:?}");
-    assert!(names.iter().any(|n| n.starts_with("/groom_rig/")), "{names:?}");
+    assert!(
+        names.iter().any(|n| n.starts_with("/groom_rig/")),
+        "{names:?}"
+    );
     let model = StrandModel::load(&common::root().join("hairmeshes/sintel_hair.abc")).unwrap();
     assert_eq!(model.strands.len(), known.strands.len());
     // The objects may come in either order: match strands by their roots.
@@ -85,7 +88,13 @@ fn fidelity(model: &StrandModel) -> (hairmesh::fit::metric::Fidelity, hairmesh::
         ..FitOptions::default()
     };
     let fitted = fit(model, None, &opts).unwrap();
-    let baked = bake(&fitted.mesh, &fitted.style, BakeOptions::default(), |_, _| {}).unwrap();
+    let baked = bake(
+        &fitted.mesh,
+        &fitted.style,
+        BakeOptions::default(),
+        |_, _| {},
+    )
+    .unwrap();
     let (per, _) = strands_per_bundle_for(&baked, &fitted.style, model.strands.len() as u64);
     let out = CpuGenerator::new(&baked, fitted.style)
         .generate(per, 5)
@@ -104,8 +113,16 @@ fn fits_like_the_hair() {
     assert!(close(fa.two_sided.0, fk.two_sided.0), "{fa} vs {fk}");
     assert!(close(fa.coverage, fk.coverage), "{fa} vs {fk}");
     // The widths set the style's: root 2 mm, tip a fifth of it, as from the .hair.
-    assert!((style.strand_width - 0.002).abs() < 1e-6, "{}", style.strand_width);
-    assert!((style.tip_width_ratio - 0.2).abs() < 1e-3, "{}", style.tip_width_ratio);
+    assert!(
+        (style.strand_width - 0.002).abs() < 1e-6,
+        "{}",
+        style.strand_width
+    );
+    assert!(
+        (style.tip_width_ratio - 0.2).abs() < 1e-3,
+        "{}",
+        style.tip_width_ratio
+    );
     assert!((style.strand_width - known_style.strand_width).abs() < 1e-7);
     assert!((style.tip_width_ratio - known_style.tip_width_ratio).abs() < 1e-6);
 }
@@ -155,5 +172,59 @@ fn points_stay_in_place() {
             .filter(|s| roots.iter().any(|r| r.distance(s[0]) < 1e-3))
             .count();
         assert_eq!(near, o.strands.len(), "{}", o.name);
+    }
+}
+
+/// `fit --report` on the sample reports fidelity and FLIP as for `.tfx` (validation on); an
+/// HDF5 archive and a truncated one are refused in one line naming the file, writing nothing.
+#[test]
+fn fit_tool_reads_the_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("fitted.obj");
+    let abc = common::root().join("hairmeshes/sintel_hair.abc");
+    let run = |input: &std::path::Path, extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_fit"))
+            .arg(input)
+            .args([
+                "-o",
+                out.to_str().unwrap(),
+                "--bundles",
+                "20",
+                "--layers",
+                "6",
+            ])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = run(&abc, &["--report", "--validation"]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("228 strands, 7296 points"), "{stdout}");
+    assert!(
+        stdout.contains("two-sided mean") && stdout.contains("FLIP mean"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("strand_width 0.0020"), "{stdout}");
+    let bytes = sample_bytes();
+    let hdf5 = dir.path().join("old.abc");
+    std::fs::write(&hdf5, [&b"\x89HDF\r\n\x1a\n"[..], &bytes[8..]].concat()).unwrap();
+    let cut = dir.path().join("cut.abc");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    for (file, cause) in [(&hdf5, "HDF5"), (&cut, "malformed")] {
+        std::fs::remove_file(&out).ok();
+        let o = run(file, &[]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success());
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        assert!(
+            stderr.contains(file.to_str().unwrap()) && stderr.contains(cause),
+            "{stderr}"
+        );
+        assert!(!out.exists());
     }
 }

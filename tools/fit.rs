@@ -1,8 +1,8 @@
-//! `fit`: turn a strand model (TressFX `.tfx` or Yuksel's `.hair`) into a hair mesh OBJ and a
+//! `fit`: turn a strand model (TressFX `.tfx`, Yuksel's `.hair` or Alembic `.abc` curves) into a hair mesh OBJ and a
 //! style TOML beside it, ready for `bake` (method: `src/fit/mod.rs`); `--report` measures the
 //! fitted hair mesh against the input strands.
 //!
-//! `fit STRANDS.tfx|.hair [--head HEAD.obj] -o OUT.obj [--bundles 64] [--layers L] [--report]
+//! `fit STRANDS.tfx|.hair|.abc [--head HEAD.obj] -o OUT.obj [--bundles 64] [--layers L] [--report]
 //! [--picture side_by_side.png]`
 
 use std::io::Write as _;
@@ -27,7 +27,7 @@ use hairmesh::{BakeOptions, CpuGenerator, bake, outln};
 #[derive(Parser)]
 #[command(version, about)]
 struct Args {
-    /// Strand model: TressFX 4.0 `.tfx` or `.hair`.
+    /// Strand model: TressFX 4.0 `.tfx`, `.hair` or Alembic (Ogawa) `.abc` curves.
     strands: PathBuf,
     /// Head mesh OBJ: the scalp is placed on its surface.
     #[arg(long)]

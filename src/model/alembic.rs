@@ -82,7 +82,9 @@ pub fn read_curves(name: &str, bytes: &[u8]) -> Result<Vec<CurveObject>> {
                 .map(|s| s.to_string())
                 .or_else(|| panic.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "unknown".into());
-            Err(bad(format!("malformed archive (the Ogawa reader stopped: {why})")))
+            Err(bad(format!(
+                "malformed archive (the Ogawa reader stopped: {why})"
+            )))
         }
     }
 }
@@ -97,9 +99,13 @@ fn check_ogawa(bytes: &[u8]) -> std::result::Result<(), String> {
     let word = |at: u64| -> std::result::Result<u64, String> {
         match at.checked_add(8).filter(|end| *end <= len) {
             Some(end) => Ok(u64::from_le_bytes(
-                bytes[at as usize..end as usize].try_into().expect("8 bytes"),
+                bytes[at as usize..end as usize]
+                    .try_into()
+                    .expect("8 bytes"),
             )),
-            None => Err(format!("a chunk at byte {at} runs past the end ({len} bytes)")),
+            None => Err(format!(
+                "a chunk at byte {at} runs past the end ({len} bytes)"
+            )),
         }
     };
     // Magic (5), frozen flag (1), version (2), then the root group's position.
@@ -216,7 +222,8 @@ impl Walk {
         let mut world = parent;
         match schema.as_deref() {
             Some(s) if s.starts_with("AbcGeom_Xform") => {
-                world = parent * xform(object, reader, archive).map_err(|e| format!("{full_name}: {e}"))?;
+                world = parent
+                    * xform(object, reader, archive).map_err(|e| format!("{full_name}: {e}"))?;
             }
             Some(s) if s.starts_with("AbcGeom_Curve") => {
                 let curves = curves(object, reader, archive, parent)
@@ -227,7 +234,12 @@ impl Walk {
         }
         for i in 0..object.child_count() {
             let child = object
-                .load_child(i, reader, &archive.indexed_meta_data, &archive.time_samplings)
+                .load_child(
+                    i,
+                    reader,
+                    &archive.indexed_meta_data,
+                    &archive.time_samplings,
+                )
                 .map_err(ogawa(&format!("{full_name}: child {i}")))?;
             self.object(&child, reader, archive, world, depth + 1)?;
         }
@@ -245,7 +257,9 @@ fn schema_name(
     if let Some(s) = object.header.meta_data.tokens.get("schema") {
         return Ok(Some(s.clone()));
     }
-    let has_schema = object.properties().is_some_and(|p| p.sub_property_count() > 0);
+    let has_schema = object
+        .properties()
+        .is_some_and(|p| p.sub_property_count() > 0);
     if !has_schema {
         return Ok(None);
     }
@@ -315,9 +329,7 @@ fn sample(
             }
         }
         PropertyReader::Compound(_) => {
-            return Err(format!(
-                "{what}: an indexed (compound) property, not read"
-            ));
+            return Err(format!("{what}: an indexed (compound) property, not read"));
         }
     };
     Ok(read)
@@ -583,7 +595,13 @@ mod tests {
 
     #[test]
     fn curves_split_place_and_carry_widths() {
-        let pts = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.0]];
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [1.0, 2.0, 0.0],
+        ];
         let world = DMat4::from_scale(DVec3::splat(2.0));
         let c = place_curves("o", (&pts, &[2, 3], Some(&[0.5, 0.25])), world, 1).unwrap();
         assert_eq!(c.strands.len(), 2);
@@ -607,7 +625,10 @@ mod tests {
             (&b"Ogawa\xff\x01\x00"[..], "malformed"),
         ] {
             let e = read_curves("x.abc", bytes).unwrap_err().to_string();
-            assert!(e.starts_with("x.abc: ") && e.contains(says) && !e.contains('\n'), "{e}");
+            assert!(
+                e.starts_with("x.abc: ") && e.contains(says) && !e.contains('\n'),
+                "{e}"
+            );
         }
     }
 }

@@ -48,9 +48,7 @@ impl StrandModel {
             Some(e) if e.eq_ignore_ascii_case("hair") => {
                 Self::from_hair(&name, &HairFile::parse(&name, &bytes)?, bytes.len() as u64)
             }
-            Some(e) if e.eq_ignore_ascii_case("abc") => {
-                super::alembic::strand_model(&name, &bytes)
-            }
+            Some(e) if e.eq_ignore_ascii_case("abc") => super::alembic::strand_model(&name, &bytes),
             _ => Err(HairError::invalid(
                 name,
                 "unknown strand file type (expected .tfx, .hair or .abc)",
