@@ -82,6 +82,7 @@ impl Host {
             queue_family: self.family,
             queue: self.queue,
             validation: true,
+            allocator: None,
         }
     }
 

@@ -1,6 +1,6 @@
 //! Camera, LoD settings and the per-view data of a frame ([`View`] -> [`FrameBlock`]).
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::shared::FrameBlock;
 
@@ -23,6 +23,13 @@ pub struct Camera {
     pub near: f32,
     /// Far plane distance.
     pub far: f32,
+    /// Where the view axis meets the image, in normalised device coordinates (0: the centre;
+    /// off-centre and jittered projections of host engines, [`super::host::HostCamera`]).
+    pub shift: Vec2,
+    /// Image x mirrored: the view is a reflection (a host whose world and view space differ in
+    /// handedness, [`super::host::HostCamera`]); every pipeline is two-sided, so only the
+    /// picture flips.
+    pub mirror: bool,
 }
 
 /// Check a camera: finite eye and target, eye != target, vertical field of view in degrees in
@@ -84,6 +91,8 @@ impl Camera {
             fov_y: fov_y_degrees.to_radians(),
             near: dist * 0.01,
             far: dist * 20.0,
+            shift: Vec2::ZERO,
+            mirror: false,
         }
     }
 
@@ -113,10 +122,12 @@ impl Camera {
         );
         let g = 1.0 / (self.fov_y * 0.5).tan();
         let (n, fa) = (self.near, self.far);
+        let sx = if self.mirror { -g / aspect } else { g / aspect };
         let proj = Mat4::from_cols(
-            Vec4::new(g / aspect, 0.0, 0.0, 0.0),
+            Vec4::new(sx, 0.0, 0.0, 0.0),
             Vec4::new(0.0, -g, 0.0, 0.0),
-            Vec4::new(0.0, 0.0, fa / (n - fa), -1.0),
+            // The view axis lands on `shift` (w = -z).
+            Vec4::new(-self.shift.x, -self.shift.y, fa / (n - fa), -1.0),
             Vec4::new(0.0, 0.0, n * fa / (n - fa), 0.0),
         );
         proj * view
@@ -271,11 +282,16 @@ impl View {
     pub fn validate(&self) -> Result<(), String> {
         let c = &self.camera;
         validate_camera(c.eye, c.target, c.fov_y.to_degrees())?;
-        let planes_ok = c.near > 0.0 && c.far > c.near && c.far.is_finite() && c.up.is_finite();
+        let planes_ok = c.near > 0.0
+            && c.far > c.near
+            && c.far.is_finite()
+            && c.up.is_finite()
+            && c.shift.is_finite()
+            && c.shift.abs().max_element() < 1e3;
         if !planes_ok {
             return Err(format!(
-                "camera near {} / far {} planes are invalid",
-                c.near, c.far
+                "camera near {} / far {} planes or lens shift {} are invalid",
+                c.near, c.far, c.shift
             ));
         }
         validate_light(self.light_dir)?;

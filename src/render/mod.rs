@@ -10,6 +10,7 @@ pub mod deform;
 pub mod dynamics;
 pub mod frame;
 pub mod graph;
+pub mod host;
 pub mod passes;
 pub mod prop_table;
 pub mod renderer;
@@ -27,6 +28,7 @@ pub mod workspace;
 
 pub use camera::{Camera, DEFAULT_VIEW_DIR, LodSettings, View};
 pub use crowd::{CharacterId, Crowd, StrandParams};
+pub use host::{HostCamera, HostFrame, HostImage};
 pub use renderer::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,
     RendererDesc, check_msaa, software_raster_conflict, supported_msaa,

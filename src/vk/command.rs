@@ -195,6 +195,19 @@ pub struct CommandRecorder<'a> {
     rendering: bool,
 }
 
+impl<'a> CommandRecorder<'a> {
+    /// Record into a host's command buffer `raw`: in the recording state, allocated on `ctx`'s
+    /// device from a pool of its queue family, outside any render pass. The host ends and
+    /// submits it.
+    pub(crate) fn host(ctx: &'a Context, raw: vk::CommandBuffer) -> Self {
+        CommandRecorder {
+            ctx,
+            raw,
+            rendering: false,
+        }
+    }
+}
+
 impl CommandRecorder<'_> {
     pub(crate) fn raw(&self) -> vk::CommandBuffer {
         self.raw

@@ -156,7 +156,8 @@ pub struct Context {
     pub(crate) device: ash::Device,
     queue: vk::Queue,
     pub(crate) queue_family: u32,
-    allocator: ManuallyDrop<Mutex<Allocator>>,
+    /// The memory allocator: the context's own, or one shared with a host.
+    allocator: ManuallyDrop<Arc<Mutex<Allocator>>>,
     pub(crate) mesh_ext: Option<ash::ext::mesh_shader::Device>,
     pub(crate) surface: Option<Surface>,
     pub(crate) swapchain_ext: Option<ash::khr::swapchain::Device>,
@@ -187,6 +188,10 @@ pub struct HostDevice {
     /// Count and print validation messages through a messenger of the renderer's own on the
     /// host's instance (which must have `VK_EXT_debug_utils` and the validation layer).
     pub validation: bool,
+    /// The host's memory allocator (`gpu-allocator` 0.28, created on this device with buffer
+    /// device addresses on) for the renderer to allocate from too; `None`: the renderer makes
+    /// its own.
+    pub allocator: Option<Arc<Mutex<Allocator>>>,
 }
 
 /// The instance extensions `desc`'s window needs (none without one).
@@ -342,7 +347,7 @@ impl Context {
                 surface.is_some(),
             )?;
             let allocator = match new_allocator(&instance, &device, physical) {
-                Ok(a) => a,
+                Ok(a) => Arc::new(Mutex::new(a)),
                 Err(e) => {
                     // SAFETY: nothing was created on the device yet.
                     unsafe { device.destroy_device(None) };
@@ -398,6 +403,7 @@ impl Context {
             queue_family,
             queue,
             validation,
+            allocator: shared,
         } = host;
         // SAFETY: valid physical device of the host's instance.
         let props = unsafe { instance.get_physical_device_properties(physical) };
@@ -420,7 +426,11 @@ impl Context {
         } else {
             None
         };
-        let allocator = match new_allocator(&instance, &device, physical) {
+        let made = match shared {
+            Some(a) => Ok(a),
+            None => new_allocator(&instance, &device, physical).map(|a| Arc::new(Mutex::new(a))),
+        };
+        let allocator = match made {
             Ok(a) => a,
             Err(error) => {
                 if let Some((loader, messenger)) = debug {
@@ -475,7 +485,7 @@ impl Context {
             device: p.device,
             queue: p.queue,
             queue_family: p.queue_family,
-            allocator: ManuallyDrop::new(Mutex::new(p.allocator)),
+            allocator: ManuallyDrop::new(p.allocator),
             mesh_ext,
             surface: p.surface,
             swapchain_ext,
@@ -655,7 +665,7 @@ struct Parts {
     device: ash::Device,
     queue: vk::Queue,
     queue_family: u32,
-    allocator: Allocator,
+    allocator: Arc<Mutex<Allocator>>,
     surface: Option<Surface>,
     owns_device: bool,
     info: DeviceInfo,

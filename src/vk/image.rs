@@ -71,15 +71,40 @@ pub struct Image {
     raw: vk::Image,
     view: vk::ImageView,
     allocation: Option<Allocation>,
+    /// Created here (destroyed with this); else a host's image, of which only the view is ours.
+    owned: bool,
     /// Creation parameters.
     pub desc: ImageDesc,
 }
 
+/// Every aspect of `format` (barriers name all of them).
 pub(crate) fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
     match format {
-        vk::Format::D32_SFLOAT | vk::Format::D16_UNORM => vk::ImageAspectFlags::DEPTH,
+        vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => {
+            vk::ImageAspectFlags::DEPTH
+        }
+        vk::Format::D16_UNORM_S8_UINT
+        | vk::Format::D24_UNORM_S8_UINT
+        | vk::Format::D32_SFLOAT_S8_UINT => {
+            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+        }
+        vk::Format::S8_UINT => vk::ImageAspectFlags::STENCIL,
         _ => vk::ImageAspectFlags::COLOR,
     }
+}
+
+/// The aspect a view of `format` shows (depth alone for depth-stencil formats: sampled depth).
+fn view_aspect(format: vk::Format) -> vk::ImageAspectFlags {
+    let all = aspect(format);
+    match all.contains(vk::ImageAspectFlags::DEPTH) {
+        true => vk::ImageAspectFlags::DEPTH,
+        false => all,
+    }
+}
+
+/// Whether `format` has depth.
+pub fn is_depth_format(format: vk::Format) -> bool {
+    aspect(format).contains(vk::ImageAspectFlags::DEPTH)
 }
 
 /// Bytes per texel of the formats this project uses.
@@ -139,6 +164,42 @@ impl Image {
                 return Err(e);
             }
         };
+        match Self::with_view(ctx, raw, desc, Some(allocation)) {
+            Ok(image) => Ok(image),
+            Err((e, allocation)) => {
+                // SAFETY: the image is unused; its memory is freed after it.
+                unsafe { ctx.device.destroy_image(raw, None) };
+                if let Some(a) = allocation {
+                    let _ = ctx.allocator().free(a);
+                }
+                Err(e)
+            }
+        }
+    }
+
+    /// A host's image, described by `desc` (its format, extent, samples and the usage it was
+    /// created with): the renderer makes a view of its own and never destroys the image. The
+    /// host keeps the image alive until this is dropped, and drops this only after the GPU is
+    /// done with the frames that used it.
+    pub fn from_host(ctx: &Arc<Context>, raw: vk::Image, desc: &ImageDesc) -> GpuResult<Self> {
+        if raw == vk::Image::null() || desc.dim_3d || desc.extent[2] != 1 {
+            return Err(GpuError::Unsupported(format!(
+                "{}: a host image must be a non-null 2D image",
+                desc.name
+            )));
+        }
+        Self::with_view(ctx, raw, desc, None).map_err(|(e, _)| e)
+    }
+
+    /// `raw` with a full view; `allocation`: its memory, when the image is ours. On error the
+    /// allocation comes back for the caller to free.
+    #[allow(clippy::result_large_err)]
+    fn with_view(
+        ctx: &Arc<Context>,
+        raw: vk::Image,
+        desc: &ImageDesc,
+        allocation: Option<Allocation>,
+    ) -> Result<Self, (GpuError, Option<Allocation>)> {
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(if desc.dim_3d {
@@ -149,30 +210,32 @@ impl Image {
             .format(desc.format)
             .subresource_range(
                 vk::ImageSubresourceRange::default()
-                    .aspect_mask(aspect(desc.format))
+                    .aspect_mask(view_aspect(desc.format))
                     .level_count(1)
                     .layer_count(1),
             );
-        // SAFETY: view of a bound image.
+        // SAFETY: view of a bound image (ours, or a host's on this device).
         let view = match unsafe { ctx.device.create_image_view(&view_info, None) } {
             Ok(v) => v,
             Err(result) => {
-                // SAFETY: the image is unused; its memory is freed after it.
-                unsafe { ctx.device.destroy_image(raw, None) };
-                let _ = ctx.allocator().free(allocation);
-                return Err(GpuError::Vk {
+                let e = GpuError::Vk {
                     what: "create image view",
                     result,
-                });
+                };
+                return Err((e, allocation));
             }
         };
-        ctx.name_object(raw, &desc.name);
+        let owned = allocation.is_some();
+        if owned {
+            ctx.name_object(raw, &desc.name);
+        }
         ctx.name_object(view, &desc.name);
         Ok(Image {
             ctx: ctx.clone(),
             raw,
             view,
-            allocation: Some(allocation),
+            allocation,
+            owned,
             desc: desc.clone(),
         })
     }
@@ -228,7 +291,9 @@ impl Drop for Image {
         // SAFETY: callers wait for the GPU before dropping images it uses.
         unsafe {
             self.ctx.device.destroy_image_view(self.view, None);
-            self.ctx.device.destroy_image(self.raw, None);
+            if self.owned {
+                self.ctx.device.destroy_image(self.raw, None);
+            }
         }
         if let Some(a) = self.allocation.take() {
             let _ = self.ctx.allocator().free(a);

@@ -60,6 +60,8 @@ pub enum DepthMode {
     TestOnly,
     /// Test `EQUAL`, no write (the fragments of a depth-peeled layer).
     Equal,
+    /// No test, write every fragment (a depth image filled by a full-screen pass).
+    Replace,
 }
 
 /// Colour blending of a graphics pipeline.
@@ -176,6 +178,10 @@ fn depth_state(mode: DepthMode) -> vk::PipelineDepthStencilStateCreateInfo<'stat
         DepthMode::Equal => d
             .depth_test_enable(true)
             .depth_compare_op(vk::CompareOp::EQUAL),
+        DepthMode::Replace => d
+            .depth_test_enable(true)
+            .depth_write_enable(true)
+            .depth_compare_op(vk::CompareOp::ALWAYS),
     }
 }
 
