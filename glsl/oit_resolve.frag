@@ -1,7 +1,9 @@
 #version 460
 // Composite the transparent strands over the opaque image: the K-buffer's sorted nodes front
 // to back, then its tail as one layer behind them (frame.transparency.x == 1), or the depth
-// peeling accumulation (== 2, PEEL_RESOLVE). Output (C, 1 - A) with blending dst = C + dst (1 - A).
+// peeling accumulation (== 2, PEEL_RESOLVE). Output premultiplied (C, A), blended over:
+// dst = C + dst (1 - A), coverage A + a_dst (1 - A) (an opaque image stays opaque; a host
+// frame's transparent layer gains the strands' coverage).
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 // Compiled twice: with PEEL_RESOLVE for depth peeling (no 64-bit integers needed), without
@@ -44,5 +46,5 @@ void main() {
         }
     }
 #endif
-    out_color = vec4(c, 1.0 - a);
+    out_color = vec4(c, a);
 }

@@ -11,7 +11,10 @@ use std::time::Instant;
 use super::RenderPath;
 use super::camera::View;
 use super::graph::FrameGraph;
+use super::graph::ImageState::Tracked;
+use super::host::{DepthMapping, HostImage};
 use super::passes::hair_dynamics::SimulatedCharacter;
+use super::passes::host_targets::HostTargetRes;
 use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::PropDraw;
 use super::passes::temporal::TemporalWork;
@@ -28,7 +31,7 @@ use super::soft::StrandRaster;
 use super::temporal::{FrameMotion, PreviousFrame, Temporal, TemporalTuning, jittered};
 use super::transparency::Transparency;
 use super::workspace::FrameBuffers;
-use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
+use crate::vk::{Access, Buffer, BufferDesc, CommandRecorder, Context, GpuError, GpuResult};
 
 /// The density volumes of a frame.
 struct DensityWork {
@@ -68,6 +71,25 @@ pub(super) struct FrameWork<'a> {
     transients: FrameTransients,
 }
 
+/// Where a frame is recorded and what it draws into.
+pub(super) enum FrameTarget<'t, 'p> {
+    /// The renderer's own command buffer, submitted here, and its own targets; the output is
+    /// blitted onto a swapchain image when presented.
+    Own(Option<&'t mut PresentTarget<'p>>),
+    /// A host's command buffer (the host submits it), the hair composited over its colour and
+    /// hidden behind its depth.
+    Host(HostTargets<'t>),
+}
+
+/// A host frame's command buffer and images.
+pub(super) struct HostTargets<'t> {
+    pub cmd: ash::vk::CommandBuffer,
+    pub color: &'t HostImage<'t>,
+    pub depth: Option<&'t HostImage<'t>>,
+    /// The host's depth in the renderer's terms.
+    pub mapping: DepthMapping,
+}
+
 impl Renderer {
     /// [`Renderer::render_frame`], then blit the image onto `present.image` (scaled to its
     /// size) after `present.wait`, signalling `present.signal` for presentation.
@@ -77,12 +99,24 @@ impl Renderer {
         opts: &FrameOptions,
         mut present: Option<PresentTarget>,
     ) -> GpuResult<FrameTicket> {
+        self.draw_frame(self.next, view, opts, FrameTarget::Own(present.as_mut()))
+    }
+
+    /// Draw one frame in frame slot `i` (waited for first) into `target`: check the settings,
+    /// write the slot's tables, build and run the frame graph, and submit it (the renderer's
+    /// own command buffer) or leave it to the host.
+    pub(super) fn draw_frame(
+        &mut self,
+        i: usize,
+        view: &View,
+        opts: &FrameOptions,
+        mut target: FrameTarget,
+    ) -> GpuResult<FrameTicket> {
         let (path, kbuffer_budget) = self.check_frame(view, opts)?;
         let temporal = self.temporal_work(view, opts, path)?;
         // What draws the frame's bundles, decided once (`auto` with k-buffer OIT is all
         // software): the passes, buffers and frame blocks all follow it.
         let raster = opts.raster.under(view.transparency);
-        let i = self.next;
         self.retire_slot(i)?;
         if temporal.is_some_and(|t| t.accumulate)
             && let Some(old) = self
@@ -135,7 +169,7 @@ impl Renderer {
             temporal,
             transients,
         };
-        let frame_graph = self.record(i, work, opts, present.as_mut())?;
+        let frame_graph = self.record(i, work, opts, &mut target)?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
         let (width, height) = self.targets.size();
         let pending = Pending {
@@ -149,7 +183,15 @@ impl Renderer {
             frame_graph,
             volume_characters: (work_draw.alone, work_draw.blended),
         };
-        self.submit(i, pending, present.as_ref())?;
+        match target {
+            FrameTarget::Own(present) => self.submit(i, pending, present.as_deref())?,
+            // The host submits; the slot's fence stays signalled, and the host vouches for
+            // the frame's completion before it reuses the slot.
+            FrameTarget::Host(_) => {
+                self.frames[i].pending = Some(pending);
+                self.frame_number += 1;
+            }
+        }
         self.remember_frame(&records, &motion, temporal);
         self.after_submit(path, raster);
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
@@ -475,15 +517,16 @@ impl Renderer {
         Ok(prop_draws)
     }
 
-    /// Record frame slot `i`: build the frame graph (hair mesh updates, LHS skinning, the
-    /// frame's passes, overlay, readbacks, presentation) and run it. Returns the graph's
-    /// description when `opts` asks for it.
+    /// Record frame slot `i` into `target`'s command buffer: build the frame graph (hair mesh
+    /// updates, LHS skinning, the frame's passes, overlay, readbacks, presentation, or a host
+    /// frame's depth and composite) and run it. Returns the graph's description when `opts`
+    /// asks for it.
     fn record(
         &mut self,
         i: usize,
         work: FrameWork,
         opts: &FrameOptions,
-        present: Option<&mut PresentTarget>,
+        target: &mut FrameTarget,
     ) -> GpuResult<Option<String>> {
         let FrameSlot {
             cmd,
@@ -499,7 +542,10 @@ impl Renderer {
             density_jobs,
             ..
         } = &mut self.frames[i];
-        let mut rec = cmd.begin()?;
+        let mut rec = match target {
+            FrameTarget::Host(h) => CommandRecorder::host(&self.ctx, h.cmd),
+            FrameTarget::Own(_) => cmd.begin()?,
+        };
         profiler.reset(&mut rec);
         if let Some(q) = mesh_query.as_mut() {
             q.reset(&mut rec);
@@ -512,6 +558,11 @@ impl Renderer {
             .map(|(state, pose)| SimulatedCharacter { state, pose })
             .collect();
         let size = self.targets.size();
+        // The host's images start in the uses the host left them in.
+        let (mut host_color_use, mut host_depth_use) = match target {
+            FrameTarget::Host(h) => (h.color.before, h.depth.map_or(Access::Nothing, |d| d.before)),
+            FrameTarget::Own(_) => (Access::Nothing, Access::Nothing),
+        };
         let mut g = FrameGraph::new(opts.describe_frame);
         if let Some((pass, resource, access)) = &self.desc.omit_use {
             g.omit_use(pass, resource, *access);
@@ -534,7 +585,6 @@ impl Renderer {
         }
         let textures = self.crowd.texture_set();
         let bg = self.background;
-        let clear = opts.clear.then_some([bg[0], bg[1], bg[2], 1.0]);
         let sets = (
             PassSets {
                 frame: set,
@@ -552,12 +602,27 @@ impl Renderer {
             let build = (table, volumes.as_slice(), work.density.most_bundles);
             self.passes.add_density_volumes(&mut g, &r, sets.0, build);
         }
+        // A host frame starts from its depth and a transparent colour instead of a clear.
+        let host = match (&*target, self.host_passes.as_ref()) {
+            (FrameTarget::Host(h), Some(passes)) => {
+                let color = g.import_image("host colour", h.color.image, Tracked(&mut host_color_use));
+                let depth = h.depth.map(|d| {
+                    let res = g.import_image("host depth", d.image, Tracked(&mut host_depth_use));
+                    (res, d.after)
+                });
+                passes.add_depth(&mut g, &r, i, (depth.map(|d| d.0), h.mapping));
+                let color = (color, h.color.image, h.color.after);
+                Some((passes, HostTargetRes { color, depth }))
+            }
+            _ => None,
+        };
+        let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
         let mut inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
         inputs.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
         self.passes.add(&mut g, &r, inputs)?;
-        let (overlay, image) = match present {
-            Some(p) => (p.overlay.as_deref_mut(), Some(p.image)),
-            None => (None, None),
+        let (overlay, image) = match target {
+            FrameTarget::Own(Some(p)) => (p.overlay.as_deref_mut(), Some(p.image)),
+            _ => (None, None),
         };
         let outputs = FrameOutputs {
             overlay,
@@ -566,12 +631,17 @@ impl Renderer {
             present: image,
         };
         add_outputs(&mut g, &r, outputs);
+        if let Some((passes, res)) = host {
+            passes.add_composite(&mut g, &r, i, res)?;
+        }
         let result = g.run(&mut rec, profiler, &mut self.transients);
         let released = self.transients.take_released();
         retired.extend(released.into_iter().map(Retired::Resource));
         let description = result?;
         drop(rec);
-        cmd.end()?;
+        if let FrameTarget::Own(_) = target {
+            cmd.end()?;
+        }
         Ok(description)
     }
 

@@ -78,6 +78,8 @@ pub struct Renderer {
     pub(super) completed: VecDeque<FrameReport>,
     /// Requested strand density volumes.
     pub(super) volumes: super::volume::DensityVolumes,
+    /// The passes of host frames, made by the first one.
+    pub(super) host_passes: Option<super::passes::host_targets::HostTargetPasses>,
     /// Background colour (linear RGB).
     pub background: [f32; 3],
 }
@@ -129,6 +131,7 @@ impl Renderer {
             temporal: Default::default(),
             completed: VecDeque::new(),
             volumes: Default::default(),
+            host_passes: None,
             background: [0.6, 0.65, 0.7],
         })
     }

@@ -31,10 +31,12 @@ pub struct RenderTargets {
 impl RenderTargets {
     /// Targets of `width x height` (1..=8192 each) with `samples` per pixel.
     pub fn new(ctx: &Arc<Context>, width: u32, height: u32, samples: u32) -> GpuResult<Self> {
-        // Transfers both ways: read back and copied out and in by temporal accumulation.
+        // Transfers both ways: read back and copied out and in by temporal accumulation;
+        // sampled by a host frame's composite.
         let single = vk::ImageUsageFlags::COLOR_ATTACHMENT
             | vk::ImageUsageFlags::TRANSFER_SRC
-            | vk::ImageUsageFlags::TRANSFER_DST;
+            | vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::SAMPLED;
         let color_usage = if samples > 1 {
             vk::ImageUsageFlags::COLOR_ATTACHMENT
         } else {

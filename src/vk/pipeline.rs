@@ -73,9 +73,6 @@ pub enum BlendMode {
     PremultipliedOver,
     /// Additive.
     Additive,
-    /// `dst.rgb = src.rgb + dst.rgb * src.a`, `dst.a` kept: premultiplied colour over, with
-    /// the source carrying its transmittance in alpha (the transparency resolve).
-    Transmittance,
 }
 
 /// Face culling of a graphics pipeline.
@@ -194,13 +191,8 @@ fn blend_attachment(mode: BlendMode) -> vk::PipelineColorBlendAttachmentState {
             (vk::BlendFactor::ONE, vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
         }
         BlendMode::Additive => (vk::BlendFactor::ONE, vk::BlendFactor::ONE),
-        BlendMode::Transmittance => (vk::BlendFactor::ONE, vk::BlendFactor::SRC_ALPHA),
     };
-    // The transmittance blend keeps the target's alpha (the image stays opaque).
-    let (src_a, dst_a) = match mode {
-        BlendMode::Transmittance => (vk::BlendFactor::ZERO, vk::BlendFactor::ONE),
-        _ => (src, dst),
-    };
+    let (src_a, dst_a) = (src, dst);
     b.blend_enable(true)
         .src_color_blend_factor(src)
         .dst_color_blend_factor(dst)

@@ -5,6 +5,7 @@ pub mod compute_generate;
 pub mod density_volume;
 pub mod hair_dynamics;
 pub mod hair_mesh_update;
+pub mod host_targets;
 pub mod lhs_skin;
 pub mod output;
 pub mod pool_segments;

@@ -126,7 +126,7 @@ impl TransparencyPass {
             .formats
             .graphics_desc(if peel { "peel resolve" } else { "oit resolve" })
             .depth(DepthMode::Off)
-            .blend(BlendMode::Transmittance)
+            .blend(BlendMode::PremultipliedOver)
             .stage(vk::ShaderStageFlags::VERTEX, &v)
             .stage(vk::ShaderStageFlags::FRAGMENT, &f);
         Pipeline::graphics(&self.ctx, &self.layout, &desc)
