@@ -560,7 +560,10 @@ impl Renderer {
         let size = self.targets.size();
         // The host's images start in the uses the host left them in.
         let (mut host_color_use, mut host_depth_use) = match target {
-            FrameTarget::Host(h) => (h.color.before, h.depth.map_or(Access::Nothing, |d| d.before)),
+            FrameTarget::Host(h) => (
+                h.color.before,
+                h.depth.map_or(Access::Nothing, |d| d.before),
+            ),
             FrameTarget::Own(_) => (Access::Nothing, Access::Nothing),
         };
         let mut g = FrameGraph::new(opts.describe_frame);
@@ -605,7 +608,8 @@ impl Renderer {
         // A host frame starts from its depth and a transparent colour instead of a clear.
         let host = match (&*target, self.host_passes.as_ref()) {
             (FrameTarget::Host(h), Some(passes)) => {
-                let color = g.import_image("host colour", h.color.image, Tracked(&mut host_color_use));
+                let color =
+                    g.import_image("host colour", h.color.image, Tracked(&mut host_color_use));
                 let depth = h.depth.map(|d| {
                     let res = g.import_image("host depth", d.image, Tracked(&mut host_depth_use));
                     (res, d.after)

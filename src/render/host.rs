@@ -326,8 +326,16 @@ impl Renderer {
         passes.bind(frame.slot, depth_image, self.targets.output())?;
         // The renderer's depth range: the host's near plane, and far enough for the hair.
         let size = (width, height);
-        let eye = frame.camera.view(size, f32::MAX).map_err(refuse)?.camera.eye;
-        let host = frame.camera.view(size, self.hair_far(eye)).map_err(refuse)?;
+        let eye = frame
+            .camera
+            .view(size, f32::MAX)
+            .map_err(refuse)?
+            .camera
+            .eye;
+        let host = frame
+            .camera
+            .view(size, self.hair_far(eye))
+            .map_err(refuse)?;
         let view = View {
             camera: host.camera,
             ..*look
@@ -357,6 +365,7 @@ impl Renderer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec4;
 
     /// A right-handed look-at and Vulkan projections (y down) of every depth convention.
     fn host_matrices(reversed: bool, infinite: bool) -> HostCamera {
@@ -364,8 +373,13 @@ mod tests {
         let f = (target - eye).normalize();
         let s = f.cross(Vec3::Y).normalize();
         let u = s.cross(f);
-        let view = Mat4::from_cols(s.extend(0.0), u.extend(0.0), (-f).extend(0.0), eye.extend(1.0))
-            .inverse();
+        let view = Mat4::from_cols(
+            s.extend(0.0),
+            u.extend(0.0),
+            (-f).extend(0.0),
+            eye.extend(1.0),
+        )
+        .inverse();
         let (g, aspect, n, far) = (1.0 / 0.4f32.tan(), 1.5, 0.1f32, 50.0f32);
         // Depth -a + b / t at distance t.
         let (a, b) = match (reversed, infinite) {
@@ -390,7 +404,11 @@ mod tests {
 
     #[test]
     fn every_depth_convention_maps_points_and_depth_alike() {
-        let points = [Vec3::new(0.1, 1.3, 0.2), Vec3::new(-0.4, 1.8, -2.0), Vec3::new(0.0, 1.4, 0.0)];
+        let points = [
+            Vec3::new(0.1, 1.3, 0.2),
+            Vec3::new(-0.4, 1.8, -2.0),
+            Vec3::new(0.0, 1.4, 0.0),
+        ];
         for reversed in [false, true] {
             for infinite in [false, true] {
                 let host = host_matrices(reversed, infinite);
@@ -400,7 +418,10 @@ mod tests {
                 assert_eq!(v.planes.1.is_infinite(), infinite);
                 let ours = v.camera.view_proj(1.5);
                 for p in points {
-                    let (a, b) = (clip_to_pixel(host.proj * host.view, p), clip_to_pixel(ours, p));
+                    let (a, b) = (
+                        clip_to_pixel(host.proj * host.view, p),
+                        clip_to_pixel(ours, p),
+                    );
                     assert!((a - b).length() < 1e-4, "{reversed} {infinite}: {a} vs {b}");
                     // Depth through the mapping is our depth of the same point.
                     let hc = host.proj * host.view * p.extend(1.0);
@@ -428,7 +449,10 @@ mod tests {
         let v = lh.view((1500, 1000), 20.0).unwrap();
         let host_pixel = clip_to_pixel(lh.proj * lh.view, z.transform_point3(p));
         let ours = clip_to_pixel(v.camera.view_proj(1.5), z.transform_point3(p));
-        assert!((host_pixel - ours).length() < 1e-4, "{host_pixel} vs {ours}");
+        assert!(
+            (host_pixel - ours).length() < 1e-4,
+            "{host_pixel} vs {ours}"
+        );
         // Jitter: an off-centre projection moves the picture by the same amount.
         let mut jittered = rh;
         jittered.proj.z_axis.x += 0.01;
@@ -450,9 +474,27 @@ mod tests {
     fn bad_matrices_are_refused() {
         let good = host_matrices(false, false);
         let cases = [
-            (HostCamera { proj: Mat4::from_scale(Vec3::new(0.5, -0.5, 0.1)), ..good }, "perspective"),
-            (HostCamera { view: good.view * Mat4::from_scale(Vec3::splat(2.0)), ..good }, "scale"),
-            (HostCamera { view: Mat4::NAN, ..good }, "finite"),
+            (
+                HostCamera {
+                    proj: Mat4::from_scale(Vec3::new(0.5, -0.5, 0.1)),
+                    ..good
+                },
+                "perspective",
+            ),
+            (
+                HostCamera {
+                    view: good.view * Mat4::from_scale(Vec3::splat(2.0)),
+                    ..good
+                },
+                "scale",
+            ),
+            (
+                HostCamera {
+                    view: Mat4::NAN,
+                    ..good
+                },
+                "finite",
+            ),
         ];
         for (host, says) in cases {
             let e = host.view((1500, 1000), 20.0).unwrap_err();
@@ -460,6 +502,5 @@ mod tests {
         }
         let e = good.view((1000, 1000), 20.0).unwrap_err();
         assert!(e.contains("aspect"), "{e}");
-        let _ = Vec4::ZERO;
     }
 }

@@ -237,7 +237,13 @@ impl CommandRecorder<'_> {
     /// Set push constants of `pipeline` (all stages, offset 0).
     pub fn push_constants<T: Pod>(&mut self, pipeline: &Pipeline, data: &T) {
         let bytes = bytemuck::bytes_of(data);
-        debug_assert!(bytes.len() as u32 <= super::pipeline::PUSH_CONSTANT_BYTES);
+        // Past the layout's range is undefined behaviour in the driver: never let it through.
+        assert!(
+            bytes.len() as u32 <= super::pipeline::PUSH_CONSTANT_BYTES,
+            "{} bytes of push constants: the layouts hold {}",
+            bytes.len(),
+            super::pipeline::PUSH_CONSTANT_BYTES
+        );
         // SAFETY: recording; the range lies within the layout's push constant range.
         unsafe {
             self.ctx.device.cmd_push_constants(

@@ -10,7 +10,7 @@ use super::descriptor::DescriptorSetLayout;
 use super::{Context, GpuResult, VkContext};
 
 /// Push constant bytes of every pipeline layout (all stages).
-pub const PUSH_CONSTANT_BYTES: u32 = 16;
+pub const PUSH_CONSTANT_BYTES: u32 = 32;
 
 /// A pipeline layout: descriptor set layouts (set `i` = element `i`) and the push constants.
 pub struct PipelineLayout {

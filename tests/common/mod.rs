@@ -3,6 +3,8 @@
 //! `tools/setup.sh` for lavapipe).
 #![allow(dead_code)]
 
+pub mod host;
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
