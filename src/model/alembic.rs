@@ -305,29 +305,25 @@ fn sample(
         Ok(true)
     };
     let what = format!("property {}", property.name());
+    // Scalar and array readers have the same methods but no common trait (nor a nameable
+    // type): one body for both.
+    macro_rules! read_checked {
+        ($p:expr) => {{
+            unreadable(&$p.header.data_type, &what)?;
+            let samples = $p.sample_count();
+            let size = match samples {
+                0 => 0,
+                _ => $p.sample_size(0, reader).map_err(ogawa(&what))?,
+            };
+            match check(size, samples)? {
+                true => Some($p.load_sample(0, reader).map_err(ogawa(&what))?),
+                false => None,
+            }
+        }};
+    }
     let read = match property {
-        PropertyReader::Scalar(p) => {
-            unreadable(&p.header.data_type, &what)?;
-            let size = match p.sample_count() {
-                0 => 0,
-                _ => p.sample_size(0, reader).map_err(ogawa(&what))?,
-            };
-            match check(size, p.sample_count())? {
-                true => Some(p.load_sample(0, reader).map_err(ogawa(&what))?),
-                false => None,
-            }
-        }
-        PropertyReader::Array(p) => {
-            unreadable(&p.header.data_type, &what)?;
-            let size = match p.sample_count() {
-                0 => 0,
-                _ => p.sample_size(0, reader).map_err(ogawa(&what))?,
-            };
-            match check(size, p.sample_count())? {
-                true => Some(p.load_sample(0, reader).map_err(ogawa(&what))?),
-                false => None,
-            }
-        }
+        PropertyReader::Scalar(p) => read_checked!(p),
+        PropertyReader::Array(p) => read_checked!(p),
         PropertyReader::Compound(_) => {
             return Err(format!("{what}: an indexed (compound) property, not read"));
         }

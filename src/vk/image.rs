@@ -77,8 +77,9 @@ pub struct Image {
     pub desc: ImageDesc,
 }
 
-/// Every aspect of `format` (barriers name all of them).
-pub(crate) fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
+/// Every aspect of `format` (barriers name all of them): colour, depth, stencil, or depth and
+/// stencil.
+pub fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
     match format {
         vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => {
             vk::ImageAspectFlags::DEPTH

@@ -11,21 +11,22 @@
 //! without the engine's depth) to count the hair pixels shown and hidden by the engine's
 //! geometry, and fails when either is zero or a validation message was printed.
 
+mod engine;
+
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use anyhow::{Context as _, Result, bail};
 use ash::vk;
 use clap::Parser;
+use engine::{Buf, Engine, Img, Validation, barrier, copy};
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
-use gpu_allocator::vulkan::{
-    Allocation, AllocationCreateDesc, AllocationScheme, Allocator, AllocatorCreateDesc,
-};
 use hairmesh::render::{
-    FrameOptions, HostCamera, HostFrame, HostImage, Renderer, RendererDesc, StrandParams, View,
+    FrameOptions, FrameTicket, HostCamera, HostFrame, HostImage, Renderer, RendererDesc,
+    StrandParams, View,
 };
-use hairmesh::vk::{Access, Context, HostDevice, Image, ImageDesc, create_host_device};
+use hairmesh::vk::{Access, Context, Image, ImageDesc};
 
 /// Embed the hair renderer in a minimal engine and draw one frame.
 #[derive(Parser)]
@@ -72,9 +73,13 @@ fn run(args: Args) -> Result<()> {
     let head = hairmesh::model::obj_io::load_triangles(&root.join("sintel_head.obj"))?;
     let (baked, style) =
         hairmesh::render::scene::load_mesh(&root.join("sintel.obj"), None, Default::default())?;
-    let engine = Engine::new(args.validation)?;
+    let validation = match args.validation {
+        true => Validation::On,
+        false => Validation::Off,
+    };
+    let engine = Engine::new(validation)?;
     // The renderer on the engine's device, queue and allocator.
-    let ctx = Arc::new(Context::from_host(engine.lend(args.validation))?);
+    let ctx = Arc::new(Context::from_host(engine.lend(args.validation, true))?);
     let mut renderer = Renderer::new(&ctx, &RendererDesc::default().size(w, h))?;
     let params = StrandParams {
         strands_per_bundle: 64,
@@ -86,9 +91,9 @@ fn run(args: Args) -> Result<()> {
     // The crowd's look (Marschner, shadows, multiple scattering); its camera is the engine's.
     let look = View::crowd_look(hairmesh::render::Camera::look_at(Vec3::Z, Vec3::ZERO, 40.0));
     let opts = FrameOptions::default();
-    let host_only = engine.frame(&scene, &targets, |_| Ok(None))?;
+    let host_only = frame(&engine, &scene, &targets, |_| Ok(None))?;
     let mut draw_hair = |with_depth: bool, slot: usize| {
-        engine.frame(&scene, &targets, |cmd| {
+        frame(&engine, &scene, &targets, |cmd| {
             let frame = HostFrame {
                 cmd,
                 slot,
@@ -146,335 +151,34 @@ fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-/// The engine: instance, device, queue, allocator, one command buffer and fence.
-struct Engine {
-    entry: ash::Entry,
-    instance: ash::Instance,
-    physical: vk::PhysicalDevice,
-    device: ash::Device,
-    family: u32,
-    queue: vk::Queue,
-    allocator: Option<Arc<Mutex<Allocator>>>,
-    pool: vk::CommandPool,
-    cmd: vk::CommandBuffer,
-    fence: vk::Fence,
-}
-
-impl Engine {
-    fn new(validation: bool) -> Result<Self> {
-        // SAFETY: the engine's own Vulkan setup; every handle is destroyed in drop.
+/// One engine frame: the scene, then `hair` into the same command buffer, the colour copied
+/// out; submitted and waited for. The colour's bytes (BGRA). The hair hands the colour back in
+/// transfer-read use; without hair the engine moves it there itself.
+fn frame(
+    engine: &Engine,
+    scene: &Scene,
+    targets: &Targets,
+    hair: impl FnOnce(vk::CommandBuffer) -> Result<Option<FrameTicket>>,
+) -> Result<Vec<u8>> {
+    let d = &engine.device;
+    engine.submit(|cmd| {
+        // SAFETY: the engine's command buffer, recording; its objects outlive the submission.
         unsafe {
-            let entry = ash::Entry::load().context("Vulkan loader (run tools/setup.sh)")?;
-            let app = vk::ApplicationInfo::default()
-                .application_name(c"embed")
-                .api_version(vk::API_VERSION_1_3);
-            let layers = [c"VK_LAYER_KHRONOS_validation".as_ptr()];
-            let extensions = [ash::ext::debug_utils::NAME.as_ptr()];
-            let n = validation as usize;
-            let info = vk::InstanceCreateInfo::default()
-                .application_info(&app)
-                .enabled_layer_names(&layers[..n])
-                .enabled_extension_names(&extensions[..n]);
-            let instance = entry.create_instance(&info, None)?;
-            let (physical, family) = instance
-                .enumerate_physical_devices()?
-                .into_iter()
-                .find_map(|p| {
-                    let wanted = vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE;
-                    instance
-                        .get_physical_device_queue_family_properties(p)
-                        .iter()
-                        .position(|f| f.queue_flags.contains(wanted))
-                        .map(|i| (p, i as u32))
-                })
-                .context("no device with a graphics and compute queue")?;
-            // What the renderer needs, and nothing of the engine's own.
-            let device = create_host_device(&instance, physical, family, &[])?;
-            let queue = device.get_device_queue(family, 0);
-            let allocator = Allocator::new(&AllocatorCreateDesc {
-                instance: instance.clone(),
-                device: device.clone(),
-                physical_device: physical,
-                debug_settings: Default::default(),
-                buffer_device_address: true,
-                allocation_sizes: Default::default(),
-            })?;
-            let pool_info = vk::CommandPoolCreateInfo::default()
-                .queue_family_index(family)
-                .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-            let pool = device.create_command_pool(&pool_info, None)?;
-            let alloc = vk::CommandBufferAllocateInfo::default()
-                .command_pool(pool)
-                .command_buffer_count(1);
-            let cmd = device.allocate_command_buffers(&alloc)?[0];
-            let fence = device.create_fence(&vk::FenceCreateInfo::default(), None)?;
-            Ok(Engine {
-                entry,
-                instance,
-                physical,
-                device,
-                family,
-                queue,
-                allocator: Some(Arc::new(Mutex::new(allocator))),
-                pool,
-                cmd,
-                fence,
-            })
-        }
-    }
-
-    /// What the renderer borrows: device, queue and allocator.
-    fn lend(&self, validation: bool) -> HostDevice {
-        HostDevice {
-            entry: self.entry.clone(),
-            instance: self.instance.clone(),
-            physical: self.physical,
-            device: self.device.clone(),
-            queue_family: self.family,
-            queue: self.queue,
-            validation,
-            allocator: self.allocator.clone(),
-        }
-    }
-
-    fn allocate(&self, name: &str, req: vk::MemoryRequirements, cpu: bool) -> Result<Allocation> {
-        let location = match cpu {
-            true => MemoryLocation::CpuToGpu,
-            false => MemoryLocation::GpuOnly,
-        };
-        let desc = AllocationCreateDesc {
-            name,
-            requirements: req,
-            location,
-            linear: cpu,
-            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-        };
-        let allocator = self.allocator.as_ref().context("allocator")?;
-        let mut allocator = allocator
-            .lock()
-            .map_err(|_| anyhow::anyhow!("allocator lock"))?;
-        Ok(allocator.allocate(&desc)?)
-    }
-
-    /// A buffer holding `data` (host-visible), or `bytes` of GPU-to-CPU memory when `data` is
-    /// empty.
-    fn buffer(&self, usage: vk::BufferUsageFlags, data: &[u8], bytes: u64) -> Result<Buf> {
-        // SAFETY: the engine's device; the buffer is destroyed by `Buf::destroy`.
-        unsafe {
-            let info = vk::BufferCreateInfo::default()
-                .size(bytes.max(data.len() as u64))
-                .usage(usage);
-            let raw = self.device.create_buffer(&info, None)?;
-            let req = self.device.get_buffer_memory_requirements(raw);
-            let mut memory = match data.is_empty() {
-                true => self
-                    .allocator
-                    .as_ref()
-                    .context("allocator")?
-                    .lock()
-                    .map_err(|_| anyhow::anyhow!("allocator lock"))?
-                    .allocate(&AllocationCreateDesc {
-                        name: "readback",
-                        requirements: req,
-                        location: MemoryLocation::GpuToCpu,
-                        linear: true,
-                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-                    })?,
-                false => self.allocate("buffer", req, true)?,
-            };
-            self.device
-                .bind_buffer_memory(raw, memory.memory(), memory.offset())?;
-            if !data.is_empty() {
-                memory.mapped_slice_mut().context("mapped")?[..data.len()].copy_from_slice(data);
-            }
-            Ok(Buf {
-                raw,
-                memory: Some(memory),
-            })
-        }
-    }
-
-    /// A 2D image of `format` and `usage`.
-    fn image(
-        &self,
-        (w, h): (u32, u32),
-        format: vk::Format,
-        usage: vk::ImageUsageFlags,
-    ) -> Result<Img> {
-        // SAFETY: the engine's device; the image is destroyed by `Img::destroy`.
-        unsafe {
-            let info = vk::ImageCreateInfo::default()
-                .image_type(vk::ImageType::TYPE_2D)
-                .format(format)
-                .extent(vk::Extent3D {
-                    width: w,
-                    height: h,
-                    depth: 1,
-                })
-                .mip_levels(1)
-                .array_layers(1)
-                .samples(vk::SampleCountFlags::TYPE_1)
-                .tiling(vk::ImageTiling::OPTIMAL)
-                .usage(usage);
-            let raw = self.device.create_image(&info, None)?;
-            let memory = self.allocate(
-                "image",
-                self.device.get_image_memory_requirements(raw),
-                false,
-            )?;
-            self.device
-                .bind_image_memory(raw, memory.memory(), memory.offset())?;
-            let aspect = match format {
-                DEPTH_FORMAT => vk::ImageAspectFlags::DEPTH,
-                _ => vk::ImageAspectFlags::COLOR,
-            };
-            let view_info = vk::ImageViewCreateInfo::default()
-                .image(raw)
-                .view_type(vk::ImageViewType::TYPE_2D)
-                .format(format)
-                .subresource_range(range(aspect));
-            let view = self.device.create_image_view(&view_info, None)?;
-            Ok(Img {
-                raw,
-                view,
-                memory: Some(memory),
-                aspect,
-            })
-        }
-    }
-
-    /// Record one frame (the scene, then `hair` into the same command buffer), copy the colour
-    /// out, submit, wait; the colour's bytes (BGRA). The hair hands the colour back in
-    /// transfer-read use; without hair the engine moves it there itself.
-    fn frame(
-        &self,
-        scene: &Scene,
-        targets: &Targets,
-        hair: impl FnOnce(vk::CommandBuffer) -> Result<Option<hairmesh::render::FrameTicket>>,
-    ) -> Result<Vec<u8>> {
-        let d = &self.device;
-        let cmd = self.cmd;
-        // SAFETY: the engine's command buffer and objects; the submission is waited for.
-        unsafe {
-            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?;
-            scene.record(self, targets, cmd);
-            let drew_hair = hair(cmd)?.is_some();
-            if !drew_hair {
-                barrier(
-                    d,
-                    cmd,
-                    targets.color.raw,
-                    targets.color.aspect,
-                    (
-                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    ),
+            scene.record(engine, targets, cmd);
+            if hair(cmd)?.is_none() {
+                let layouts = (
+                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                 );
+                barrier(d, cmd, &targets.color, layouts);
             }
-            let (w, h) = targets.size;
-            let copy = vk::BufferImageCopy::default()
-                .image_subresource(
-                    vk::ImageSubresourceLayers::default()
-                        .aspect_mask(vk::ImageAspectFlags::COLOR)
-                        .layer_count(1),
-                )
-                .image_extent(vk::Extent3D {
-                    width: w,
-                    height: h,
-                    depth: 1,
-                });
-            d.cmd_copy_image_to_buffer(
-                cmd,
-                targets.color.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                targets.readback.raw,
-                &[copy],
-            );
-            let to_host = [vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-            d.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().memory_barriers(&to_host),
-            );
-            d.end_command_buffer(cmd)?;
-            let cmds = [cmd];
-            d.queue_submit(
-                self.queue,
-                &[vk::SubmitInfo::default().command_buffers(&cmds)],
-                self.fence,
-            )?;
-            d.wait_for_fences(&[self.fence], true, u64::MAX)?;
-            d.reset_fences(&[self.fence])?;
-            let bytes = (w * h * 4) as usize;
-            let memory = targets.readback.memory.as_ref().context("readback")?;
-            Ok(memory.mapped_slice().context("mapped")?[..bytes].to_vec())
+            copy(d, cmd, (&targets.color, &targets.readback), false);
         }
-    }
-}
-
-impl Drop for Engine {
-    fn drop(&mut self) {
-        // SAFETY: everything made on the device is gone (the renderer's context too).
-        unsafe {
-            let _ = self.device.device_wait_idle();
-            self.device.destroy_fence(self.fence, None);
-            self.device.destroy_command_pool(self.pool, None);
-            self.allocator.take();
-            self.device.destroy_device(None);
-            self.instance.destroy_instance(None);
-        }
-    }
-}
-
-struct Buf {
-    raw: vk::Buffer,
-    memory: Option<Allocation>,
-}
-
-struct Img {
-    raw: vk::Image,
-    view: vk::ImageView,
-    memory: Option<Allocation>,
-    aspect: vk::ImageAspectFlags,
-}
-
-fn range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
-    vk::ImageSubresourceRange::default()
-        .aspect_mask(aspect)
-        .level_count(1)
-        .layer_count(1)
-}
-
-/// A full barrier between two layouts of `image` (the engine is not the subject here).
-///
-/// # Safety
-/// `cmd` is recording on `d`.
-unsafe fn barrier(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    image: vk::Image,
-    aspect: vk::ImageAspectFlags,
-    (old, new): (vk::ImageLayout, vk::ImageLayout),
-) {
-    let b = [vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-        .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
-        .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-        .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)
-        .old_layout(old)
-        .new_layout(new)
-        .image(image)
-        .subresource_range(range(aspect))];
-    // SAFETY: per the caller.
-    unsafe {
-        d.cmd_pipeline_barrier2(
-            cmd,
-            &vk::DependencyInfo::default().image_memory_barriers(&b),
-        )
-    };
+        Ok(())
+    })?;
+    let (w, h) = targets.size;
+    let memory = targets.readback.memory.as_ref().context("readback")?;
+    Ok(memory.mapped_slice().context("mapped")?[..(w * h * 4) as usize].to_vec())
 }
 
 /// The engine's colour and depth targets, the renderer's wrappers of them, a readback buffer.
@@ -496,10 +200,11 @@ impl<'e> Targets<'e> {
         let depth_usage = U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED;
         let color = engine.image(size, COLOR_FORMAT, color_usage)?;
         let depth = engine.image(size, DEPTH_FORMAT, depth_usage)?;
+        let bytes = size.0 as u64 * size.1 as u64 * 4;
         let readback = engine.buffer(
             vk::BufferUsageFlags::TRANSFER_DST,
+            (bytes, MemoryLocation::GpuToCpu),
             &[],
-            size.0 as u64 * size.1 as u64 * 4,
         )?;
         let desc =
             |name, format, usage| ImageDesc::new_2d(name, format, size.0, size.1).usage(usage);
@@ -525,25 +230,12 @@ impl<'e> Targets<'e> {
 
 impl Drop for Targets<'_> {
     fn drop(&mut self) {
+        // The frames that used them completed (each frame is waited for).
         let e = self.engine;
-        // SAFETY: the frames that used them completed (each frame is waited for).
-        unsafe {
-            for img in [&mut self.color, &mut self.depth] {
-                e.device.destroy_image_view(img.view, None);
-                e.device.destroy_image(img.raw, None);
-                free(e, img.memory.take());
-            }
-            e.device.destroy_buffer(self.readback.raw, None);
+        for img in [&mut self.color, &mut self.depth] {
+            e.destroy_image(std::mem::replace(img, Img::null()));
         }
-        free(e, self.readback.memory.take());
-    }
-}
-
-fn free(engine: &Engine, memory: Option<Allocation>) {
-    if let (Some(m), Some(a)) = (memory, engine.allocator.as_ref())
-        && let Ok(mut a) = a.lock()
-    {
-        let _ = a.free(m);
+        e.destroy_buffer(std::mem::replace(&mut self.readback, Buf::null()));
     }
 }
 
@@ -642,11 +334,9 @@ impl<'e> Scene<'e> {
             }
         }
         let counts = (6, (head.len() * 3) as u32);
-        let vertices = engine.buffer(
-            vk::BufferUsageFlags::VERTEX_BUFFER,
-            bytemuck::cast_slice(&data),
-            0,
-        )?;
+        let bytes: &[u8] = bytemuck::cast_slice(&data);
+        let place = (bytes.len() as u64, MemoryLocation::CpuToGpu);
+        let vertices = engine.buffer(vk::BufferUsageFlags::VERTEX_BUFFER, place, bytes)?;
         // A front three-quarter view from above: the head hides the hair behind it.
         let eye = centre + Vec3::new(0.8, 0.35, 1.0).normalize() * size * 1.6;
         let view = look_at(eye, centre);
@@ -689,8 +379,7 @@ impl<'e> Scene<'e> {
             barrier(
                 d,
                 cmd,
-                t.color.raw,
-                t.color.aspect,
+                &t.color,
                 (
                     vk::ImageLayout::UNDEFINED,
                     vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
@@ -699,8 +388,7 @@ impl<'e> Scene<'e> {
             barrier(
                 d,
                 cmd,
-                t.depth.raw,
-                t.depth.aspect,
+                &t.depth,
                 (
                     vk::ImageLayout::UNDEFINED,
                     vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
@@ -792,12 +480,10 @@ impl Drop for Scene<'_> {
             d.destroy_descriptor_pool(self.descriptor_pool, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);
             d.destroy_sampler(self.sampler, None);
-            d.destroy_image_view(self.texture.view, None);
-            d.destroy_image(self.texture.raw, None);
-            d.destroy_buffer(self.vertices.raw, None);
         }
-        free(self.engine, self.texture.memory.take());
-        free(self.engine, self.vertices.memory.take());
+        let e = self.engine;
+        e.destroy_image(std::mem::replace(&mut self.texture, Img::null()));
+        e.destroy_buffer(std::mem::replace(&mut self.vertices, Buf::null()));
     }
 }
 
@@ -826,63 +512,23 @@ fn checker_texture(engine: &Engine) -> Result<Img> {
         .collect();
     let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
     let image = engine.image((n, n), vk::Format::R8G8B8A8_SRGB, usage)?;
-    let mut staging = engine.buffer(vk::BufferUsageFlags::TRANSFER_SRC, &texels, 0)?;
+    let place = (texels.len() as u64, MemoryLocation::CpuToGpu);
+    let staging = engine.buffer(vk::BufferUsageFlags::TRANSFER_SRC, place, &texels)?;
     let d = &engine.device;
-    let cmd = engine.cmd;
-    // SAFETY: the engine's command buffer; the upload is waited for before the staging buffer
-    // is destroyed.
-    unsafe {
-        d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?;
-        barrier(
-            d,
-            cmd,
-            image.raw,
-            image.aspect,
-            (
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            ),
-        );
-        let copy = vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: n,
-                height: n,
-                depth: 1,
-            });
-        d.cmd_copy_buffer_to_image(
-            cmd,
-            staging.raw,
-            image.raw,
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            &[copy],
-        );
-        barrier(
-            d,
-            cmd,
-            image.raw,
-            image.aspect,
-            (
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            ),
-        );
-        d.end_command_buffer(cmd)?;
-        let cmds = [cmd];
-        d.queue_submit(
-            engine.queue,
-            &[vk::SubmitInfo::default().command_buffers(&cmds)],
-            engine.fence,
-        )?;
-        d.wait_for_fences(&[engine.fence], true, u64::MAX)?;
-        d.reset_fences(&[engine.fence])?;
-        d.destroy_buffer(staging.raw, None);
-    }
-    free(engine, staging.memory.take());
+    let uploaded = engine.submit(|cmd| {
+        use vk::ImageLayout as L;
+        // SAFETY: the engine's command buffer, recording; waited for before the staging
+        // buffer goes.
+        unsafe {
+            barrier(d, cmd, &image, (L::UNDEFINED, L::TRANSFER_DST_OPTIMAL));
+            copy(d, cmd, (&image, &staging), true);
+            let layouts = (L::TRANSFER_DST_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL);
+            barrier(d, cmd, &image, layouts);
+        }
+        Ok(())
+    });
+    engine.destroy_buffer(staging);
+    uploaded?;
     Ok(image)
 }
 
