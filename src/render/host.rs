@@ -284,9 +284,10 @@ impl Renderer {
     /// for everything else (light, shading, shadows, LoD; its camera is replaced). The host
     /// submits the buffer, and once that submission has completed, [`Renderer::wait`] with the
     /// ticket returns the frame's report without waiting (host frames complete when the host
-    /// says so). The renderer's targets follow the host colour's size. Refused: temporal
-    /// accumulation (the host's own anti-aliasing jitters its projection, which host frames
-    /// follow) and a slot out of range.
+    /// says so). The renderer's targets follow the host colour's size. `opts.clear` does not
+    /// apply (the hair is drawn over a transparent layer, which `opts.read_image` reads back).
+    /// Refused: temporal accumulation (the host's own anti-aliasing jitters its projection,
+    /// which host frames follow), a slot out of range, images the host wants back unused.
     pub fn record_host_frame(
         &mut self,
         look: &View,

@@ -144,6 +144,7 @@ impl HostTargetPasses {
         (host, mapping): (Option<Res>, DepthMapping),
     ) {
         let (color, depth) = (r.images.color, r.images.depth);
+        g.begin_scope("host depth");
         let p = g
             .pass("host depth")
             .discard(r.color, Access::ColorAttachment)
@@ -172,6 +173,7 @@ impl HostTargetPasses {
             rec.end_rendering();
             Ok(())
         });
+        g.end_scope();
     }
 
     /// Add the composite of the renderer's output over the host's colour, then hand the host's
@@ -189,6 +191,7 @@ impl HostTargetPasses {
             GpuError::Unsupported(format!("host frame: no composite pipeline for {key:?}"))
         })?;
         let set = &self.sets[slot];
+        g.begin_scope("host composite");
         g.pass("host composite")
             .read(r.output, Access::SampledRead)
             .write(color_res, Access::ColorAttachment)
@@ -203,6 +206,7 @@ impl HostTargetPasses {
                 rec.end_rendering();
                 Ok(())
             });
+        g.end_scope();
         let mut back = g.pass("hand back host images");
         for (res, after) in std::iter::once((color_res, color_after)).chain(host.depth) {
             back = match after.writes() {
