@@ -7,5 +7,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo test --release
 mkdir -p target/embed
-cargo run --release --example embed -- --out target/embed/embed.png --validation
+cargo run --release --example embed -- --out target/embed/embed.png
 bash tools/check_embed.sh

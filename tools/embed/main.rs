@@ -5,7 +5,7 @@
 //! writes a PNG. The engine is raw `ash`, as a real one would be, and lends the renderer its
 //! memory allocator.
 //!
-//! `cargo run --release --example embed -- [--out embed.png] [--size 640x480] [--validation]`
+//! `cargo run --release --example embed -- [--out embed.png] [--size 640x480] [--no-validation]`
 //!
 //! It draws the frame three times (the engine alone, with the hair, and with the hair but
 //! without the engine's depth) to count the hair pixels shown and hidden by the engine's
@@ -37,9 +37,10 @@ struct Args {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480")]
     size: String,
-    /// Vulkan validation (the layer must be installed: tools/setup.sh); any message fails.
+    /// Run without the Vulkan validation layer (on by default, installed by tools/setup.sh;
+    /// any message fails the run).
     #[arg(long)]
-    validation: bool,
+    no_validation: bool,
 }
 
 const COLOR_FORMAT: vk::Format = vk::Format::B8G8R8A8_SRGB;
@@ -73,13 +74,13 @@ fn run(args: Args) -> Result<()> {
     let head = hairmesh::model::obj_io::load_triangles(&root.join("sintel_head.obj"))?;
     let (baked, style) =
         hairmesh::render::scene::load_mesh(&root.join("sintel.obj"), None, Default::default())?;
-    let validation = match args.validation {
-        true => Validation::On,
-        false => Validation::Off,
+    let validation = match args.no_validation {
+        false => Validation::On,
+        true => Validation::Off,
     };
     let engine = Engine::new(validation)?;
     // The renderer on the engine's device, queue and allocator.
-    let ctx = Arc::new(Context::from_host(engine.lend(args.validation, true))?);
+    let ctx = Arc::new(Context::from_host(engine.lend(!args.no_validation, true))?);
     let mut renderer = Renderer::new(&ctx, &RendererDesc::default().size(w, h))?;
     let params = StrandParams {
         strands_per_bundle: 64,
