@@ -14,7 +14,7 @@ use super::graph::FrameGraph;
 use super::graph::ImageState::Tracked;
 use super::host::{DepthMapping, HostImage};
 use super::passes::hair_dynamics::SimulatedCharacter;
-use super::passes::host_targets::HostTargetRes;
+use super::passes::host_targets::{HostTargetPasses, HostTargetRes};
 use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::PropDraw;
 use super::passes::temporal::TemporalWork;
@@ -79,6 +79,19 @@ pub(super) enum FrameTarget<'t, 'p> {
     /// A host's command buffer (the host submits it), the hair composited over its colour and
     /// hidden behind its depth.
     Host(HostTargets<'t>),
+}
+
+impl FrameTarget<'_, '_> {
+    /// The uses the host left its colour and depth in (`Nothing` for own frames).
+    fn host_uses(&self) -> (Access, Access) {
+        match self {
+            FrameTarget::Host(h) => (
+                h.color.before,
+                h.depth.map_or(Access::Nothing, |d| d.before),
+            ),
+            FrameTarget::Own(_) => (Access::Nothing, Access::Nothing),
+        }
+    }
 }
 
 /// A host frame's command buffer and images.
@@ -183,15 +196,7 @@ impl Renderer {
             frame_graph,
             volume_characters: (work_draw.alone, work_draw.blended),
         };
-        match target {
-            FrameTarget::Own(present) => self.submit(i, pending, present.as_deref())?,
-            // The host submits; the slot's fence stays signalled, and the host vouches for
-            // the frame's completion before it reuses the slot.
-            FrameTarget::Host(_) => {
-                self.frames[i].pending = Some(pending);
-                self.frame_number += 1;
-            }
-        }
+        self.hand_over(i, pending, target)?;
         self.remember_frame(&records, &motion, temporal);
         self.after_submit(path, raster);
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
@@ -558,14 +563,7 @@ impl Renderer {
             .map(|(state, pose)| SimulatedCharacter { state, pose })
             .collect();
         let size = self.targets.size();
-        // The host's images start in the uses the host left them in.
-        let (mut host_color_use, mut host_depth_use) = match target {
-            FrameTarget::Host(h) => (
-                h.color.before,
-                h.depth.map_or(Access::Nothing, |d| d.before),
-            ),
-            FrameTarget::Own(_) => (Access::Nothing, Access::Nothing),
-        };
+        let (mut host_color_use, mut host_depth_use) = target.host_uses();
         let mut g = FrameGraph::new(opts.describe_frame);
         if let Some((pass, resource, access)) = &self.desc.omit_use {
             g.omit_use(pass, resource, *access);
@@ -588,16 +586,7 @@ impl Renderer {
         }
         let textures = self.crowd.texture_set();
         let bg = self.background;
-        let sets = (
-            PassSets {
-                frame: set,
-                textures,
-            },
-            PassSets {
-                frame: light_set,
-                textures,
-            },
-        );
+        let sets = PassSets::camera_and_light((set, light_set), textures);
         if let Some(table) = density_jobs.as_ref()
             && !work.density.built.is_empty()
         {
@@ -605,36 +594,20 @@ impl Renderer {
             let build = (table, volumes.as_slice(), work.density.most_bundles);
             self.passes.add_density_volumes(&mut g, &r, sets.0, build);
         }
-        // A host frame starts from its depth and a transparent colour instead of a clear.
-        let host = match (&*target, self.host_passes.as_ref()) {
-            (FrameTarget::Host(h), Some(passes)) => {
-                let color =
-                    g.import_image("host colour", h.color.image, Tracked(&mut host_color_use));
-                let depth = h.depth.map(|d| {
-                    let res = g.import_image("host depth", d.image, Tracked(&mut host_depth_use));
-                    (res, d.after)
-                });
-                passes.add_depth(&mut g, &r, i, (depth.map(|d| d.0), h.mapping));
-                let color = (color, h.color.image, h.color.after);
-                Some((passes, HostTargetRes { color, depth }))
-            }
-            _ => None,
-        };
+        let host_uses = (&mut host_color_use, &mut host_depth_use);
+        let host = add_host_start(
+            &mut g,
+            &r,
+            (&*target, self.host_passes.as_ref()),
+            host_uses,
+            i,
+        );
         let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
         let mut inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
         inputs.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
         self.passes.add(&mut g, &r, inputs)?;
-        let (overlay, image) = match target {
-            FrameTarget::Own(Some(p)) => (p.overlay.as_deref_mut(), Some(p.image)),
-            _ => (None, None),
-        };
-        let outputs = FrameOutputs {
-            overlay,
-            stats_readback,
-            image_readback: image_readback.as_ref().filter(|_| opts.read_image),
-            present: image,
-        };
-        add_outputs(&mut g, &r, outputs);
+        let image_readback = image_readback.as_ref().filter(|_| opts.read_image);
+        add_outputs(&mut g, &r, outputs(target, stats_readback, image_readback));
         if let Some((passes, res)) = host {
             passes.add_composite(&mut g, &r, i, res)?;
         }
@@ -647,6 +620,19 @@ impl Renderer {
             cmd.end()?;
         }
         Ok(description)
+    }
+
+    /// Submit slot `i` (own frames), or leave it to the host: the slot's fence stays
+    /// signalled, and the host vouches for the frame's completion before it reuses the slot.
+    fn hand_over(&mut self, i: usize, pending: Pending, target: FrameTarget) -> GpuResult<()> {
+        match target {
+            FrameTarget::Own(present) => self.submit(i, pending, present.as_deref()),
+            FrameTarget::Host(_) => {
+                self.frames[i].pending = Some(pending);
+                self.frame_number += 1;
+                Ok(())
+            }
+        }
     }
 
     /// Submit slot `i` (after `present.wait`, signalling `present.signal`).
@@ -749,6 +735,48 @@ impl Renderer {
             .collect();
         LightView::fit(&bounds, view.light_dir, self.shadow.resolution())
     }
+}
+
+/// Where the frame's results go: the statistics and `image_readback` for the report, and an
+/// own frame's overlay and swapchain image.
+fn outputs<'a, 'o>(
+    target: &'a mut FrameTarget<'_, 'o>,
+    stats_readback: &'a Buffer,
+    image_readback: Option<&'a Buffer>,
+) -> FrameOutputs<'a, 'o> {
+    let (overlay, present) = match target {
+        FrameTarget::Own(Some(p)) => (p.overlay.as_deref_mut(), Some(p.image)),
+        _ => (None, None),
+    };
+    FrameOutputs {
+        overlay,
+        stats_readback,
+        image_readback,
+        present,
+    }
+}
+
+/// A host frame's images in the graph (their uses start from `uses`, the host's), and its
+/// start: the host's depth in the renderer's and a transparent colour instead of a clear.
+/// `None` for the renderer's own frames.
+fn add_host_start<'a>(
+    g: &mut FrameGraph<'a>,
+    r: &FrameRes<'a>,
+    (target, passes): (&FrameTarget<'a, '_>, Option<&'a HostTargetPasses>),
+    (color_use, depth_use): (&'a mut Access, &'a mut Access),
+    slot: usize,
+) -> Option<(&'a HostTargetPasses, HostTargetRes<'a>)> {
+    let (FrameTarget::Host(h), Some(passes)) = (target, passes) else {
+        return None;
+    };
+    let color = g.import_image("host colour", h.color.image, Tracked(color_use));
+    let depth = h.depth.map(|d| {
+        let res = g.import_image("host depth", d.image, Tracked(depth_use));
+        (res, d.after)
+    });
+    passes.add_depth(g, r, slot, (depth.map(|d| d.0), h.mapping));
+    let color = (color, h.color.image, h.color.after);
+    Some((passes, HostTargetRes { color, depth }))
 }
 
 /// Make `readback` a buffer of `bytes` when the frame `wants` it and it is not one already.

@@ -59,17 +59,7 @@ fn main() -> std::process::ExitCode {
 }
 
 fn run(args: Args) -> Result<()> {
-    let (w, h) = args
-        .size
-        .split_once('x')
-        .and_then(|(a, b)| Some((a.parse::<u32>().ok()?, b.parse::<u32>().ok()?)))
-        .filter(|&(a, b)| (16..=4096).contains(&a) && (16..=4096).contains(&b))
-        .with_context(|| {
-            format!(
-                "--size {}: expected WIDTHxHEIGHT, 16..=4096 each",
-                args.size
-            )
-        })?;
+    let (w, h) = parse_size(&args.size)?;
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("hairmeshes");
     let head = hairmesh::model::obj_io::load_triangles(&root.join("sintel_head.obj"))?;
     let (baked, style) =
@@ -89,46 +79,7 @@ fn run(args: Args) -> Result<()> {
     renderer.add_character(&baked, &style, params, Mat4::IDENTITY)?;
     let scene = Scene::new(&engine, &head, (w, h))?;
     let targets = Targets::new(&engine, &ctx, (w, h))?;
-    // The crowd's look (Marschner, shadows, multiple scattering); its camera is the engine's.
-    let look = View::crowd_look(hairmesh::render::Camera::look_at(Vec3::Z, Vec3::ZERO, 40.0));
-    let opts = FrameOptions::default();
-    let ticket = std::cell::Cell::new(None);
-    let host_only = frame(&engine, &scene, &targets, |_| Ok(None))?;
-    let mut draw_hair = |with_depth: bool, slot: usize| {
-        frame(&engine, &scene, &targets, |cmd| {
-            let frame = HostFrame {
-                cmd,
-                slot,
-                camera: scene.camera,
-                color: HostImage {
-                    image: &targets.color_image,
-                    before: Access::ColorAttachment,
-                    after: Access::TransferRead,
-                },
-                depth: with_depth.then_some(HostImage {
-                    image: &targets.depth_image,
-                    before: Access::DepthAttachment,
-                    after: Access::DepthAttachment,
-                }),
-            };
-            let t = renderer.record_host_frame(&look, &opts, frame)?;
-            ticket.set(Some(t));
-            Ok(Some(t))
-        })
-    };
-    let with_depth = draw_hair(true, 0)?;
-    let first = ticket.take().context("no hair frame")?;
-    let without_depth = draw_hair(false, 1)?;
-    // The engine waited for both submissions: their reports are ready without waiting.
-    let report = renderer.wait(first)?;
-    let pass = |name: &str| {
-        report
-            .pass_ms
-            .iter()
-            .filter(|p| p.0 == name)
-            .map(|p| p.1)
-            .sum::<f64>()
-    };
+    let [host_only, with_depth, without_depth] = draw(&engine, (&scene, &targets), &mut renderer)?;
     let differ = |a: &[u8], b: &[u8]| a.chunks(4).zip(b.chunks(4)).filter(|(p, q)| p != q).count();
     let shown = differ(&host_only, &with_depth);
     let hidden = differ(&with_depth, &without_depth);
@@ -145,13 +96,6 @@ fn run(args: Args) -> Result<()> {
         args.out.display(),
         ctx.info.name
     );
-    println!(
-        "the hair frame with the engine's depth: {} strands, GPU {:.1} ms (lavapipe: the first frame of a pipeline is slow), of which the engine's depth in {:.2} ms and the composite {:.2} ms",
-        report.stats.strands_drawn,
-        report.gpu_ms(),
-        pass("host depth"),
-        pass("host composite"),
-    );
     drop(targets);
     drop(renderer);
     let errors = ctx.validation_errors();
@@ -166,9 +110,68 @@ fn run(args: Args) -> Result<()> {
             "expected hair both shown and hidden by the engine's depth ({shown} shown, {hidden} hidden)"
         );
     }
-    drop(ctx);
-    drop(scene);
     Ok(())
+}
+
+/// `WIDTHxHEIGHT`, 16..=4096 each.
+fn parse_size(size: &str) -> Result<(u32, u32)> {
+    size.split_once('x')
+        .and_then(|(a, b)| Some((a.parse::<u32>().ok()?, b.parse::<u32>().ok()?)))
+        .filter(|&(a, b)| (16..=4096).contains(&a) && (16..=4096).contains(&b))
+        .with_context(|| format!("--size {size}: expected WIDTHxHEIGHT, 16..=4096 each"))
+}
+
+/// Three engine frames: the engine alone, with the hair behind its depth (slot 0), with the
+/// hair ignoring its depth (slot 1); their colours (BGRA). Prints the second one's timings.
+fn draw(
+    engine: &Engine,
+    (scene, targets): (&Scene, &Targets),
+    renderer: &mut Renderer,
+) -> Result<[Vec<u8>; 3]> {
+    // The crowd's look (Marschner, shadows, multiple scattering); its camera is the engine's.
+    let look = View::crowd_look(hairmesh::render::Camera::look_at(Vec3::Z, Vec3::ZERO, 40.0));
+    let opts = FrameOptions::default();
+    let host_only = frame(engine, scene, targets, |_| Ok(None))?;
+    let mut draw_hair = |with_depth: bool, slot: usize| {
+        let mut ticket = None;
+        let colour = frame(engine, scene, targets, |cmd| {
+            let frame = HostFrame {
+                cmd,
+                slot,
+                camera: scene.camera,
+                color: HostImage {
+                    image: &targets.color_image,
+                    before: Access::ColorAttachment,
+                    after: Access::TransferRead,
+                },
+                depth: with_depth.then_some(HostImage {
+                    image: &targets.depth_image,
+                    before: Access::DepthAttachment,
+                    after: Access::DepthAttachment,
+                }),
+            };
+            let t = renderer.record_host_frame(&look, &opts, frame)?;
+            ticket = Some(t);
+            Ok(Some(t))
+        })?;
+        Ok::<_, anyhow::Error>((colour, ticket.context("no hair frame")?))
+    };
+    let (with_depth, first) = draw_hair(true, 0)?;
+    let (without_depth, _) = draw_hair(false, 1)?;
+    // The engine waited for both submissions: their reports are ready without waiting.
+    let report = renderer.wait(first)?;
+    let pass = |name: &str| -> f64 {
+        let times = report.pass_ms.iter().filter(|p| p.0 == name);
+        times.map(|p| p.1).sum()
+    };
+    println!(
+        "the hair frame with the engine's depth: {} strands, GPU {:.1} ms (lavapipe: the first frame of a pipeline is slow), of which the engine's depth in {:.2} ms and the composite {:.2} ms",
+        report.stats.strands_drawn,
+        report.gpu_ms(),
+        pass("host depth"),
+        pass("host composite"),
+    );
+    Ok([host_only, with_depth, without_depth])
 }
 
 /// One engine frame: the scene, then `hair` into the same command buffer, the colour copied
@@ -611,6 +614,24 @@ fn texture_set(
     }
 }
 
+/// The scene pipelines' layout: the texture's set and the push constants.
+fn scene_layout(
+    d: &ash::Device,
+    set_layout: vk::DescriptorSetLayout,
+) -> Result<vk::PipelineLayout> {
+    let push = [vk::PushConstantRange {
+        stage_flags: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+        offset: 0,
+        size: size_of::<Push>() as u32,
+    }];
+    let sets = [set_layout];
+    let info = vk::PipelineLayoutCreateInfo::default()
+        .set_layouts(&sets)
+        .push_constant_ranges(&push);
+    // SAFETY: the engine's device; destroyed with the scene.
+    Ok(unsafe { d.create_pipeline_layout(&info, None) }?)
+}
+
 /// The scene's pipeline: lit or textured triangles, reversed depth (GREATER), two-sided.
 fn scene_pipeline(
     engine: &Engine,
@@ -626,20 +647,9 @@ fn scene_pipeline(
     let vert = spirv(SCENE_VERT, shaderc::ShaderKind::Vertex, "scene.vert")?;
     let frag = spirv(SCENE_FRAG, shaderc::ShaderKind::Fragment, "scene.frag")?;
     let d = &engine.device;
+    let layout = scene_layout(d, set_layout)?;
     // SAFETY: the engine's device; the modules are destroyed once the pipeline is made.
     unsafe {
-        let push = [vk::PushConstantRange {
-            stage_flags: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-            offset: 0,
-            size: size_of::<Push>() as u32,
-        }];
-        let sets = [set_layout];
-        let layout = d.create_pipeline_layout(
-            &vk::PipelineLayoutCreateInfo::default()
-                .set_layouts(&sets)
-                .push_constant_ranges(&push),
-            None,
-        )?;
         let vm =
             d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&vert), None)?;
         let fm =
@@ -654,68 +664,76 @@ fn scene_pipeline(
                 .module(fm)
                 .name(c"main"),
         ];
-        let bindings = [vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: (VERTEX_FLOATS * 4) as u32,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
-        let attributes = [(0, 0), (1, 12), (2, 24)].map(|(location, offset)| {
-            vk::VertexInputAttributeDescription {
-                location,
-                binding: 0,
-                format: if location == 2 {
-                    vk::Format::R32G32_SFLOAT
-                } else {
-                    vk::Format::R32G32B32_SFLOAT
-                },
-                offset,
-            }
-        });
-        let vertex = vk::PipelineVertexInputStateCreateInfo::default()
-            .vertex_binding_descriptions(&bindings)
-            .vertex_attribute_descriptions(&attributes);
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
-            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
-            .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(vk::CullModeFlags::NONE)
-            .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(true)
-            .depth_write_enable(true)
-            .depth_compare_op(vk::CompareOp::GREATER);
-        let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
-            .color_write_mask(vk::ColorComponentFlags::RGBA)];
-        let blend =
-            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-        let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
-        let formats = [COLOR_FORMAT];
-        let mut rendering = vk::PipelineRenderingCreateInfo::default()
-            .color_attachment_formats(&formats)
-            .depth_attachment_format(DEPTH_FORMAT);
-        let info = [vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
-            .vertex_input_state(&vertex)
-            .input_assembly_state(&assembly)
-            .viewport_state(&viewport)
-            .rasterization_state(&raster)
-            .multisample_state(&multisample)
-            .depth_stencil_state(&depth)
-            .color_blend_state(&blend)
-            .dynamic_state(&dynamic)
-            .layout(layout)
-            .push_next(&mut rendering)];
-        let pipeline = d
-            .create_graphics_pipelines(vk::PipelineCache::null(), &info, None)
-            .map_err(|(_, e)| e)?[0];
+        let pipeline = graphics_pipeline(d, layout, &stages);
         d.destroy_shader_module(vm, None);
         d.destroy_shader_module(fm, None);
-        Ok((layout, pipeline))
+        Ok((layout, pipeline?))
     }
+}
+
+/// A pipeline of `stages` for the engine's targets: position, normal and uv vertices, reversed
+/// depth (GREATER, written), two-sided, dynamic viewport and scissor.
+fn graphics_pipeline(
+    d: &ash::Device,
+    layout: vk::PipelineLayout,
+    stages: &[vk::PipelineShaderStageCreateInfo],
+) -> Result<vk::Pipeline> {
+    let bindings = [vk::VertexInputBindingDescription {
+        binding: 0,
+        stride: (VERTEX_FLOATS * 4) as u32,
+        input_rate: vk::VertexInputRate::VERTEX,
+    }];
+    let attributes =
+        [(0, 0), (1, 12), (2, 24)].map(|(location, offset)| vk::VertexInputAttributeDescription {
+            location,
+            binding: 0,
+            format: if location == 2 {
+                vk::Format::R32G32_SFLOAT
+            } else {
+                vk::Format::R32G32B32_SFLOAT
+            },
+            offset,
+        });
+    let vertex = vk::PipelineVertexInputStateCreateInfo::default()
+        .vertex_binding_descriptions(&bindings)
+        .vertex_attribute_descriptions(&attributes);
+    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+        .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport = vk::PipelineViewportStateCreateInfo::default()
+        .viewport_count(1)
+        .scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .line_width(1.0);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(true)
+        .depth_write_enable(true)
+        .depth_compare_op(vk::CompareOp::GREATER);
+    let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+    let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
+    let formats = [COLOR_FORMAT];
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(&formats)
+        .depth_attachment_format(DEPTH_FORMAT);
+    let info = [vk::GraphicsPipelineCreateInfo::default()
+        .stages(stages)
+        .vertex_input_state(&vertex)
+        .input_assembly_state(&assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&depth)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(layout)
+        .push_next(&mut rendering)];
+    // SAFETY: the engine's device; every create info lives for the call.
+    let made = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &info, None) };
+    Ok(made.map_err(|(_, e)| e)?[0])
 }

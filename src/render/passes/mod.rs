@@ -53,6 +53,15 @@ pub struct PassSets<'a> {
 }
 
 impl<'a> PassSets<'a> {
+    /// The camera's sets and the light's: each frame block's set with the crowd's textures.
+    pub fn camera_and_light(
+        (camera, light): (&'a DescriptorSet, &'a DescriptorSet),
+        textures: &'a DescriptorSet,
+    ) -> (Self, Self) {
+        let of = |frame| PassSets { frame, textures };
+        (of(camera), of(light))
+    }
+
     /// As a slice for binding.
     pub fn both(&self) -> [&'a DescriptorSet; 2] {
         [self.frame, self.textures]
