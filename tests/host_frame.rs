@@ -121,6 +121,7 @@ fn host_frame(
                 }),
             },
         ));
+        true
     });
     let ticket = result.unwrap().unwrap();
     // The host's submission completed: the report is there without waiting.
@@ -265,4 +266,156 @@ fn host_frames_match_own_frames_and_hide_behind_host_depth() {
 #[test]
 fn host_frames_with_msaa_and_a_stencil_depth() {
     check(4, vk::Format::D32_SFLOAT_S8_UINT, false);
+}
+
+/// What a host frame refuses, before recording anything: each a one-line error naming the
+/// cause (the host's command buffer is left as it was, so the host can go on).
+#[test]
+fn bad_host_frames_are_refused() {
+    use hairmesh::vk::{Image, ImageDesc};
+    let host = Host::new();
+    let ctx = Arc::new(Context::from_host(host.lend(true)).unwrap());
+    let (baked, style) = sample("head_long.obj");
+    let mut r = Renderer::new(&ctx, &RendererDesc::default().size(W, H)).unwrap();
+    upload(&mut r, &baked, &style, 4, 3);
+    let camera = framing(&baked);
+    let mut frame = Frame::new(
+        &host,
+        (W, H),
+        vk::Format::B8G8R8A8_SRGB,
+        vk::Format::D32_SFLOAT,
+    );
+    let (color, depth) = frame.images(&ctx);
+    let desc = |name, format, usage, (w, h)| ImageDesc::new_2d(name, format, w, h).usage(usage);
+    use vk::ImageUsageFlags as U;
+    // The same images described as the renderer must refuse them.
+    let unsampled = Image::from_host(
+        &ctx,
+        frame.depth.raw,
+        &desc(
+            "d",
+            vk::Format::D32_SFLOAT,
+            U::DEPTH_STENCIL_ATTACHMENT,
+            (W, H),
+        ),
+    )
+    .unwrap();
+    let smaller = Image::from_host(
+        &ctx,
+        frame.depth.raw,
+        &desc("d", vk::Format::D32_SFLOAT, U::SAMPLED, (W / 2, H)),
+    )
+    .unwrap();
+    let not_color = Image::from_host(
+        &ctx,
+        frame.depth.raw,
+        &desc("c", vk::Format::D32_SFLOAT, U::COLOR_ATTACHMENT, (W, H)),
+    )
+    .unwrap();
+    let good = host_camera(&camera, Convention::Standard);
+    let mut ortho = good;
+    ortho.proj = Mat4::from_scale(Vec3::new(0.5, -0.5, 0.1));
+    let look = View::new(camera);
+    let taa = View {
+        temporal: hairmesh::render::Temporal::Taa,
+        ..look
+    };
+    type Case<'a> = (
+        &'a str,
+        usize,
+        &'a View,
+        HostCamera,
+        (&'a Image, Option<&'a Image>),
+        Access,
+    );
+    let cases: [Case; 7] = [
+        (
+            "slot 2",
+            2,
+            &look,
+            good,
+            (&color, Some(&depth)),
+            Access::DepthAttachment,
+        ),
+        (
+            "temporal accumulation",
+            0,
+            &taa,
+            good,
+            (&color, Some(&depth)),
+            Access::DepthAttachment,
+        ),
+        (
+            "SAMPLED",
+            0,
+            &look,
+            good,
+            (&color, Some(&unsampled)),
+            Access::DepthAttachment,
+        ),
+        (
+            "differ in size",
+            0,
+            &look,
+            good,
+            (&color, Some(&smaller)),
+            Access::DepthAttachment,
+        ),
+        (
+            "not a colour attachment",
+            0,
+            &look,
+            good,
+            (&not_color, None),
+            Access::DepthAttachment,
+        ),
+        (
+            "perspective",
+            0,
+            &look,
+            ortho,
+            (&color, Some(&depth)),
+            Access::DepthAttachment,
+        ),
+        (
+            "unused",
+            0,
+            &look,
+            good,
+            (&color, Some(&depth)),
+            Access::Nothing,
+        ),
+    ];
+    let pixels = (W * H) as usize;
+    for (cause, slot, view, camera, (c, d), after) in cases {
+        let mut error = None;
+        frame.run(BACKGROUND, &vec![1.0; pixels], |cmd| {
+            let f = HostFrame {
+                cmd,
+                slot,
+                camera,
+                color: HostImage {
+                    image: c,
+                    before: Access::TransferWrite,
+                    after: Access::TransferRead,
+                },
+                depth: d.map(|image| HostImage {
+                    image,
+                    before: Access::TransferWrite,
+                    after,
+                }),
+            };
+            error = r.record_host_frame(view, &FrameOptions::default(), f).err();
+            false
+        });
+        let e = error
+            .unwrap_or_else(|| panic!("{cause}: accepted"))
+            .to_string();
+        println!("{e}");
+        assert!(e.contains(cause) && !e.contains('\n'), "{cause}: {e}");
+    }
+    drop((color, depth, unsampled, smaller, not_color));
+    drop(frame);
+    drop(r);
+    assert_no_validation_errors(&ctx);
 }

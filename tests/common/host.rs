@@ -107,14 +107,15 @@ impl<'h> HostFrame<'h> {
     }
 
     /// One host frame: clear the colour to `background`, copy `depth` (one float per pixel)
-    /// into the depth image, let `renderer` record (both images left in transfer-write use; it
-    /// hands the colour back in transfer-read use), copy the colour out, submit and wait.
-    /// Returns the colour's bytes (in its format's channel order).
+    /// into the depth image, let `renderer` record (both images left in transfer-write use;
+    /// it returns whether it handed the colour back in transfer-read use, else the host moves
+    /// it there), copy the colour out, submit and wait. Returns the colour's bytes (in its
+    /// format's channel order).
     pub fn run(
         &mut self,
         background: [f32; 4],
         depth: &[f32],
-        renderer: impl FnOnce(vk::CommandBuffer),
+        renderer: impl FnOnce(vk::CommandBuffer) -> bool,
     ) -> Vec<u8> {
         let e = &self.host.0;
         let d = &e.device;
@@ -142,8 +143,14 @@ impl<'h> HostFrame<'h> {
                 let range = engine::range(vk::ImageAspectFlags::COLOR);
                 d.cmd_clear_color_image(cmd, color.raw, L::TRANSFER_DST_OPTIMAL, &clear, &[range]);
                 copy(d, cmd, (depth_image, staging), true);
-                renderer(cmd);
-                // The renderer handed the colour back in transfer-read use.
+                if !renderer(cmd) {
+                    barrier(
+                        d,
+                        cmd,
+                        color,
+                        (L::TRANSFER_DST_OPTIMAL, L::TRANSFER_SRC_OPTIMAL),
+                    );
+                }
                 copy(d, cmd, (color, readback), false);
             }
             Ok(())
