@@ -155,6 +155,11 @@ impl HostCamera {
         })
     }
 
+    /// Where the camera is, in world space (a handedness flip of view space leaves it there).
+    pub fn eye(&self) -> Vec3 {
+        self.view.inverse().transform_point3(Vec3::ZERO)
+    }
+
     /// The host's matrices with a right-handed view space (w = -z, scaled to exactly that):
     /// a left-handed pair is reflected in z on both sides, which leaves clip space unchanged.
     fn right_handed(&self) -> Result<(Mat4, Mat4), String> {
@@ -327,15 +332,9 @@ impl Renderer {
         passes.bind(frame.slot, depth_image, self.targets.output())?;
         // The renderer's depth range: the host's near plane, and far enough for the hair.
         let size = (width, height);
-        let eye = frame
-            .camera
-            .view(size, f32::MAX)
-            .map_err(refuse)?
-            .camera
-            .eye;
         let host = frame
             .camera
-            .view(size, self.hair_far(eye))
+            .view(size, self.hair_far(frame.camera.eye()))
             .map_err(refuse)?;
         let view = View {
             camera: host.camera,
