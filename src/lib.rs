@@ -21,6 +21,7 @@ pub mod reference;
 pub mod render;
 pub mod rng;
 pub mod shade;
+pub mod skin;
 pub mod vk;
 
 pub use bake::{BakeOptions, BakedHairMesh, BundleDesc, MeshInfo, bake};

@@ -5,6 +5,7 @@
 
 pub mod alembic;
 pub mod exact_array;
+pub mod gltf;
 pub mod hair_file;
 pub mod hair_mesh;
 pub mod obj_io;

@@ -254,3 +254,13 @@ pub(crate) mod tests {
         assert!(on_cone > 0.9 && off_cone < 0.1, "{on_cone} {off_cone}");
     }
 }
+
+/// The sRGB transfer function's inverse: an sRGB-encoded value in 0..=1 to linear (IEC
+/// 61966-2-1).
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}

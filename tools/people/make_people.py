@@ -37,6 +37,7 @@ import numpy as np
 NECK_BASE = np.array([0.0, 1.425, -0.025])  # canonical frame, metres
 FPS = 30.0
 WALK_PERIOD = 1.1
+SHOE = 0.012  # shoe thickness over the feet, metres
 STRIDE = 1.2  # metres per cycle (two steps) for the man; the woman's legs scale it
 
 
@@ -280,6 +281,8 @@ def leg_ik(rig, side, local, rot, pos, ball_target, pitch):
     local[thigh] = quat_mul(quat_conj(parent), g_thigh)
     local[calf] = quat_mul(quat_conj(g_thigh), g_calf)
     local[foot] = quat_mul(quat_conj(g_calf), foot_rot)
+    # The toes stay flat on the ground: the ball joint undoes the pitch.
+    local[ball] = quat_conj(foot_rot)
 
 
 def smooth(x):
@@ -441,9 +444,9 @@ def build(data, sex, out_path):
     scale = 0.1 * (NECK_BASE[1]) / (0.1 * (neck[1] - feet))
     if sex == "female":
         scale *= 0.985
-    offset = NECK_BASE - (neck - np.array([0.0, feet, 0.0])) * scale * np.array([1, 0, 1]) * 0
     def to_m(p):
-        q = (p - np.array([0.0, feet, 0.0])) * scale
+        # The soles of the shoes (pushed SHOE out of the feet) on the ground.
+        q = (p - np.array([0.0, feet, 0.0])) * scale + np.array([0.0, SHOE, 0.0])
         return q + np.array([NECK_BASE[0] - neck[0] * scale, 0.0, NECK_BASE[2] - neck[2] * scale])
     verts_m = to_m(verts)
     rest = {n: to_m(joints_obj[n]) for n in order}
@@ -491,7 +494,7 @@ def build(data, sex, out_path):
         Part("shirt", tights["shirt"], 0.009),
         Part("sleeves", tights["sleeves"], 0.006),
         Part("trousers", tights["trousers"], 0.005),
-        Part("shoes", tights["shoes"], 0.012),
+        Part("shoes", tights["shoes"], SHOE),
         Part("skirt", groups["helper-skirt"], 0.012),
     ]
     g = Glb()
