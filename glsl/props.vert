@@ -1,11 +1,15 @@
 #version 460
-// Props (bodies, ground): static triangle lists pulled from the prop vertex buffer, one
-// instance record (transform, colour) per placed prop.
+// Props: static triangle lists pulled from the prop vertex buffer (the ground, heads), or
+// skinned meshes (bodies, clothes): their triangle list indexes the instance's posed vertices,
+// written this frame by skin.comp. One instance record (transform, colour) per placed prop;
+// the colour multiplies a skinned vertex's own.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 
 layout(set = SET_FRAME, binding = BINDING_PROP_VERTICES, std430) readonly buffer PropVertices { PropVertex prop_vertices[]; };
 layout(set = SET_FRAME, binding = BINDING_PROP_INSTANCES, std430) readonly buffer PropInstances { PropInstance prop_instances[]; };
+layout(set = SET_FRAME, binding = BINDING_SKIN_INDICES, std430) readonly buffer SkinIndices { uint skin_indices[]; };
+layout(set = SET_FRAME, binding = BINDING_SKINNED_VERTICES, std430) readonly buffer Posed { SkinnedVertex skinned[]; };
 
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) flat out vec3 out_color;
@@ -13,12 +17,24 @@ layout(location = 2) out vec3 out_pos;
 layout(location = 3) flat out uint out_instance;
 
 void main() {
-    PropVertex v = prop_vertices[gl_VertexIndex];
     PropInstance inst = prop_instances[gl_InstanceIndex];
-    vec4 world = inst.model * vec4(v.position.xyz, 1.0);
+    vec3 position;
+    vec3 normal;
+    vec3 color = inst.color.rgb;
+    if (inst.skin.x == SKIN_NONE) {
+        PropVertex v = prop_vertices[gl_VertexIndex];
+        position = v.position.xyz;
+        normal = v.normal.xyz;
+    } else {
+        SkinnedVertex v = skinned[inst.skin.x + skin_indices[gl_VertexIndex]];
+        position = v.position;
+        normal = v.normal;
+        color *= unpackUnorm4x8(v.color).rgb;
+    }
+    vec4 world = inst.model * vec4(position, 1.0);
     // Inverse transpose: people are scaled non-uniformly (head proportions).
-    out_normal = normalize(transpose(inverse(mat3(inst.model))) * v.normal.xyz);
-    out_color = inst.color.rgb;
+    out_normal = normalize(transpose(inverse(mat3(inst.model))) * normal);
+    out_color = color;
     out_pos = world.xyz;
     out_instance = uint(gl_InstanceIndex);
     gl_Position = frame.view_proj * world;

@@ -87,6 +87,7 @@ fn hair_covers_the_scalp_seen_from_above() {
                     model: model.to_cols_array_2d(),
                     color,
                     clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
+                    skin: [hairmesh::render::shared::SKIN_NONE, 0, 0, 0],
                 },
             )
         };

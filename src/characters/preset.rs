@@ -281,6 +281,7 @@ pub fn world_props() -> Vec<(usize, PropInstance)> {
             model: Mat4::IDENTITY.to_cols_array_2d(),
             color: [0.32, 0.34, 0.3, 1.0],
             clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
+            skin: [crate::render::shared::SKIN_NONE, 0, 0, 0],
         },
     )]
 }
@@ -296,6 +297,7 @@ pub fn character_props(c: &CrowdCharacter) -> Result<Vec<(usize, PropInstance)>>
                 model: model.to_cols_array_2d(),
                 color,
                 clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
+                skin: [crate::render::shared::SKIN_NONE, 0, 0, 0],
             },
         )
     };

@@ -138,6 +138,7 @@ impl Renderer {
             targets: &mut self.targets,
             shadow: &mut self.shadow,
             history: None,
+            skinned: &slot.skinned,
         };
         let (passes, pool) = (&self.passes, &mut self.transients);
         let result = ctx.submit_and_wait(|rec| {

@@ -48,6 +48,8 @@ pub(super) struct FrameWork<'a> {
     path: RenderPath,
     bundles: u32,
     props: &'a [PropDraw],
+    /// Skinning jobs this frame and the most vertices of one.
+    skin: (u32, u32),
     /// Shadow mode, when shadows are on and there is hair to shadow.
     shadows: Option<ShadowMode>,
     /// How strands are composited.
@@ -165,12 +167,13 @@ impl Renderer {
             self.write_density_jobs(i, &mut records, (&view.volumes, &block), &pose_updates)?;
         let work_draw = density.draw;
         let blocks = (&block, light_block.as_ref());
-        let prop_draws = self.write_slot(i, blocks, &records, moving, opts)?;
+        let (prop_draws, skin) = self.write_slot(i, blocks, &records, moving, opts)?;
         let start = Instant::now();
         let work = FrameWork {
             path,
             bundles: self.crowd.bundle_count(),
             props: &prop_draws,
+            skin,
             shadows: light_block.map(|_| view.shadows),
             transparency: view.transparency,
             raster,
@@ -471,8 +474,9 @@ impl Renderer {
         (block, light_block)
     }
 
-    /// Write slot `i`'s frame blocks, `records` and prop instances (with their motion where
-    /// the frame has motion vectors) and size its readbacks; returns this frame's prop draws.
+    /// Write slot `i`'s frame blocks, `records`, prop instances (with their motion where
+    /// the frame has motion vectors) and skinning jobs and matrices, and size its readbacks;
+    /// returns this frame's prop draws and its skinning jobs and widest job.
     fn write_slot(
         &mut self,
         i: usize,
@@ -480,7 +484,7 @@ impl Renderer {
         records: &[super::shared::CharacterRecord],
         motion: Option<&FrameMotion>,
         opts: &FrameOptions,
-    ) -> GpuResult<Vec<PropDraw>> {
+    ) -> GpuResult<(Vec<PropDraw>, (u32, u32))> {
         let crowd = &self.crowd;
         let still = glam::Mat4::IDENTITY;
         let moved = |id: super::crowd::CharacterId| {
@@ -496,7 +500,10 @@ impl Renderer {
             height: block.camera_pos[3],
             cot_half_fov: block.light_dir[3],
         };
-        let (prop_instances, prop_draws) = self.props.frame_lists(moved, world, &camera);
+        let (mut prop_instances, mut prop_draws) = self.props.frame_lists(&moved, world, &camera);
+        let skin = self
+            .skinned
+            .frame_lists(&moved, &camera, &mut prop_instances, &mut prop_draws);
         let (width, height) = self.targets.size();
         let slot = &mut self.frames[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;
@@ -506,6 +513,11 @@ impl Renderer {
         slot.records.write(0, bytemuck::cast_slice(records))?;
         slot.prop_instances
             .write(0, bytemuck::cast_slice(&prop_instances))?;
+        if !skin.jobs.is_empty() {
+            slot.skin_jobs.write(0, bytemuck::cast_slice(&skin.jobs))?;
+            slot.skin_matrices
+                .write(0, bytemuck::cast_slice(&skin.matrices))?;
+        }
         let pixels = width as u64 * height as u64;
         size_readback(
             &self.ctx,
@@ -519,7 +531,7 @@ impl Renderer {
             opts.read_motion,
             pixels * 16,
         )?;
-        Ok(prop_draws)
+        Ok((prop_draws, (skin.jobs.len() as u32, skin.widest)))
     }
 
     /// Record frame slot `i` into `target`'s command buffer: build the frame graph (hair mesh
@@ -545,6 +557,7 @@ impl Renderer {
             retired,
             sim_jobs,
             density_jobs,
+            skinned,
             ..
         } = &mut self.frames[i];
         let mut rec = match target {
@@ -573,6 +586,7 @@ impl Renderer {
             targets: &mut self.targets,
             shadow: &mut self.shadow,
             history: self.temporal.history(),
+            skinned,
         };
         let r = FrameRes::new(&mut g, sources, &work.transients);
         g.bind_transients(set);
@@ -696,10 +710,12 @@ impl Renderer {
         if slot.records.size < slots as u64 * size_of::<super::shared::CharacterRecord>() as u64 {
             slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
         }
-        let instances = (self.props.instances.len() + self.props.attached.len()) as u32;
+        let (skinned, matrices, posed) = self.skinned.capacity();
+        let instances = (self.props.instances.len() + self.props.attached.len()) as u32 + skinned;
         if slot.prop_instances.size < instances as u64 * size_of::<PropInstance>() as u64 {
             slot.prop_instances = prop_instance_buffer(&self.ctx, instances.next_power_of_two())?;
         }
+        grow_skin_buffers(&self.ctx, slot, (skinned, matrices, posed))?;
         let slot = &self.frames[i];
         for (set, ubo) in [
             (&slot.set, &slot.frame_ubo),
@@ -713,6 +729,13 @@ impl Renderer {
                     prop_instances: &slot.prop_instances,
                     bundle_table: self.crowd.bundle_table(),
                     prop_vertices: self.props.vertices.as_ref(),
+                    skin: [
+                        self.skinned.rest.as_ref(),
+                        self.skinned.indices.as_ref(),
+                        Some(&slot.skin_matrices),
+                        Some(&slot.skin_jobs),
+                        Some(&slot.skinned),
+                    ],
                     shadow: &self.shadow,
                     history: self.temporal.history(),
                 },
@@ -779,6 +802,25 @@ fn add_host_start<'a>(
     Some((passes, HostTargetRes { color, depth }))
 }
 
+/// Grow frame slot `slot`'s skinning buffers for `(instances, matrices, posed vertices)`
+/// (its earlier frame has completed, so they may be replaced).
+fn grow_skin_buffers(ctx: &Arc<Context>, slot: &mut FrameSlot, (jobs, matrices, posed): (u32, u32, u32)) -> GpuResult<()> {
+    use super::shared::{SkinJob, SkinnedVertex};
+    use super::slots::{host_table, skinned_buffer};
+    let job_bytes = jobs as u64 * size_of::<SkinJob>() as u64;
+    if slot.skin_jobs.size < job_bytes {
+        slot.skin_jobs = host_table(ctx, "skin jobs", job_bytes.next_power_of_two())?;
+    }
+    let matrix_bytes = matrices as u64 * 64;
+    if slot.skin_matrices.size < matrix_bytes {
+        slot.skin_matrices = host_table(ctx, "skin matrices", matrix_bytes.next_power_of_two())?;
+    }
+    if slot.skinned.size < posed as u64 * size_of::<SkinnedVertex>() as u64 {
+        slot.skinned = skinned_buffer(ctx, posed.next_power_of_two())?;
+    }
+    Ok(())
+}
+
 /// Make `readback` a buffer of `bytes` when the frame `wants` it and it is not one already.
 fn size_readback(
     ctx: &Arc<Context>,
@@ -815,6 +857,7 @@ fn frame_inputs<'a>(
         path: work.path,
         clear,
         props: work.props,
+        skin: work.skin,
         shadow: work.shadows,
         transparency: work.transparency,
         raster: work.raster,

@@ -18,6 +18,7 @@ pub mod scene;
 pub mod settings;
 pub mod shadow;
 pub mod shared;
+pub mod skinned_props;
 pub mod slots;
 pub mod soft;
 pub mod targets;

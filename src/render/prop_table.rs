@@ -37,7 +37,7 @@ pub(super) struct Projection {
 impl Projection {
     /// Diameter in pixels of a sphere of `radius` at `centre` (infinite at the eye or in
     /// orthographic views).
-    fn pixels(&self, centre: Vec3, radius: f32) -> f32 {
+    pub(super) fn pixels(&self, centre: Vec3, radius: f32) -> f32 {
         let d = centre.distance(self.eye);
         if self.cot_half_fov <= 0.0 || d <= radius {
             return f32::INFINITY;
@@ -84,7 +84,7 @@ impl Props {
     /// sees a prop small.
     pub(super) fn frame_lists(
         &self,
-        model_of: impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
+        model_of: &impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
         world_clip_to_prev: Mat4,
         camera: &Projection,
     ) -> (Vec<PropInstance>, Vec<PropDraw>) {
@@ -101,6 +101,7 @@ impl Props {
                     model: model.to_cols_array_2d(),
                     color: inst.color,
                     clip_to_prev: clip_to_prev.to_cols_array_2d(),
+                    skin: inst.skin,
                 },
             ))
         }));
@@ -119,6 +120,7 @@ impl Props {
                     vertex_count,
                     first_instance: k as u32,
                     instance_count: 1,
+                    skinned: false,
                 }),
             }
         }

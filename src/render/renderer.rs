@@ -56,6 +56,8 @@ pub struct Renderer {
     pub(super) passes: FramePasses,
     pub(super) frames: Vec<FrameSlot>,
     pub(super) props: Props,
+    /// Skinned bodies and clothes.
+    pub(super) skinned: super::skinned_props::SkinnedProps,
     pub(super) next: usize,
     pub(super) frame_number: u64,
     pub(super) targets: RenderTargets,
@@ -118,6 +120,7 @@ impl Renderer {
             passes,
             frames,
             props: Props::default(),
+            skinned: Default::default(),
             next: 0,
             frame_number: 0,
             targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
@@ -213,6 +216,7 @@ impl Renderer {
     pub fn remove_character(&mut self, id: CharacterId) -> GpuResult<()> {
         let removed = self.crowd.remove(id)?;
         self.props.attached.retain(|(c, ..)| *c != id);
+        self.skinned.remove(id);
         if let Some(cells) = self.volumes.remove(id) {
             self.retire(Retired::Resource(Box::new(cells)));
         }
@@ -436,6 +440,46 @@ impl Renderer {
             Some(model) => self.props.attached_models(id, model),
             None => Vec::new(),
         }
+    }
+
+    /// Upload the skinned meshes (bodies, clothes); characters wear them by index
+    /// ([`Self::set_character_skin`]). Replaces earlier ones and what characters wore.
+    pub fn set_skinned_meshes(&mut self, meshes: &[crate::skin::SkinnedMesh]) -> GpuResult<()> {
+        for old in self.skinned.set_meshes(&self.ctx, meshes)? {
+            self.retire(Retired::Resource(Box::new(old)));
+        }
+        Ok(())
+    }
+
+    /// Far versions of skinned meshes (as [`Self::set_prop_lods`]).
+    pub fn set_skinned_lods(&mut self, lods: &[super::prop_table::PropLod]) -> GpuResult<()> {
+        self.skinned.set_lods(lods)
+    }
+
+    /// Character `id` wears skinned meshes `parts` (`(mesh, linear colour)`, the colour
+    /// multiplying the mesh's own) over a skeleton of `joints`, posed at the character's
+    /// model by [`Self::set_character_pose`] and skinned on the GPU every frame it is drawn.
+    pub fn set_character_skin(
+        &mut self,
+        id: CharacterId,
+        parts: &[(usize, [f32; 4])],
+        joints: usize,
+    ) -> GpuResult<()> {
+        if !self.crowd.contains(id) {
+            return Err(GpuError::Unsupported(format!("no character {id:?}")));
+        }
+        self.skinned.set_wearer(id, parts, joints)
+    }
+
+    /// Character `id`'s skin matrices for the next frames (bind pose to the character's
+    /// frame, one per joint: `skin::Skeleton::skin_matrices`).
+    pub fn set_character_pose(&mut self, id: CharacterId, matrices: &[Mat4]) -> GpuResult<()> {
+        self.skinned.set_pose(id, matrices)
+    }
+
+    /// Character `id`'s skin matrices as last set.
+    pub fn character_pose(&self, id: CharacterId) -> Option<&[Mat4]> {
+        self.skinned.pose(id)
     }
 
     /// Where character `id` is drawn this frame (`None`: hidden or removed).

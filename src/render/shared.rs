@@ -224,11 +224,22 @@ pub enum FrameBinding {
     VertexMotion = 30,
     /// Temporal: per software segment, its deformation residual (as `VertexMotion`).
     SegmentMotion = 31,
+    /// `SkinRestVertex[]`: every skinned mesh's vertices at bind time.
+    SkinRest = 32,
+    /// `uint[]`: every skinned mesh's triangle list (indices into its own vertices).
+    SkinIndices = 33,
+    /// `mat4[]`: this frame's skin matrices, character after character.
+    SkinMatrices = 34,
+    /// `SkinJob[]`: this frame's skinned mesh instances.
+    SkinJobs = 35,
+    /// `SkinnedVertex[]`: this frame's posed vertices, written by `skin.comp`, read by
+    /// `props.vert`.
+    SkinnedVertices = 36,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 32] = [
+    pub const ALL: [(FrameBinding, &'static str); 37] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -261,6 +272,11 @@ impl FrameBinding {
         (FrameBinding::HistoryOut, "BINDING_HISTORY_OUT"),
         (FrameBinding::VertexMotion, "BINDING_VERTEX_MOTION"),
         (FrameBinding::SegmentMotion, "BINDING_SEGMENT_MOTION"),
+        (FrameBinding::SkinRest, "BINDING_SKIN_REST"),
+        (FrameBinding::SkinIndices, "BINDING_SKIN_INDICES"),
+        (FrameBinding::SkinMatrices, "BINDING_SKIN_MATRICES"),
+        (FrameBinding::SkinJobs, "BINDING_SKIN_JOBS"),
+        (FrameBinding::SkinnedVertices, "BINDING_SKINNED_VERTICES"),
     ];
 
     /// What the binding holds.
@@ -742,9 +758,71 @@ pub struct PropInstance {
     /// This frame's unjittered clip space to the previous frame's for this prop (filled in
     /// by the renderer each frame).
     pub clip_to_prev: [[f32; 4]; 4],
+    /// x: first posed vertex of a skinned instance in `SkinnedVertices` ([`SKIN_NONE`]: a
+    /// static prop, pulled from `PropVertices`); yzw unused.
+    pub skin: [u32; 4],
 }
 
-gpu_struct!(PropInstance as "PropInstance" { model: "mat4", color: "vec4", clip_to_prev: "mat4" });
+gpu_struct!(PropInstance as "PropInstance" { model: "mat4", color: "vec4", clip_to_prev: "mat4", skin: "uvec4" });
+
+/// `PropInstance::skin.x` of a static prop.
+pub const SKIN_NONE: u32 = u32::MAX;
+/// Invocations per workgroup of `skin.comp`.
+pub const SKIN_GROUP_SIZE: u32 = 64;
+
+/// A skinned mesh's vertex at bind time (`skin::SkinVertex` on the GPU).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct SkinRestVertex {
+    /// Position, mesh frame.
+    pub position: [f32; 3],
+    /// Linear RGB colour, unorm8 packed (`packUnorm4x8`).
+    pub color: u32,
+    /// Unit normal.
+    pub normal: [f32; 3],
+    /// Joints 0 and 1 (16 bits each, 0 low).
+    pub joints01: u32,
+    /// Weights of the four joints.
+    pub weights: [f32; 4],
+    /// x: joints 2 and 3; yzw unused.
+    pub joints23: [u32; 4],
+}
+
+gpu_struct!(SkinRestVertex as "SkinRestVertex" {
+    position: "vec3", color: "uint", normal: "vec3", joints01: "uint", weights: "vec4", joints23: "uvec4",
+});
+
+/// A posed vertex (written by `skin.comp`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct SkinnedVertex {
+    /// Position, character frame.
+    pub position: [f32; 3],
+    /// The rest vertex's packed colour.
+    pub color: u32,
+    /// Unit normal.
+    pub normal: [f32; 3],
+    /// Unused.
+    pub pad: u32,
+}
+
+gpu_struct!(SkinnedVertex as "SkinnedVertex" { position: "vec3", color: "uint", normal: "vec3", pad: "uint" });
+
+/// One skinned mesh instance of a frame: which rest vertices, which matrices, where to.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
+pub struct SkinJob {
+    /// First rest vertex of the mesh in `SkinRest`.
+    pub rest_first: u32,
+    /// Its vertices.
+    pub vertex_count: u32,
+    /// First skin matrix of its character in `SkinMatrices`.
+    pub matrix_first: u32,
+    /// First posed vertex in `SkinnedVertices`.
+    pub out_first: u32,
+}
+
+gpu_struct!(SkinJob as "SkinJob" { rest_first: "uint", vertex_count: "uint", matrix_first: "uint", out_first: "uint" });
 
 /// Task shader -> mesh shader payload: up to [`TASK_PAYLOAD_BUNDLES`] visible bundles of one
 /// task workgroup, compacted, with the first mesh workgroup of each.
@@ -957,6 +1035,9 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<SoftSegment>(),
         info::<PropVertex>(),
         info::<PropInstance>(),
+        info::<SkinRestVertex>(),
+        info::<SkinnedVertex>(),
+        info::<SkinJob>(),
         info::<TaskPayload>(),
         info::<DeformParams>(),
         info::<LhsWeights>(),
@@ -1027,6 +1108,8 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("DISPATCH_ROW", DISPATCH_ROW),
         layout("DEFORM_GROUP_SIZE", DEFORM_GROUP_SIZE),
         layout("LHS_GROUP_SIZE", LHS_GROUP_SIZE),
+        layout("SKIN_GROUP_SIZE", SKIN_GROUP_SIZE),
+        uint("SKIN_NONE", SKIN_NONE),
         layout("MAX_SIM_COLLIDERS", MAX_SIM_COLLIDERS),
         uint("COLLIDER_ELLIPSOID", COLLIDER_ELLIPSOID),
         uint("COLLIDER_CAPSULE", COLLIDER_CAPSULE),

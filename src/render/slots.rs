@@ -88,6 +88,10 @@ pub(crate) struct FrameSlot {
     pub light_ubo: Buffer,
     pub records: Buffer,
     pub prop_instances: Buffer,
+    /// This frame's skin matrices and skinning jobs (host-visible), and posed vertices.
+    pub skin_matrices: Buffer,
+    pub skin_jobs: Buffer,
+    pub skinned: Buffer,
     pub stats_readback: Buffer,
     pub image_readback: Option<Buffer>,
     /// Motion vectors for the host (`uvec4` per pixel), when asked for.
@@ -114,6 +118,9 @@ impl FrameSlot {
             light_ubo: frame_block_buffer(ctx, "light frame block")?,
             records: records_buffer(ctx, 1)?,
             prop_instances: prop_instance_buffer(ctx, 1)?,
+            skin_matrices: host_table(ctx, "skin matrices", 64)?,
+            skin_jobs: host_table(ctx, "skin jobs", 16)?,
+            skinned: skinned_buffer(ctx, 1)?,
             stats_readback: Buffer::new(
                 ctx,
                 &BufferDesc::new(
@@ -151,6 +158,26 @@ fn frame_block_buffer(ctx: &Arc<Context>, name: &str) -> GpuResult<Buffer> {
 }
 
 /// A host-visible buffer for `n` prop instances.
+/// A host-visible storage buffer of `bytes` (at least 1 element's worth).
+pub(crate) fn host_table(ctx: &Arc<Context>, name: &'static str, bytes: u64) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(name, bytes.max(16), vk::BufferUsageFlags::STORAGE_BUFFER).host_visible(),
+    )
+}
+
+/// A device-local buffer for `n` posed vertices (written by the skinning pass).
+pub(crate) fn skinned_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
+    Buffer::new(
+        ctx,
+        &BufferDesc::new(
+            "skinned vertices",
+            n.max(1) as u64 * size_of::<super::shared::SkinnedVertex>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        ),
+    )
+}
+
 pub(crate) fn prop_instance_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
     Buffer::new(
         ctx,

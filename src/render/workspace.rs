@@ -36,6 +36,9 @@ pub struct FrameBuffers<'a> {
     pub bundle_table: Option<&'a Buffer>,
     /// The prop meshes, once set.
     pub prop_vertices: Option<&'a Buffer>,
+    /// Skinned meshes' rest vertices and indices, once set; the frame slot's skin matrices,
+    /// skinning jobs and posed vertices.
+    pub skin: [Option<&'a Buffer>; 5],
     /// The light's maps.
     pub shadow: &'a super::targets::ShadowMaps,
     /// The temporal history this frame reads and writes, once made.
@@ -222,6 +225,11 @@ impl Workspace {
                 FrameBinding::Vertices => pool,
                 FrameBinding::PropVertices => prop_vertices,
                 FrameBinding::PropInstances => frame.prop_instances,
+                FrameBinding::SkinRest => frame.skin[0].unwrap_or(&self.placeholder),
+                FrameBinding::SkinIndices => frame.skin[1].unwrap_or(&self.placeholder),
+                FrameBinding::SkinMatrices => frame.skin[2].unwrap_or(&self.placeholder),
+                FrameBinding::SkinJobs => frame.skin[3].unwrap_or(&self.placeholder),
+                FrameBinding::SkinnedVertices => frame.skin[4].unwrap_or(&self.placeholder),
                 FrameBinding::OitNodes
                 | FrameBinding::OitTail
                 | FrameBinding::PeelDepth

@@ -10,6 +10,7 @@ pub mod lhs_skin;
 pub mod output;
 pub mod pool_segments;
 pub mod props;
+pub mod skin;
 pub mod scalp;
 pub mod shadow;
 pub mod soft_raster;
@@ -261,6 +262,8 @@ pub struct FrameRes<'a> {
     pub visibility: Option<Res>,
     /// The temporal passes' other resources, in frames with motion vectors.
     pub temporal: Option<TemporalRes>,
+    /// This frame's posed vertices of skinned props.
+    pub skinned: Res,
     /// The `args` buffer (indirect commands name it).
     pub args_buffer: &'a Buffer,
     /// The imported images attachments and copies name.
@@ -351,6 +354,8 @@ pub struct FrameSources<'a> {
     pub shadow: &'a mut ShadowMaps,
     /// The temporal history (read, written), once made.
     pub history: Option<(&'a Buffer, &'a Buffer)>,
+    /// The frame slot's posed vertices (the skinning pass writes, prop passes read).
+    pub skinned: &'a Buffer,
 }
 
 /// The transient resources of a frame, sized for its settings; the frame graph creates them
@@ -474,6 +479,7 @@ impl<'a> FrameRes<'a> {
             soft_shadow_layers,
             visibility,
             temporal: temporal.map(|t| t.1),
+            skinned: g.import_buffer("skinned vertices", src.skinned),
             args_buffer: w.args,
             images: FrameImages {
                 color,
@@ -514,6 +520,8 @@ pub struct FrameInputs<'a> {
     pub clear: Option<[f32; 4]>,
     /// Props to draw (bodies, ground).
     pub props: &'a [PropDraw],
+    /// Skinning jobs and the most vertices of one (0 jobs: no skinning pass).
+    pub skin: (u32, u32),
     /// Shadow mode of this frame; `None` when off (or nothing to shadow).
     pub shadow: Option<super::shadow::ShadowMode>,
     /// How the strands are composited.
@@ -547,6 +555,7 @@ pub struct FramePasses {
     generate: ComputeGenerate,
     shadow: ShadowPass,
     props: PropPass,
+    skin: skin::SkinPass,
     scalp: ScalpPass,
     strands: StrandDraw,
     transparency: TransparencyPass,
@@ -629,6 +638,7 @@ impl FramePasses {
             generate: ComputeGenerate::new(ctx, layout)?,
             shadow: ShadowPass::new(ctx, layout, task_bundles)?,
             props: PropPass::new(ctx, layout, camera)?,
+            skin: skin::SkinPass::new(ctx, layout)?,
             scalp: ScalpPass::new(ctx, layout, targets)?,
             strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
@@ -785,6 +795,7 @@ impl FramePasses {
             add_clear_args(g, r);
         }
         let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
+        self.skin.add(g, r, inp.sets, inp.skin);
         if let Some(mode) = inp.shadow {
             self.add_light(g, r, &inp, mode)?;
             // The camera's statistics start from zero again.
@@ -936,6 +947,7 @@ impl FramePasses {
         }
         p = p
             .read(r.constants, Access::VertexRead)
+            .read(r.skinned, Access::VertexRead)
             .read(r.textures, Access::VertexRead)
             .read_all(&r.shadow, Access::SampledRead)
             .write_some(r.visibility, Access::FragmentReadWrite);

@@ -1,6 +1,7 @@
-//! Props: static triangle meshes placed by instance records (character bodies, the ground).
-//! Reads: frame block, prop vertices, prop instances. Writes: colour and depth (camera) or the
-//! light's prop depth map.
+//! Props: static triangle meshes placed by instance records (the ground, heads), and skinned
+//! ones posed by the skinning pass (bodies and clothes). Reads: frame block, prop vertices,
+//! prop instances, skin indices and this frame's posed vertices. Writes: colour and depth
+//! (camera) or the light's prop depth map.
 
 use std::sync::Arc;
 
@@ -18,6 +19,9 @@ pub struct PropDraw {
     pub first_instance: u32,
     /// Instances.
     pub instance_count: u32,
+    /// A skinned mesh: `first_vertex` and `vertex_count` are its range of the skin index
+    /// buffer, and each instance names its posed vertices.
+    pub skinned: bool,
 }
 
 /// The prop pipeline.

@@ -102,6 +102,7 @@ impl ShadowPass {
         let prop_image = r.images.shadow[1];
         g.pass("shadow props")
             .read(r.constants, Access::VertexRead)
+            .read(r.skinned, Access::VertexRead)
             .discard(r.shadow[1], Access::DepthAttachment)
             .record(move |rec, _| {
                 rec.begin_rendering_depth(Attachment {

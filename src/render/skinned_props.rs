@@ -1,0 +1,309 @@
+//! Skinned props (the crowd's bodies and clothes): skinned meshes on the GPU, the meshes each
+//! character wears and its skin matrices for the next frame, and this frame's skinning jobs.
+//! The skinning pass (`passes/skin.rs`, `glsl/skin.comp`) poses every drawn instance into the
+//! frame's posed vertices, which the prop passes of the camera and the light both draw.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+use super::crowd::CharacterId;
+use super::passes::props::PropDraw;
+use super::prop_table::{PropLod, Projection};
+use super::shared::{PropInstance, SkinJob, SkinRestVertex};
+use crate::skin::SkinnedMesh;
+use crate::vk::{Buffer, Context, GpuError, GpuResult};
+
+/// One skinned mesh on the GPU.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct MeshRange {
+    rest_first: u32,
+    vertex_count: u32,
+    index_first: u32,
+    index_count: u32,
+    /// Bounding sphere at bind time, padded for poses.
+    centre: Vec3,
+    radius: f32,
+}
+
+/// What a character wears: `(mesh, colour)` and its joint count.
+#[derive(Clone, Debug, PartialEq)]
+struct Wearer {
+    parts: Vec<(usize, [f32; 4])>,
+    joints: usize,
+    /// Skin matrices for the next frame (character frame).
+    matrices: Vec<Mat4>,
+}
+
+/// This frame's skinning: jobs, matrices, posed vertices, and the instances and draws.
+#[derive(Default)]
+pub(super) struct SkinWork {
+    pub jobs: Vec<SkinJob>,
+    pub matrices: Vec<[[f32; 4]; 4]>,
+    pub vertices: u32,
+    /// The most vertices of any job (the pass's dispatch width).
+    pub widest: u32,
+}
+
+/// Skinned meshes and the characters wearing them.
+#[derive(Default)]
+pub(super) struct SkinnedProps {
+    pub(super) rest: Option<Buffer>,
+    pub(super) indices: Option<Buffer>,
+    meshes: Vec<MeshRange>,
+    far: Vec<Option<(usize, f32)>>,
+    wearers: HashMap<CharacterId, Wearer>,
+}
+
+/// Bounding sphere of a skinned mesh's bind pose, padded by a fifth for poses.
+fn bounds(mesh: &SkinnedMesh) -> (Vec3, f32) {
+    let (lo, hi) = mesh
+        .vertices
+        .iter()
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), v| (lo.min(v.position), hi.max(v.position)));
+    let centre = (lo + hi) * 0.5;
+    let r = mesh
+        .vertices
+        .iter()
+        .map(|v| v.position.distance(centre))
+        .fold(0.0, f32::max);
+    (centre, r * 1.2)
+}
+
+/// A rest vertex for the GPU.
+fn rest_vertex(v: &crate::skin::SkinVertex) -> SkinRestVertex {
+    let c = v.color.clamp(Vec3::ZERO, Vec3::ONE) * 255.0 + 0.5;
+    let j = v.joints.map(u32::from);
+    SkinRestVertex {
+        position: v.position.to_array(),
+        color: c.x as u32 | (c.y as u32) << 8 | (c.z as u32) << 16 | 255 << 24,
+        normal: v.normal.to_array(),
+        joints01: j[0] | j[1] << 16,
+        weights: v.weights,
+        joints23: [j[2] | j[3] << 16, 0, 0, 0],
+    }
+}
+
+impl SkinnedProps {
+    /// Replace the skinned meshes (forgetting what characters wear); returns the old buffers.
+    pub(super) fn set_meshes(
+        &mut self,
+        ctx: &Arc<Context>,
+        meshes: &[SkinnedMesh],
+    ) -> GpuResult<Vec<Buffer>> {
+        let mut rest = Vec::new();
+        let mut indices = Vec::new();
+        let mut ranges = Vec::new();
+        for (k, m) in meshes.iter().enumerate() {
+            let bad = m.indices.len() % 3 != 0
+                || m.indices.iter().any(|&i| i as usize >= m.vertices.len())
+                || m.vertices.iter().any(|v| !(v.position.is_finite() && v.normal.is_finite()));
+            if bad || m.vertices.is_empty() {
+                return Err(GpuError::Unsupported(format!(
+                    "skinned mesh {k} '{}' is not a finite, non-empty triangle list",
+                    m.name
+                )));
+            }
+            let (centre, radius) = bounds(m);
+            ranges.push(MeshRange {
+                rest_first: rest.len() as u32,
+                vertex_count: m.vertices.len() as u32,
+                index_first: indices.len() as u32,
+                index_count: m.indices.len() as u32,
+                centre,
+                radius,
+            });
+            rest.extend(m.vertices.iter().map(rest_vertex));
+            indices.extend_from_slice(&m.indices);
+        }
+        let upload = |name, bytes: &[u8]| {
+            Buffer::device_local_with_data(ctx, name, vk::BufferUsageFlags::STORAGE_BUFFER, bytes)
+        };
+        let (new_rest, new_indices) = if ranges.is_empty() {
+            (None, None)
+        } else {
+            (
+                Some(upload("skin rest vertices", bytemuck::cast_slice(&rest))?),
+                Some(upload("skin indices", bytemuck::cast_slice(&indices))?),
+            )
+        };
+        self.meshes = ranges;
+        self.far = vec![None; self.meshes.len()];
+        self.wearers.clear();
+        let old = [
+            std::mem::replace(&mut self.rest, new_rest),
+            std::mem::replace(&mut self.indices, new_indices),
+        ];
+        Ok(old.into_iter().flatten().collect())
+    }
+
+    /// Give skinned meshes far versions (as [`super::prop_table::Props::set_lods`]).
+    pub(super) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
+        let n = self.meshes.len();
+        for l in lods {
+            let chained = lods.iter().any(|o| o.mesh == l.far_mesh);
+            if l.mesh >= n || l.far_mesh >= n || l.mesh == l.far_mesh || chained {
+                return Err(GpuError::Unsupported(format!(
+                    "skinned far version {} of mesh {}: no such mesh, or a chain",
+                    l.far_mesh, l.mesh
+                )));
+            }
+            if !(l.below_pixels.is_finite() && l.below_pixels >= 0.0) {
+                return Err(GpuError::Unsupported(format!(
+                    "far prop threshold {} is not a finite pixel count",
+                    l.below_pixels
+                )));
+            }
+        }
+        self.far = vec![None; n];
+        for l in lods {
+            self.far[l.mesh] = Some((l.far_mesh, l.below_pixels));
+        }
+        Ok(())
+    }
+
+    /// Character `id` wears `parts` (`(mesh, linear colour)`) over a skeleton of `joints`
+    /// (posed at rest until [`Self::set_pose`]); no parts: it wears nothing skinned.
+    pub(super) fn set_wearer(
+        &mut self,
+        id: CharacterId,
+        parts: &[(usize, [f32; 4])],
+        joints: usize,
+    ) -> GpuResult<()> {
+        if let Some((m, _)) = parts.iter().find(|(m, _)| *m >= self.meshes.len()) {
+            return Err(GpuError::Unsupported(format!("no skinned mesh {m}")));
+        }
+        if !parts.iter().all(|(_, c)| c.iter().all(|x| x.is_finite())) || joints == 0 {
+            return Err(GpuError::Unsupported(
+                "skinned parts need finite colours and a skeleton".into(),
+            ));
+        }
+        if parts.is_empty() {
+            self.wearers.remove(&id);
+            return Ok(());
+        }
+        self.wearers.insert(
+            id,
+            Wearer {
+                parts: parts.to_vec(),
+                joints,
+                matrices: vec![Mat4::IDENTITY; joints],
+            },
+        );
+        Ok(())
+    }
+
+    /// Character `id`'s skin matrices for the next frame (one per joint, finite).
+    pub(super) fn set_pose(&mut self, id: CharacterId, matrices: &[Mat4]) -> GpuResult<()> {
+        let w = self
+            .wearers
+            .get_mut(&id)
+            .ok_or_else(|| GpuError::Unsupported("the character wears no skinned mesh".into()))?;
+        if matrices.len() != w.joints || !matrices.iter().all(|m| m.is_finite()) {
+            return Err(GpuError::Unsupported(format!(
+                "{} finite skin matrices expected, got {}",
+                w.joints,
+                matrices.len()
+            )));
+        }
+        w.matrices.copy_from_slice(matrices);
+        Ok(())
+    }
+
+    /// Forget character `id`.
+    pub(super) fn remove(&mut self, id: CharacterId) {
+        self.wearers.remove(&id);
+    }
+
+    /// Character `id`'s skin matrices as last set.
+    pub(super) fn pose(&self, id: CharacterId) -> Option<&[Mat4]> {
+        self.wearers.get(&id).map(|w| w.matrices.as_slice())
+    }
+
+    /// Upper bounds of a frame's instances, matrices and posed vertices.
+    pub(super) fn capacity(&self) -> (u32, u32, u32) {
+        let mut out = (0u32, 0u32, 0u32);
+        for w in self.wearers.values() {
+            out.0 += w.parts.len() as u32;
+            out.1 += w.joints as u32;
+            out.2 += w.parts.iter().map(|(m, _)| self.meshes[*m].vertex_count).sum::<u32>();
+        }
+        out
+    }
+
+    /// This frame's skinning work, instances (appended to `records`, with their motion) and
+    /// draws, for the characters `model_of` places (`None`: not drawn); far versions where
+    /// `camera` sees a mesh small. Characters are taken in id order, so frames are repeatable.
+    pub(super) fn frame_lists(
+        &self,
+        model_of: impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
+        camera: &Projection,
+        records: &mut Vec<PropInstance>,
+        draws: &mut Vec<PropDraw>,
+    ) -> SkinWork {
+        let mut work = SkinWork::default();
+        let mut ids: Vec<&CharacterId> = self.wearers.keys().collect();
+        ids.sort_by_key(|id| id.slot());
+        let mut placed: Vec<(usize, PropInstance)> = Vec::new();
+        for id in ids {
+            let w = &self.wearers[id];
+            let Some((model, clip_to_prev)) = model_of(*id) else {
+                continue;
+            };
+            let matrix_first = work.matrices.len() as u32;
+            work.matrices
+                .extend(w.matrices.iter().map(|m| m.to_cols_array_2d()));
+            for &(mesh, color) in &w.parts {
+                let mesh = self.mesh_for(mesh, &model, camera);
+                let r = self.meshes[mesh];
+                work.jobs.push(SkinJob {
+                    rest_first: r.rest_first,
+                    vertex_count: r.vertex_count,
+                    matrix_first,
+                    out_first: work.vertices,
+                });
+                placed.push((
+                    mesh,
+                    PropInstance {
+                        model: model.to_cols_array_2d(),
+                        color,
+                        clip_to_prev: clip_to_prev.to_cols_array_2d(),
+                        skin: [work.vertices, 0, 0, 0],
+                    },
+                ));
+                work.vertices += r.vertex_count;
+                work.widest = work.widest.max(r.vertex_count);
+            }
+        }
+        placed.sort_by_key(|(m, _)| *m);
+        for (mesh, inst) in placed {
+            let r = self.meshes[mesh];
+            let k = records.len() as u32;
+            records.push(inst);
+            match draws.last_mut() {
+                Some(d) if d.first_vertex == r.index_first && d.skinned => d.instance_count += 1,
+                _ => draws.push(PropDraw {
+                    first_vertex: r.index_first,
+                    vertex_count: r.index_count,
+                    first_instance: k,
+                    instance_count: 1,
+                    skinned: true,
+                }),
+            }
+        }
+        work
+    }
+
+    /// The mesh an instance of `mesh` at `model` is drawn with.
+    fn mesh_for(&self, mesh: usize, model: &Mat4, camera: &Projection) -> usize {
+        let Some((far, below)) = self.far[mesh] else {
+            return mesh;
+        };
+        let r = self.meshes[mesh];
+        let scale = model.x_axis.truncate().length().max(model.y_axis.truncate().length());
+        let pixels = camera.pixels(model.transform_point3(r.centre), r.radius * scale);
+        if pixels < below { far } else { mesh }
+    }
+}
