@@ -12,7 +12,6 @@ layout(set = SET_FRAME, binding = BINDING_SKIN_REST, std430) readonly buffer Res
 layout(set = SET_FRAME, binding = BINDING_SKIN_MATRICES, std430) readonly buffer Matrices { mat4 skin_matrices[]; };
 layout(set = SET_FRAME, binding = BINDING_SKIN_JOBS, std430) readonly buffer Jobs { SkinJob skin_jobs[]; };
 layout(set = SET_FRAME, binding = BINDING_SKINNED_VERTICES, std430) writeonly buffer Posed { SkinnedVertex skinned[]; };
-layout(push_constant) uniform Push { uvec4 params; } push;
 
 void main() {
     SkinJob job = skin_jobs[push.params.x + gl_WorkGroupID.y];

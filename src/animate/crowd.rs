@@ -32,6 +32,8 @@ pub struct AnimatedCharacter {
     roots: Vec<Vec3>,
     /// Whether the renderer holds its hair dynamics' current state (GPU path).
     on_gpu: bool,
+    /// A skinned person: placed by their path and clip instead of `motion`.
+    walker: Option<super::walk::Walker>,
 }
 
 /// What the last [`CrowdAnimation::advance`] did.
@@ -164,7 +166,25 @@ impl CrowdAnimation {
             pending_dt: 0.0,
             roots,
             on_gpu: false,
+            walker: None,
         });
+    }
+
+    /// Animate character `id` as a skinned person walking or standing (`walker`), its hair
+    /// bound to the head joint (`hair` as in [`Self::add`], colliders in the person frame);
+    /// its body's skin matrices are handed to the renderer every frame.
+    pub fn add_person(
+        &mut self,
+        id: CharacterId,
+        walker: super::walk::Walker,
+        hair: Option<(&HairMesh, Vec<Collider>)>,
+    ) -> crate::error::Result<()> {
+        let (model, _) = walker.frame(0.0)?;
+        self.add(id, CharacterMotion::still(model), hair);
+        if let Some(c) = self.characters.last_mut() {
+            c.walker = Some(walker);
+        }
+        Ok(())
     }
 
     /// Hair roots of simulated character `id` as last handed to the renderer (its frame), or
@@ -202,7 +222,16 @@ impl CrowdAnimation {
         // Place everyone; pick the characters whose hair is due this frame.
         let mut due: Vec<(&mut AnimatedCharacter, glam::Mat4)> = Vec::new();
         for c in &mut self.characters {
-            let model = c.motion.model(self.time);
+            let model = match &c.walker {
+                Some(w) => {
+                    let (model, skin) = w
+                        .frame(self.time)
+                        .map_err(|e| crate::vk::GpuError::Unsupported(e.to_string()))?;
+                    renderer.set_character_pose(c.id, &skin)?;
+                    model
+                }
+                None => c.motion.model(self.time),
+            };
             renderer.set_model(c.id, model)?;
             if c.dynamics.is_none() {
                 continue;

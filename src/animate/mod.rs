@@ -6,6 +6,7 @@
 
 pub mod crowd;
 pub mod motion;
+pub mod walk;
 
 pub use crate::dynamics::{Collider, DynamicsSettings, HairDynamics, Wind};
 pub use crowd::{AnimationStats, CrowdAnimation, DynamicsPath};

@@ -7,6 +7,7 @@ pub mod far_mesh;
 pub mod hairstyle;
 pub mod head;
 pub mod human;
+pub mod people;
 pub mod person;
 pub mod preset;
 pub mod teapot;

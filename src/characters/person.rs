@@ -366,6 +366,22 @@ pub fn head_mesh() -> Result<Vec<PropVertex>> {
     Ok(human_head()?.prop_mesh())
 }
 
+/// Height (canonical frame, metres) below which the bust is cut off when it sits on a skinned
+/// body: the neck, above the shoulders, inside the body's collar.
+pub const NECK_CUT: f32 = 1.43;
+
+/// The bust above [`NECK_CUT`] (triangles wholly above it), the head the crowd's skinned
+/// people wear.
+pub fn neck_up_mesh() -> Result<Vec<PropVertex>> {
+    let full = head_mesh()?;
+    Ok(full
+        .chunks_exact(3)
+        .filter(|t| t.iter().all(|v| v.position[1] >= NECK_CUT))
+        .flatten()
+        .copied()
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -69,6 +69,8 @@ pub struct CrowdCharacter {
     pub body: Body,
     /// Skin (or ball) colour, linear RGB.
     pub skin: [f32; 3],
+    /// A person's skinned, clothed body and its path (people only).
+    pub walker: Option<crate::animate::walk::Walker>,
 }
 
 /// Indices of [`prop_meshes`].
@@ -220,20 +222,78 @@ pub fn build_families(
             Body::Person(p) => p.skin,
             _ => hair.style.color.map(|c| c * 0.8),
         };
+        let walker = match body {
+            Body::Person(p) => Some(person_walker(p, character_seed, (i, count, side), model)),
+            _ => None,
+        };
         out.push(CrowdCharacter {
             hair,
             model,
             body,
             skin,
+            walker,
         });
     }
     Ok(out)
 }
 
+/// Person `i` of `count` on a grid of `side` columns, placed at `model`: half the people (all
+/// of a crowd of four or fewer) walk round the crowd's centre through their own place, on
+/// rings turning one way and the other by the ring's distance, the others stand.
+fn person_walker(
+    p: PersonShape,
+    seed: u32,
+    (i, count, side): (usize, usize, usize),
+    model: Mat4,
+) -> crate::animate::walk::Walker {
+    use crate::animate::walk::{WalkPath, Walker};
+    let walks = count <= 4 || i % 2 == 0;
+    let outfit = super::people::Outfit::draw(seed, walks);
+    let centre = Vec3::new(0.0, 0.0, (side as f32 - 1.0) * 0.5 * SPACING);
+    let at = model.w_axis.truncate() - centre;
+    let radius = Vec3::new(at.x, 0.0, at.z).length().max(0.6);
+    let path = match walks {
+        true => WalkPath::Ring {
+            centre,
+            radius,
+            angle: at.z.atan2(at.x),
+            clockwise: ((radius / SPACING).round() as i32) % 2 == 0,
+        },
+        false => WalkPath::Stand(model),
+    };
+    Walker {
+        outfit,
+        height: p.height,
+        path,
+    }
+}
+
+/// Give character `id` of `renderer` what it wears: its props (a person's head and eyes, a
+/// ball, a teapot) and a person's skinned, clothed body, posed and placed at time 0 (the
+/// animation moves both on).
+pub fn dress(
+    renderer: &mut crate::render::Renderer,
+    id: crate::render::CharacterId,
+    c: &CrowdCharacter,
+) -> Result<()> {
+    let gpu = |e: crate::vk::GpuError| HairError::invalid("crowd", e.to_string());
+    renderer.set_character_props(id, &character_props(c)?).map_err(gpu)?;
+    if let Some(w) = &c.walker {
+        let joints = super::people::figures()?[w.outfit.figure as usize].skeleton.joints.len();
+        renderer
+            .set_character_skin(id, &w.outfit.parts(c.skin), joints)
+            .map_err(gpu)?;
+        let (model, skin) = w.frame(0.0)?;
+        renderer.set_character_pose(id, &skin).map_err(gpu)?;
+        renderer.set_model(id, model).map_err(gpu)?;
+    }
+    Ok(())
+}
+
 /// Prop meshes of crowds, indexed by [`prop_mesh`].
 pub fn prop_meshes() -> Result<Vec<Vec<PropVertex>>> {
     let ball = ball_head();
-    let head = super::person::head_mesh()?;
+    let head = super::person::neck_up_mesh()?;
     let body = super::person::body_mesh();
     let far_head = super::far_mesh::far_mesh(&head, FAR_HEAD_CELL);
     let far_body = super::far_mesh::far_mesh(&body, FAR_BODY_CELL);
@@ -304,10 +364,8 @@ pub fn character_props(c: &CrowdCharacter) -> Result<Vec<(usize, PropInstance)>>
     Ok(match c.body {
         Body::Person(p) => {
             let head = p.head_transform()?;
-            let mut props = vec![
-                at(prop_mesh::HEAD, head),
-                at(prop_mesh::BODY, p.body_transform()),
-            ];
+            // The body is skinned ([`dress`]); the mannequin body is not drawn.
+            let mut props = vec![at(prop_mesh::HEAD, head)];
             for eye in super::human::human_head()?.eyes {
                 let iris = eye.centre + Vec3::Z * (IRIS_OFFSET * eye.radius);
                 for (centre, radius, color) in [

@@ -141,6 +141,7 @@ fn scene(
 fn crowd(r: &mut Renderer) -> Result<CrowdAnimation> {
     let characters = preset::build(Preset::People, 4, 7)?;
     r.set_prop_meshes(&preset::prop_meshes()?)?;
+    r.set_skinned_meshes(&hairmesh::characters::people::skinned_meshes()?)?;
     r.set_prop_instances(&preset::world_props())?;
     let mut animation = CrowdAnimation::new();
     animation.wind = Wind {
@@ -159,14 +160,17 @@ fn crowd(r: &mut Renderer) -> Result<CrowdAnimation> {
         };
         let baked = hairmesh::bake(&c.hair.mesh, &c.hair.style, options, |_, _| {})?;
         let id = r.add_character(&baked, &c.hair.style, c.strand_params(params), c.model)?;
-        r.set_character_props(id, &preset::character_props(c)?)?;
+        preset::dress(r, id, c)?;
         let colliders: Vec<Collider> = match c.body {
             preset::Body::Person(p) => p.colliders()?,
             _ => Vec::new(),
         };
         r.make_deformable(id, DeformBasis::new(&c.hair.mesh, &baked, options)?)?;
         let motion = CharacterMotion::idle(c.model, 11 ^ k as u32);
-        animation.add(id, motion, Some((&c.hair.mesh, colliders)));
+        match &c.walker {
+            Some(w) => animation.add_person(id, *w, Some((&c.hair.mesh, colliders)))?,
+            None => animation.add(id, motion, Some((&c.hair.mesh, colliders))),
+        }
     }
     Ok(animation)
 }

@@ -243,10 +243,11 @@ impl Scene {
         renderer.set_prop_meshes(&meshes)?;
         renderer.set_prop_lods(&preset::prop_lods(&meshes))?;
         renderer.set_prop_instances(&preset::world_props())?;
+        renderer.set_skinned_meshes(&hairmesh::characters::people::skinned_meshes()?)?;
         for (c, b) in self.characters.iter().zip(&self.baked) {
             let id = renderer.add_character(b, &c.hair.style, c.strand_params(params), c.model)?;
             // Heads and bodies move with their characters: drawn at the same model as the hair.
-            renderer.set_character_props(id, &preset::character_props(c)?)?;
+            preset::dress(&mut renderer, id, c)?;
         }
         Ok(renderer)
     }
@@ -300,7 +301,10 @@ impl Scene {
                 }
                 None => None,
             };
-            anim.add(id, motion, hair);
+            match &c.walker {
+                Some(w) => anim.add_person(id, *w, hair)?,
+                None => anim.add(id, motion, hair),
+            }
         }
         Ok(anim)
     }
