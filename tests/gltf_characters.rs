@@ -9,7 +9,11 @@ use hairmesh::model::gltf::{load_character, parse_character};
 use hairmesh::skin::{ground_speed, skin_vertices};
 
 fn man() -> hairmesh::model::gltf::Character {
-    load_character(Path::new("hairmeshes/people/man.glb"), MemoryBudget::default()).unwrap()
+    load_character(
+        Path::new("hairmeshes/people/man.glb"),
+        MemoryBudget::default(),
+    )
+    .unwrap()
 }
 
 /// The man: 53 joints (the game-engine rig), six clothing and skin meshes, a walk and an
@@ -29,7 +33,10 @@ fn the_shipped_man_loads() {
     let s = &c.skeleton;
     let feet = [s.find("ball_l").unwrap(), s.find("ball_r").unwrap()];
     let speed = ground_speed(s, walk, &feet, 0.01).unwrap();
-    assert!((speed - 1.2 / 1.1).abs() < 0.05 * 1.2 / 1.1, "stride speed {speed}");
+    assert!(
+        (speed - 1.2 / 1.1).abs() < 0.05 * 1.2 / 1.1,
+        "stride speed {speed}"
+    );
 }
 
 /// Skinned at every frame of the walk, the shoes' lowest point stays within 2 cm of the
@@ -44,12 +51,20 @@ fn the_walk_keeps_feet_on_the_ground() {
         let pose = walk.sample(&c.skeleton, k as f32 * 0.05);
         let m = c.skeleton.skin_matrices(&pose);
         let posed = skin_vertices(shoes, &m);
-        let low = posed.iter().map(|v| v.position.y).fold(f32::INFINITY, f32::min);
+        let low = posed
+            .iter()
+            .map(|v| v.position.y)
+            .fold(f32::INFINITY, f32::min);
         assert!(posed.iter().all(|v| v.position.abs().max_element() < 2.0));
         lowest.push(low);
     }
-    let (lo, hi) = lowest.iter().fold((f32::MAX, f32::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-    assert!(lo > -0.02 && hi < 0.03, "shoe soles between {lo} and {hi} m");
+    let (lo, hi) = lowest
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    assert!(
+        lo > -0.02 && hi < 0.03,
+        "shoe soles between {lo} and {hi} m"
+    );
 }
 
 /// Broken files: one line naming the file and the cause.
@@ -57,9 +72,13 @@ fn the_walk_keeps_feet_on_the_ground() {
 fn broken_files_are_refused_in_one_line() {
     let bytes = std::fs::read("hairmeshes/people/man.glb").unwrap();
     let budget = MemoryBudget::default();
-    let truncated = parse_character("man.glb", &bytes[..bytes.len() / 2], None, budget).unwrap_err();
+    let truncated =
+        parse_character("man.glb", &bytes[..bytes.len() / 2], None, budget).unwrap_err();
     let text = truncated.to_string();
-    assert!(text.starts_with("man.glb: ") && !text.contains('\n'), "{text}");
+    assert!(
+        text.starts_with("man.glb: ") && !text.contains('\n'),
+        "{text}"
+    );
     // The JSON chunk with an accessor's count made absurd: refused by the bounds check.
     let mut json_len = [0u8; 4];
     json_len.copy_from_slice(&bytes[12..16]);
@@ -74,10 +93,14 @@ fn broken_files_are_refused_in_one_line() {
     out.extend(&bytes[20 + len..]);
     let total = out.len() as u32;
     out[8..12].copy_from_slice(&total.to_le_bytes());
-    let e = parse_character("man.glb", &out, None, budget).unwrap_err().to_string();
+    let e = parse_character("man.glb", &out, None, budget)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("accessor") && !e.contains('\n'), "{e}");
     // A tiny budget is refused before reading.
     let tiny = MemoryBudget::from_mib(1, "--memory-budget-mib").unwrap();
-    let e = parse_character("man.glb", &bytes, None, tiny).unwrap_err().to_string();
+    let e = parse_character("man.glb", &bytes, None, tiny)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("budget"), "{e}");
 }

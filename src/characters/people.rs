@@ -121,7 +121,11 @@ impl Outfit {
     pub fn draw(seed: u32, walks: bool) -> Self {
         let mut rng = Pcg32::hashed(seed as u64 ^ 0x6f75_7466_6974);
         let mut pick = |n: usize| (rng.next_u32() as usize) % n;
-        let figure = if pick(2) == 0 { Figure::Man } else { Figure::Woman };
+        let figure = if pick(2) == 0 {
+            Figure::Man
+        } else {
+            Figure::Woman
+        };
         let shirt = SHIRTS[pick(SHIRTS.len())];
         let legs = LEGS[pick(LEGS.len())];
         let shoes = [[0.02, 0.015, 0.01], [0.25, 0.25, 0.25], [0.12, 0.06, 0.03]][pick(3)];
@@ -145,7 +149,11 @@ impl Outfit {
     pub fn parts(&self, skin: [f32; 3]) -> Vec<(usize, [f32; 4])> {
         let base = self.figure as usize * PARTS.len();
         let c = |rgb: [f32; 3]| [rgb[0], rgb[1], rgb[2], 1.0];
-        let mut out = vec![(base, c(skin)), (base + 1, c(self.shirt)), (base + 4, c(self.shoes))];
+        let mut out = vec![
+            (base, c(skin)),
+            (base + 1, c(self.shirt)),
+            (base + 4, c(self.shoes)),
+        ];
         if self.long_sleeves {
             out.push((base + 2, c(self.shirt)));
         }
@@ -164,7 +172,9 @@ pub fn pose(outfit: &Outfit, t: f32) -> Result<(Vec<Mat4>, Mat4)> {
     let figure = &figures()?[outfit.figure as usize];
     let clip = figure
         .clip(if outfit.walks { "walk" } else { "idle" })
-        .ok_or_else(|| HairError::invalid("hairmeshes/people", "a figure lacks its walk or idle clip"))?;
+        .ok_or_else(|| {
+            HairError::invalid("hairmeshes/people", "a figure lacks its walk or idle clip")
+        })?;
     let s = &figure.skeleton;
     let m = s.skin_matrices(&clip.sample(s, t + outfit.phase));
     let head = s
@@ -178,8 +188,13 @@ pub fn pose(outfit: &Outfit, t: f32) -> Result<(Vec<Mat4>, Mat4)> {
 pub fn walk_speed(figure: Figure) -> Result<f32> {
     let c = &figures()?[figure as usize];
     let s = &c.skeleton;
-    let walk = c.clip("walk").ok_or_else(|| HairError::invalid("hairmeshes/people", "no walk clip"))?;
-    let feet: Vec<usize> = ["ball_l", "ball_r"].iter().filter_map(|n| s.find(n)).collect();
+    let walk = c
+        .clip("walk")
+        .ok_or_else(|| HairError::invalid("hairmeshes/people", "no walk clip"))?;
+    let feet: Vec<usize> = ["ball_l", "ball_r"]
+        .iter()
+        .filter_map(|n| s.find(n))
+        .collect();
     crate::skin::ground_speed(s, walk, &feet, 0.01)
         .ok_or_else(|| HairError::invalid("hairmeshes/people", "the walk does not plant its feet"))
 }

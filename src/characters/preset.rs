@@ -277,9 +277,14 @@ pub fn dress(
     c: &CrowdCharacter,
 ) -> Result<()> {
     let gpu = |e: crate::vk::GpuError| HairError::invalid("crowd", e.to_string());
-    renderer.set_character_props(id, &character_props(c)?).map_err(gpu)?;
+    renderer
+        .set_character_props(id, &character_props(c)?)
+        .map_err(gpu)?;
     if let Some(w) = &c.walker {
-        let joints = super::people::figures()?[w.outfit.figure as usize].skeleton.joints.len();
+        let joints = super::people::figures()?[w.outfit.figure as usize]
+            .skeleton
+            .joints
+            .len();
         renderer
             .set_character_skin(id, &w.outfit.parts(c.skin), joints)
             .map_err(gpu)?;

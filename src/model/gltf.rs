@@ -17,7 +17,7 @@ use gltf::accessor::{DataType, Dimensions};
 use crate::budget::{Estimate, MemoryBudget};
 use crate::error::{HairError, Result};
 use crate::skin::{
-    Channel, ChannelValues, Clip, Interpolation, Joint, SkinVertex, SkinnedMesh, Skeleton, Trs,
+    Channel, ChannelValues, Clip, Interpolation, Joint, Skeleton, SkinVertex, SkinnedMesh, Trs,
 };
 
 /// A skinned character: meshes bound to one skeleton, and its clips.
@@ -70,7 +70,12 @@ pub fn parse_character(
     let gltf = gltf::Gltf::from_slice(bytes)
         .map_err(|e| bad(format!("not a valid glTF 2.0 file: {e}")))?;
     let doc = &gltf.document;
-    budget.check(name, "reading the character", &estimate(doc), "a smaller model")?;
+    budget.check(
+        name,
+        "reading the character",
+        &estimate(doc),
+        "a smaller model",
+    )?;
     let buffers = load_buffers(name, doc, gltf.blob.as_deref(), dir, budget)?;
     let data = Data {
         name,
@@ -159,7 +164,12 @@ fn load_buffers(
     for b in doc.buffers() {
         let bytes = match b.source() {
             gltf::buffer::Source::Bin => blob
-                .ok_or_else(|| bad(format!("buffer {} is the GLB chunk, but there is none", b.index())))?
+                .ok_or_else(|| {
+                    bad(format!(
+                        "buffer {} is the GLB chunk, but there is none",
+                        b.index()
+                    ))
+                })?
                 .to_vec(),
             gltf::buffer::Source::Uri(uri) => {
                 read_beside(name, dir, uri, budget, &format!("buffer {}", b.index()))?
@@ -189,16 +199,29 @@ fn read_beside(
 ) -> Result<Vec<u8>> {
     let bad = |why: &str| HairError::invalid(name, format!("{what}: {why}"));
     if uri.starts_with("data:") {
-        return Err(bad("data: URIs are not read (use .glb, or files beside the .gltf)"));
+        return Err(bad(
+            "data: URIs are not read (use .glb, or files beside the .gltf)",
+        ));
     }
     let rel = Path::new(uri);
-    if rel.is_absolute() || rel.components().any(|c| matches!(c, std::path::Component::ParentDir)) {
+    if rel.is_absolute()
+        || rel
+            .components()
+            .any(|c| matches!(c, std::path::Component::ParentDir))
+    {
         return Err(bad(&format!("'{uri}' is not a file beside the document")));
     }
     let dir = dir.ok_or_else(|| bad(&format!("'{uri}' is external and no folder was given")))?;
     let path = dir.join(rel);
-    let len = std::fs::metadata(&path).map_err(|e| HairError::io(&path, e))?.len();
-    budget.check(name, what, &Estimate::new().with("file", len, 1), "a smaller model")?;
+    let len = std::fs::metadata(&path)
+        .map_err(|e| HairError::io(&path, e))?
+        .len();
+    budget.check(
+        name,
+        what,
+        &Estimate::new().with("file", len, 1),
+        "a smaller model",
+    )?;
     std::fs::read(&path).map_err(|e| HairError::io(&path, e))
 }
 
@@ -286,7 +309,9 @@ fn read_skeleton(data: &Data, doc: &gltf::Document, skin: &gltf::Skin) -> Result
             up = parent[p];
         }
         joints.push(Joint {
-            name: doc_nodes[n].name().map_or(format!("joint {k}", k = joints.len()), str::to_string),
+            name: doc_nodes[n]
+                .name()
+                .map_or(format!("joint {k}", k = joints.len()), str::to_string),
             parent: up.and_then(|p| joint_of_node[p]),
             rest: node_trs(&doc_nodes[n]),
             inverse_bind: inverse_bind[j],
@@ -297,7 +322,10 @@ fn read_skeleton(data: &Data, doc: &gltf::Document, skin: &gltf::Skin) -> Result
         .validate()
         .map_err(|e| data.bad(format!("skin {}: {e}", skin.index())))?;
     // Meshes index joints in the skin's order; they are remapped to the sorted order.
-    let skin_to_sorted = nodes.iter().map(|&n| joint_of_node[n].unwrap_or(0)).collect();
+    let skin_to_sorted = nodes
+        .iter()
+        .map(|&n| joint_of_node[n].unwrap_or(0))
+        .collect();
     Ok(SkeletonRead {
         skeleton,
         joint_of_node,
@@ -324,7 +352,10 @@ fn read_primitive(
     let joint_count = order.len();
     let at = format!("mesh {} primitive {}", mesh.index(), prim.index());
     if prim.mode() != gltf::mesh::Mode::Triangles {
-        return Err(data.bad(format!("{at}: {:?} primitives are not read (triangles only)", prim.mode())));
+        return Err(data.bad(format!(
+            "{at}: {:?} primitives are not read (triangles only)",
+            prim.mode()
+        )));
     }
     let attr = |s: gltf::Semantic| prim.get(&s);
     let need = |s: gltf::Semantic, what: &str| {
@@ -332,14 +363,26 @@ fn read_primitive(
     };
     let positions = read_vec3(data, &need(gltf::Semantic::Positions, "POSITION")?, &at)?;
     let n = positions.len();
-    let joints = read_floats(data, &need(gltf::Semantic::Joints(0), "JOINTS_0")?, &[Dimensions::Vec4], &at)?;
-    let weights = read_floats(data, &need(gltf::Semantic::Weights(0), "WEIGHTS_0")?, &[Dimensions::Vec4], &at)?;
+    let joints = read_floats(
+        data,
+        &need(gltf::Semantic::Joints(0), "JOINTS_0")?,
+        &[Dimensions::Vec4],
+        &at,
+    )?;
+    let weights = read_floats(
+        data,
+        &need(gltf::Semantic::Weights(0), "WEIGHTS_0")?,
+        &[Dimensions::Vec4],
+        &at,
+    )?;
     let indices = match prim.indices() {
         Some(acc) => read_indices(data, &acc, n, &at)?,
         None => (0..n as u32).collect(),
     };
     if indices.len() % 3 != 0 || joints.len() != n * 4 || weights.len() != n * 4 {
-        return Err(data.bad(format!("{at}: attribute counts or index count do not make triangles over {n} vertices")));
+        return Err(data.bad(format!(
+            "{at}: attribute counts or index count do not make triangles over {n} vertices"
+        )));
     }
     let normals = match attr(gltf::Semantic::Normals) {
         Some(acc) => read_vec3(data, &acc, &at)?,
@@ -357,10 +400,15 @@ fn read_primitive(
             let joint = joints[k * 4 + c];
             w[c] = weights[k * 4 + c];
             if !(w[c].is_finite() && w[c] >= 0.0) {
-                return Err(data.bad(format!("{at}: vertex {k} has weight {} (finite, >= 0 expected)", w[c])));
+                return Err(data.bad(format!(
+                    "{at}: vertex {k} has weight {} (finite, >= 0 expected)",
+                    w[c]
+                )));
             }
             if w[c] > 0.0 && (joint < 0.0 || joint as usize >= joint_count) {
-                return Err(data.bad(format!("{at}: vertex {k} names joint {joint} of {joint_count}")));
+                return Err(data.bad(format!(
+                    "{at}: vertex {k} names joint {joint} of {joint_count}"
+                )));
             }
             j[c] = order.get(joint as usize).copied().unwrap_or(0) as u16;
         }
@@ -380,7 +428,11 @@ fn read_primitive(
         .name()
         .or(prim.material().name())
         .map_or(format!("mesh {}", mesh.index()), str::to_string);
-    Ok(SkinnedMesh { name, vertices, indices })
+    Ok(SkinnedMesh {
+        name,
+        vertices,
+        indices,
+    })
 }
 
 /// Per-vertex linear colour: the material's base colour factor times its base colour texture
@@ -395,11 +447,17 @@ fn vertex_colors(data: &Data, prim: &gltf::Primitive, n: usize, at: &str) -> Res
         return Ok(vec![factor; n]);
     };
     let Some(uv_acc) = prim.get(&gltf::Semantic::TexCoords(info.tex_coord())) else {
-        return Err(data.bad(format!("{at}: a base colour texture but no TEXCOORD_{}", info.tex_coord())));
+        return Err(data.bad(format!(
+            "{at}: a base colour texture but no TEXCOORD_{}",
+            info.tex_coord()
+        )));
     };
     let uvs = read_floats(data, &uv_acc, &[Dimensions::Vec2], at)?;
     if uvs.len() != n * 2 {
-        return Err(data.bad(format!("{at}: {} texture coordinates for {n} positions", uvs.len() / 2)));
+        return Err(data.bad(format!(
+            "{at}: {} texture coordinates for {n} positions",
+            uvs.len() / 2
+        )));
     }
     let image = read_image(data, &info.texture().source(), at)?;
     Ok(uvs
@@ -413,14 +471,18 @@ fn read_image(data: &Data, image: &gltf::Image, at: &str) -> Result<image::RgbaI
     let what = format!("{at}: image {}", image.index());
     let bytes: Vec<u8> = match image.source() {
         gltf::image::Source::View { view, .. } => view_bytes(data, &view, &what)?.to_vec(),
-        gltf::image::Source::Uri { uri, .. } => read_beside(data.name, data.dir, uri, data.budget, &what)?,
+        gltf::image::Source::Uri { uri, .. } => {
+            read_beside(data.name, data.dir, uri, data.budget, &what)?
+        }
     };
-    let reader = image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
+    let reader =
+        image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
     let (w, h) = reader
         .into_dimensions()
         .map_err(|e| data.bad(format!("{what}: not a PNG image: {e}")))?;
     let est = Estimate::new().with("texture", w as u64 * h as u64, 8);
-    data.budget.check(data.name, &what, &est, "a smaller texture")?;
+    data.budget
+        .check(data.name, &what, &est, "a smaller texture")?;
     image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
         .map(|i| i.to_rgba8())
         .map_err(|e| data.bad(format!("{what}: {e}")))
@@ -442,7 +504,8 @@ fn sample_srgb(image: &image::RgbaImage, uv: Vec2) -> Vec3 {
         let p = image.get_pixel(px, py).0;
         Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) / 255.0
     };
-    let c = texel(0.0, 0.0).lerp(texel(1.0, 0.0), fx)
+    let c = texel(0.0, 0.0)
+        .lerp(texel(1.0, 0.0), fx)
         .lerp(texel(0.0, 1.0).lerp(texel(1.0, 1.0), fx), fy);
     c.map(crate::shade::srgb_to_linear)
 }
@@ -466,7 +529,11 @@ fn read_clip(data: &Data, anim: &gltf::Animation, joint_of_node: &[Option<usize>
     let at = format!("animation {}", anim.index());
     let mut channels = Vec::new();
     for ch in anim.channels() {
-        let Some(joint) = joint_of_node.get(ch.target().node().index()).copied().flatten() else {
+        let Some(joint) = joint_of_node
+            .get(ch.target().node().index())
+            .copied()
+            .flatten()
+        else {
             continue;
         };
         let s = ch.sampler();
@@ -479,7 +546,9 @@ fn read_clip(data: &Data, anim: &gltf::Animation, joint_of_node: &[Option<usize>
         };
         use gltf::animation::Property;
         let values = match ch.target().property() {
-            Property::Translation => ChannelValues::Translation(read_vec3(data, &s.output(), &cat)?),
+            Property::Translation => {
+                ChannelValues::Translation(read_vec3(data, &s.output(), &cat)?)
+            }
             Property::Scale => ChannelValues::Scale(read_vec3(data, &s.output(), &cat)?),
             Property::Rotation => ChannelValues::Rotation(
                 read_floats(data, &s.output(), &[Dimensions::Vec4], &cat)?
@@ -489,8 +558,15 @@ fn read_clip(data: &Data, anim: &gltf::Animation, joint_of_node: &[Option<usize>
             ),
             Property::MorphTargetWeights => continue,
         };
-        let channel = Channel { joint, times, interpolation, values };
-        channel.validate().map_err(|e| data.bad(format!("{cat}: {e}")))?;
+        let channel = Channel {
+            joint,
+            times,
+            interpolation,
+            values,
+        };
+        channel
+            .validate()
+            .map_err(|e| data.bad(format!("{cat}: {e}")))?;
         channels.push(channel);
     }
     let duration = channels
@@ -498,7 +574,9 @@ fn read_clip(data: &Data, anim: &gltf::Animation, joint_of_node: &[Option<usize>
         .filter_map(|c| c.times.last().copied())
         .fold(0.0, f32::max);
     Ok(Clip {
-        name: anim.name().map_or(format!("animation {}", anim.index()), str::to_string),
+        name: anim
+            .name()
+            .map_or(format!("animation {}", anim.index()), str::to_string),
         duration,
         channels,
     })
@@ -523,10 +601,18 @@ fn view_bytes<'d>(data: &'d Data, view: &gltf::buffer::View, at: &str) -> Result
 
 /// Components of `acc` as f32 (floats as they are, normalized integers scaled, other
 /// integers converted), checked against its view; its dimensions must be one of `dims`.
-fn read_floats(data: &Data, acc: &gltf::Accessor, dims: &[Dimensions], at: &str) -> Result<Vec<f32>> {
+fn read_floats(
+    data: &Data,
+    acc: &gltf::Accessor,
+    dims: &[Dimensions],
+    at: &str,
+) -> Result<Vec<f32>> {
     let what = format!("{at}: accessor {}", acc.index());
     if !dims.contains(&acc.dimensions()) {
-        return Err(data.bad(format!("{what}: {:?} where {dims:?} is expected", acc.dimensions())));
+        return Err(data.bad(format!(
+            "{what}: {:?} where {dims:?} is expected",
+            acc.dimensions()
+        )));
     }
     if acc.sparse().is_some() {
         return Err(data.bad(format!("{what}: sparse accessors are not read")));
@@ -575,7 +661,10 @@ fn component(t: DataType, normalized: bool, b: &[u8]) -> f32 {
         DataType::I8 => ((b[0] as i8) as f32, 127.0),
         DataType::U16 => (u16::from_le_bytes([b[0], b[1]]) as f32, 65535.0),
         DataType::I16 => (i16::from_le_bytes([b[0], b[1]]) as f32, 32767.0),
-        DataType::U32 => (u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32, u32::MAX as f32),
+        DataType::U32 => (
+            u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+            u32::MAX as f32,
+        ),
     };
     if normalized { (v / scale).max(-1.0) } else { v }
 }
@@ -590,8 +679,15 @@ fn read_vec3(data: &Data, acc: &gltf::Accessor, at: &str) -> Result<Vec<Vec3>> {
 
 /// Triangle indices, each below `vertices`.
 fn read_indices(data: &Data, acc: &gltf::Accessor, vertices: usize, at: &str) -> Result<Vec<u32>> {
-    if !matches!(acc.data_type(), DataType::U8 | DataType::U16 | DataType::U32) || acc.normalized() {
-        return Err(data.bad(format!("{at}: accessor {}: indices must be unsigned integers", acc.index())));
+    if !matches!(
+        acc.data_type(),
+        DataType::U8 | DataType::U16 | DataType::U32
+    ) || acc.normalized()
+    {
+        return Err(data.bad(format!(
+            "{at}: accessor {}: indices must be unsigned integers",
+            acc.index()
+        )));
     }
     let values = read_floats(data, acc, &[Dimensions::Scalar], at)?;
     // f32 holds every u32 index below 2^24 exactly; larger meshes are refused.
@@ -605,7 +701,10 @@ fn read_indices(data: &Data, acc: &gltf::Accessor, vertices: usize, at: &str) ->
             if (i as usize) < vertices {
                 Ok(i)
             } else {
-                Err(data.bad(format!("{at}: accessor {}: index {i} of {vertices} vertices", acc.index())))
+                Err(data.bad(format!(
+                    "{at}: accessor {}: index {i} of {vertices} vertices",
+                    acc.index()
+                )))
             }
         })
         .collect()

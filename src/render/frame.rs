@@ -804,7 +804,11 @@ fn add_host_start<'a>(
 
 /// Grow frame slot `slot`'s skinning buffers for `(instances, matrices, posed vertices)`
 /// (its earlier frame has completed, so they may be replaced).
-fn grow_skin_buffers(ctx: &Arc<Context>, slot: &mut FrameSlot, (jobs, matrices, posed): (u32, u32, u32)) -> GpuResult<()> {
+fn grow_skin_buffers(
+    ctx: &Arc<Context>,
+    slot: &mut FrameSlot,
+    (jobs, matrices, posed): (u32, u32, u32),
+) -> GpuResult<()> {
     use super::shared::{SkinJob, SkinnedVertex};
     use super::slots::{host_table, skinned_buffer};
     let job_bytes = jobs as u64 * size_of::<SkinJob>() as u64;

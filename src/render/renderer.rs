@@ -347,6 +347,27 @@ impl Renderer {
             .collect())
     }
 
+    /// The posed vertices the last frame's skinning pass wrote (its jobs in order: characters
+    /// by slot, each one's parts as given to [`Self::set_character_skin`]), read back after
+    /// the frames in flight; `vertices` of them.
+    pub fn read_posed_vertices(
+        &mut self,
+        vertices: usize,
+    ) -> GpuResult<Vec<super::shared::SkinnedVertex>> {
+        self.finish()?;
+        let last = (self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT;
+        let buffer = &self.frames[last].skinned;
+        let bytes = vertices as u64 * size_of::<super::shared::SkinnedVertex>() as u64;
+        if bytes > buffer.size {
+            return Err(GpuError::Unsupported(format!(
+                "{vertices} posed vertices asked for, the frame holds {}",
+                buffer.size / size_of::<super::shared::SkinnedVertex>() as u64
+            )));
+        }
+        let data = super::debug::read_device_buffer(&self.ctx, buffer, bytes)?;
+        Ok(bytemuck::pod_collect_to_vec(&data))
+    }
+
     /// Store the strands of the last compute-path frame for the LHS baseline (`RenderPath::Lhs`):
     /// its first `vertices` pool vertices (`FrameStats::vertex_slots_written` of that frame,
     /// rendered with LoD off), `verts_per_strand` each, with `fraction` of them as guides

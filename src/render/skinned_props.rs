@@ -11,7 +11,7 @@ use glam::{Mat4, Vec3};
 
 use super::crowd::CharacterId;
 use super::passes::props::PropDraw;
-use super::prop_table::{PropLod, Projection};
+use super::prop_table::{Projection, PropLod};
 use super::shared::{PropInstance, SkinJob, SkinRestVertex};
 use crate::skin::SkinnedMesh;
 use crate::vk::{Buffer, Context, GpuError, GpuResult};
@@ -62,7 +62,9 @@ fn bounds(mesh: &SkinnedMesh) -> (Vec3, f32) {
     let (lo, hi) = mesh
         .vertices
         .iter()
-        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), v| (lo.min(v.position), hi.max(v.position)));
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), v| {
+            (lo.min(v.position), hi.max(v.position))
+        });
     let centre = (lo + hi) * 0.5;
     let r = mesh
         .vertices
@@ -99,7 +101,9 @@ impl SkinnedProps {
         for (k, m) in meshes.iter().enumerate() {
             let bad = m.indices.len() % 3 != 0
                 || m.indices.iter().any(|&i| i as usize >= m.vertices.len())
-                || m.vertices.iter().any(|v| !(v.position.is_finite() && v.normal.is_finite()));
+                || m.vertices
+                    .iter()
+                    .any(|v| !(v.position.is_finite() && v.normal.is_finite()));
             if bad || m.vertices.is_empty() {
                 return Err(GpuError::Unsupported(format!(
                     "skinned mesh {k} '{}' is not a finite, non-empty triangle list",
@@ -228,7 +232,11 @@ impl SkinnedProps {
         for w in self.wearers.values() {
             out.0 += w.parts.len() as u32;
             out.1 += w.joints as u32;
-            out.2 += w.parts.iter().map(|(m, _)| self.meshes[*m].vertex_count).sum::<u32>();
+            out.2 += w
+                .parts
+                .iter()
+                .map(|(m, _)| self.meshes[*m].vertex_count)
+                .sum::<u32>();
         }
         out
     }
@@ -302,7 +310,11 @@ impl SkinnedProps {
             return mesh;
         };
         let r = self.meshes[mesh];
-        let scale = model.x_axis.truncate().length().max(model.y_axis.truncate().length());
+        let scale = model
+            .x_axis
+            .truncate()
+            .length()
+            .max(model.y_axis.truncate().length());
         let pixels = camera.pixels(model.transform_point3(r.centre), r.radius * scale);
         if pixels < below { far } else { mesh }
     }

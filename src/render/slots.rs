@@ -173,7 +173,7 @@ pub(crate) fn skinned_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
         &BufferDesc::new(
             "skinned vertices",
             n.max(1) as u64 * size_of::<super::shared::SkinnedVertex>() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
         ),
     )
 }

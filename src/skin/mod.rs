@@ -259,12 +259,24 @@ mod tests {
             weights: [0.5, 0.5, 0.0, 0.0],
         };
         // Fully on the tip: (0, 2) turns about (0, 1) to (-1, 1).
-        let full = skin_vertex(&SkinVertex { weights: [0.0, 1.0, 0.0, 0.0], ..v }, &m);
-        assert!(full.position.abs_diff_eq(Vec3::new(-1.0, 1.0, 0.0), 1e-5), "{full:?}");
+        let full = skin_vertex(
+            &SkinVertex {
+                weights: [0.0, 1.0, 0.0, 0.0],
+                ..v
+            },
+            &m,
+        );
+        assert!(
+            full.position.abs_diff_eq(Vec3::new(-1.0, 1.0, 0.0), 1e-5),
+            "{full:?}"
+        );
         assert!(full.normal.abs_diff_eq(Vec3::Y, 1e-5));
         // Half and half: the average of (0, 2) and (-1, 1).
         let half = skin_vertex(&v, &m);
-        assert!(half.position.abs_diff_eq(Vec3::new(-0.5, 1.5, 0.0), 1e-5), "{half:?}");
+        assert!(
+            half.position.abs_diff_eq(Vec3::new(-0.5, 1.5, 0.0), 1e-5),
+            "{half:?}"
+        );
     }
 
     /// A child listed before its parent is refused.
