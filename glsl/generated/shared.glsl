@@ -21,6 +21,8 @@
 #define DISPATCH_ROW 65535u
 #define DEFORM_GROUP_SIZE 64
 #define LHS_GROUP_SIZE 64
+#define SKIN_GROUP_SIZE 64
+#define SKIN_NONE 4294967295u
 #define MAX_SIM_COLLIDERS 16
 #define COLLIDER_ELLIPSOID 0u
 #define COLLIDER_CAPSULE 1u
@@ -123,6 +125,11 @@
 #define BINDING_HISTORY_OUT 29
 #define BINDING_VERTEX_MOTION 30
 #define BINDING_SEGMENT_MOTION 31
+#define BINDING_SKIN_REST 32
+#define BINDING_SKIN_INDICES 33
+#define BINDING_SKIN_MATRICES 34
+#define BINDING_SKIN_JOBS 35
+#define BINDING_SKINNED_VERTICES 36
 #define BINDING_TEX_POSITION 0
 #define BINDING_TEX_UV 1
 #define BINDING_TEX_W 2
@@ -279,6 +286,30 @@ struct PropInstance {
     mat4 model;
     vec4 color;
     mat4 clip_to_prev;
+    uvec4 skin;
+};
+
+struct SkinRestVertex {
+    vec3 position;
+    uint color;
+    vec3 normal;
+    uint joints01;
+    vec4 weights;
+    uvec4 joints23;
+};
+
+struct SkinnedVertex {
+    vec3 position;
+    uint color;
+    vec3 normal;
+    uint pad;
+};
+
+struct SkinJob {
+    uint rest_first;
+    uint vertex_count;
+    uint matrix_first;
+    uint out_first;
 };
 
 struct TaskPayload {

@@ -503,7 +503,7 @@ impl Renderer {
         let (mut prop_instances, mut prop_draws) = self.props.frame_lists(&moved, world, &camera);
         let skin = self
             .skinned
-            .frame_lists(&moved, &camera, &mut prop_instances, &mut prop_draws);
+            .frame_lists(moved, &camera, &mut prop_instances, &mut prop_draws);
         let (width, height) = self.targets.size();
         let slot = &mut self.frames[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;

@@ -184,6 +184,16 @@ pub fn azimuthal_factors(cos_phi: f32, cos_d: f32) -> AzimuthalFactors {
 /// 1.096); this scale keeps every tested case at or below 1 (tests below).
 pub const ENERGY_SCALE: f32 = 0.9;
 
+/// The sRGB transfer function's inverse: an sRGB-encoded value in 0..=1 to linear (IEC
+/// 61966-2-1).
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -252,15 +262,5 @@ pub(crate) mod tests {
         let (_, on_cone) = kajiya_kay(t, l, Vec3::new(-0.8, -0.6, 0.0).normalize());
         let (_, off_cone) = kajiya_kay(t, l, Vec3::new(-0.6, 0.8, 0.0));
         assert!(on_cone > 0.9 && off_cone < 0.1, "{on_cone} {off_cone}");
-    }
-}
-
-/// The sRGB transfer function's inverse: an sRGB-encoded value in 0..=1 to linear (IEC
-/// 61966-2-1).
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
     }
 }
