@@ -36,11 +36,13 @@ pub enum Reader {
     /// `SceneDesc::parse` of a scene naming the sample files, then `load_mesh` of every
     /// character it names (each file it names is read through the input policy).
     SceneFiles,
+    /// `model::gltf::parse_character` (glTF characters) on the shipped man.
+    Gltf,
 }
 
 impl Reader {
     /// Every reader.
-    pub const ALL: [Reader; 8] = [
+    pub const ALL: [Reader; 9] = [
         Reader::Obj,
         Reader::Style,
         Reader::Scene,
@@ -49,6 +51,7 @@ impl Reader {
         Reader::Tfx,
         Reader::Head,
         Reader::SceneFiles,
+        Reader::Gltf,
     ];
 }
 
@@ -410,6 +413,10 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
             crate::render::scene::SceneDesc::parse("fuzz.toml", t, Path::new(".")).is_ok()
         }),
         Reader::Hmb => crate::bake::baked_file::from_bytes("fuzz.hmb", input).is_ok(),
+        Reader::Gltf => {
+            let budget = crate::budget::MemoryBudget::default();
+            crate::model::gltf::parse_character("fuzz.glb", input, None, budget).is_ok()
+        }
         Reader::Hair => crate::model::hair_file::HairFile::parse("fuzz.hair", input).is_ok(),
         Reader::Tfx => match crate::model::strands::StrandModel::from_tfx("fuzz.tfx", input) {
             Ok(m) if m.point_count() <= 4096 => {
@@ -456,6 +463,45 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
     })
 }
 
+/// The glTF reader's seed: the shipped man.
+const GLB_SEED: &[u8] = include_bytes!("../hairmeshes/people/man.glb");
+
+/// A mutated GLB: its JSON chunk mutated as text and repacked, a few bytes changed anywhere
+/// (the binary chunk's data, the headers), or the file cut short.
+fn mutate_glb(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
+    let json_len = u32::from_le_bytes([seed[12], seed[13], seed[14], seed[15]]) as usize;
+    match below(rng, 3) {
+        0 => {
+            let json = std::str::from_utf8(&seed[20..20 + json_len]).unwrap_or("");
+            // One JSON line per object, so line mutations hit fields.
+            let text = json.replace(",\"", ",\n\"");
+            let mut m: Vec<u8> = mutate_text(rng, &text)
+                .into_iter()
+                .filter(|&b| b != b'\n')
+                .collect();
+            m.resize(m.len().div_ceil(4) * 4, b' ');
+            let rest = &seed[20 + json_len..];
+            let mut out = Vec::with_capacity(seed.len());
+            out.extend_from_slice(&seed[..8]);
+            out.extend(((20 + m.len() + rest.len()) as u32).to_le_bytes());
+            out.extend((m.len() as u32).to_le_bytes());
+            out.extend_from_slice(b"JSON");
+            out.extend(m);
+            out.extend_from_slice(rest);
+            out
+        }
+        1 => {
+            let mut out = seed.to_vec();
+            for _ in 0..1 + below(rng, 8) {
+                let at = below(rng, out.len());
+                out[at] = rng.next_u32() as u8;
+            }
+            out
+        }
+        _ => seed[..below(rng, seed.len())].to_vec(),
+    }
+}
+
 /// Run `iterations` mutated inputs through `reader`, seeded with `seed`.
 pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
     let mut rng = Pcg32::new(seed ^ (reader as u64) << 32);
@@ -484,6 +530,7 @@ pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
                 mutate_text(&mut rng, seed)
             }
             Reader::SceneFiles => mutate_text(&mut rng, SCENE_FILES_SEED),
+            Reader::Gltf => mutate_glb(&mut rng, GLB_SEED),
         };
         let start = Instant::now();
         let outcome = run_one(reader, &input);
