@@ -179,7 +179,7 @@ impl CrowdAnimation {
         walker: super::walk::Walker,
         hair: Option<(&HairMesh, Vec<Collider>)>,
     ) -> crate::error::Result<()> {
-        let (model, _) = walker.frame(0.0)?;
+        let model = walker.frame(0.0)?.hair;
         self.add(id, CharacterMotion::still(model), hair);
         if let Some(c) = self.characters.last_mut() {
             c.walker = Some(walker);
@@ -224,11 +224,11 @@ impl CrowdAnimation {
         for c in &mut self.characters {
             let model = match &c.walker {
                 Some(w) => {
-                    let (model, skin) = w
+                    let f = w
                         .frame(self.time)
                         .map_err(|e| crate::vk::GpuError::Unsupported(e.to_string()))?;
-                    renderer.set_character_pose(c.id, &skin)?;
-                    model
+                    renderer.set_character_pose(c.id, f.body, &f.skin)?;
+                    f.hair
                 }
                 None => c.motion.model(self.time),
             };

@@ -34,6 +34,8 @@ pub struct Walker {
     pub outfit: Outfit,
     /// Uniform scale of the figure (the person's height).
     pub height: f32,
+    /// The head's proportions (width, height, depth) about the cranium centre.
+    pub head: Vec3,
     /// The path.
     pub path: WalkPath,
 }
@@ -60,10 +62,22 @@ impl Walker {
         })
     }
 
-    /// The character model (the head-bound person frame) and body skin matrices relative to
-    /// it at `t` seconds.
-    pub fn frame(&self, t: f32) -> Result<(Mat4, Vec<Mat4>)> {
-        let (skin, head) = pose(&self.outfit, t)?;
-        Ok(head_bound(self.root(t)?, self.height, &skin, head))
+    /// At `t` seconds: the hair's model (the head-bound person frame), the body's model
+    /// and its skin matrices ([`crate::characters::people::head_bound`]).
+    pub fn frame(&self, t: f32) -> Result<PersonFrame> {
+        let (skin, head) = pose(&self.outfit, t, self.head)?;
+        let (hair, body) = head_bound(self.root(t)?, self.height, head);
+        Ok(PersonFrame { hair, body, skin })
     }
+}
+
+/// A walker at one instant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PersonFrame {
+    /// The hair's model (person frame to world).
+    pub hair: Mat4,
+    /// The body's model (figure frame to world).
+    pub body: Mat4,
+    /// The body's skin matrices, the head shape joint's last.
+    pub skin: Vec<Mat4>,
 }

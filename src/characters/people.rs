@@ -58,17 +58,143 @@ pub fn figures() -> Result<&'static [Arc<Character>; 2]> {
         .map_err(|e| HairError::invalid("hairmeshes/people", e.clone()))
 }
 
-/// Every figure's meshes, figure after figure (what `Renderer::set_skinned_meshes` takes):
-/// mesh `k` of figure `f` is at `f * PARTS.len() + k`.
+/// Index of the head meshes (the bust, then the eyes) in [`skinned_meshes`], after both
+/// figures' parts.
+pub const HEAD_MESH: usize = 2 * PARTS.len();
+/// Index of the first far mesh in [`skinned_meshes`]: far versions follow the near ones in
+/// the same order.
+pub const FAR_MESHES: usize = HEAD_MESH + 2;
+/// Vertex clustering cell of far bodies and clothes, metres.
+pub const FAR_BODY_CELL: f32 = 0.04;
+/// Vertex clustering cell of far heads and eyes, metres.
+pub const FAR_HEAD_CELL: f32 = 0.02;
+
+/// The joint the head meshes are bound to: one past the figure's skeleton, a matrix of each
+/// person's own (the head joint's, then the person's head proportions about the cranium).
+pub fn head_shape_joint() -> Result<usize> {
+    Ok(figures()?[0].skeleton.joints.len())
+}
+
+/// Clustering cell of mesh `k` of [`skinned_meshes`].
+fn far_cell(k: usize) -> f32 {
+    if k >= HEAD_MESH {
+        FAR_HEAD_CELL
+    } else {
+        FAR_BODY_CELL
+    }
+}
+
+/// Every figure's meshes, figure after figure (mesh `k` of figure `f` at
+/// `f * PARTS.len() + k`), the head's bust and eyes ([`HEAD_MESH`]), then the far version of
+/// each in the same order ([`FAR_MESHES`]): what `Renderer::set_skinned_meshes` takes.
 pub fn skinned_meshes() -> Result<Vec<crate::skin::SkinnedMesh>> {
-    let mut out = Vec::new();
+    let mut near = Vec::new();
     for c in figures()? {
         for part in PARTS {
             let m = c.meshes.iter().find(|m| m.name == part);
-            out.extend(m.cloned());
+            near.extend(m.cloned());
         }
     }
-    Ok(out)
+    near.extend(head_meshes()?);
+    let far: Vec<_> = near
+        .iter()
+        .enumerate()
+        .map(|(k, m)| crate::skin::far::far_mesh(m, far_cell(k)))
+        .collect();
+    near.extend(far);
+    Ok(near)
+}
+
+/// Far versions of [`skinned_meshes`]: a mesh switches to its far version where a cell spans
+/// under [`super::preset::FAR_CELL_PIXELS`] (as the static props do).
+pub fn skinned_lods(
+    meshes: &[crate::skin::SkinnedMesh],
+) -> Vec<crate::render::prop_table::PropLod> {
+    (0..FAR_MESHES.min(meshes.len()))
+        .map(|k| {
+            let (lo, hi) = meshes[k]
+                .vertices
+                .iter()
+                .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), v| {
+                    (lo.min(v.position), hi.max(v.position))
+                });
+            crate::render::prop_table::PropLod {
+                mesh: k,
+                far_mesh: FAR_MESHES + k,
+                below_pixels: super::preset::FAR_CELL_PIXELS * (hi - lo).length() / far_cell(k),
+            }
+        })
+        .collect()
+}
+
+/// The Sintel head above the neck and its eyes as skinned meshes bound wholly to
+/// [`head_shape_joint`] (canonical frame): the bust white (the person's skin tone tints it),
+/// the eyes' whites and irises in their own colours.
+fn head_meshes() -> Result<[crate::skin::SkinnedMesh; 2]> {
+    let joint = head_shape_joint()? as u16;
+    let head = super::human::human_head()?;
+    let bust = super::person::neck_up_mesh()?;
+    let mut eyes = Vec::new();
+    let mut eye_colors = Vec::new();
+    for eye in head.eyes {
+        let iris = eye.centre + Vec3::Z * (super::preset::IRIS_OFFSET * eye.radius);
+        for (centre, radius, color) in [
+            (eye.centre, eye.radius, super::preset::SCLERA_COLOR),
+            (
+                iris,
+                super::preset::IRIS_RADIUS * eye.radius,
+                super::preset::IRIS_COLOR,
+            ),
+        ] {
+            let mut tris = Vec::new();
+            super::person::ellipsoid(&mut tris, centre, Vec3::splat(radius), 10, 16);
+            let n = tris.len() * 3;
+            eyes.extend(super::human::smooth_prop_mesh(&tris));
+            let rgb = Vec3::new(color[0], color[1], color[2]);
+            eye_colors.extend(std::iter::repeat_n(rgb, n));
+        }
+    }
+    let white = vec![Vec3::ONE; bust.len()];
+    Ok([
+        welded("head", &bust, &white, joint),
+        welded("eyes", &eyes, &eye_colors, joint),
+    ])
+}
+
+/// A triangle list of prop vertices as an indexed skinned mesh bound to `joint` (corners with
+/// the same position, normal and colour welded).
+fn welded(
+    name: &str,
+    list: &[crate::render::shared::PropVertex],
+    colors: &[Vec3],
+    joint: u16,
+) -> crate::skin::SkinnedMesh {
+    use std::collections::HashMap;
+    let mut index: HashMap<[u32; 9], u32> = HashMap::new();
+    let mut vertices = Vec::new();
+    let mut indices = Vec::with_capacity(list.len());
+    for (v, c) in list.iter().zip(colors) {
+        let p = Vec3::from_slice(&v.position[..3]);
+        let n = Vec3::from_slice(&v.normal[..3]);
+        let key = [p.x, p.y, p.z, n.x, n.y, n.z, c.x, c.y, c.z].map(f32::to_bits);
+        let next = vertices.len() as u32;
+        let i = *index.entry(key).or_insert_with(|| {
+            vertices.push(crate::skin::SkinVertex {
+                position: p,
+                normal: n,
+                color: *c,
+                joints: [joint, 0, 0, 0],
+                weights: [1.0, 0.0, 0.0, 0.0],
+            });
+            next
+        });
+        indices.push(i);
+    }
+    crate::skin::SkinnedMesh {
+        name: name.into(),
+        vertices,
+        indices,
+    }
 }
 
 /// What one person wears, and how they move.
@@ -153,6 +279,8 @@ impl Outfit {
             (base, c(skin)),
             (base + 1, c(self.shirt)),
             (base + 4, c(self.shoes)),
+            (HEAD_MESH, c(skin)),
+            (HEAD_MESH + 1, [1.0; 4]),
         ];
         if self.long_sleeves {
             out.push((base + 2, c(self.shirt)));
@@ -167,8 +295,10 @@ impl Outfit {
 
 /// A person's skeleton at time `t`: the figure's clip (walk or idle) sampled at `t + phase`.
 /// Returns the skin matrices (bind frame to the figure's frame, which moves in place: the
-/// crowd moves the root along its path) and the head joint's.
-pub fn pose(outfit: &Outfit, t: f32) -> Result<(Vec<Mat4>, Mat4)> {
+/// crowd moves the root along its path), the head shape joint's last (the head joint's with
+/// the `head_shape` proportions about the cranium centre: [`head_shape_joint`]), and the head
+/// joint's alone.
+pub fn pose(outfit: &Outfit, t: f32, head_shape: Vec3) -> Result<(Vec<Mat4>, Mat4)> {
     let figure = &figures()?[outfit.figure as usize];
     let clip = figure
         .clip(if outfit.walks { "walk" } else { "idle" })
@@ -176,11 +306,16 @@ pub fn pose(outfit: &Outfit, t: f32) -> Result<(Vec<Mat4>, Mat4)> {
             HairError::invalid("hairmeshes/people", "a figure lacks its walk or idle clip")
         })?;
     let s = &figure.skeleton;
-    let m = s.skin_matrices(&clip.sample(s, t + outfit.phase));
+    let mut m = s.skin_matrices(&clip.sample(s, t + outfit.phase));
     let head = s
         .find("head")
         .ok_or_else(|| HairError::invalid("hairmeshes/people", "a figure has no head joint"))?;
-    Ok((m.clone(), m[head]))
+    let c = super::human::human_head()?.centre;
+    let shape =
+        Mat4::from_translation(c) * Mat4::from_scale(head_shape) * Mat4::from_translation(-c);
+    let h = m[head];
+    m.push(h * shape);
+    Ok((m, h))
 }
 
 /// Ground speed of a figure's walk (metres per second at scale 1): the speed its planted feet
@@ -199,14 +334,12 @@ pub fn walk_speed(figure: Figure) -> Result<f32> {
         .ok_or_else(|| HairError::invalid("hairmeshes/people", "the walk does not plant its feet"))
 }
 
-/// The placement of a person bound to their head: the hair, head and eyes live in the
-/// person frame (canonical scaled by `height` about the feet), which follows the head joint
-/// (`head`, canonical bind to posed); returns the character model for `root` (the person's
-/// placement) and the body's skin matrices relative to it: `model = root S H S^-1` and
-/// `X_j = S H^-1 M_j`, so that `model X_j = root S M_j`.
-pub fn head_bound(root: Mat4, height: f32, skin: &[Mat4], head: Mat4) -> (Mat4, Vec<Mat4>) {
+/// Where a person's hair and body go: the hair lives in the person frame (canonical scaled
+/// by `height` about the feet), which follows the head joint (`head`, canonical bind to
+/// posed): its model is `root S H S^-1`. The body and the skinned head are drawn at `root S`,
+/// posed by the skin matrices on the GPU: two data paths that meet at the scalp (what the
+/// root-gap measure checks). Returns `(hair model, body model)`.
+pub fn head_bound(root: Mat4, height: f32, head: Mat4) -> (Mat4, Mat4) {
     let s = Mat4::from_scale(Vec3::splat(height));
-    let model = root * s * head * s.inverse();
-    let back = s * head.inverse();
-    (model, skin.iter().map(|m| back * *m).collect())
+    (root * s * head * s.inverse(), root * s)
 }

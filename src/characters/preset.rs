@@ -264,6 +264,7 @@ fn person_walker(
     Walker {
         outfit,
         height: p.height,
+        head: p.head,
         path,
     }
 }
@@ -281,16 +282,13 @@ pub fn dress(
         .set_character_props(id, &character_props(c)?)
         .map_err(gpu)?;
     if let Some(w) = &c.walker {
-        let joints = super::people::figures()?[w.outfit.figure as usize]
-            .skeleton
-            .joints
-            .len();
+        let joints = super::people::head_shape_joint()? + 1;
         renderer
             .set_character_skin(id, &w.outfit.parts(c.skin), joints)
             .map_err(gpu)?;
-        let (model, skin) = w.frame(0.0)?;
-        renderer.set_character_pose(id, &skin).map_err(gpu)?;
-        renderer.set_model(id, model).map_err(gpu)?;
+        let f = w.frame(0.0)?;
+        renderer.set_character_pose(id, f.body, &f.skin).map_err(gpu)?;
+        renderer.set_model(id, f.hair).map_err(gpu)?;
     }
     Ok(())
 }
@@ -367,26 +365,8 @@ pub fn character_props(c: &CrowdCharacter) -> Result<Vec<(usize, PropInstance)>>
         )
     };
     Ok(match c.body {
-        Body::Person(p) => {
-            let head = p.head_transform()?;
-            // The body is skinned ([`dress`]); the mannequin body is not drawn.
-            let mut props = vec![at(prop_mesh::HEAD, head)];
-            for eye in super::human::human_head()?.eyes {
-                let iris = eye.centre + Vec3::Z * (IRIS_OFFSET * eye.radius);
-                for (centre, radius, color) in [
-                    (eye.centre, eye.radius, SCLERA_COLOR),
-                    (iris, IRIS_RADIUS * eye.radius, IRIS_COLOR),
-                ] {
-                    let model = head
-                        * Mat4::from_translation(centre)
-                        * Mat4::from_scale(Vec3::splat(radius));
-                    let (_, mut inst) = at(prop_mesh::EYE, model);
-                    inst.color = color;
-                    props.push((prop_mesh::EYE, inst));
-                }
-            }
-            props
-        }
+        // Head, eyes, body and clothes are skinned meshes ([`dress`]).
+        Body::Person(_) => Vec::new(),
         Body::Ball => vec![at(prop_mesh::BALL, Mat4::IDENTITY)],
         Body::Teapot => vec![at(prop_mesh::TEAPOT, Mat4::IDENTITY)],
     })

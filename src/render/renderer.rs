@@ -478,8 +478,9 @@ impl Renderer {
     }
 
     /// Character `id` wears skinned meshes `parts` (`(mesh, linear colour)`, the colour
-    /// multiplying the mesh's own) over a skeleton of `joints`, posed at the character's
-    /// model by [`Self::set_character_pose`] and skinned on the GPU every frame it is drawn.
+    /// multiplying the mesh's own) over a skeleton of `joints`, placed and posed by
+    /// [`Self::set_character_pose`] and skinned on the GPU every frame the character is drawn
+    /// (hidden with it, removed with it).
     pub fn set_character_skin(
         &mut self,
         id: CharacterId,
@@ -492,14 +493,20 @@ impl Renderer {
         self.skinned.set_wearer(id, parts, joints)
     }
 
-    /// Character `id`'s skin matrices for the next frames (bind pose to the character's
-    /// frame, one per joint: `skin::Skeleton::skin_matrices`).
-    pub fn set_character_pose(&mut self, id: CharacterId, matrices: &[Mat4]) -> GpuResult<()> {
-        self.skinned.set_pose(id, matrices)
+    /// Character `id`'s body for the next frames: its placement (`body`, the skinned
+    /// meshes' frame to world, independent of the hair's model) and skin matrices (bind pose
+    /// to that frame, one per joint: `skin::Skeleton::skin_matrices`).
+    pub fn set_character_pose(
+        &mut self,
+        id: CharacterId,
+        body: Mat4,
+        matrices: &[Mat4],
+    ) -> GpuResult<()> {
+        self.skinned.set_pose(id, body, matrices)
     }
 
-    /// Character `id`'s skin matrices as last set.
-    pub fn character_pose(&self, id: CharacterId) -> Option<&[Mat4]> {
+    /// Character `id`'s body placement and skin matrices as last set.
+    pub fn character_pose(&self, id: CharacterId) -> Option<(Mat4, &[Mat4])> {
         self.skinned.pose(id)
     }
 

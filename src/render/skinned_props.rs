@@ -33,7 +33,9 @@ struct MeshRange {
 struct Wearer {
     parts: Vec<(usize, [f32; 4])>,
     joints: usize,
-    /// Skin matrices for the next frame (character frame).
+    /// The body's placement for the next frame (figure frame to world).
+    body: Mat4,
+    /// Skin matrices for the next frame (bind frame to figure frame).
     matrices: Vec<Mat4>,
 }
 
@@ -193,19 +195,26 @@ impl SkinnedProps {
             Wearer {
                 parts: parts.to_vec(),
                 joints,
+                body: Mat4::IDENTITY,
                 matrices: vec![Mat4::IDENTITY; joints],
             },
         );
         Ok(())
     }
 
-    /// Character `id`'s skin matrices for the next frame (one per joint, finite).
-    pub(super) fn set_pose(&mut self, id: CharacterId, matrices: &[Mat4]) -> GpuResult<()> {
+    /// Character `id`'s body placement and skin matrices for the next frame (one per joint,
+    /// all finite).
+    pub(super) fn set_pose(
+        &mut self,
+        id: CharacterId,
+        body: Mat4,
+        matrices: &[Mat4],
+    ) -> GpuResult<()> {
         let w = self
             .wearers
             .get_mut(&id)
             .ok_or_else(|| GpuError::Unsupported("the character wears no skinned mesh".into()))?;
-        if matrices.len() != w.joints || !matrices.iter().all(|m| m.is_finite()) {
+        if matrices.len() != w.joints || !matrices.iter().all(|m| m.is_finite()) || !body.is_finite() {
             return Err(GpuError::Unsupported(format!(
                 "{} finite skin matrices expected, got {}",
                 w.joints,
@@ -213,6 +222,7 @@ impl SkinnedProps {
             )));
         }
         w.matrices.copy_from_slice(matrices);
+        w.body = body;
         Ok(())
     }
 
@@ -221,9 +231,9 @@ impl SkinnedProps {
         self.wearers.remove(&id);
     }
 
-    /// Character `id`'s skin matrices as last set.
-    pub(super) fn pose(&self, id: CharacterId) -> Option<&[Mat4]> {
-        self.wearers.get(&id).map(|w| w.matrices.as_slice())
+    /// Character `id`'s body placement and skin matrices as last set.
+    pub(super) fn pose(&self, id: CharacterId) -> Option<(Mat4, &[Mat4])> {
+        self.wearers.get(&id).map(|w| (w.body, w.matrices.as_slice()))
     }
 
     /// Upper bounds of a frame's instances, matrices and posed vertices.
@@ -242,8 +252,10 @@ impl SkinnedProps {
     }
 
     /// This frame's skinning work, instances (appended to `records`, with their motion) and
-    /// draws, for the characters `model_of` places (`None`: not drawn); far versions where
-    /// `camera` sees a mesh small. Characters are taken in id order, so frames are repeatable.
+    /// draws, for the characters `model_of` draws (`None`: hidden; the second matrix is the
+    /// character's clip-space motion, which the body shares), each at its body placement; far
+    /// versions where `camera` sees a mesh small. Characters are taken in slot order, so
+    /// frames are repeatable.
     pub(super) fn frame_lists(
         &self,
         model_of: impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
@@ -257,9 +269,10 @@ impl SkinnedProps {
         let mut placed: Vec<(usize, PropInstance)> = Vec::new();
         for id in ids {
             let w = &self.wearers[id];
-            let Some((model, clip_to_prev)) = model_of(*id) else {
+            let Some((_, clip_to_prev)) = model_of(*id) else {
                 continue;
             };
+            let model = w.body;
             let matrix_first = work.matrices.len() as u32;
             work.matrices
                 .extend(w.matrices.iter().map(|m| m.to_cols_array_2d()));

@@ -6,6 +6,7 @@
 //! inverse bind matrix; Magnenat-Thalmann et al. 1988, glTF 2.0 section 3.7.3).
 
 pub mod clip;
+pub mod far;
 
 use glam::{Mat4, Quat, Vec3, Vec4};
 

@@ -141,7 +141,9 @@ fn scene(
 fn crowd(r: &mut Renderer) -> Result<CrowdAnimation> {
     let characters = preset::build(Preset::People, 4, 7)?;
     r.set_prop_meshes(&preset::prop_meshes()?)?;
-    r.set_skinned_meshes(&hairmesh::characters::people::skinned_meshes()?)?;
+    let skinned = hairmesh::characters::people::skinned_meshes()?;
+    r.set_skinned_meshes(&skinned)?;
+    r.set_skinned_lods(&hairmesh::characters::people::skinned_lods(&skinned))?;
     r.set_prop_instances(&preset::world_props())?;
     let mut animation = CrowdAnimation::new();
     animation.wind = Wind {

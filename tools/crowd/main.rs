@@ -243,7 +243,9 @@ impl Scene {
         renderer.set_prop_meshes(&meshes)?;
         renderer.set_prop_lods(&preset::prop_lods(&meshes))?;
         renderer.set_prop_instances(&preset::world_props())?;
-        renderer.set_skinned_meshes(&hairmesh::characters::people::skinned_meshes()?)?;
+        let skinned = hairmesh::characters::people::skinned_meshes()?;
+        renderer.set_skinned_meshes(&skinned)?;
+        renderer.set_skinned_lods(&hairmesh::characters::people::skinned_lods(&skinned))?;
         for (c, b) in self.characters.iter().zip(&self.baked) {
             let id = renderer.add_character(b, &c.hair.style, c.strand_params(params), c.model)?;
             // Heads and bodies move with their characters: drawn at the same model as the hair.

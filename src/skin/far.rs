@@ -1,0 +1,108 @@
+//! Far versions of skinned meshes: vertex clustering (Rossignac and Borrel 1993), as
+//! `characters::far_mesh` does for static props, carrying skinning data. Vertices are snapped
+//! to `cell`-sized cubes at bind time; each cell keeps the vertex nearest its mean (its joints,
+//! weights and colour, so the far mesh skins like the near one), triangles whose corners fall
+//! into fewer than three cells vanish, duplicates are dropped, and normals are the kept
+//! vertices' own.
+
+use std::collections::{HashMap, HashSet};
+
+use glam::Vec3;
+
+use super::SkinnedMesh;
+
+/// The far version of `mesh` with vertices clustered into `cell`-sized cubes.
+pub fn far_mesh(mesh: &SkinnedMesh, cell: f32) -> SkinnedMesh {
+    let cell_of = |p: Vec3| (p / cell).floor().as_ivec3().to_array();
+    let mut sums: HashMap<[i32; 3], (Vec3, f32)> = HashMap::new();
+    for v in &mesh.vertices {
+        let e = sums.entry(cell_of(v.position)).or_default();
+        e.0 += v.position;
+        e.1 += 1.0;
+    }
+    // The representative of each cell: the vertex nearest its mean (lowest index on ties).
+    let mut best: HashMap<[i32; 3], (f32, usize)> = HashMap::new();
+    for (k, v) in mesh.vertices.iter().enumerate() {
+        let c = cell_of(v.position);
+        let (sum, n) = sums[&c];
+        let d = v.position.distance_squared(sum / n);
+        let e = best.entry(c).or_insert((f32::INFINITY, usize::MAX));
+        if d < e.0 {
+            *e = (d, k);
+        }
+    }
+    let mut remap: HashMap<usize, u32> = HashMap::new();
+    let mut vertices = Vec::new();
+    let mut indices = Vec::new();
+    let mut seen = HashSet::new();
+    for t in mesh.indices.chunks_exact(3) {
+        let cells = [0, 1, 2].map(|k| cell_of(mesh.vertices[t[k] as usize].position));
+        if cells[0] == cells[1] || cells[1] == cells[2] || cells[0] == cells[2] {
+            continue;
+        }
+        let first = (0..3).min_by_key(|&k| cells[k]).unwrap_or(0);
+        if !seen.insert([0, 1, 2].map(|k| cells[(first + k) % 3])) {
+            continue;
+        }
+        for c in cells {
+            let rep = best[&c].1;
+            let next = vertices.len() as u32;
+            let i = *remap.entry(rep).or_insert_with(|| {
+                vertices.push(mesh.vertices[rep]);
+                next
+            });
+            indices.push(i);
+        }
+    }
+    SkinnedMesh {
+        name: format!("{} (far)", mesh.name),
+        vertices,
+        indices,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::skin::SkinVertex;
+
+    /// A finely tessellated square loses most of its triangles, keeps its extent within a
+    /// cell, and every kept vertex is one of the original's (joints and weights included).
+    #[test]
+    fn clustering_keeps_skinning_data() {
+        let n = 40;
+        let mut vertices = Vec::new();
+        for y in 0..=n {
+            for x in 0..=n {
+                vertices.push(SkinVertex {
+                    position: Vec3::new(x as f32, y as f32, 0.0) / n as f32,
+                    normal: Vec3::Z,
+                    color: Vec3::ONE,
+                    joints: [(x % 3) as u16, 0, 0, 0],
+                    weights: [1.0, 0.0, 0.0, 0.0],
+                });
+            }
+        }
+        let mut indices = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                let a = (y * (n + 1) + x) as u32;
+                let (b, c, d) = (a + 1, a + n as u32 + 1, a + n as u32 + 2);
+                indices.extend([a, b, d, a, d, c]);
+            }
+        }
+        let mesh = SkinnedMesh {
+            name: "square".into(),
+            vertices,
+            indices,
+        };
+        let far = far_mesh(&mesh, 0.1);
+        assert!(far.indices.len() * 8 < mesh.indices.len(), "{}", far.indices.len());
+        assert!(!far.indices.is_empty());
+        for v in &far.vertices {
+            assert!(mesh.vertices.contains(v));
+        }
+        let max = far.vertices.iter().fold(Vec3::MIN, |m, v| m.max(v.position));
+        assert!(max.x > 0.9 && max.y > 0.9, "{max}");
+    }
+}
