@@ -343,3 +343,56 @@ pub fn head_bound(root: Mat4, height: f32, head: Mat4) -> (Mat4, Mat4) {
     let s = Mat4::from_scale(Vec3::splat(height));
     (root * s * head * s.inverse(), root * s)
 }
+
+/// The root of every bundle's first strand in the hair's own frame (the person frame), by the
+/// CPU reference generator: where the GPU's root probe must find them, carried by the body.
+pub fn expected_roots(
+    baked: &crate::bake::BakedHairMesh,
+    style: &crate::model::style::HairStyle,
+) -> Vec<Vec3> {
+    let generator = crate::reference::generate::CpuGenerator::new(baked, *style);
+    let (mut pos, mut tan, mut width) = ([Vec3::ZERO; 2], [Vec3::ZERO; 2], [0.0; 2]);
+    (0..baked.bundles.len() as u32)
+        .map(|b| {
+            generator.strand(b, 0, 1, &mut pos, &mut tan, &mut width);
+            pos[0]
+        })
+        .collect()
+}
+
+/// The GPU's probed roots (`FrameReport::roots`) of the character in slot `slot`, in bundle
+/// order.
+pub fn probed_roots(roots: &[[f32; 4]], slot: u32) -> Vec<Vec3> {
+    roots
+        .iter()
+        .filter(|r| r[3] == (slot + 1) as f32)
+        .map(|r| Vec3::new(r[0], r[1], r[2]))
+        .collect()
+}
+
+/// Largest distance, in head radii, between the roots the GPU placed (`probed`, world, the
+/// hair's data path: its model and textures) and where the skinned scalp carries them
+/// (`expected`, person frame, moved by the body's data path: `body` times the head shape
+/// joint's skin matrix `head_joint`, from the canonical head, after `head_to_person`, the
+/// person's head placement, is undone). `None` when the counts differ (the probe missed the
+/// character).
+pub fn root_gap(
+    probed: &[Vec3],
+    expected: &[Vec3],
+    (body, head_joint): (Mat4, Mat4),
+    head_to_person: Mat4,
+    head_scale: f32,
+) -> Option<f32> {
+    if probed.len() != expected.len() || probed.is_empty() {
+        return None;
+    }
+    let carry = body * head_joint * head_to_person.inverse();
+    let radius = super::person::CANONICAL_RADIUS * head_scale;
+    Some(
+        probed
+            .iter()
+            .zip(expected)
+            .map(|(g, e)| g.distance(carry.transform_point3(*e)) / radius)
+            .fold(0.0, f32::max),
+    )
+}

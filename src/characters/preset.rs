@@ -287,7 +287,9 @@ pub fn dress(
             .set_character_skin(id, &w.outfit.parts(c.skin), joints)
             .map_err(gpu)?;
         let f = w.frame(0.0)?;
-        renderer.set_character_pose(id, f.body, &f.skin).map_err(gpu)?;
+        renderer
+            .set_character_pose(id, f.body, &f.skin)
+            .map_err(gpu)?;
         renderer.set_model(id, f.hair).map_err(gpu)?;
     }
     Ok(())

@@ -198,6 +198,7 @@ impl Renderer {
             read_motion: opts.read_motion,
             frame_graph,
             volume_characters: (work_draw.alone, work_draw.blended),
+            probe_roots: opts.probe_roots.then_some(self.crowd.bundle_count()),
         };
         self.hand_over(i, pending, target)?;
         self.remember_frame(&records, &motion, temporal);
@@ -558,6 +559,7 @@ impl Renderer {
             sim_jobs,
             density_jobs,
             skinned,
+            root_probe,
             ..
         } = &mut self.frames[i];
         let mut rec = match target {
@@ -618,6 +620,10 @@ impl Renderer {
         );
         let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
         let mut inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
+        if opts.probe_roots {
+            let probe = g.import_buffer("root probe", root_probe);
+            inputs.probe = Some((probe, work.bundles));
+        }
         inputs.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
         self.passes.add(&mut g, &r, inputs)?;
         let image_readback = image_readback.as_ref().filter(|_| opts.read_image);
@@ -716,6 +722,11 @@ impl Renderer {
             slot.prop_instances = prop_instance_buffer(&self.ctx, instances.next_power_of_two())?;
         }
         grow_skin_buffers(&self.ctx, slot, (skinned, matrices, posed))?;
+        let probe_bytes = self.crowd.bundle_count() as u64 * 16;
+        if slot.root_probe.size < probe_bytes {
+            slot.root_probe =
+                super::slots::host_table(&self.ctx, "root probe", probe_bytes.next_power_of_two())?;
+        }
         let slot = &self.frames[i];
         for (set, ubo) in [
             (&slot.set, &slot.frame_ubo),
@@ -736,6 +747,7 @@ impl Renderer {
                         Some(&slot.skin_jobs),
                         Some(&slot.skinned),
                     ],
+                    root_probe: &slot.root_probe,
                     shadow: &self.shadow,
                     history: self.temporal.history(),
                 },
@@ -862,6 +874,7 @@ fn frame_inputs<'a>(
         clear,
         props: work.props,
         skin: work.skin,
+        probe: None,
         shadow: work.shadows,
         transparency: work.transparency,
         raster: work.raster,

@@ -563,6 +563,13 @@ impl Renderer {
                 }
                 _ => None,
             };
+            let roots = match p.probe_roots {
+                Some(n) => {
+                    let bytes = slot.root_probe.read_range(0, n as usize * 16)?;
+                    Some(bytemuck::pod_collect_to_vec(&bytes))
+                }
+                None => None,
+            };
             let mesh_primitives = match (&slot.mesh_query, p.path) {
                 (Some(q), RenderPath::Mesh) => q.result()?,
                 _ => None,
@@ -580,6 +587,7 @@ impl Renderer {
                 motion,
                 frame_graph: p.frame_graph,
                 volume_characters: p.volume_characters,
+                roots,
             });
             while self.completed.len() > 2 * FRAMES_IN_FLIGHT {
                 self.completed.pop_front();

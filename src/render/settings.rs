@@ -206,6 +206,9 @@ pub struct FrameOptions {
     pub raster: super::soft::StrandRaster,
     /// How the light's passes draw the hair (with shadows on).
     pub light_raster: LightRaster,
+    /// Place every bundle's first strand root on the GPU from this frame's textures and
+    /// records and read them back (`FrameReport::roots`): the root-gap measure's input.
+    pub probe_roots: bool,
 }
 
 impl Default for FrameOptions {
@@ -218,6 +221,7 @@ impl Default for FrameOptions {
             describe_frame: false,
             raster: super::soft::StrandRaster::Hardware,
             light_raster: LightRaster::Hardware,
+            probe_roots: false,
         }
     }
 }

@@ -235,11 +235,14 @@ pub enum FrameBinding {
     /// `SkinnedVertex[]`: this frame's posed vertices, written by `skin.comp`, read by
     /// `props.vert`.
     SkinnedVertices = 36,
+    /// `vec4[]` per crowd bundle: the root of its first strand placed by the GPU (w:
+    /// character slot + 1), written by `root_probe.comp` when the frame probes roots.
+    RootProbe = 37,
 }
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 37] = [
+    pub const ALL: [(FrameBinding, &'static str); 38] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -277,6 +280,7 @@ impl FrameBinding {
         (FrameBinding::SkinMatrices, "BINDING_SKIN_MATRICES"),
         (FrameBinding::SkinJobs, "BINDING_SKIN_JOBS"),
         (FrameBinding::SkinnedVertices, "BINDING_SKINNED_VERTICES"),
+        (FrameBinding::RootProbe, "BINDING_ROOT_PROBE"),
     ];
 
     /// What the binding holds.

@@ -214,7 +214,10 @@ impl SkinnedProps {
             .wearers
             .get_mut(&id)
             .ok_or_else(|| GpuError::Unsupported("the character wears no skinned mesh".into()))?;
-        if matrices.len() != w.joints || !matrices.iter().all(|m| m.is_finite()) || !body.is_finite() {
+        if matrices.len() != w.joints
+            || !matrices.iter().all(|m| m.is_finite())
+            || !body.is_finite()
+        {
             return Err(GpuError::Unsupported(format!(
                 "{} finite skin matrices expected, got {}",
                 w.joints,
@@ -233,7 +236,9 @@ impl SkinnedProps {
 
     /// Character `id`'s body placement and skin matrices as last set.
     pub(super) fn pose(&self, id: CharacterId) -> Option<(Mat4, &[Mat4])> {
-        self.wearers.get(&id).map(|w| (w.body, w.matrices.as_slice()))
+        self.wearers
+            .get(&id)
+            .map(|w| (w.body, w.matrices.as_slice()))
     }
 
     /// Upper bounds of a frame's instances, matrices and posed vertices.

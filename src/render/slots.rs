@@ -56,6 +56,9 @@ pub struct FrameReport {
     /// The volume tier: characters drawn as their density volume alone, and those blended
     /// between strands and volume.
     pub volume_characters: (u32, u32),
+    /// With `FrameOptions::probe_roots`: per crowd bundle, its first strand's root as the GPU
+    /// placed it this frame (world), and the character slot + 1 in w (0: no bundle).
+    pub roots: Option<Vec<[f32; 4]>>,
 }
 
 impl FrameReport {
@@ -77,6 +80,8 @@ pub(crate) struct Pending {
     pub frame_graph: Option<String>,
     /// Volume-only and blended characters.
     pub volume_characters: (u32, u32),
+    /// The frame probed roots (`FrameOptions::probe_roots`) of this many bundles.
+    pub probe_roots: Option<u32>,
 }
 
 /// One frame in flight.
@@ -92,6 +97,8 @@ pub(crate) struct FrameSlot {
     pub skin_matrices: Buffer,
     pub skin_jobs: Buffer,
     pub skinned: Buffer,
+    /// The root probe's output (host-visible), sized for the crowd's bundles.
+    pub root_probe: Buffer,
     pub stats_readback: Buffer,
     pub image_readback: Option<Buffer>,
     /// Motion vectors for the host (`uvec4` per pixel), when asked for.
@@ -121,6 +128,7 @@ impl FrameSlot {
             skin_matrices: host_table(ctx, "skin matrices", 64)?,
             skin_jobs: host_table(ctx, "skin jobs", 16)?,
             skinned: skinned_buffer(ctx, 1)?,
+            root_probe: host_table(ctx, "root probe", 16)?,
             stats_readback: Buffer::new(
                 ctx,
                 &BufferDesc::new(

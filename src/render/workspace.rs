@@ -39,6 +39,8 @@ pub struct FrameBuffers<'a> {
     /// Skinned meshes' rest vertices and indices, once set; the frame slot's skin matrices,
     /// skinning jobs and posed vertices.
     pub skin: [Option<&'a Buffer>; 5],
+    /// The frame slot's root probe output.
+    pub root_probe: &'a Buffer,
     /// The light's maps.
     pub shadow: &'a super::targets::ShadowMaps,
     /// The temporal history this frame reads and writes, once made.
@@ -230,6 +232,7 @@ impl Workspace {
                 FrameBinding::SkinMatrices => frame.skin[2].unwrap_or(&self.placeholder),
                 FrameBinding::SkinJobs => frame.skin[3].unwrap_or(&self.placeholder),
                 FrameBinding::SkinnedVertices => frame.skin[4].unwrap_or(&self.placeholder),
+                FrameBinding::RootProbe => frame.root_probe,
                 FrameBinding::OitNodes
                 | FrameBinding::OitTail
                 | FrameBinding::PeelDepth

@@ -97,12 +97,19 @@ mod tests {
             indices,
         };
         let far = far_mesh(&mesh, 0.1);
-        assert!(far.indices.len() * 8 < mesh.indices.len(), "{}", far.indices.len());
+        assert!(
+            far.indices.len() * 8 < mesh.indices.len(),
+            "{}",
+            far.indices.len()
+        );
         assert!(!far.indices.is_empty());
         for v in &far.vertices {
             assert!(mesh.vertices.contains(v));
         }
-        let max = far.vertices.iter().fold(Vec3::MIN, |m, v| m.max(v.position));
+        let max = far
+            .vertices
+            .iter()
+            .fold(Vec3::MIN, |m, v| m.max(v.position));
         assert!(max.x > 0.9 && max.y > 0.9, "{max}");
     }
 }

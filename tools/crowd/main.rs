@@ -185,6 +185,8 @@ pub fn portrait_camera(model: glam::Mat4, view: &str) -> Camera {
 pub struct Scene {
     characters: Vec<preset::CrowdCharacter>,
     baked: Vec<hairmesh::BakedHairMesh>,
+    /// Per character, its bundles' first roots in its own frame (the root-gap reference).
+    expected: Vec<Vec<glam::Vec3>>,
     /// Seconds to generate and bake.
     pub generate_s: f64,
 }
@@ -209,9 +211,15 @@ impl Scene {
                 |_, _| {},
             )?);
         }
+        let expected = characters
+            .iter()
+            .zip(&baked)
+            .map(|(c, b)| hairmesh::characters::people::expected_roots(b, &c.hair.style))
+            .collect();
         Ok(Scene {
             characters,
             baked,
+            expected,
             generate_s: start.elapsed().as_secs_f64(),
         })
     }
@@ -311,25 +319,45 @@ impl Scene {
         Ok(anim)
     }
 
-    /// Largest distance of a person's hair roots from the scalp of the head drawn with them
-    /// this frame, in head radii (0 without people): the roots as last posed by `animation`
-    /// (or at rest), both placed as `renderer` draws them.
-    pub fn root_gap(&self, renderer: &Renderer, animation: &CrowdAnimation) -> Result<f32> {
+    /// Largest distance, in head radii, of a person's hair roots as the GPU placed them
+    /// this frame (`report.roots`: the hair's model and textures) from where the skinned scalp
+    /// carries them (the body's placement and head joint), over every person (0 without
+    /// people). Fails when the frame did not probe roots or missed a person.
+    pub fn root_gap(
+        &self,
+        renderer: &Renderer,
+        report: &hairmesh::render::FrameReport,
+    ) -> Result<f32> {
+        let Some(roots) = report.roots.as_deref() else {
+            bail!("the frame did not probe roots");
+        };
         let mut worst = 0.0f32;
-        for (c, id) in self.characters.iter().zip(renderer.crowd().ids()) {
-            if !matches!(c.body, preset::Body::Person(_)) {
-                continue;
-            }
-            let (Some(model), Some(head)) = (
-                renderer.drawn_model(id),
-                renderer.character_prop_models(id).first().copied(),
-            ) else {
+        let ids = renderer.crowd().ids();
+        for ((c, id), expected) in self.characters.iter().zip(ids).zip(&self.expected) {
+            let preset::Body::Person(p) = c.body else {
                 continue;
             };
-            let roots = animation
-                .roots(id)
-                .unwrap_or(c.hair.mesh.layers[0].as_slice());
-            worst = worst.max(hairmesh::characters::person::root_gap(head, model, roots)?);
+            let Some((body, skin)) = renderer.character_pose(id) else {
+                continue;
+            };
+            let probed = hairmesh::characters::people::probed_roots(roots, id.slot());
+            let head_joint = skin.last().copied().unwrap_or_default();
+            let gap = hairmesh::characters::people::root_gap(
+                &probed,
+                expected,
+                (body, head_joint),
+                p.head_transform()?,
+                p.head_scale(),
+            )
+            .ok_or_else(|| {
+                anyhow::anyhow!(
+                    "the root probe found {} of {} roots of character {}",
+                    probed.len(),
+                    expected.len(),
+                    id.slot()
+                )
+            })?;
+            worst = worst.max(gap);
         }
         Ok(worst)
     }
@@ -517,11 +545,12 @@ fn run(args: Args) -> Result<()> {
                 read_image: true,
                 raster: settings.raster,
                 light_raster: settings.light_raster,
+                probe_roots: true,
                 ..Default::default()
             },
         )?;
         let wall_ms = t.elapsed().as_secs_f64() * 1e3;
-        let root_gap = scene.root_gap(&renderer, &animation)?;
+        let root_gap = scene.root_gap(&renderer, &report)?;
         if ctx.validation_errors() > 0 {
             bail!(
                 "{} Vulkan validation error(s) in frame {f}; no image written",

@@ -10,6 +10,7 @@ pub mod lhs_skin;
 pub mod output;
 pub mod pool_segments;
 pub mod props;
+pub mod root_probe;
 pub mod scalp;
 pub mod shadow;
 pub mod skin;
@@ -522,6 +523,8 @@ pub struct FrameInputs<'a> {
     pub props: &'a [PropDraw],
     /// Skinning jobs and the most vertices of one (0 jobs: no skinning pass).
     pub skin: (u32, u32),
+    /// The root probe's output and the bundles to probe, when the frame probes roots.
+    pub probe: Option<(crate::render::graph::Res, u32)>,
     /// Shadow mode of this frame; `None` when off (or nothing to shadow).
     pub shadow: Option<super::shadow::ShadowMode>,
     /// How the strands are composited.
@@ -556,6 +559,7 @@ pub struct FramePasses {
     shadow: ShadowPass,
     props: PropPass,
     skin: skin::SkinPass,
+    root_probe: root_probe::RootProbePass,
     scalp: ScalpPass,
     strands: StrandDraw,
     transparency: TransparencyPass,
@@ -639,6 +643,7 @@ impl FramePasses {
             shadow: ShadowPass::new(ctx, layout, task_bundles)?,
             props: PropPass::new(ctx, layout, camera)?,
             skin: skin::SkinPass::new(ctx, layout)?,
+            root_probe: root_probe::RootProbePass::new(ctx, layout)?,
             scalp: ScalpPass::new(ctx, layout, targets)?,
             strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
@@ -796,6 +801,9 @@ impl FramePasses {
         }
         let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
         self.skin.add(g, r, inp.sets, inp.skin);
+        if let Some(probe) = inp.probe {
+            self.root_probe.add(g, r, inp.sets, probe);
+        }
         if let Some(mode) = inp.shadow {
             self.add_light(g, r, &inp, mode)?;
             // The camera's statistics start from zero again.
