@@ -22,14 +22,15 @@ fn worst_gap(frames: u32, lag: bool) -> f32 {
     };
     let walker: Walker = c.walker.unwrap();
     assert!(walker.outfit.walks);
-    let baked = hairmesh::bake(&c.hair.mesh, &c.hair.style, Default::default(), |_, _| {})
-        .unwrap();
+    let baked = hairmesh::bake(&c.hair.mesh, &c.hair.style, Default::default(), |_, _| {}).unwrap();
     let mut r = common::renderer(&ctx, 64);
     let params = StrandParams {
         strands_per_bundle: 4,
         verts_log2: 3,
     };
-    let id = r.add_character(&baked, &c.hair.style, params, c.model).unwrap();
+    let id = r
+        .add_character(&baked, &c.hair.style, params, c.model)
+        .unwrap();
     r.set_skinned_meshes(&skinned_meshes().unwrap()).unwrap();
     preset::dress(&mut r, id, &c).unwrap();
     let mut anim = CrowdAnimation::new();
@@ -75,5 +76,8 @@ fn roots_follow_the_skinned_head_and_a_lag_is_caught() {
     println!("root gap in step {in_step:.5}, hair one frame late {lagging:.5} head radii");
     assert!(in_step < 0.01, "in step: {in_step} head radii");
     // Measured on lavapipe: 0.366 head radii; the crowd's bound (0.01) must catch it.
-    assert!(lagging > 0.01, "one frame of lag shows only {lagging} head radii");
+    assert!(
+        lagging > 0.01,
+        "one frame of lag shows only {lagging} head radii"
+    );
 }

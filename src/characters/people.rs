@@ -396,3 +396,153 @@ pub fn root_gap(
             .fold(0.0, f32::max),
     )
 }
+
+/// The bones whose capsules hair collides with: the shoulders (clavicle to upper arm),
+/// radii fitted to the shirt.
+const COLLIDER_BONES: [(&str, &str); 2] =
+    [("clavicle_l", "upperarm_l"), ("clavicle_r", "upperarm_r")];
+
+/// The neck the hair meets: the Sintel bust's (canonical frame; axis ends and radius).
+const NECK: (Vec3, Vec3, f32) = (
+    Vec3::new(0.0, 1.40, -0.025),
+    Vec3::new(0.0, 1.50, -0.015),
+    0.048,
+);
+
+/// Colliders for the hair dynamics of a person of `figure` shaped `person`, in the person
+/// frame (canonical scaled by height): the bust's neck, capsules fitted to the figure's
+/// shoulder bones at bind time (each radius the median distance from the bone of the shirt's
+/// vertices it moves by a quarter or more), an ellipsoid over the upper chest and back (the
+/// shirt's vertices the upper spine moves, their box), then the head itself (last: where the
+/// neck and the jaw disagree, the head wins). Not yet: they stay where the bind pose puts
+/// them relative to the head, rather than following their bones through the clip.
+pub fn colliders(
+    figure: Figure,
+    person: &super::person::PersonShape,
+) -> Result<Vec<crate::dynamics::Collider>> {
+    use crate::dynamics::Collider;
+    let c = &figures()?[figure as usize];
+    let s = &c.skeleton;
+    let rest = s.globals(&s.rest_pose());
+    let joint = |name: &str| -> Result<usize> {
+        s.find(name)
+            .ok_or_else(|| HairError::invalid("hairmeshes/people", format!("no joint {name}")))
+    };
+    let shirt = c
+        .meshes
+        .iter()
+        .find(|m| m.name == "shirt")
+        .ok_or_else(|| HairError::invalid("hairmeshes/people", "no shirt"))?;
+    // The shirt's vertices joint `j` moves by a quarter or more.
+    let moved_by = |j: usize| {
+        shirt
+            .vertices
+            .iter()
+            .filter(move |v| (0..4).any(|k| v.joints[k] as usize == j && v.weights[k] >= 0.25))
+            .map(|v| v.position)
+    };
+    let h = person.height;
+    let mut out = vec![Collider::Capsule {
+        a: NECK.0 * h,
+        b: NECK.1 * h,
+        radius: NECK.2 * h,
+    }];
+    for (from, to) in COLLIDER_BONES {
+        let (j, k) = (joint(from)?, joint(to)?);
+        let (a, b) = (rest[j].w_axis.truncate(), rest[k].w_axis.truncate());
+        let mut d: Vec<f32> = moved_by(j).map(|p| segment_distance(p, a, b)).collect();
+        if d.is_empty() {
+            return Err(HairError::invalid(
+                "hairmeshes/people",
+                format!("no shirt vertex follows joint {from}"),
+            ));
+        }
+        d.sort_by(f32::total_cmp);
+        out.push(Collider::Capsule {
+            a: a * h,
+            b: b * h,
+            radius: d[d.len() / 2] * h,
+        });
+    }
+    let (lo, hi) = moved_by(joint("spine_03")?)
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    if lo.x > hi.x {
+        return Err(HairError::invalid(
+            "hairmeshes/people",
+            "no shirt vertex follows the chest",
+        ));
+    }
+    out.push(Collider::Ellipsoid {
+        centre: (lo + hi) * 0.5 * h,
+        radii: (hi - lo) * 0.5 * h,
+    });
+    out.push(Collider::head(
+        &super::human::human_head()?.map,
+        person.head_transform()?,
+        0.005,
+    ));
+    Ok(out)
+}
+
+/// Distance of `p` from the segment `a..b`.
+fn segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
+    p.distance(a + ab * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Both figures load with every part and the same skeleton size, and their colliders are
+    /// body-sized: the neck, shoulder capsules of radius 3-12 cm above 1.1 m, a chest
+    /// ellipsoid of half-axes 5-30 cm, then the head.
+    #[test]
+    fn figures_and_their_colliders() {
+        use crate::dynamics::Collider;
+        let f = figures().unwrap();
+        assert_eq!(f[0].skeleton.joints.len(), f[1].skeleton.joints.len());
+        let person = super::super::person::PersonShape::default();
+        for figure in [Figure::Man, Figure::Woman] {
+            let c = colliders(figure, &person).unwrap();
+            assert_eq!(c.len(), COLLIDER_BONES.len() + 3, "{figure:?}");
+            for k in &c[1..=COLLIDER_BONES.len()] {
+                let Collider::Capsule { a, b, radius } = *k else {
+                    panic!("{k:?}")
+                };
+                println!("{figure:?}: {a} .. {b}, radius {radius}");
+                assert!(
+                    (0.03..0.12).contains(&radius),
+                    "{figure:?}: radius {radius}"
+                );
+                assert!(a.y > 1.1 && b.y > 1.1, "{figure:?}: {a} {b}");
+            }
+            let Collider::Ellipsoid { centre, radii } = c[COLLIDER_BONES.len() + 1] else {
+                panic!("no chest")
+            };
+            println!("{figure:?}: chest {centre} radii {radii}");
+            assert!(
+                radii.min_element() > 0.05 && radii.max_element() < 0.3,
+                "{radii}"
+            );
+            assert!(matches!(c.last(), Some(Collider::Head { .. })));
+        }
+        let meshes = skinned_meshes().unwrap();
+        assert_eq!(meshes.len(), 2 * FAR_MESHES);
+        // Far versions never have more triangles; the bodies, clothes and head lose most.
+        let (mut near_all, mut far_all) = (0, 0);
+        for k in 0..FAR_MESHES {
+            let (near, far) = (&meshes[k], &meshes[FAR_MESHES + k]);
+            println!(
+                "{}: {} -> {} triangles",
+                near.name,
+                near.indices.len() / 3,
+                far.indices.len() / 3
+            );
+            assert!(far.indices.len() <= near.indices.len(), "{}", near.name);
+            (near_all, far_all) = (near_all + near.indices.len(), far_all + far.indices.len());
+        }
+        assert!(far_all * 3 < near_all, "{far_all} of {near_all}");
+    }
+}

@@ -164,7 +164,10 @@ fn crowd(r: &mut Renderer) -> Result<CrowdAnimation> {
         let id = r.add_character(&baked, &c.hair.style, c.strand_params(params), c.model)?;
         preset::dress(r, id, c)?;
         let colliders: Vec<Collider> = match c.body {
-            preset::Body::Person(p) => p.colliders()?,
+            preset::Body::Person(p) => match &c.walker {
+                Some(w) => hairmesh::characters::people::colliders(w.outfit.figure, &p)?,
+                None => p.colliders()?,
+            },
             _ => Vec::new(),
         };
         r.make_deformable(id, DeformBasis::new(&c.hair.mesh, &baked, options)?)?;

@@ -293,7 +293,10 @@ impl Scene {
                 },
             };
             let colliders = match c.body {
-                preset::Body::Person(p) => Some(p.colliders()?),
+                preset::Body::Person(p) => Some(match &c.walker {
+                    Some(w) => hairmesh::characters::people::colliders(w.outfit.figure, &p)?,
+                    None => p.colliders()?,
+                }),
                 preset::Body::Ball => {
                     let h = preset::ball_head();
                     Some(vec![Collider::Ellipsoid {
