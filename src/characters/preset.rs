@@ -238,26 +238,29 @@ pub fn build_families(
 }
 
 /// Person `i` of `count` on a grid of `side` columns, placed at `model`: half the people (all
-/// of a crowd of four or fewer) walk round the crowd's centre through their own place, on
-/// rings turning one way and the other by the ring's distance, the others stand.
+/// of a crowd of four or fewer) walk, the others stand. Walkers all go the same way round one
+/// centre beside the crowd, each on the ring through their own place, so they move along
+/// parallel arcs at the same speed and never meet each other, turning gently enough
+/// (rings of at least [`MIN_RING_RADIUS`](crate::animate::walk::MIN_RING_RADIUS)) that their
+/// planted feet stay put. Not yet: walkers pass through people who stand in their way.
 fn person_walker(
     p: PersonShape,
     seed: u32,
     (i, count, side): (usize, usize, usize),
     model: Mat4,
 ) -> crate::animate::walk::Walker {
-    use crate::animate::walk::{WalkPath, Walker};
+    use crate::animate::walk::{MIN_RING_RADIUS, WalkPath, Walker};
     let walks = count <= 4 || i % 2 == 0;
     let outfit = super::people::Outfit::draw(seed, walks);
-    let centre = Vec3::new(0.0, 0.0, (side as f32 - 1.0) * 0.5 * SPACING);
+    let half = (side as f32 - 1.0) * 0.5 * SPACING;
+    let centre = Vec3::new(-(half + MIN_RING_RADIUS), 0.0, half);
     let at = model.w_axis.truncate() - centre;
-    let radius = Vec3::new(at.x, 0.0, at.z).length().max(0.6);
     let path = match walks {
         true => WalkPath::Ring {
             centre,
-            radius,
+            radius: Vec3::new(at.x, 0.0, at.z).length().max(MIN_RING_RADIUS),
             angle: at.z.atan2(at.x),
-            clockwise: ((radius / SPACING).round() as i32) % 2 == 0,
+            clockwise: false,
         },
         false => WalkPath::Stand(model),
     };
