@@ -7,7 +7,6 @@ use std::sync::Arc;
 
 use super::{FrameRes, PassSets, device_shader_options, dispatch_2d};
 use crate::render::graph::{FrameGraph, Res};
-use crate::render::shared::SKIN_GROUP_SIZE;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 
@@ -43,7 +42,8 @@ impl RootProbePass {
             .record(move |rec, _| {
                 rec.bind(&self.pipeline, &sets.both());
                 rec.push_constants(&self.pipeline, &[bundles, 0u32, 0, 0]);
-                let (x, y) = dispatch_2d(bundles.div_ceil(SKIN_GROUP_SIZE));
+                // One workgroup a bundle (`root_probe.comp`: uniform texture index).
+                let (x, y) = dispatch_2d(bundles);
                 rec.dispatch(x, y, 1);
                 Ok(())
             });
