@@ -2,7 +2,8 @@
 //! over every frame the renderer can draw: each valid combination of generation path x strand
 //! raster x shadows x transparency x MSAA (as `FrameSettings::validate` decides), with the
 //! volume tier off, occluding, blending and alone in turn, two frames in
-//! flight each on small images, then the static and LHS paths and an animated hair mesh (posed
+//! flight each on small images, every frame with skinned bodies (the skinning pass) and every
+//! other one probing roots, then the static and LHS paths and an animated hair mesh (posed
 //! from the CPU, then simulated on the GPU). Any
 //! validation message fails. The frame graph derives every barrier from the passes' declared
 //! uses; the last test removes one declared read and shows validation catches it.
@@ -39,9 +40,20 @@ fn params() -> StrandParams {
 fn scene(ctx: &Arc<Context>, desc: RendererDesc) -> (Renderer, View) {
     let (baked, style) = sample("head_long.obj");
     let mut r = Renderer::new(ctx, &desc.size(40, 32)).unwrap();
+    // Each character also wears the man's skinned body in the walk (the skinning pass, read
+    // by the camera's and the light's prop passes), small and beside its hair.
+    let meshes = hairmesh::characters::people::skinned_meshes().unwrap();
+    r.set_skinned_meshes(&meshes).unwrap();
+    let man = &hairmesh::characters::people::figures().unwrap()[0];
+    let walk = man.clip("walk").unwrap();
+    let pose = man.skeleton.skin_matrices(&walk.sample(&man.skeleton, 0.3));
+    let parts: Vec<(usize, [f32; 4])> = (0..5).map(|k| (k, [0.5, 0.4, 0.3, 1.0])).collect();
     for x in [-0.15f32, 0.15] {
         let model = Mat4::from_translation(Vec3::new(x, 0.0, 0.0));
-        r.add_character(&baked, &style, params(), model).unwrap();
+        let id = r.add_character(&baked, &style, params(), model).unwrap();
+        r.set_character_skin(id, &parts, pose.len()).unwrap();
+        let body = model * Mat4::from_scale(Vec3::splat(0.2));
+        r.set_character_pose(id, body, &pose).unwrap();
     }
     let view = View {
         shading: ShadingModel::Marschner,
@@ -145,6 +157,7 @@ fn every_pass_combination_is_free_of_hazards() {
                             light_raster,
                             read_image: valid % 2 == 0,
                             read_motion: valid % 3 == 1,
+                            probe_roots: valid % 2 == 1,
                             ..Default::default()
                         };
                         let what = format!(
@@ -268,6 +281,29 @@ fn a_missing_declared_read_is_caught() {
         ..Default::default()
     };
     r.render_one(&view, &opts).unwrap();
+    let messages = ctx.validation_messages();
+    assert!(
+        messages.iter().any(|m| m.contains("SYNC-HAZARD")),
+        "no hazard reported: {messages:#?}"
+    );
+}
+
+#[test]
+fn a_missing_skinned_read_is_caught() {
+    // The opaque pass draws the bodies the skinning pass posed this frame: leave out its
+    // declared read of the posed vertices and nothing orders the vertex reads after the
+    // compute writes.
+    let ctx = sync_context();
+    let desc = RendererDesc {
+        omit_use: Some((
+            "opaque".into(),
+            "skinned vertices".into(),
+            Some(Access::VertexRead),
+        )),
+        ..RendererDesc::default()
+    };
+    let (mut r, view) = scene(&ctx, desc);
+    r.render_one(&view, &FrameOptions::default()).unwrap();
     let messages = ctx.validation_messages();
     assert!(
         messages.iter().any(|m| m.contains("SYNC-HAZARD")),
