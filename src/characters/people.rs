@@ -318,20 +318,31 @@ pub fn pose(outfit: &Outfit, t: f32, head_shape: Vec3) -> Result<(Vec<Mat4>, Mat
     Ok((m, h))
 }
 
+/// The figures' walk ground speeds, measured once (walkers ask every frame).
+static WALK_SPEEDS: OnceLock<std::result::Result<[f32; 2], String>> = OnceLock::new();
+
 /// Ground speed of a figure's walk (metres per second at scale 1): the speed its planted feet
-/// move backward, which the root must move forward at ([`crate::skin::ground_speed`]).
+/// move backward, which the root must move forward at ([`crate::skin::ground_speed`]);
+/// measured on the first call, the same thereafter.
 pub fn walk_speed(figure: Figure) -> Result<f32> {
-    let c = &figures()?[figure as usize];
-    let s = &c.skeleton;
-    let walk = c
-        .clip("walk")
-        .ok_or_else(|| HairError::invalid("hairmeshes/people", "no walk clip"))?;
-    let feet: Vec<usize> = ["ball_l", "ball_r"]
-        .iter()
-        .filter_map(|n| s.find(n))
-        .collect();
-    crate::skin::ground_speed(s, walk, &feet, 0.01)
-        .ok_or_else(|| HairError::invalid("hairmeshes/people", "the walk does not plant its feet"))
+    let speeds = WALK_SPEEDS.get_or_init(|| {
+        let measure = |c: &Character| {
+            let s = &c.skeleton;
+            let walk = c.clip("walk").ok_or("no walk clip")?;
+            let feet: Vec<usize> = ["ball_l", "ball_r"]
+                .iter()
+                .filter_map(|n| s.find(n))
+                .collect();
+            crate::skin::ground_speed(s, walk, &feet, 0.01)
+                .ok_or("the walk does not plant its feet")
+        };
+        let f = figures().map_err(|e| e.to_string())?;
+        Ok([measure(&f[0])?, measure(&f[1])?])
+    });
+    speeds
+        .as_ref()
+        .map(|s| s[figure as usize])
+        .map_err(|e| HairError::invalid("hairmeshes/people", e.clone()))
 }
 
 /// Where a person's hair and body go: the hair lives in the person frame (canonical scaled
