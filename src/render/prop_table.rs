@@ -64,18 +64,7 @@ impl Props {
     /// The mesh an instance of `mesh` at `model` is drawn with: its far version where the
     /// camera sees it small.
     fn mesh_for(&self, mesh: usize, model: &Mat4, camera: &Projection) -> usize {
-        let Some((far, below)) = self.far[mesh] else {
-            return mesh;
-        };
-        let (centre, radius) = self.bounds[mesh];
-        let scale = model
-            .x_axis
-            .truncate()
-            .length()
-            .max(model.y_axis.truncate().length())
-            .max(model.z_axis.truncate().length());
-        let pixels = camera.pixels(model.transform_point3(centre), radius * scale);
-        if pixels < below { far } else { mesh }
+        far_choice(mesh, self.far[mesh], self.bounds[mesh], model, camera)
     }
 
     /// This frame's instance records (sorted by mesh) and one draw per mesh: the world props
@@ -189,31 +178,7 @@ impl Props {
     /// is its own far version, a far version with one of its own, and thresholds that are
     /// not finite and non-negative.
     pub(super) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
-        let n = self.meshes.len();
-        for l in lods {
-            let bad = if l.mesh >= n || l.far_mesh >= n {
-                Some(format!("no prop mesh {}", l.mesh.max(l.far_mesh)))
-            } else if l.mesh == l.far_mesh || lods.iter().any(|o| o.mesh == l.far_mesh) {
-                Some(format!(
-                    "prop mesh {} cannot be a far version and have one",
-                    l.far_mesh
-                ))
-            } else if !(l.below_pixels.is_finite() && l.below_pixels >= 0.0) {
-                Some(format!(
-                    "far prop threshold {} is not a finite pixel count",
-                    l.below_pixels
-                ))
-            } else {
-                None
-            };
-            if let Some(e) = bad {
-                return Err(GpuError::Unsupported(e));
-            }
-        }
-        self.far = vec![None; n];
-        for l in lods {
-            self.far[l.mesh] = Some((l.far_mesh, l.below_pixels));
-        }
+        self.far = far_table(lods, self.meshes.len())?;
         Ok(())
     }
 
@@ -245,6 +210,60 @@ impl Props {
             .map(|(_, _, i)| model * Mat4::from_cols_array_2d(&i.model))
             .collect()
     }
+}
+
+/// The far version table of `n` meshes from `lods`: refuses unknown meshes, a mesh that is
+/// its own far version, a far version with one of its own, and thresholds that are not
+/// finite and non-negative.
+pub(super) fn far_table(lods: &[PropLod], n: usize) -> GpuResult<Vec<Option<(usize, f32)>>> {
+    for l in lods {
+        let bad = if l.mesh >= n || l.far_mesh >= n {
+            Some(format!("no prop mesh {}", l.mesh.max(l.far_mesh)))
+        } else if l.mesh == l.far_mesh || lods.iter().any(|o| o.mesh == l.far_mesh) {
+            Some(format!(
+                "prop mesh {} cannot be a far version and have one",
+                l.far_mesh
+            ))
+        } else if !(l.below_pixels.is_finite() && l.below_pixels >= 0.0) {
+            Some(format!(
+                "far prop threshold {} is not a finite pixel count",
+                l.below_pixels
+            ))
+        } else {
+            None
+        };
+        if let Some(e) = bad {
+            return Err(GpuError::Unsupported(e));
+        }
+    }
+    let mut far = vec![None; n];
+    for l in lods {
+        far[l.mesh] = Some((l.far_mesh, l.below_pixels));
+    }
+    Ok(far)
+}
+
+/// The mesh an instance of `mesh` (bounding sphere `(centre, radius)` in its own frame) at
+/// `model` is drawn with: `far`'s mesh where `camera` sees the sphere, scaled by the model's
+/// largest axis, smaller than `far`'s pixel threshold.
+pub(super) fn far_choice(
+    mesh: usize,
+    far: Option<(usize, f32)>,
+    (centre, radius): (Vec3, f32),
+    model: &Mat4,
+    camera: &Projection,
+) -> usize {
+    let Some((far, below)) = far else {
+        return mesh;
+    };
+    let scale = model
+        .x_axis
+        .truncate()
+        .length()
+        .max(model.y_axis.truncate().length())
+        .max(model.z_axis.truncate().length());
+    let pixels = camera.pixels(model.transform_point3(centre), radius * scale);
+    if pixels < below { far } else { mesh }
 }
 
 /// A bounding sphere of a triangle list: the box's centre and the farthest vertex from it.

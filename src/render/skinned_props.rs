@@ -145,28 +145,9 @@ impl SkinnedProps {
         Ok(old.into_iter().flatten().collect())
     }
 
-    /// Give skinned meshes far versions (as [`super::prop_table::Props::set_lods`]).
+    /// Give skinned meshes far versions (checked as the static props' are).
     pub(super) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
-        let n = self.meshes.len();
-        for l in lods {
-            let chained = lods.iter().any(|o| o.mesh == l.far_mesh);
-            if l.mesh >= n || l.far_mesh >= n || l.mesh == l.far_mesh || chained {
-                return Err(GpuError::Unsupported(format!(
-                    "skinned far version {} of mesh {}: no such mesh, or a chain",
-                    l.far_mesh, l.mesh
-                )));
-            }
-            if !(l.below_pixels.is_finite() && l.below_pixels >= 0.0) {
-                return Err(GpuError::Unsupported(format!(
-                    "far prop threshold {} is not a finite pixel count",
-                    l.below_pixels
-                )));
-            }
-        }
-        self.far = vec![None; n];
-        for l in lods {
-            self.far[l.mesh] = Some((l.far_mesh, l.below_pixels));
-        }
+        self.far = super::prop_table::far_table(lods, self.meshes.len())?;
         Ok(())
     }
 
@@ -324,16 +305,7 @@ impl SkinnedProps {
 
     /// The mesh an instance of `mesh` at `model` is drawn with.
     fn mesh_for(&self, mesh: usize, model: &Mat4, camera: &Projection) -> usize {
-        let Some((far, below)) = self.far[mesh] else {
-            return mesh;
-        };
         let r = self.meshes[mesh];
-        let scale = model
-            .x_axis
-            .truncate()
-            .length()
-            .max(model.y_axis.truncate().length());
-        let pixels = camera.pixels(model.transform_point3(r.centre), r.radius * scale);
-        if pixels < below { far } else { mesh }
+        super::prop_table::far_choice(mesh, self.far[mesh], (r.centre, r.radius), model, camera)
     }
 }
