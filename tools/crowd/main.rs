@@ -525,7 +525,16 @@ fn run(args: Args) -> Result<()> {
                     50.0,
                 )
             }
-            view => portrait_camera(characters[0].model, view),
+            // Where the first character will be drawn this frame: a person's head-bound frame
+            // at the time the animation is about to reach, else its placement.
+            view => {
+                let dt = if animation.moving { 1.0 / 30.0 } else { 0.0 };
+                let model = match &characters[0].walker {
+                    Some(w) => w.frame(animation.time() + dt)?.hair,
+                    None => characters[0].model,
+                };
+                portrait_camera(model, view)
+            }
         };
         // Headless frames are 1/30 s apart in animation time.
         animation.advance(&mut renderer, 1.0 / 30.0, &camera, height)?;
