@@ -18,7 +18,7 @@
 use glam::{Vec2, Vec3};
 
 use super::human::direction;
-use super::person::{PersonShape, PlacedHead};
+use super::person::{GrowthSite, PersonShape, PlacedHead};
 use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::dynamics::Collider;
 use crate::error::Result;
@@ -551,22 +551,16 @@ struct Settle<'a> {
 const FACE_SHIELD: (Vec3, Vec3) = (Vec3::new(0.0, 1.47, 0.055), Vec3::new(0.078, 0.115, 0.075));
 
 impl Settle<'_> {
-    fn new<'a>(head: &'a PlacedHead, person: &PersonShape) -> Result<Settle<'a>> {
-        let place = person.head_transform()?;
+    fn new(site: &GrowthSite) -> Settle<'_> {
         let (c, r) = FACE_SHIELD;
-        let s = person.head * person.height;
-        Ok(Settle {
-            head,
-            body: person
-                .colliders()?
-                .into_iter()
-                .filter(|c| !matches!(c, Collider::Head { .. }))
-                .collect(),
+        Settle {
+            head: &site.head,
+            body: site.body.clone(),
             face: Collider::Ellipsoid {
-                centre: place.transform_point3(c),
-                radii: r * s,
+                centre: site.head.to_person.transform_point3(c),
+                radii: r * site.proportions,
             },
-        })
+        }
     }
 
     /// `p` kept `lift` outside the head, the face shield and the body.
@@ -816,18 +810,18 @@ fn tail_path(settle: &Settle, tie: &Tie, length: f32, gravity: f32) -> Vec<Vec3>
     }
 }
 
-/// A hair mesh of `family` for `person`, drawn from `rng`.
+/// A hair mesh of `family` grown on `site`, drawn from `rng`.
 fn grown(
     family: StyleFamily,
-    person: &PersonShape,
+    site: &GrowthSite,
     rng: &mut Pcg32,
     name: &str,
     margin: f32,
 ) -> Result<HairMesh> {
     let cut = cut(family, rng);
-    let head = person.head()?;
-    let settle = Settle::new(&head, person)?;
-    let scale = person.height;
+    let head = site.head;
+    let settle = Settle::new(site);
+    let scale = site.height;
     let length = range(rng, cut.length.0, cut.length.1) * scale;
     let hem_y = cut.hem.map_or(f32::NEG_INFINITY, |(a, b)| {
         head.centre().y - range(rng, a, b) * scale
@@ -1008,7 +1002,7 @@ fn lift_bundle_interiors(
 /// The Sintel hair mesh (`fit` of the Sintel Lite strands with 20 bundles and 6 layers,
 /// `hairmeshes/sintel_crowd.obj`) on its own head, its roots snapped onto the scalp, placed like the person's head; each copy's hair (not its scalp) is a little longer or
 /// shorter, in the person's own colour.
-fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hairstyle> {
+fn fitted_sintel(seed: u32, site: &GrowthSite, rng: &mut Pcg32) -> Result<Hairstyle> {
     let mesh = crate::model::obj_io::parse_hair_mesh_obj(
         "hairmeshes/sintel_crowd.obj",
         include_bytes!("../../hairmeshes/sintel_crowd.obj"),
@@ -1017,10 +1011,10 @@ fn fitted_sintel(seed: u32, person: &PersonShape, rng: &mut Pcg32) -> Result<Hai
         "hairmeshes/sintel_crowd.toml",
         include_str!("../../hairmeshes/sintel_crowd.toml"),
     )?;
-    let place = person.head_transform()? * super::human::file_to_canonical();
-    let scale = super::human::FILE_SCALE * person.head_scale();
+    let head = site.head;
+    let place = head.to_person * super::human::file_to_canonical();
+    let scale = super::human::FILE_SCALE * head.scale;
     let stretch = range(rng, 0.85, 1.15);
-    let head = person.head()?;
     // Each column moves with its root, snapped radially onto the scalp.
     let snapped: Vec<(Vec3, Vec3)> = mesh.layers[0]
         .iter()
@@ -1096,13 +1090,19 @@ fn family_rng(seed: u32, family: StyleFamily) -> Pcg32 {
 
 /// Generate a hairstyle of `family` for `person` from `seed`.
 pub fn generate(family: StyleFamily, seed: u32, person: &PersonShape) -> Result<Hairstyle> {
+    generate_on(family, seed, &person.site()?)
+}
+
+/// Generate a hairstyle of `family` from `seed` on the head and body of `site` (any head
+/// normalized into the canonical frame: [`super::any_head`]).
+pub fn generate_on(family: StyleFamily, seed: u32, site: &GrowthSite) -> Result<Hairstyle> {
     let mut rng = family_rng(seed, family);
     if family == StyleFamily::Fitted {
-        return fitted_sintel(seed, person, &mut rng);
+        return fitted_sintel(seed, site, &mut rng);
     }
     let style = style_for(family, seed, &mut rng);
     let name = format!("{family:?} #{seed}");
-    let mesh = grown(family, person, &mut rng, &name, interior_margin(&style))?;
+    let mesh = grown(family, site, &mut rng, &name, interior_margin(&style))?;
     Ok(Hairstyle {
         family,
         mesh,

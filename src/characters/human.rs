@@ -70,11 +70,12 @@ pub struct Eye {
 pub struct HumanHead {
     /// Triangles, canonical character frame, metres.
     pub triangles: Vec<[Vec3; 3]>,
-    /// Triangles closing the mouth's opening (a fan from its centre), drawn with the bust.
+    /// Triangles closing the mouth's opening (a fan from its centre), drawn with the bust
+    /// (none for a head of the user's: [`HumanHead::from_triangles`]).
     pub mouth: Vec<[Vec3; 3]>,
     /// The eyeballs in the two eye sockets (the bust's openings above the mouth), left then
-    /// right.
-    pub eyes: [Eye; 2],
+    /// right (`None` for a head of the user's, which brings its own).
+    pub eyes: Option<[Eye; 2]>,
     /// Centre of the cranium (origin of the radial map).
     pub centre: Vec3,
     /// The head's surface about [`Self::centre`]: what hair dynamics collide with.
@@ -99,13 +100,23 @@ pub fn human_head() -> Result<&'static HumanHead> {
 }
 
 impl HumanHead {
-    /// Parse the bust and build its radial map.
+    /// Parse the bust, build its radial map and find its eyes and mouth.
     pub fn from_obj(name: &str, bytes: &[u8]) -> Result<Self> {
         let triangles: Vec<[Vec3; 3]> = crate::model::obj_io::parse_triangles(name, bytes)?
             .into_iter()
             .map(|t| t.map(from_file))
             .collect();
-        let centre = from_file(FILE_CENTRE);
+        let mut head = Self::from_triangles(name, triangles, from_file(FILE_CENTRE))?;
+        let (eyes, mouth) = face_openings(name, &head.triangles, head.centre)?;
+        head.eyes = Some(eyes);
+        head.mouth = mouth;
+        Ok(head)
+    }
+
+    /// A head from its triangles in the canonical frame (metres) and the centre of its
+    /// cranium: its radial map (the farthest crossing within [`RADIAL_REACH`] in every
+    /// direction), no eyes and no mouth cap. `name` names the source in errors.
+    pub fn from_triangles(name: &str, triangles: Vec<[Vec3; 3]>, centre: Vec3) -> Result<Self> {
         let mut radius = vec![f32::NAN; MAP_ROWS * MAP_COLS];
         // Only triangles that reach within RADIAL_REACH can be hit within it.
         let near: Vec<&[Vec3; 3]> = triangles
@@ -132,11 +143,10 @@ impl HumanHead {
             radius,
         };
         let cranium = map(opened(&radius, EAR_WINDOW));
-        let (eyes, mouth) = face_openings(name, &triangles, centre)?;
         Ok(HumanHead {
             triangles,
-            mouth,
-            eyes,
+            mouth: Vec::new(),
+            eyes: None,
             centre,
             map: map(radius),
             cranium,
@@ -370,7 +380,7 @@ mod tests {
     fn the_eyes_fill_their_sockets_and_the_mouth_is_closed() {
         let head = human_head().unwrap();
         let loops = boundary_loops(&head.triangles);
-        for eye in head.eyes {
+        for eye in head.eyes.unwrap() {
             let rim = loops
                 .iter()
                 .find(|ring| {
@@ -391,7 +401,7 @@ mod tests {
             assert!(worst <= 1.02, "the rim reaches {worst} radii");
             assert!(bulge < 0.5 * eye.radius && eye.radius < 0.04, "{eye:?}");
         }
-        let [l, r] = head.eyes;
+        let [l, r] = head.eyes.unwrap();
         assert!(l.centre.x < -0.01 && r.centre.x > 0.01 && (l.centre.y - r.centre.y).abs() < 1e-3);
         assert!(!head.mouth.is_empty());
         let forward = head

@@ -136,7 +136,10 @@ fn head_meshes() -> Result<[crate::skin::SkinnedMesh; 2]> {
     let bust = super::person::neck_up_mesh()?;
     let mut eyes = Vec::new();
     let mut eye_colors = Vec::new();
-    for eye in head.eyes {
+    let head_eyes = head
+        .eyes
+        .ok_or_else(|| HairError::invalid("hairmeshes/sintel_head.obj", "no eye sockets"))?;
+    for eye in head_eyes {
         let iris = eye.centre + Vec3::Z * (super::preset::IRIS_OFFSET * eye.radius);
         for (centre, radius, color) in [
             (eye.centre, eye.radius, super::preset::SCLERA_COLOR),

@@ -66,11 +66,15 @@ impl PersonShape {
     /// The head's placement (canonical head to person frame): its proportions about the
     /// cranium centre, then the height scale.
     pub fn head_transform(&self) -> Result<Mat4> {
-        let c = human_head()?.centre;
-        Ok(self.body_transform()
+        Ok(self.head_transform_about(human_head()?.centre))
+    }
+
+    /// [`Self::head_transform`] about cranium centre `c`.
+    fn head_transform_about(&self, c: Vec3) -> Mat4 {
+        self.body_transform()
             * Mat4::from_translation(c)
             * Mat4::from_scale(self.head)
-            * Mat4::from_translation(-c))
+            * Mat4::from_translation(-c)
     }
 
     /// Mean linear scale of the head (for distances measured in canonical units).
@@ -80,37 +84,71 @@ impl PersonShape {
 
     /// This person's head: its shape and placement.
     pub fn head(&self) -> Result<PlacedHead> {
-        let to_person = self.head_transform()?;
-        Ok(PlacedHead {
-            shape: human_head()?,
+        Ok(self.head_on(human_head()?))
+    }
+
+    /// `shape` (a head in the canonical frame) placed as this person's head.
+    pub fn head_on(&self, shape: &'static HumanHead) -> PlacedHead {
+        let to_person = self.head_transform_about(shape.centre);
+        PlacedHead {
+            shape,
             to_person,
             to_canonical: to_person.inverse(),
             scale: self.head_scale(),
+        }
+    }
+
+    /// Where this person's hair grows: their head and the body below it.
+    pub fn site(&self) -> Result<GrowthSite> {
+        self.site_on(human_head()?)
+    }
+
+    /// [`Self::site`] with `shape` as the head (the mannequin's neck, shoulders and chest
+    /// below it: a head normalized into the canonical frame sits where the Sintel head does).
+    pub fn site_on(&self, shape: &'static HumanHead) -> Result<GrowthSite> {
+        let b = self.body_transform();
+        let body = BODY
+            .iter()
+            .filter(|p| p.collides)
+            .map(|part| Collider::Capsule {
+                a: b.transform_point3(part.a),
+                b: b.transform_point3(part.b),
+                radius: part.ra.max(part.rb) * self.height,
+            })
+            .collect();
+        Ok(GrowthSite {
+            head: self.head_on(shape),
+            body,
+            height: self.height,
+            proportions: self.head * self.height,
         })
     }
 
     /// Colliders for the hair dynamics: the neck, the shoulders and the upper torso (the
     /// body's own shapes, [`body_mesh`]), then the head itself.
     pub fn colliders(&self) -> Result<Vec<Collider>> {
-        let b = self.body_transform();
-        let h = self.height;
-        let mut out: Vec<Collider> = BODY
-            .iter()
-            .filter(|p| p.collides)
-            .map(|part| Collider::Capsule {
-                a: b.transform_point3(part.a),
-                b: b.transform_point3(part.b),
-                radius: part.ra.max(part.rb) * h,
-            })
-            .collect();
+        let mut out = self.site()?.body;
         // The head last: where the neck capsule and the jaw disagree, the head wins.
         out.push(Collider::head(
-            &super::human::human_head()?.map,
+            &human_head()?.map,
             self.head_transform()?,
             0.005,
         ));
         Ok(out)
     }
+}
+
+/// Where hair grows, in a person frame (canonical scaled by the person's size): what the
+/// hairstyle generator needs of a person, whichever head they have.
+pub struct GrowthSite {
+    /// The head.
+    pub head: PlacedHead,
+    /// Colliders of the body below the head (neck, shoulders, chest), person frame.
+    pub body: Vec<Collider>,
+    /// Scale of the person (lengths of hair scale with it).
+    pub height: f32,
+    /// Scale of the head: width, height, depth (with the height scale).
+    pub proportions: Vec3,
 }
 
 /// A head placed in a person's frame.

@@ -78,6 +78,24 @@ pub struct HairStyle {
     pub cuticle_tilt_degrees: f32,
 }
 
+impl HairStyle {
+    /// The same style for a mesh scaled by `s` (units per old unit): widths, radii and
+    /// amplitudes scale with it, frequencies per unit of `w` inversely.
+    pub fn scaled(self, s: f32) -> Self {
+        HairStyle {
+            strand_width: self.strand_width * s,
+            root_ramp: self.root_ramp * s,
+            curl_radius: self.curl_radius * s,
+            curl_frequency: self.curl_frequency / s,
+            wave_amplitude: self.wave_amplitude * s,
+            wave_frequency: self.wave_frequency / s,
+            frizz_amplitude: self.frizz_amplitude * s,
+            frizz_frequency: self.frizz_frequency / s,
+            ..self
+        }
+    }
+}
+
 impl Default for HairStyle {
     fn default() -> Self {
         HairStyle {
