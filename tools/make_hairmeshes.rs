@@ -1,7 +1,9 @@
-//! Generates the sample hair meshes in `hairmeshes/` (OBJ + style TOML). Deterministic: running
-//! it again reproduces the committed files byte for byte.
+//! Generates the sample hair meshes in `hairmeshes/` (OBJ + style TOML), or grows the crowd's
+//! hairstyle families on a head of the user's. Deterministic: running it again reproduces the
+//! committed files byte for byte.
 //!
 //! `cargo run --release --bin make-hairmeshes -- [OUT_DIR]`
+//! `cargo run --release --bin make-hairmeshes -- --head FILE.{obj,glb,gltf} --family bob -o DIR`
 
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
@@ -9,7 +11,11 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use clap::Parser;
 use glam::{Vec2, Vec3};
+use hairmesh::budget::MemoryBudget;
+use hairmesh::characters::any_head::AnyHead;
+use hairmesh::characters::hairstyle::StyleFamily;
 use hairmesh::fsutil::OutputPath;
+use hairmesh::model::gltf::load_character;
 use hairmesh::model::obj_io::hair_mesh_obj_bytes;
 use hairmesh::{ExtrudeDesc, Face, HairMesh, extrude};
 
@@ -249,21 +255,107 @@ fn main() {
     }
 }
 
-/// Write the sample hair meshes (OBJ) and their styles (TOML) into a folder.
+/// Write the sample hair meshes (OBJ) and their styles (TOML) into a folder, or, with
+/// `--head`, hairstyles grown on that head.
 #[derive(Parser)]
 #[command(version, about)]
 struct Args {
     /// Existing folder to write into.
     #[arg(default_value = "hairmeshes")]
     out_dir: PathBuf,
+    /// Existing folder to write into (instead of OUT_DIR).
+    #[arg(short = 'o', long = "out", conflicts_with = "out_dir")]
+    out: Option<PathBuf>,
+    /// A head to grow hair on: an OBJ (all of it is the head; a bust is fine) or a glTF
+    /// character (the part `--joint` moves), upright (+Y) and facing +Z, in any unit.
+    #[arg(long)]
+    head: Option<PathBuf>,
+    /// Hairstyle families to grow on `--head` (comma-separated): buzz, shortcrop, bob,
+    /// longstraight, longwavy, longcurly, ponytail, bun, sidebangs, mohawk, afro, fitted.
+    #[arg(long, value_delimiter = ',', requires = "head")]
+    family: Vec<StyleFamily>,
+    /// The glTF joint whose vertices are the head.
+    #[arg(long, default_value = "head", requires = "head")]
+    joint: String,
+    /// Seed of the grown hairstyles.
+    #[arg(long, default_value_t = 1, requires = "head")]
+    seed: u32,
 }
 
 fn run() -> Result<()> {
     let args = Args::parse();
-    let out = &args.out_dir;
+    let out = args.out.as_ref().unwrap_or(&args.out_dir);
     if !out.is_dir() {
         anyhow::bail!("{}: not an existing folder", out.display());
     }
+    match &args.head {
+        Some(head) => grow_on_head(&args, head, out),
+        None => samples(out),
+    }
+}
+
+/// Grow `args.family` (every family if none) on `head` into `out`: `<family>.obj` and
+/// `<family>.toml` each, in the head file's frame and units, all checked before any is
+/// written.
+fn grow_on_head(args: &Args, head: &Path, out: &Path) -> Result<()> {
+    let any = read_head(head, &args.joint)?;
+    let families = match args.family.is_empty() {
+        true => StyleFamily::PEOPLE.to_vec(),
+        false => args.family.clone(),
+    };
+    let mut files: Vec<(OutputPath, Vec<u8>, String)> = Vec::new();
+    for family in families {
+        if family == StyleFamily::Fur {
+            anyhow::bail!("--family fur grows on balls and teapots, not on heads");
+        }
+        let hair = any.grow(family, args.seed)?;
+        let name = family.name();
+        let path = out.join(format!("{name}.obj"));
+        let comment = format!(
+            "{} grown on {} by tools/make_hairmeshes.rs (seed {})",
+            name,
+            head.display(),
+            args.seed
+        );
+        let bytes = hair_mesh_obj_bytes(&hair.mesh, &comment)?;
+        let line = format!(
+            "{}: {} bundles, {} layers",
+            path.display(),
+            hair.mesh.faces.len(),
+            hair.mesh.layer_count()
+        );
+        files.push((OutputPath::check(&path, &[head])?, bytes, line));
+        let style = path.with_extension("toml");
+        let text = format!("# {comment}\n{}", toml::to_string(&hair.style)?);
+        let line = format!("{}: style", style.display());
+        files.push((OutputPath::check(&style, &[head])?, text.into_bytes(), line));
+    }
+    for (_, _, line) in &files {
+        hairmesh::outln!("{line}")?;
+    }
+    let outputs: Vec<_> = files.iter().map(|(p, b, _)| (p, b.as_slice())).collect();
+    hairmesh::fsutil::write_together(&outputs)?;
+    Ok(())
+}
+
+/// The head in `path`: an OBJ whole, a glTF character's `joint` and below.
+fn read_head(path: &Path, joint: &str) -> Result<AnyHead> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    Ok(match ext.as_deref() {
+        Some("obj") => AnyHead::from_obj(path)?,
+        Some("glb" | "gltf") => {
+            let c = load_character(path, MemoryBudget::default())?;
+            AnyHead::from_character(&path.display().to_string(), &c, joint)?
+        }
+        _ => anyhow::bail!("{}: a head is an .obj, .glb or .gltf file", path.display()),
+    })
+}
+
+/// The sample hair meshes and styles.
+fn samples(out: &Path) -> Result<()> {
     let meshes = [
         sphere_fur()?,
         head_long()?,

