@@ -3,9 +3,14 @@
 //! idle clip plays. The body is skinned from the clip and the hair follows the head joint
 //! ([`crate::characters::people::head_bound`]).
 
+use std::sync::Arc;
+
 use glam::{Mat4, Quat, Vec3};
 
+use crate::characters::own::OwnCharacter;
 use crate::characters::people::{Outfit, head_bound, pose, walk_speed};
+use crate::characters::person::PersonShape;
+use crate::dynamics::Collider;
 use crate::error::Result;
 
 /// The smallest ring people walk: turning swings a planted foot about the body, so tighter
@@ -31,11 +36,27 @@ pub enum WalkPath {
     },
 }
 
+/// What a walker's body is.
+#[derive(Clone)]
+pub enum Rig {
+    /// One of the crowd's people: a figure in an outfit, wearing the Sintel head.
+    Person(Outfit),
+    /// A copy of the user's character ([`OwnCharacter`]), its clip `phase` seconds in.
+    Own {
+        /// The character.
+        character: Arc<OwnCharacter>,
+        /// Walks (else plays its clip standing).
+        walks: bool,
+        /// Seconds into the clip at time 0.
+        phase: f32,
+    },
+}
+
 /// A walking (or standing) person.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone)]
 pub struct Walker {
-    /// Clothes, figure, clip and phase.
-    pub outfit: Outfit,
+    /// Their body: figure and clothes, or the user's character.
+    pub rig: Rig,
     /// Uniform scale of the figure (the person's height).
     pub height: f32,
     /// The head's proportions (width, height, depth) about the cranium centre.
@@ -55,7 +76,7 @@ impl Walker {
                 angle,
                 clockwise,
             } => {
-                let speed = walk_speed(self.outfit.figure)? * self.height;
+                let speed = self.speed()?;
                 let sign = if clockwise { -1.0 } else { 1.0 };
                 let a = angle + sign * speed * t / radius.max(0.05);
                 let at = centre + Vec3::new(a.cos(), 0.0, a.sin()) * radius;
@@ -66,12 +87,72 @@ impl Walker {
         })
     }
 
+    /// Ground speed while walking, metres per second (0 for a clip that plants no feet).
+    pub fn speed(&self) -> Result<f32> {
+        Ok(match &self.rig {
+            Rig::Person(outfit) => walk_speed(outfit.figure)? * self.height,
+            Rig::Own { character, .. } => character.walk_speed().unwrap_or(0.0) * self.height,
+        })
+    }
+
+    /// Whether they walk (else they stand and play their clip in place).
+    pub fn walks(&self) -> bool {
+        match &self.rig {
+            Rig::Person(outfit) => outfit.walks,
+            Rig::Own { walks, .. } => *walks,
+        }
+    }
+
     /// At `t` seconds: the hair's model (the head-bound person frame), the body's model
     /// and its skin matrices ([`crate::characters::people::head_bound`]).
     pub fn frame(&self, t: f32) -> Result<PersonFrame> {
-        let (skin, head) = pose(&self.outfit, t, self.head)?;
+        let (skin, head) = match &self.rig {
+            Rig::Person(outfit) => pose(outfit, t, self.head)?,
+            Rig::Own {
+                character, phase, ..
+            } => character.pose(t + phase),
+        };
         let (hair, body) = head_bound(self.root(t)?, self.height, head);
         Ok(PersonFrame { hair, body, skin })
+    }
+
+    /// The skinned parts they wear (`(mesh, colour)`, the skin tinted `skin`) and the number
+    /// of skin matrices their frames carry.
+    pub fn parts(&self, skin: [f32; 3]) -> Result<(Vec<(usize, [f32; 4])>, usize)> {
+        Ok(match &self.rig {
+            Rig::Person(outfit) => (
+                outfit.parts(skin),
+                crate::characters::people::head_shape_joint()? + 1,
+            ),
+            Rig::Own { character, .. } => (character.parts(), character.joint_count()),
+        })
+    }
+
+    /// Colliders for their hair dynamics, in the hair's frame; `person`: the shape of one of
+    /// the people (ignored for the user's character).
+    pub fn colliders(&self, person: &PersonShape) -> Result<Vec<Collider>> {
+        match &self.rig {
+            Rig::Person(outfit) => crate::characters::people::colliders(outfit.figure, person),
+            Rig::Own { character, .. } => character.colliders(),
+        }
+    }
+
+    /// How the scalp follows the skin: the index of the skin matrix that carries it, the
+    /// head's placement in the hair's frame (canonical head to hair frame), and its mean
+    /// scale (the root-gap unit is the canonical head radius times it).
+    pub fn scalp(&self, person: &PersonShape) -> Result<(usize, Mat4, f32)> {
+        Ok(match &self.rig {
+            Rig::Person(_) => (
+                crate::characters::people::head_shape_joint()?,
+                person.head_transform()?,
+                person.head_scale(),
+            ),
+            Rig::Own { character, .. } => (
+                character.head_joint,
+                Mat4::IDENTITY,
+                character.head.scale,
+            ),
+        })
     }
 }
 
@@ -101,7 +182,7 @@ mod tests {
             ..Outfit::draw(1, true)
         };
         let w = Walker {
-            outfit,
+            rig: Rig::Person(outfit),
             height: 1.0,
             head: Vec3::ONE,
             path: WalkPath::Ring {

@@ -8,6 +8,7 @@ pub mod far_mesh;
 pub mod hairstyle;
 pub mod head;
 pub mod human;
+pub mod own;
 pub mod people;
 pub mod person;
 pub mod preset;

@@ -7,6 +7,7 @@ use glam::{Mat4, Quat, Vec3};
 use super::hairstyle::{Hairstyle, StyleFamily, ball_fur, generate, teapot_fur};
 use super::head::{HeadShape, ground_mesh};
 use super::person::PersonShape;
+use crate::animate::walk::{MIN_RING_RADIUS, Rig, WalkPath, Walker};
 use crate::error::{HairError, Result};
 use crate::render::StrandParams;
 use crate::render::shared::{PropInstance, PropVertex};
@@ -57,6 +58,8 @@ pub enum Body {
     Ball,
     /// A Utah teapot the fur grows on.
     Teapot,
+    /// A copy of the user's character ([`super::own::OwnCharacter`]; its walker carries it).
+    Own,
 }
 
 /// One character of a crowd.
@@ -133,7 +136,7 @@ impl CrowdCharacter {
     /// fur (balls, teapots) caps the vertex level at [`FUR_MAX_VERTS_LOG2`].
     pub fn strand_params(&self, crowd: StrandParams) -> StrandParams {
         match self.body {
-            Body::Person(_) => StrandParams {
+            Body::Person(_) | Body::Own => StrandParams {
                 strands_per_bundle: self.hair.strands_per_bundle(crowd.strands_per_bundle),
                 ..crowd
             },
@@ -142,6 +145,28 @@ impl CrowdCharacter {
                 ..crowd
             },
         }
+    }
+
+    /// Colliders for this character's hair dynamics in its hair's frame: a person's body and
+    /// head (following their figure when skinned), the ball; `None` for a teapot (its fur is
+    /// not simulated).
+    pub fn colliders(&self) -> Result<Option<Vec<crate::dynamics::Collider>>> {
+        let person = match self.body {
+            Body::Person(p) => p,
+            Body::Own => PersonShape::default(),
+            Body::Ball => {
+                let h = ball_head();
+                return Ok(Some(vec![crate::dynamics::Collider::Ellipsoid {
+                    centre: h.centre,
+                    radii: h.radii * 0.97,
+                }]));
+            }
+            Body::Teapot => return Ok(None),
+        };
+        Ok(Some(match &self.walker {
+            Some(w) => w.colliders(&person)?,
+            None => person.colliders()?,
+        }))
     }
 }
 
@@ -210,20 +235,23 @@ pub fn build_families(
             let person = PersonShape::draw(character_seed);
             (generate(f, character_seed, &person)?, Body::Person(person))
         };
-        let x = (i % side) as f32 - (side as f32 - 1.0) * 0.5;
-        let z = (i / side) as f32;
-        let jitter = Vec3::new(rng.next_f32() - 0.5, 0.0, rng.next_f32() - 0.5) * 0.3;
-        let yaw = (rng.next_f32() - 0.5) * 2.4 + std::f32::consts::PI;
-        let model = Mat4::from_rotation_translation(
-            Quat::from_rotation_y(yaw),
-            Vec3::new(x, 0.0, z) * SPACING + jitter,
-        );
+        let model = grid_place(i, side, &mut rng);
         let skin = match body {
             Body::Person(p) => p.skin,
             _ => hair.style.color.map(|c| c * 0.8),
         };
         let walker = match body {
-            Body::Person(p) => Some(person_walker(p, character_seed, (i, count, side), model)),
+            Body::Person(p) => {
+                let walks = count <= 4 || i % 2 == 0;
+                let outfit = super::people::Outfit::draw(character_seed, walks);
+                let path = walk_path(walks, side, model);
+                Some(Walker {
+                    rig: Rig::Person(outfit),
+                    height: p.height,
+                    head: p.head,
+                    path,
+                })
+            }
             _ => None,
         };
         out.push(CrowdCharacter {
@@ -237,25 +265,29 @@ pub fn build_families(
     Ok(out)
 }
 
-/// Person `i` of `count` on a grid of `side` columns, placed at `model`: half the people (all
-/// of a crowd of four or fewer) walk, the others stand. Walkers all go the same way round one
-/// centre beside the crowd, each on the ring through their own place, so they move along
-/// parallel arcs at the same speed and never meet each other, turning gently enough
-/// (rings of at least [`MIN_RING_RADIUS`](crate::animate::walk::MIN_RING_RADIUS)) that their
-/// planted feet stay put. Not yet: walkers pass through people who stand in their way.
-fn person_walker(
-    p: PersonShape,
-    seed: u32,
-    (i, count, side): (usize, usize, usize),
-    model: Mat4,
-) -> crate::animate::walk::Walker {
-    use crate::animate::walk::{MIN_RING_RADIUS, WalkPath, Walker};
-    let walks = count <= 4 || i % 2 == 0;
-    let outfit = super::people::Outfit::draw(seed, walks);
+/// Place `i` of a grid of `side` columns: a little jitter and a random heading, roughly
+/// toward -Z (the cameras' side).
+fn grid_place(i: usize, side: usize, rng: &mut Pcg32) -> Mat4 {
+    let x = (i % side) as f32 - (side as f32 - 1.0) * 0.5;
+    let z = (i / side) as f32;
+    let jitter = Vec3::new(rng.next_f32() - 0.5, 0.0, rng.next_f32() - 0.5) * 0.3;
+    let yaw = (rng.next_f32() - 0.5) * 2.4 + std::f32::consts::PI;
+    Mat4::from_rotation_translation(
+        Quat::from_rotation_y(yaw),
+        Vec3::new(x, 0.0, z) * SPACING + jitter,
+    )
+}
+
+/// The path of a person of a crowd on a grid of `side` columns placed at `model`: walkers
+/// all go the same way round one centre beside the crowd, each on the ring through their own
+/// place, so they move along parallel arcs at the same speed and never meet each other,
+/// turning gently enough (rings of at least [`MIN_RING_RADIUS`]) that their planted feet stay
+/// put. Not yet: walkers pass through people who stand in their way.
+fn walk_path(walks: bool, side: usize, model: Mat4) -> WalkPath {
     let half = (side as f32 - 1.0) * 0.5 * SPACING;
     let centre = Vec3::new(-(half + MIN_RING_RADIUS), 0.0, half);
     let at = model.w_axis.truncate() - centre;
-    let path = match walks {
+    match walks {
         true => WalkPath::Ring {
             centre,
             radius: Vec3::new(at.x, 0.0, at.z).length().max(MIN_RING_RADIUS),
@@ -263,13 +295,56 @@ fn person_walker(
             clockwise: false,
         },
         false => WalkPath::Stand(model),
-    };
-    Walker {
-        outfit,
-        height: p.height,
-        head: p.head,
-        path,
     }
+}
+
+/// A crowd of `count` copies of the user's character `own`, each with its own hairstyle
+/// (families from `families` in turn, grown on its head from the copy's seed) and clip phase;
+/// half walk (all of four or fewer) where its clip walks, the others play it in place.
+pub fn build_own(
+    own: &std::sync::Arc<super::own::OwnCharacter>,
+    count: usize,
+    seed: u32,
+    families: &[StyleFamily],
+) -> Result<Vec<CrowdCharacter>> {
+    if families.is_empty() || families.contains(&StyleFamily::Fur) {
+        return Err(HairError::invalid(&own.name, "no hairstyle families for heads"));
+    }
+    if count == 0 || count > MAX_CROWD {
+        return Err(HairError::invalid(
+            "crowd",
+            format!("count {count} outside 1..={MAX_CROWD}"),
+        ));
+    }
+    let mut rng = Pcg32::new(seed as u64);
+    let side = (count as f32).sqrt().ceil() as usize;
+    (0..count)
+        .map(|i| {
+            let character_seed = seed.wrapping_mul(0x9E37_79B9).wrapping_add(i as u32);
+            let family = families[(i + seed as usize) % families.len()];
+            let hair = own.grow(family, character_seed)?;
+            let model = grid_place(i, side, &mut rng);
+            let walks = own.walk_speed().is_some() && (count <= 4 || i % 2 == 0);
+            let phase = (Pcg32::hashed(character_seed as u64).next_u32() % 1000) as f32 * 0.01;
+            let walker = Walker {
+                rig: Rig::Own {
+                    character: own.clone(),
+                    walks,
+                    phase,
+                },
+                height: 1.0,
+                head: Vec3::ONE,
+                path: walk_path(walks, side, model),
+            };
+            Ok(CrowdCharacter {
+                hair,
+                model,
+                body: Body::Own,
+                skin: [1.0; 3],
+                walker: Some(walker),
+            })
+        })
+        .collect()
 }
 
 /// Give character `id` of `renderer` what it wears: its props (a person's head and eyes, a
@@ -285,9 +360,9 @@ pub fn dress(
         .set_character_props(id, &character_props(c)?)
         .map_err(gpu)?;
     if let Some(w) = &c.walker {
-        let joints = super::people::head_shape_joint()? + 1;
+        let (parts, joints) = w.parts(c.skin)?;
         renderer
-            .set_character_skin(id, &w.outfit.parts(c.skin), joints)
+            .set_character_skin(id, &parts, joints)
             .map_err(gpu)?;
         let f = w.frame(0.0)?;
         renderer
@@ -371,7 +446,7 @@ pub fn character_props(c: &CrowdCharacter) -> Result<Vec<(usize, PropInstance)>>
     };
     Ok(match c.body {
         // Head, eyes, body and clothes are skinned meshes ([`dress`]).
-        Body::Person(_) => Vec::new(),
+        Body::Person(_) | Body::Own => Vec::new(),
         Body::Ball => vec![at(prop_mesh::BALL, Mat4::IDENTITY)],
         Body::Teapot => vec![at(prop_mesh::TEAPOT, Mat4::IDENTITY)],
     })

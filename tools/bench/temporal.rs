@@ -163,17 +163,11 @@ fn crowd(r: &mut Renderer) -> Result<CrowdAnimation> {
         let baked = hairmesh::bake(&c.hair.mesh, &c.hair.style, options, |_, _| {})?;
         let id = r.add_character(&baked, &c.hair.style, c.strand_params(params), c.model)?;
         preset::dress(r, id, c)?;
-        let colliders: Vec<Collider> = match c.body {
-            preset::Body::Person(p) => match &c.walker {
-                Some(w) => hairmesh::characters::people::colliders(w.outfit.figure, &p)?,
-                None => p.colliders()?,
-            },
-            _ => Vec::new(),
-        };
+        let colliders: Vec<Collider> = c.colliders()?.unwrap_or_default();
         r.make_deformable(id, DeformBasis::new(&c.hair.mesh, &baked, options)?)?;
         let motion = CharacterMotion::idle(c.model, 11 ^ k as u32);
         match &c.walker {
-            Some(w) => animation.add_person(id, *w, Some((&c.hair.mesh, colliders)))?,
+            Some(w) => animation.add_person(id, w.clone(), Some((&c.hair.mesh, colliders)))?,
             None => animation.add(id, motion, Some((&c.hair.mesh, colliders))),
         }
     }

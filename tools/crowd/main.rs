@@ -17,8 +17,9 @@ use std::time::Instant;
 use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::Vec3;
-use hairmesh::animate::{CharacterMotion, Collider, CrowdAnimation, Wind};
+use hairmesh::animate::{CharacterMotion, CrowdAnimation, Wind};
 use hairmesh::bake::deform::DeformBasis;
+use hairmesh::characters::own::OwnCharacter;
 use hairmesh::characters::preset::{self, Preset, SPACING};
 use hairmesh::fsutil::{RunFiles, StagedFolder};
 use hairmesh::render::{
@@ -61,6 +62,15 @@ pub struct Args {
     /// Scene preset: people, mixed (people and furry balls) or teapots (furry Utah teapots).
     #[arg(long, default_value = "people")]
     preset: Preset,
+    /// Fill the crowd with copies of this glTF character (.glb or .gltf: skinned, upright,
+    /// facing +Z, metres) instead of the preset, each with its own hair grown on its head
+    /// (--family) and bound to its head joint (--joint); they play its `walk` clip (else its
+    /// first) and walk where that clip plants its feet.
+    #[arg(long)]
+    character: Option<PathBuf>,
+    /// The --character's head joint.
+    #[arg(long, default_value = "head", requires = "character")]
+    joint: String,
     /// People's hairstyle families, comma-separated (default: all twelve in turn): buzz,
     /// shortcrop, bob, longstraight, longwavy, longcurly, ponytail, bun, sidebangs, mohawk,
     /// afro, fitted.
@@ -184,6 +194,8 @@ pub fn portrait_camera(model: glam::Mat4, view: &str) -> Camera {
 /// The crowd: generated characters and their bakes.
 pub struct Scene {
     characters: Vec<preset::CrowdCharacter>,
+    /// The user's character the crowd copies (`--character`), else the people.
+    own: Option<Arc<OwnCharacter>>,
     baked: Vec<hairmesh::BakedHairMesh>,
     /// Per character, its bundles' first roots in its own frame (the root-gap reference).
     expected: Vec<Vec<glam::Vec3>>,
@@ -200,8 +212,19 @@ impl Scene {
         } else {
             args.family.clone()
         };
-        let characters =
-            preset::build_families(args.preset, args.count as usize, args.seed, &families)?;
+        let own = match &args.character {
+            Some(path) => Some(Arc::new(OwnCharacter::load(
+                path,
+                &args.joint,
+                args.memory_budget_mib,
+            )?)),
+            None => None,
+        };
+        let count = args.count as usize;
+        let characters = match &own {
+            Some(own) => preset::build_own(own, count, args.seed, &families)?,
+            None => preset::build_families(args.preset, count, args.seed, &families)?,
+        };
         let mut baked = Vec::with_capacity(characters.len());
         for c in &characters {
             baked.push(hairmesh::bake(
@@ -218,6 +241,7 @@ impl Scene {
             .collect();
         Ok(Scene {
             characters,
+            own,
             baked,
             expected,
             generate_s: start.elapsed().as_secs_f64(),
@@ -251,9 +275,17 @@ impl Scene {
         renderer.set_prop_meshes(&meshes)?;
         renderer.set_prop_lods(&preset::prop_lods(&meshes))?;
         renderer.set_prop_instances(&preset::world_props())?;
-        let skinned = hairmesh::characters::people::skinned_meshes()?;
-        renderer.set_skinned_meshes(&skinned)?;
-        renderer.set_skinned_lods(&hairmesh::characters::people::skinned_lods(&skinned))?;
+        match &self.own {
+            Some(own) => {
+                renderer.set_skinned_meshes(&own.skinned_meshes())?;
+                renderer.set_skinned_lods(&own.skinned_lods())?;
+            }
+            None => {
+                let skinned = hairmesh::characters::people::skinned_meshes()?;
+                renderer.set_skinned_meshes(&skinned)?;
+                renderer.set_skinned_lods(&hairmesh::characters::people::skinned_lods(&skinned))?;
+            }
+        }
         for (c, b) in self.characters.iter().zip(&self.baked) {
             let id = renderer.add_character(b, &c.hair.style, c.strand_params(params), c.model)?;
             // Heads and bodies move with their characters: drawn at the same model as the hair.
@@ -292,20 +324,7 @@ impl Scene {
                     ..CharacterMotion::idle(c.model, args.seed ^ k as u32)
                 },
             };
-            let colliders = match c.body {
-                preset::Body::Person(p) => Some(match &c.walker {
-                    Some(w) => hairmesh::characters::people::colliders(w.outfit.figure, &p)?,
-                    None => p.colliders()?,
-                }),
-                preset::Body::Ball => {
-                    let h = preset::ball_head();
-                    Some(vec![Collider::Ellipsoid {
-                        centre: h.centre,
-                        radii: h.radii * 0.97,
-                    }])
-                }
-                preset::Body::Teapot => None,
-            };
+            let colliders = c.colliders()?;
             let hair = match colliders {
                 Some(colliders) => {
                     let options = bake_options(c, true);
@@ -315,7 +334,7 @@ impl Scene {
                 None => None,
             };
             match &c.walker {
-                Some(w) => anim.add_person(id, *w, hair)?,
+                Some(w) => anim.add_person(id, w.clone(), hair)?,
                 None => anim.add(id, motion, hair),
             }
         }
@@ -337,20 +356,22 @@ impl Scene {
         let mut worst = 0.0f32;
         let ids = renderer.crowd().ids();
         for ((c, id), expected) in self.characters.iter().zip(ids).zip(&self.expected) {
-            let preset::Body::Person(p) = c.body else {
+            let (Some(w), Some((body, skin))) = (&c.walker, renderer.character_pose(id)) else {
                 continue;
             };
-            let Some((body, skin)) = renderer.character_pose(id) else {
-                continue;
+            let person = match c.body {
+                preset::Body::Person(p) => p,
+                _ => Default::default(),
             };
             let probed = hairmesh::characters::people::probed_roots(roots, id.slot());
-            let head_joint = skin.last().copied().unwrap_or_default();
+            let (joint, head_to_hair, head_scale) = w.scalp(&person)?;
+            let head_joint = skin.get(joint).copied().unwrap_or_default();
             let gap = hairmesh::characters::people::root_gap(
                 &probed,
                 expected,
                 (body, head_joint),
-                p.head_transform()?,
-                p.head_scale(),
+                head_to_hair,
+                head_scale,
             )
             .ok_or_else(|| {
                 anyhow::anyhow!(
