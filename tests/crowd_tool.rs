@@ -88,6 +88,34 @@ fn animated_frames_differ() {
     );
 }
 
+/// `--character`: copies of the example glTF character (its own head), walking in wind, their
+/// hair grown on that head and bound to its head joint: the GPU's roots stay on the skinned
+/// scalp (root gap below 0.01 head radii; 0.00016 measured on lavapipe).
+#[test]
+fn the_users_character_fills_the_crowd_with_its_hair_on() {
+    let (dir, _) = headless(
+        &[
+            "--character",
+            "hairmeshes/people/character.glb",
+            "--count",
+            "4",
+            "--frames",
+            "2",
+            "--wind",
+            "10",
+        ],
+        2,
+        500,
+    );
+    let csv = std::fs::read_to_string(dir.path().join("frames/stats.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = header.iter().position(|c| *c == "root_gap").unwrap();
+    for row in csv.lines().skip(1) {
+        let gap: f32 = row.split(',').nth(column).unwrap().parse().unwrap();
+        assert!(gap < 0.01, "root gap {gap} head radii");
+    }
+}
+
 #[test]
 fn headless_crowd_renders_frames_and_stats() {
     headless(&["--frames", "3", "--count", "16"], 3, 1000);

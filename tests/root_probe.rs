@@ -20,8 +20,8 @@ fn worst_gap(frames: u32, lag: bool) -> f32 {
     let Body::Person(person) = c.body else {
         panic!("not a person")
     };
-    let walker: Walker = c.walker.unwrap();
-    assert!(walker.outfit.walks);
+    let walker: Walker = c.walker.clone().unwrap();
+    assert!(walker.walks());
     let baked = hairmesh::bake(&c.hair.mesh, &c.hair.style, Default::default(), |_, _| {}).unwrap();
     let mut r = common::renderer(&ctx, 64);
     let params = StrandParams {

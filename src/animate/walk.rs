@@ -36,6 +36,9 @@ pub enum WalkPath {
     },
 }
 
+/// A skinned mesh a walker wears and its colour: `(mesh index, linear RGBA)`.
+pub type SkinPart = (usize, [f32; 4]);
+
 /// What a walker's body is.
 #[derive(Clone)]
 pub enum Rig {
@@ -118,7 +121,7 @@ impl Walker {
 
     /// The skinned parts they wear (`(mesh, colour)`, the skin tinted `skin`) and the number
     /// of skin matrices their frames carry.
-    pub fn parts(&self, skin: [f32; 3]) -> Result<(Vec<(usize, [f32; 4])>, usize)> {
+    pub fn parts(&self, skin: [f32; 3]) -> Result<(Vec<SkinPart>, usize)> {
         Ok(match &self.rig {
             Rig::Person(outfit) => (
                 outfit.parts(skin),
@@ -147,11 +150,9 @@ impl Walker {
                 person.head_transform()?,
                 person.head_scale(),
             ),
-            Rig::Own { character, .. } => (
-                character.head_joint,
-                Mat4::IDENTITY,
-                character.head.scale,
-            ),
+            Rig::Own { character, .. } => {
+                (character.head_joint, Mat4::IDENTITY, character.head.scale)
+            }
         })
     }
 }

@@ -57,7 +57,10 @@ impl AnyHead {
     pub fn from_character(name: &str, character: &Character, joint: &str) -> Result<Self> {
         let s = &character.skeleton;
         let j = s.find(joint).ok_or_else(|| {
-            HairError::invalid(name, format!("no joint named '{joint}' (--joint names one)"))
+            HairError::invalid(
+                name,
+                format!("no joint named '{joint}' (--joint names one)"),
+            )
         })?;
         let under = joints_under(s, j);
         let mut region = Vec::new();
@@ -237,10 +240,11 @@ fn solve4(mut a: [[f64; 5]; 4]) -> Option<[f64; 4]> {
             return None;
         }
         a.swap(col, pivot);
-        for row in col + 1..4 {
-            let f = a[row][col] / a[col][col];
-            for k in col..5 {
-                a[row][k] -= f * a[col][k];
+        let pivot_row = a[col];
+        for row in a.iter_mut().skip(col + 1) {
+            let f = row[col] / pivot_row[col];
+            for (x, p) in row.iter_mut().zip(pivot_row).skip(col) {
+                *x -= f * p;
             }
         }
     }
@@ -323,8 +327,14 @@ mod tests {
                 .map(|p| gap(*p))
                 .fold(0.0f32, f32::min);
             println!("{family:?}: roots within {worst_root:.4} m, deepest {deepest:.4} m");
-            assert!(worst_root < 0.002, "{family:?}: a root {worst_root} m off the scalp");
-            assert!(deepest > -0.01, "{family:?}: hair {deepest} m inside the head");
+            assert!(
+                worst_root < 0.002,
+                "{family:?}: a root {worst_root} m off the scalp"
+            );
+            assert!(
+                deepest > -0.01,
+                "{family:?}: hair {deepest} m inside the head"
+            );
         }
         assert!(AnyHead::from_character(path, &c, "nose").is_err());
     }

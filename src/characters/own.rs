@@ -52,7 +52,10 @@ impl OwnCharacter {
         }
         let head = AnyHead::from_character(name, &character, joint)?;
         let head_joint = character.skeleton.find(joint).ok_or_else(|| {
-            HairError::invalid(name, format!("no joint named '{joint}' (--joint names one)"))
+            HairError::invalid(
+                name,
+                format!("no joint named '{joint}' (--joint names one)"),
+            )
         })?;
         let clip = character
             .clips
@@ -93,7 +96,11 @@ impl OwnCharacter {
             .iter()
             .map(|m| {
                 let far = crate::skin::far::far_mesh(m, self.far_cell(m));
-                if far.indices.is_empty() { m.clone() } else { far }
+                if far.indices.is_empty() {
+                    m.clone()
+                } else {
+                    far
+                }
             })
             .collect();
         all.extend(far);

@@ -308,7 +308,10 @@ pub fn build_own(
     families: &[StyleFamily],
 ) -> Result<Vec<CrowdCharacter>> {
     if families.is_empty() || families.contains(&StyleFamily::Fur) {
-        return Err(HairError::invalid(&own.name, "no hairstyle families for heads"));
+        return Err(HairError::invalid(
+            &own.name,
+            "no hairstyle families for heads",
+        ));
     }
     if count == 0 || count > MAX_CROWD {
         return Err(HairError::invalid(

@@ -518,11 +518,14 @@ fn run(args: Args) -> Result<()> {
         "frame,gpu_ms,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
     );
     outln!(
-        "device: {} ({}); {} characters ({:?}), generated and baked in {generate_s:.2} s, textures {:.1} MiB",
+        "device: {} ({}); {} characters ({}), generated and baked in {generate_s:.2} s, textures {:.1} MiB",
         ctx.info.name,
         ctx.info.driver,
         characters.len(),
-        args.preset,
+        match &scene.own {
+            Some(own) => own.name.clone(),
+            None => format!("{:?}", args.preset),
+        },
         renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64
     )?;
     let lod = if args.lod {
