@@ -76,36 +76,15 @@ pub struct CrowdCharacter {
     pub walker: Option<crate::animate::walk::Walker>,
 }
 
-/// Indices of [`prop_meshes`].
+/// Indices of [`prop_meshes`]. People's heads, bodies and eyes are skinned meshes
+/// ([`super::people::skinned_meshes`]), not props.
 pub mod prop_mesh {
     /// The ground.
     pub const GROUND: usize = 0;
-    /// A person's head and shoulders (the bust).
-    pub const HEAD: usize = 1;
-    /// A person's mannequin body below the bust.
-    pub const BODY: usize = 2;
     /// A ball.
-    pub const BALL: usize = 3;
+    pub const BALL: usize = 1;
     /// A teapot.
-    pub const TEAPOT: usize = 4;
-    /// The far version of [`HEAD`] ([`super::prop_lods`]).
-    pub const FAR_HEAD: usize = 5;
-    /// The far version of [`BODY`].
-    pub const FAR_BODY: usize = 6;
-    /// An eyeball or an iris (unit sphere, placed by [`super::character_props`]).
-    pub const EYE: usize = 7;
-    /// The far version of [`EYE`].
-    pub const FAR_EYE: usize = 8;
-}
-
-/// An eye sphere's far version is drawn once it spans fewer pixels than this.
-pub const FAR_EYE_PIXELS: f32 = 12.0;
-
-/// A unit sphere of `rings x segments` quads: the eyes' meshes.
-fn eye_mesh(rings: usize, segments: usize) -> Vec<PropVertex> {
-    let mut tris = Vec::new();
-    super::person::ellipsoid(&mut tris, Vec3::ZERO, Vec3::ONE, rings, segments);
-    super::human::smooth_prop_mesh(&tris)
+    pub const TEAPOT: usize = 2;
 }
 
 /// Colour of the whites of the eyes.
@@ -119,10 +98,6 @@ pub const IRIS_RADIUS: f32 = 0.42;
 /// See [`IRIS_RADIUS`].
 pub const IRIS_OFFSET: f32 = 0.78;
 
-/// Cell of the far head (vertex clustering, `far_mesh`), metres.
-pub const FAR_HEAD_CELL: f32 = 0.025;
-/// Cell of the far body, metres.
-pub const FAR_BODY_CELL: f32 = 0.04;
 /// Pixels a far mesh's cell spans where the switch to it happens: the far version is drawn
 /// once a cell is under two pixels.
 pub const FAR_CELL_PIXELS: f32 = 2.0;
@@ -379,44 +354,11 @@ pub fn dress(
 /// Prop meshes of crowds, indexed by [`prop_mesh`].
 pub fn prop_meshes() -> Result<Vec<Vec<PropVertex>>> {
     let ball = ball_head();
-    let head = super::person::neck_up_mesh()?;
-    let body = super::person::body_mesh();
-    let far_head = super::far_mesh::far_mesh(&head, FAR_HEAD_CELL);
-    let far_body = super::far_mesh::far_mesh(&body, FAR_BODY_CELL);
     Ok(vec![
         ground_mesh(60.0),
-        head,
-        body,
         super::head::sphere_mesh(ball.centre, ball.radii * 0.985),
         super::teapot::teapot_mesh(TEAPOT_HEIGHT),
-        far_head,
-        far_body,
-        eye_mesh(10, 16),
-        eye_mesh(4, 6),
     ])
-}
-
-/// The far versions of the crowd's prop meshes (people's heads and bodies, switched where
-/// their cells span [`FAR_CELL_PIXELS`]; eyes below [`FAR_EYE_PIXELS`]): give them to `Renderer::set_prop_lods` after
-/// [`prop_meshes`].
-pub fn prop_lods(meshes: &[Vec<PropVertex>]) -> Vec<crate::render::prop_table::PropLod> {
-    let lod = |mesh: usize, far_mesh: usize, cell: f32| {
-        let (_, radius) = crate::render::prop_table::bounding_sphere(&meshes[mesh]);
-        crate::render::prop_table::PropLod {
-            mesh,
-            far_mesh,
-            below_pixels: FAR_CELL_PIXELS * 2.0 * radius / cell,
-        }
-    };
-    vec![
-        lod(prop_mesh::HEAD, prop_mesh::FAR_HEAD, FAR_HEAD_CELL),
-        lod(prop_mesh::BODY, prop_mesh::FAR_BODY, FAR_BODY_CELL),
-        crate::render::prop_table::PropLod {
-            mesh: prop_mesh::EYE,
-            far_mesh: prop_mesh::FAR_EYE,
-            below_pixels: FAR_EYE_PIXELS,
-        },
-    ]
 }
 
 /// The world props: the ground.

@@ -273,7 +273,6 @@ impl Scene {
         };
         let meshes = preset::prop_meshes()?;
         renderer.set_prop_meshes(&meshes)?;
-        renderer.set_prop_lods(&preset::prop_lods(&meshes))?;
         renderer.set_prop_instances(&preset::world_props())?;
         match &self.own {
             Some(own) => {
