@@ -5,7 +5,7 @@
 //!
 //! Estimates are sums of `count x bytes` terms over the buffers a piece of work holds at its
 //! peak (Vec headers included where a buffer is a Vec of Vecs); they are upper bounds of what the
-//! code allocates, checked against measured peaks in the README's robustness section.
+//! code allocates, checked against measured peaks in the guide's robustness chapter.
 
 use crate::{HairError, Result};
 

@@ -16,6 +16,7 @@ pub mod error;
 pub mod fit;
 pub mod fsutil;
 pub mod fuzz;
+pub mod guide;
 pub mod model;
 pub mod reference;
 pub mod render;

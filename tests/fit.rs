@@ -72,7 +72,7 @@ fn round_trip(name: &str, per: u32) -> (Fidelity, usize, usize) {
 }
 
 /// The bar is a mean of 1% and a 95th percentile of 3% of the diagonal; these limits
-/// are the measured figures (README) with a little room. Denser strand sets are used where
+/// are the measured figures (guide, fit chapter) with a little room. Denser strand sets are used where
 /// two random sets of the same density would otherwise stand that far apart by themselves.
 #[test]
 fn synthetic_round_trips_come_back_close() {
@@ -134,7 +134,7 @@ fn sintel_fits_bakes_and_renders() {
         fitted.bundle_size,
     );
     println!("sintel: {f}");
-    // Measured: two-sided mean 1.88%, p95 4.98%, coverage 100% (README).
+    // Measured: two-sided mean 1.88%, p95 4.98%, coverage 100% (guide, fit chapter).
     assert!(f.two_sided.0 <= 0.022 && f.two_sided.1 <= 0.055, "{f:?}");
     assert!(f.coverage >= 0.98, "{f:?}");
     let ctx = context();

@@ -4,27 +4,38 @@
 
 use hairmesh::render::shared::{glsl_header, shared_structs, std430_layout, std430_type};
 
-#[test]
-fn every_shared_struct_has_the_rust_layout() {
+/// Every way the structs' Rust layouts disagree with std430 (field offsets, struct sizes),
+/// one line each, the structs laid out in order (a struct's layout depends on those before).
+fn mismatches(structs: &[hairmesh::render::shared::StructInfo]) -> Vec<String> {
     let mut known: Vec<(String, usize, usize)> = Vec::new();
-    let structs = shared_structs();
-    assert!(structs.len() >= 10, "every shared struct is registered");
-    for s in &structs {
+    let mut out = Vec::new();
+    for s in structs {
         let (offsets, size, align) = std430_layout(s, &known);
         for (f, off) in s.fields.iter().zip(&offsets) {
-            assert_eq!(
-                f.offset, *off,
-                "{}.{}: Rust offset {} but std430 offset {}",
-                s.name, f.name, f.offset, off
-            );
+            if f.offset != *off {
+                out.push(format!(
+                    "{}.{}: Rust offset {} but std430 offset {}",
+                    s.name, f.name, f.offset, off
+                ));
+            }
         }
-        assert_eq!(
-            size, s.rust_size,
-            "{}: std430 size differs from Rust",
-            s.name
-        );
+        if size != s.rust_size {
+            out.push(format!(
+                "{}: std430 size {size}, Rust {}",
+                s.name, s.rust_size
+            ));
+        }
         known.push((s.name.to_string(), size, align));
     }
+    out
+}
+
+#[test]
+fn every_shared_struct_has_the_rust_layout() {
+    let structs = shared_structs();
+    assert!(structs.len() >= 10, "every shared struct is registered");
+    let wrong = mismatches(&structs);
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }
 
 #[test]
@@ -40,13 +51,40 @@ fn the_frame_block_is_the_same_in_std140() {
     }
 }
 
+/// The check above fails on each kind of drift it guards against, run through the same
+/// function: a Rust field moved, a GLSL field type that grows (a `vec4` declared `mat4`: the
+/// fields after it, or the struct's size, move in std430), a Rust struct that grew.
 #[test]
-fn a_wrong_offset_is_caught() {
-    // The check above can fail: shifting one field breaks it.
-    let mut s = shared_structs().remove(0);
-    s.fields[1].offset += 4;
-    let (offsets, ..) = std430_layout(&s, &[]);
-    assert_ne!(offsets[1], s.fields[1].offset);
+fn the_layout_check_catches_drift() {
+    let find = |name: &str| {
+        shared_structs()
+            .into_iter()
+            .position(|s| s.name == name)
+            .unwrap()
+    };
+    // A Rust offset moved by 4 bytes.
+    let mut moved = shared_structs();
+    moved[0].fields[1].offset += 4;
+    assert_eq!(mismatches(&moved).len(), 1, "{:?}", mismatches(&moved));
+    // A GLSL field type that grows: every later field of that struct moves in std430.
+    let mut retyped = shared_structs();
+    let k = find("FrameBlock");
+    let f = retyped[k]
+        .fields
+        .iter()
+        .position(|f| f.glsl == "vec4")
+        .unwrap();
+    retyped[k].fields[f].glsl = "mat4";
+    let wrong = mismatches(&retyped);
+    assert!(
+        wrong.iter().any(|w| w.starts_with("FrameBlock")),
+        "{wrong:?}"
+    );
+    // A Rust struct that grew without its GLSL twin.
+    let mut grown = shared_structs();
+    let last = grown.len() - 1;
+    grown[last].rust_size += 16;
+    assert_eq!(mismatches(&grown).len(), 1, "{:?}", mismatches(&grown));
 }
 
 #[test]

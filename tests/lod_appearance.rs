@@ -1,7 +1,7 @@
 //! Thick-strand appearance under LoD (seed 000; `glsl/lod_appearance.glsl`): with strand LoD
 //! on, the hair region's mean luminance and mean hue at mid and far distance stay within 5% of
 //! full detail when the thick-strand term is on; the figures without it are printed (and kept
-//! in the README).
+//! in the guide's shading chapter).
 
 mod common;
 

@@ -5,7 +5,7 @@
 //! ever adds light, and adds the more the lighter the hair: black hair barely changes, light
 //! hair brightens (measured on lavapipe: grey +14.4%, blond +12.0%, brown +7.7%, black +2.0%
 //! in mean linear luminance; no pixel darker). The gallery is written to `tests/output/multiple_scattering_gallery.png` (top
-//! row without, bottom row with; the README's picture).
+//! row without, bottom row with; the shading chapter's picture).
 
 mod common;
 

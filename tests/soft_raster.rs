@@ -140,7 +140,7 @@ fn frame(
 
 /// FLIP mean of software against hardware strips, both compositing with a k-buffer of 8,
 /// must stay below these (measured on lavapipe, 192x192, LoD on: 0.005-0.015, about half the
-/// limit; see the README's software rasterizer section). The software strands are antialiased by exact coverage, the hardware ones are
+/// limit; see the guide's soft_raster chapter). The software strands are antialiased by exact coverage, the hardware ones are
 /// one-pixel strips with coverage to alpha, so the two differ along every strand.
 const SCENES: [(&str, &[&str], f32); 3] = [
     ("head", &["head_long.obj"], 0.03),

@@ -98,7 +98,7 @@ fn covered_brightness(img: &[u8]) -> f64 {
 /// cells blur about a cell (2 pixels here) beyond the strands. For scale, the strands with
 /// LoD against the strands at full detail (both the renderer's own strands) already differ by
 /// 0.069 (sintel 0.027). Bounds: the measurements plus about 15%; issue 26 asked 0.05, which
-/// these cells do not reach (README, The volume tier).
+/// these cells do not reach (guide, volume chapter).
 const SWITCH_FLIP_MEAN: [(&str, f32); 2] = [("head_long.obj", 0.15), ("sintel.obj", 0.105)];
 /// The middle of the default band (`render::volume`).
 const SWITCH_PIXELS: f32 = 0.5

@@ -327,7 +327,7 @@ impl FrameSettings {
     /// hardware strips) and the light's through the software passes, each where the
     /// settings and the device (`caps`) allow it, else hardware. Compute generation feeding
     /// the software rasterizer keeps the hair out of the graphics pipeline, the narrow part
-    /// of data-centre GPUs and the slowest part of lavapipe (README, Software rasterizer).
+    /// of data-centre GPUs and the slowest part of lavapipe (guide, soft_raster chapter).
     pub fn with_fastest(
         self,
         (raster, light): (Option<super::soft::StrandRaster>, Option<LightRaster>),

@@ -79,7 +79,7 @@ impl StrandRaster {
 
     /// What draws each bundle in a frame composited with `transparency`: `Auto` with k-buffer
     /// OIT sends every bundle to software, since the software rasterizer is never slower than
-    /// hardware strips inserted into a k-buffer (README, `bench raster`); in opaque frames
+    /// hardware strips inserted into a k-buffer (guide, soft_raster chapter, `bench raster`); in opaque frames
     /// thick bundles stay opaque hardware strips, which need no k-buffer.
     pub fn under(self, transparency: super::Transparency) -> Self {
         match (self, transparency) {

@@ -599,15 +599,24 @@ mod tests {
             "{m} vs {}",
             p_now - p_before
         );
-        // A character that moved with the camera stays put on screen.
-        let moved = Mat4::from_translation(Vec3::new(0.1, 0.0, 0.0));
-        let m = motion_at(
-            clip_to_prev(before, moved.inverse(), now),
-            p_now,
-            depth,
-            size,
-        );
-        assert!(m.length() > 1.0);
+        // A character that moved with the camera (fixed in its clip space: its previous model
+        // times the inverse of its current one is `before^-1 now`) stays put on screen,
+        // through `clip_to_prev` and through `FrameMotion::character` alike.
+        let with_camera = before.inverse() * now;
+        let m = motion_at(clip_to_prev(before, with_camera, now), p_now, depth, size);
+        assert!(m.length() < 1e-3, "{m}");
+        let frame = FrameMotion {
+            view_proj: now,
+            view_proj_inverse: now.inverse(),
+            prev_view_proj: before,
+            prev_models: vec![Some(with_camera)],
+        };
+        let m = motion_at(frame.character(0, Mat4::IDENTITY), p_now, depth, size);
+        assert!(m.length() < 1e-3, "{m}");
+        // One that stood still moves by the camera's motion (0.2 px here, 200 times the bound
+        // above).
+        let m = motion_at(frame.camera(), p_now, depth, size);
+        assert!((m - (p_now - p_before)).length() < 1e-3 && m.length() > 0.1, "{m}");
     }
 
     #[test]

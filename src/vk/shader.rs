@@ -34,8 +34,107 @@ impl ShaderOptions {
     }
 }
 
-/// Compile embedded shader `name` (stage from its extension) to SPIR-V.
+/// SPIR-V already compiled in this process, by everything that determines it (the sources
+/// are embedded, so the name, definitions and generated includes do): every renderer after
+/// the first skips shaderc.
+static COMPILED: std::sync::Mutex<Option<std::collections::HashMap<String, Vec<u32>>>> =
+    std::sync::Mutex::new(None);
+
+/// The key of one compilation in [`COMPILED`].
+fn cache_key(name: &str, opts: &ShaderOptions) -> String {
+    let mut key = String::from(name);
+    for (k, v) in &opts.defines {
+        key.extend(["\0d", k, "=", v]);
+    }
+    for (n, t) in &opts.generated {
+        key.extend(["\0g", n, "\0", t]);
+    }
+    key
+}
+
+/// Compile embedded shader `name` (stage from its extension) to SPIR-V (once per process for
+/// the same options).
 pub fn compile(name: &str, opts: &ShaderOptions) -> GpuResult<Vec<u32>> {
+    let key = cache_key(name, opts);
+    let cached = |map: &mut Option<std::collections::HashMap<String, Vec<u32>>>| {
+        map.get_or_insert_with(Default::default).get(&key).cloned()
+    };
+    if let Some(spirv) = COMPILED.lock().ok().and_then(|mut m| cached(&mut m)) {
+        return Ok(spirv);
+    }
+    let disk = std::env::var_os(CACHE_ENV).map(|dir| {
+        std::path::PathBuf::from(dir).join(format!("{:032x}.spv", disk_hash(&key)))
+    });
+    let from_disk = disk.as_deref().and_then(read_spirv);
+    let spirv = match from_disk {
+        Some(spirv) => spirv,
+        None => {
+            let spirv = compile_uncached(name, opts)?;
+            if let Some(path) = &disk {
+                write_spirv(path, &spirv);
+            }
+            spirv
+        }
+    };
+    if let Ok(mut m) = COMPILED.lock() {
+        m.get_or_insert_with(Default::default)
+            .insert(key, spirv.clone());
+    }
+    Ok(spirv)
+}
+
+/// Environment variable naming a folder where compiled SPIR-V is kept between processes
+/// (the tests set it to `target/shader-cache` through `.cargo/config.toml`); unset, nothing
+/// is written.
+pub const CACHE_ENV: &str = "HAIRMESH_SHADER_CACHE";
+
+/// 128-bit FNV-1a of a compilation's key and every embedded source (an edited shader, or
+/// one it includes, misses the cache).
+fn disk_hash(key: &str) -> u128 {
+    const PRIME: u128 = 0x0000000001000000000000000000013B;
+    let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
+    let mut eat = |bytes: &[u8]| {
+        for b in bytes {
+            h ^= *b as u128;
+            h = h.wrapping_mul(PRIME);
+        }
+    };
+    eat(env!("CARGO_PKG_VERSION").as_bytes());
+    for (n, t) in SOURCES {
+        eat(n.as_bytes());
+        eat(t.as_bytes());
+    }
+    eat(key.as_bytes());
+    h
+}
+
+/// SPIR-V from a cache file: whole words starting with the magic number, else `None`.
+fn read_spirv(path: &std::path::Path) -> Option<Vec<u32>> {
+    let bytes = std::fs::read(path).ok()?;
+    if bytes.len() < 20 || bytes.len() % 4 != 0 {
+        return None;
+    }
+    let words: Vec<u32> = bytes
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    (words[0] == 0x0723_0203).then_some(words)
+}
+
+/// Keep `spirv` at `path` (written to a temporary file and renamed, so a reader never sees
+/// half a file); a cache that cannot be written is skipped.
+fn write_spirv(path: &std::path::Path, spirv: &[u32]) {
+    let Some(dir) = path.parent() else { return };
+    let _ = std::fs::create_dir_all(dir);
+    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    let bytes: Vec<u8> = spirv.iter().flat_map(|w| w.to_le_bytes()).collect();
+    if std::fs::write(&tmp, bytes).is_ok() && std::fs::rename(&tmp, path).is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+}
+
+/// [`compile`] without the caches.
+fn compile_uncached(name: &str, opts: &ShaderOptions) -> GpuResult<Vec<u32>> {
     let kind = match name.rsplit('.').next() {
         Some("comp") => shaderc::ShaderKind::Compute,
         Some("vert") => shaderc::ShaderKind::Vertex,

@@ -105,10 +105,33 @@ fn run(args: Args) -> Result<()> {
             ctx.validation_messages()
         );
     }
-    if shown == 0 || hidden == 0 {
-        bail!(
-            "expected hair both shown and hidden by the engine's depth ({shown} shown, {hidden} hidden)"
-        );
+    check_shares(shown, hidden, (w, h))
+}
+
+/// Shares of the picture with hair shown over the engine's colour and hidden by its depth,
+/// measured at 640x480 on lavapipe (18,591 and 5,961 pixels); a run passes within a factor 2
+/// of each. Hair composited nowhere (no shown pixels), the engine's depth ignored (none
+/// hidden) or misconverted (everything hidden, or nothing) all fail.
+const SHOWN_SHARE: f64 = 18_591.0 / (640.0 * 480.0);
+/// See [`SHOWN_SHARE`].
+const HIDDEN_SHARE: f64 = 5_961.0 / (640.0 * 480.0);
+
+/// Fail unless `shown` and `hidden` pixels of a `w x h` picture are within a factor 2 of the
+/// measured shares.
+fn check_shares(shown: usize, hidden: usize, (w, h): (u32, u32)) -> Result<()> {
+    let pixels = (w as f64) * (h as f64);
+    for (what, count, measured) in [
+        ("shown", shown, SHOWN_SHARE),
+        ("hidden", hidden, HIDDEN_SHARE),
+    ] {
+        let share = count as f64 / pixels;
+        if !(measured / 2.0..=measured * 2.0).contains(&share) {
+            bail!(
+                "{count} hair pixels {what} ({:.2}% of the picture); expected {:.2}% within a factor 2",
+                share * 100.0,
+                measured * 100.0
+            );
+        }
     }
     Ok(())
 }
