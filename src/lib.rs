@@ -1,8 +1,8 @@
 //! Real-time strand hair from hair meshes (Bhokare, Montalvo, Diaz, Yuksel, SIGGRAPH 2024).
 //!
 //! Data flows one way, and the modules follow it:
-//! [`model`] (hair mesh, OBJ, style) -> [`bake`] (five textures, `.hmb` file) ->
-//! [`reference`] (CPU oracle of strand generation and LoD) | [`render`] (GPU generation,
+//! [`model`] (hair mesh, OBJ, style) -> [`bake`](mod@bake) (five textures, `.hmb` file) ->
+//! [`reference`](mod@reference) (CPU oracle of strand generation and LoD) | [`render`] (GPU generation,
 //! shading, image) on the thin Vulkan layer [`vk`].
 
 #![warn(missing_docs)]

@@ -238,10 +238,12 @@ fn check(msaa: u32, depth_format: vk::Format, share_allocator: bool) {
             save_png(&output_dir().join(name), W, H, &through);
         }
         assert!(covered(&open) > 0.05, "the hair is drawn");
-        assert!(diff < 2e-3, "the host frame is the renderer's own: {diff}");
+        // Measured: 0 at 1x, 9.4e-6 at 4x MSAA (lavapipe); bound 10x the larger.
+        assert!(diff < 1e-4, "the host frame is the renderer's own: {diff}");
         assert!(covered(&left(&open)) > 0.02, "there is hair on the left");
         assert_eq!(covered(&left(&walled)), 0.0, "the wall hides the hair");
-        assert!(mean_abs_diff(&right(&walled), &right(&open)) < 1e-3);
+        // Measured 0: the wall's right half is beside the hair.
+        assert!(mean_abs_diff(&right(&walled), &right(&open)) < 1e-4);
         assert!(
             partly > 0.2 * covered(&left(&open)) && partly < 0.8 * covered(&left(&open)),
             "a wall through the head hides part of the hair: {partly}"
@@ -249,7 +251,8 @@ fn check(msaa: u32, depth_format: vk::Format, share_allocator: bool) {
         pictures.push(through);
     }
     for p in &pictures[1..] {
-        assert!(mean_abs_diff(&pictures[0], p) < 1e-3, "conventions differ");
+        // Measured 0 between conventions (same pixels); 1e-4 leaves float rounding room.
+        assert!(mean_abs_diff(&pictures[0], p) < 1e-4, "conventions differ");
     }
     drop(frame);
     drop(r);

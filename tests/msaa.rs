@@ -50,7 +50,8 @@ fn four_samples_resolve_and_smooth_edges() {
             colours(&four) * 20 > colours(&one) * 23,
             "4x MSAA adds edge colours"
         );
-        assert!(mean < 0.05, "same scene: mean abs diff {mean}");
+        // Measured 0.0045 on both paths (lavapipe): only edges differ; bound 10x.
+        assert!(mean < 0.045, "same scene: mean abs diff {mean}");
     }
     assert!(Renderer::new(&ctx, &RendererDesc::default().msaa(3)).is_err());
     assert_no_validation_errors(&ctx);

@@ -457,10 +457,10 @@ fn orbit_flicker(temporal: Temporal, frames: u32, warmup: usize) -> f64 {
 }
 
 /// Temporal accumulation steadies sub-pixel strands: over a slow orbit the hair's luminance
-/// changes from frame to frame (along the true motion) less than half as much with `taa` as
-/// without (measured on lavapipe: see the print; the ratio is the claim `bench temporal`
-/// quantifies at full size). Accumulation switched off, or history that never blends, reads
-/// a ratio near 1 and fails.
+/// changes from frame to frame (along the true motion) much less with `taa` than without:
+/// measured on lavapipe 0.00446 against 0.01035, a ratio of 0.431; the bound, 0.6, sits
+/// between that and the ratio near 1 that accumulation switched off, or history that never
+/// blends, reads (`bench temporal` quantifies the same measure at full size).
 #[test]
 fn accumulation_reduces_flicker() {
     let off = orbit_flicker(Temporal::Off, 14, 6);
@@ -469,5 +469,5 @@ fn accumulation_reduces_flicker() {
         "orbit flicker: {off:.5} off, {taa:.5} with taa (ratio {:.3})",
         taa / off
     );
-    assert!(taa < 0.5 * off, "taa {taa} against {off} without");
+    assert!(taa < 0.6 * off, "taa {taa} against {off} without");
 }

@@ -176,7 +176,7 @@ fn sintel_cranium() -> Result<(Vec3, f32)> {
     .ok_or_else(|| HairError::invalid("hairmeshes/sintel_head.obj", "no cranium found"))
 }
 
-/// The sphere through the top of a head: fitted to the points within [`CAP_DEPTH`] radii
+/// The sphere through the top of a head: fitted to the points within `CAP_DEPTH` (0.7) radii
 /// of the highest, the cap refined from the fit four times (the first cap is the top quarter
 /// of the points' height). `None` if the points do not round off at the top.
 pub fn cranium_sphere(points: &[Vec3]) -> Option<(Vec3, f32)> {

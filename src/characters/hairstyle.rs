@@ -423,7 +423,7 @@ const HAIRLINE_DEGREES: [f32; 12] = [
 ];
 
 /// The hairline at azimuth `phi` (radians): a periodic Catmull-Rom curve through
-/// [`HAIRLINE_DEGREES`], so the hairline is smooth.
+/// `HAIRLINE_DEGREES`, so the hairline is smooth.
 pub fn hairline(phi: f32) -> f32 {
     let n = HAIRLINE_DEGREES.len();
     let x = phi.rem_euclid(std::f32::consts::TAU) / std::f32::consts::TAU * n as f32;

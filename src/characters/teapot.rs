@@ -3,7 +3,7 @@
 //! vertical planes, handle and spout across one; 32 patches in all). The paper's 200-teapot
 //! scene grows fur on it.
 //!
-//! Data frame: z up, about 6.5 x 4 x 3.15 units. [`Teapot::new`] turns it into the crowd frame
+//! Data frame: z up, about 6.5 x 4 x 3.15 units. `Teapot::new` turns it into the crowd frame
 //! (+Y up, standing on y = 0) at a given scale.
 
 use glam::{Vec2, Vec3};

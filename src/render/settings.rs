@@ -90,7 +90,7 @@ impl RenderPath {
     }
 }
 
-/// How to create a [`Renderer`].
+/// How to create a [`Renderer`](crate::render::Renderer).
 #[derive(Clone, Debug)]
 pub struct RendererDesc {
     /// Default path; `None` picks mesh where available, else compute.
@@ -226,7 +226,7 @@ impl Default for FrameOptions {
     }
 }
 
-/// A submitted frame, to [`Renderer::wait`] for.
+/// A submitted frame, to [`Renderer::wait`](crate::render::Renderer::wait) for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FrameTicket(pub u64);
 

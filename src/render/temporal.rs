@@ -616,7 +616,10 @@ mod tests {
         // One that stood still moves by the camera's motion (0.2 px here, 200 times the bound
         // above).
         let m = motion_at(frame.camera(), p_now, depth, size);
-        assert!((m - (p_now - p_before)).length() < 1e-3 && m.length() > 0.1, "{m}");
+        assert!(
+            (m - (p_now - p_before)).length() < 1e-3 && m.length() > 0.1,
+            "{m}"
+        );
     }
 
     #[test]

@@ -263,7 +263,7 @@ impl Image {
     }
 
     /// Create a sampled image holding `data` (tightly packed texels), left in
-    /// [`Access::SampledRead`](super::command::Access::SampledRead). Blocks until uploaded.
+    /// [`Access::SampledRead`]. Blocks until uploaded.
     pub fn with_data(ctx: &Arc<Context>, desc: &ImageDesc, data: &[u8]) -> GpuResult<Self> {
         let desc = desc
             .clone()

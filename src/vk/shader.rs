@@ -62,9 +62,8 @@ pub fn compile(name: &str, opts: &ShaderOptions) -> GpuResult<Vec<u32>> {
     if let Some(spirv) = COMPILED.lock().ok().and_then(|mut m| cached(&mut m)) {
         return Ok(spirv);
     }
-    let disk = std::env::var_os(CACHE_ENV).map(|dir| {
-        std::path::PathBuf::from(dir).join(format!("{:032x}.spv", disk_hash(&key)))
-    });
+    let disk = std::env::var_os(CACHE_ENV)
+        .map(|dir| std::path::PathBuf::from(dir).join(format!("{:032x}.spv", disk_hash(&key))));
     let from_disk = disk.as_deref().and_then(read_spirv);
     let spirv = match from_disk {
         Some(spirv) => spirv,
