@@ -189,14 +189,8 @@ pub fn build_families(
     if families.is_empty() {
         return Err(HairError::invalid("crowd", "no hairstyle families"));
     }
-    if count == 0 || count > MAX_CROWD {
-        return Err(HairError::invalid(
-            "crowd",
-            format!("count {count} outside 1..={MAX_CROWD}"),
-        ));
-    }
+    let side = grid_side(count)?;
     let mut rng = Pcg32::new(seed as u64);
-    let side = (count as f32).sqrt().ceil() as usize;
     let mut out = Vec::with_capacity(count);
     for i in 0..count {
         let ball = preset == Preset::Mixed && i % 4 == 3;
@@ -238,6 +232,17 @@ pub fn build_families(
         });
     }
     Ok(out)
+}
+
+/// Columns of the square grid of a crowd of `count` (1..=[`MAX_CROWD`]).
+fn grid_side(count: usize) -> Result<usize> {
+    if count == 0 || count > MAX_CROWD {
+        return Err(HairError::invalid(
+            "crowd",
+            format!("count {count} outside 1..={MAX_CROWD}"),
+        ));
+    }
+    Ok((count as f32).sqrt().ceil() as usize)
 }
 
 /// Place `i` of a grid of `side` columns: a little jitter and a random heading, roughly
@@ -288,14 +293,8 @@ pub fn build_own(
             "no hairstyle families for heads",
         ));
     }
-    if count == 0 || count > MAX_CROWD {
-        return Err(HairError::invalid(
-            "crowd",
-            format!("count {count} outside 1..={MAX_CROWD}"),
-        ));
-    }
+    let side = grid_side(count)?;
     let mut rng = Pcg32::new(seed as u64);
-    let side = (count as f32).sqrt().ceil() as usize;
     (0..count)
         .map(|i| {
             let character_seed = seed.wrapping_mul(0x9E37_79B9).wrapping_add(i as u32);
