@@ -125,9 +125,13 @@ fn read_spirv(path: &std::path::Path) -> Option<Vec<u32>> {
 fn write_spirv(path: &std::path::Path, spirv: &[u32]) {
     let Some(dir) = path.parent() else { return };
     let _ = std::fs::create_dir_all(dir);
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    // Unique per process and call: two threads (or test processes) writing the same entry
+    // each rename a whole file of their own.
+    static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = path.with_extension(format!("tmp{}-{n}", std::process::id()));
     let bytes: Vec<u8> = spirv.iter().flat_map(|w| w.to_le_bytes()).collect();
-    if std::fs::write(&tmp, bytes).is_ok() && std::fs::rename(&tmp, path).is_err() {
+    if !(std::fs::write(&tmp, bytes).is_ok() && std::fs::rename(&tmp, path).is_ok()) {
         let _ = std::fs::remove_file(&tmp);
     }
 }
@@ -178,4 +182,44 @@ fn compile_uncached(name: &str, opts: &ShaderOptions) -> GpuResult<Vec<u32>> {
         .compile_into_spirv(text, kind, name, "main", Some(&options))
         .map_err(|e| GpuError::Shader(format!("glsl/{}", e.to_string().trim())))?;
     Ok(artifact.as_binary().to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cache file holds whole SPIR-V or is ignored; keys that differ hash apart.
+    #[test]
+    fn cached_spirv_round_trips_and_garbage_is_ignored() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.spv");
+        let spirv = vec![0x0723_0203, 0x0001_0600, 7, 8, 9, 10];
+        write_spirv(&path, &spirv);
+        assert_eq!(read_spirv(&path), Some(spirv.clone()));
+        std::fs::write(
+            &path,
+            [
+                1u8, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20,
+            ],
+        )
+        .unwrap();
+        assert_eq!(read_spirv(&path), None, "no magic number");
+        std::fs::write(
+            &path,
+            [
+                3u8, 2, 0x23, 7, 0, 6, 1, 0, 7, 0, 0, 0, 8, 0, 0, 0, 9, 0, 0, 0, 10,
+            ],
+        )
+        .unwrap();
+        assert_eq!(read_spirv(&path), None, "not whole words");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary left"
+        );
+        let opts = ShaderOptions::default();
+        let a = disk_hash(&cache_key("a.comp", &opts));
+        let b = disk_hash(&cache_key("a.comp", &opts.clone().define("X", 1)));
+        assert_ne!(a, b);
+    }
 }
