@@ -55,14 +55,12 @@ impl AnyHead {
     /// the joints below it move by half or more fit the cranium; every triangle near it is
     /// the surface.
     pub fn from_character(name: &str, character: &Character, joint: &str) -> Result<Self> {
-        let s = &character.skeleton;
-        let j = s.find(joint).ok_or_else(|| {
-            HairError::invalid(
-                name,
-                format!("no joint named '{joint}' (--joint names one)"),
-            )
-        })?;
-        let under = joints_under(s, j);
+        Self::from_joint(name, character, find_joint(name, character, joint)?)
+    }
+
+    /// [`Self::from_character`] with the head joint given by index.
+    pub fn from_joint(name: &str, character: &Character, j: usize) -> Result<Self> {
+        let under = joints_under(&character.skeleton, j);
         let mut region = Vec::new();
         let mut triangles = Vec::new();
         for m in &character.meshes {
@@ -118,14 +116,14 @@ impl AnyHead {
     }
 
     /// Where hair grows on this head: the canonical person (height 1) with this head.
-    pub fn site(&self) -> Result<GrowthSite> {
+    pub fn site(&self) -> GrowthSite {
         PersonShape::default().site_on(self.head)
     }
 
     /// A hairstyle of `family` from `seed`, grown on this head and returned in the user's
     /// frame and units (mesh and style).
     pub fn grow(&self, family: StyleFamily, seed: u32) -> Result<Hairstyle> {
-        let hair = generate_on(family, seed, &self.site()?)?;
+        let hair = generate_on(family, seed, &self.site())?;
         Ok(transformed(hair, self.to_user, self.scale))
     }
 }
@@ -143,6 +141,16 @@ pub fn transformed(mut hair: Hairstyle, m: Mat4, scale: f32) -> Hairstyle {
     }
     hair.style = hair.style.scaled(scale);
     hair
+}
+
+/// Index of the joint called `joint` in `character` (from `name`), or an error naming it.
+pub fn find_joint(name: &str, character: &Character, joint: &str) -> Result<usize> {
+    character.skeleton.find(joint).ok_or_else(|| {
+        HairError::invalid(
+            name,
+            format!("no joint named '{joint}' (--joint names one)"),
+        )
+    })
 }
 
 /// Whether each joint is `j` or below it.

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 
 use super::any_head::AnyHead;
 use super::hairstyle::{Hairstyle, StyleFamily};
@@ -50,13 +50,8 @@ impl OwnCharacter {
         if character.meshes.is_empty() {
             return Err(HairError::invalid(name, "no skinned mesh"));
         }
-        let head = AnyHead::from_character(name, &character, joint)?;
-        let head_joint = character.skeleton.find(joint).ok_or_else(|| {
-            HairError::invalid(
-                name,
-                format!("no joint named '{joint}' (--joint names one)"),
-            )
-        })?;
+        let head_joint = super::any_head::find_joint(name, &character, joint)?;
+        let head = AnyHead::from_joint(name, &character, head_joint)?;
         let clip = character
             .clips
             .iter()
@@ -110,7 +105,7 @@ impl OwnCharacter {
     /// Clustering cell of a mesh's far version: the people's head cell for small meshes
     /// (eyes, teeth), their body cell for the rest, in the character's units.
     fn far_cell(&self, m: &SkinnedMesh) -> f32 {
-        let (lo, hi) = bounds(m);
+        let (lo, hi) = super::people::mesh_bounds(m);
         let radius = super::person::CANONICAL_RADIUS * self.head.scale;
         let cell = match (hi - lo).length() < SMALL_MESH_RADII * radius {
             true => super::people::FAR_HEAD_CELL,
@@ -127,15 +122,7 @@ impl OwnCharacter {
             .meshes
             .iter()
             .enumerate()
-            .map(|(k, m)| {
-                let (lo, hi) = bounds(m);
-                PropLod {
-                    mesh: k,
-                    far_mesh: n + k,
-                    below_pixels: super::preset::FAR_CELL_PIXELS * (hi - lo).length()
-                        / self.far_cell(m),
-                }
-            })
+            .map(|(k, m)| super::people::far_lod(m, (k, n + k), self.far_cell(m)))
             .collect()
     }
 
@@ -172,7 +159,7 @@ impl OwnCharacter {
         let s = self.head.scale;
         let mut out: Vec<Collider> = self
             .head
-            .site()?
+            .site()
             .body
             .into_iter()
             .map(|c| match c {
@@ -191,15 +178,6 @@ impl OwnCharacter {
         out.push(Collider::head(&self.head.head.map, to, 0.005));
         Ok(out)
     }
-}
-
-/// Bind-pose box of `m`.
-fn bounds(m: &SkinnedMesh) -> (Vec3, Vec3) {
-    m.vertices
-        .iter()
-        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), v| {
-            (lo.min(v.position), hi.max(v.position))
-        })
 }
 
 /// The feet a walk plants: the two joints without children that stand lowest at rest.

@@ -111,20 +111,28 @@ pub fn skinned_lods(
     meshes: &[crate::skin::SkinnedMesh],
 ) -> Vec<crate::render::prop_table::PropLod> {
     (0..FAR_MESHES.min(meshes.len()))
-        .map(|k| {
-            let (lo, hi) = meshes[k]
-                .vertices
-                .iter()
-                .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), v| {
-                    (lo.min(v.position), hi.max(v.position))
-                });
-            crate::render::prop_table::PropLod {
-                mesh: k,
-                far_mesh: FAR_MESHES + k,
-                below_pixels: super::preset::FAR_CELL_PIXELS * (hi - lo).length() / far_cell(k),
-            }
-        })
+        .map(|k| far_lod(&meshes[k], (k, FAR_MESHES + k), far_cell(k)))
         .collect()
+}
+
+/// Bind-pose box of `mesh`.
+pub fn mesh_bounds(mesh: &crate::skin::SkinnedMesh) -> (Vec3, Vec3) {
+    crate::model::hair_mesh::bounds(mesh.vertices.iter().map(|v| v.position))
+}
+
+/// When skinned mesh `mesh` (index `k`, far version at `far`, clustered at `cell`) switches
+/// to its far version: once a cell spans under [`super::preset::FAR_CELL_PIXELS`].
+pub fn far_lod(
+    mesh: &crate::skin::SkinnedMesh,
+    (k, far): (usize, usize),
+    cell: f32,
+) -> crate::render::prop_table::PropLod {
+    let (lo, hi) = mesh_bounds(mesh);
+    crate::render::prop_table::PropLod {
+        mesh: k,
+        far_mesh: far,
+        below_pixels: super::preset::FAR_CELL_PIXELS * (hi - lo).length() / cell,
+    }
 }
 
 /// The Sintel head above the neck and its eyes as skinned meshes bound wholly to

@@ -100,12 +100,12 @@ impl PersonShape {
 
     /// Where this person's hair grows: their head and the body below it.
     pub fn site(&self) -> Result<GrowthSite> {
-        self.site_on(human_head()?)
+        Ok(self.site_on(human_head()?))
     }
 
     /// [`Self::site`] with `shape` as the head (the mannequin's neck, shoulders and chest
     /// below it: a head normalized into the canonical frame sits where the Sintel head does).
-    pub fn site_on(&self, shape: &'static HumanHead) -> Result<GrowthSite> {
+    pub fn site_on(&self, shape: &'static HumanHead) -> GrowthSite {
         let b = self.body_transform();
         let body = BODY
             .iter()
@@ -116,22 +116,23 @@ impl PersonShape {
                 radius: part.ra.max(part.rb) * self.height,
             })
             .collect();
-        Ok(GrowthSite {
+        GrowthSite {
             head: self.head_on(shape),
             body,
             height: self.height,
             proportions: self.head * self.height,
-        })
+        }
     }
 
     /// Colliders for the hair dynamics: the neck, the shoulders and the upper torso (the
     /// body's own shapes, [`body_mesh`]), then the head itself.
     pub fn colliders(&self) -> Result<Vec<Collider>> {
-        let mut out = self.site()?.body;
+        let site = self.site()?;
+        let mut out = site.body;
         // The head last: where the neck capsule and the jaw disagree, the head wins.
         out.push(Collider::head(
-            &human_head()?.map,
-            self.head_transform()?,
+            &site.head.shape.map,
+            site.head.to_person,
             0.005,
         ));
         Ok(out)

@@ -37,8 +37,9 @@ impl ShaderOptions {
 /// SPIR-V already compiled in this process, by everything that determines it (the sources
 /// are embedded, so the name, definitions and generated includes do): every renderer after
 /// the first skips shaderc.
-static COMPILED: std::sync::Mutex<Option<std::collections::HashMap<String, Vec<u32>>>> =
-    std::sync::Mutex::new(None);
+static COMPILED: std::sync::LazyLock<
+    std::sync::Mutex<std::collections::HashMap<String, Vec<u32>>>,
+> = std::sync::LazyLock::new(Default::default);
 
 /// The key of one compilation in [`COMPILED`].
 fn cache_key(name: &str, opts: &ShaderOptions) -> String {
@@ -56,10 +57,7 @@ fn cache_key(name: &str, opts: &ShaderOptions) -> String {
 /// the same options).
 pub fn compile(name: &str, opts: &ShaderOptions) -> GpuResult<Vec<u32>> {
     let key = cache_key(name, opts);
-    let cached = |map: &mut Option<std::collections::HashMap<String, Vec<u32>>>| {
-        map.get_or_insert_with(Default::default).get(&key).cloned()
-    };
-    if let Some(spirv) = COMPILED.lock().ok().and_then(|mut m| cached(&mut m)) {
+    if let Some(spirv) = COMPILED.lock().ok().and_then(|m| m.get(&key).cloned()) {
         return Ok(spirv);
     }
     let disk = std::env::var_os(CACHE_ENV)
@@ -76,8 +74,7 @@ pub fn compile(name: &str, opts: &ShaderOptions) -> GpuResult<Vec<u32>> {
         }
     };
     if let Ok(mut m) = COMPILED.lock() {
-        m.get_or_insert_with(Default::default)
-            .insert(key, spirv.clone());
+        m.insert(key, spirv.clone());
     }
     Ok(spirv)
 }
@@ -90,20 +87,27 @@ pub const CACHE_ENV: &str = "HAIRMESH_SHADER_CACHE";
 /// 128-bit FNV-1a of a compilation's key and every embedded source (an edited shader, or
 /// one it includes, misses the cache).
 fn disk_hash(key: &str) -> u128 {
-    const PRIME: u128 = 0x0000000001000000000000000000013B;
-    let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
-    let mut eat = |bytes: &[u8]| {
-        for b in bytes {
-            h ^= *b as u128;
-            h = h.wrapping_mul(PRIME);
+    // The crate version and every embedded source, hashed once per process.
+    static SOURCES_HASH: std::sync::LazyLock<u128> = std::sync::LazyLock::new(|| {
+        let mut h = fnv1a(FNV_OFFSET, env!("CARGO_PKG_VERSION").as_bytes());
+        for (n, t) in SOURCES {
+            h = fnv1a(fnv1a(h, n.as_bytes()), t.as_bytes());
         }
-    };
-    eat(env!("CARGO_PKG_VERSION").as_bytes());
-    for (n, t) in SOURCES {
-        eat(n.as_bytes());
-        eat(t.as_bytes());
+        h
+    });
+    fnv1a(*SOURCES_HASH, key.as_bytes())
+}
+
+/// FNV-1a's 128-bit offset basis.
+const FNV_OFFSET: u128 = 0x6c62272e07bb014262b821756295c58d;
+
+/// 128-bit FNV-1a of `bytes`, continuing from `h`.
+fn fnv1a(mut h: u128, bytes: &[u8]) -> u128 {
+    const PRIME: u128 = 0x0000000001000000000000000000013B;
+    for b in bytes {
+        h ^= *b as u128;
+        h = h.wrapping_mul(PRIME);
     }
-    eat(key.as_bytes());
     h
 }
 
