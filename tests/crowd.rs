@@ -113,7 +113,9 @@ fn three_hundred_characters_in_one_frame_match_one_at_a_time() {
             strands, all.stats.strands_drawn as u64,
             "{path:?}: strand totals"
         );
-        assert!(d <= 1.0 / 255.0, "{path:?}: mean absolute difference {d}");
+        // Measured 0.000000 on both paths (the same pixels in the same order); 1e-4 is a few
+        // pixels of one character drawn wrong out of 300 where 1/255 was a whole-image shift.
+        assert!(d <= 1e-4, "{path:?}: mean absolute difference {d}");
         if path == RenderPath::Compute {
             save_png(
                 &output_dir().join("crowd-300.png"),

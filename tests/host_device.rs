@@ -38,7 +38,8 @@ fn the_renderer_draws_on_a_host_device_and_leaves_it_alive() {
         let diff = mean_abs_diff(&own, &drawn);
         println!("host device: {covered} hair pixels, mean difference to its own device {diff:e}");
         assert!(covered > 200, "only {covered} pixels drawn");
-        assert!(diff < 1e-3, "the host device's image differs by {diff}");
+        // Measured 0 (the same driver draws the same pixels on either device).
+        assert!(diff < 1e-5, "the host device's image differs by {diff}");
         assert_no_validation_errors(&ctx);
     }
     // The renderer and its context are gone; the host's device is not.

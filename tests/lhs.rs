@@ -51,7 +51,8 @@ fn lhs_at_rest_equals_the_hair_mesh_and_skins_like_its_twin() {
         "{strands} strands, {} guides: LHS at rest vs hair mesh {d}",
         model.guides.len()
     );
-    assert!(d <= 1.0 / 255.0, "{d}");
+    // Measured 0: at rest the skinned guides reproduce the generated strands exactly.
+    assert!(d <= 1e-5, "{d}");
     assert!(skinned.pass_ms.iter().any(|(n, _)| *n == "lhs skin"));
     // Bend the guides: the GPU skins as the CPU twin does.
     let now: Vec<Vec3> = model
@@ -94,7 +95,8 @@ fn lhs_at_rest_equals_the_hair_mesh_and_skins_like_its_twin() {
     let moved_lhs = frame(&mut r, RenderPath::Lhs);
     let d = mean_abs_diff(&moved_mesh, &moved_lhs.rgba.unwrap());
     println!("moved character: LHS with regenerated guides vs hair mesh {d}");
-    assert!(d <= 1.0 / 255.0, "{d}");
+    // Measured 2.9e-6 (a few strands shift by a rounding step); bound about 10x.
+    assert!(d <= 3e-5, "{d}");
     assert_no_validation_errors(&ctx);
 }
 

@@ -94,8 +94,10 @@ fn mesh_path_matches_compute_path() {
             mesh.triangles
         );
         assert!(
-            d <= 1.0 / 255.0,
-            "{name}: mean absolute pixel difference {d} > 1/255"
+            // Measured 0.000000 for every mesh and LoD setting (the two paths emit the same
+            // triangles); 1e-4 fails a few wrong strands where 1/255 passed a shifted image.
+            d <= 1e-4,
+            "{name}: mean absolute pixel difference {d} > 1e-4"
         );
     }
     assert_no_validation_errors(&ctx);

@@ -112,6 +112,8 @@ fn frame_with(
 }
 
 /// Mean luminance and hue of the hair region within this fraction of full detail with the term.
+/// Measured at most 1.2% (opaque, mid) with the term, 18-22% without (opaque): 5% is about 4x
+/// the first, kept below the second so that the control (without the term) fails.
 const TOLERANCE: f64 = 0.05;
 
 /// Both transparency modes at 4x and 10x the framing distance (the field of view narrowed to

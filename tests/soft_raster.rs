@@ -313,6 +313,7 @@ fn stored_strands_take_the_software_rasterizer() {
         assert_eq!(s.tile_entries_written, g.tile_entries_written);
         let d = mean_abs_diff(&static_soft, &generated);
         println!("static through software vs compute through software: {d}");
+        // Measured 0 (the same segments through the same raster); bound a twentieth of a level.
         assert!(d <= 0.05 / 255.0, "{d}");
         assert!(
             mean_abs_diff(&static_soft, &stored) > 0.0,
@@ -379,6 +380,7 @@ fn auto_in_opaque_frames_draws_every_bundle() {
             if mean > 0.03 {
                 save_failure(&format!("auto_opaque_x{far}_{path:?}"), 128, 128, &auto, &e);
             }
+            // Measured FLIP mean 0.0000 at x1 (all strips) and 0.0049 at x5 (all software).
             assert!(mean <= 0.03, "x{far} {path:?}: {mean}");
             drawn.0 |= s.triangles_drawn > 0;
             drawn.1 |= s.segments_written > 0;

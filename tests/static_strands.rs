@@ -45,7 +45,8 @@ fn static_strands_equal_the_generated_ones() {
         let drawn = frame(&mut r, &view, RenderPath::Static).unwrap();
         let d = mean_abs_diff(&generated.rgba.unwrap(), &drawn.rgba.unwrap());
         println!("{shadows:?} {transparency}: static vs generated mean abs diff {d}");
-        assert!(d <= 1.0 / 255.0, "{d}");
+        // Measured 0 in every mode: stored strands are the generated ones, drawn the same way.
+        assert!(d <= 1e-5, "{d}");
         assert_eq!(drawn.stats.strands_drawn, generated.stats.strands_drawn);
         assert!(!drawn.pass_ms.iter().any(|(n, _)| n.contains("generate")));
     }

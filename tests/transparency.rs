@@ -122,7 +122,9 @@ fn kbuffer_is_independent_of_fragment_order() {
         &frame(&ctx, RenderPath::Compute, t, 1),
         &frame(&ctx, RenderPath::Mesh, t, 1),
     );
-    assert!(d < 1e-3, "peeling mesh vs compute {d}");
+    println!("depth peeling, mesh vs compute: mean abs diff {d}");
+    // Measured 0 (the same strands peeled the same way); 1e-5 fails a few wrong pixels.
+    assert!(d < 1e-5, "peeling mesh vs compute {d}");
 }
 
 /// OIT with 4x MSAA (lavapipe's count): the opaque edges are antialiased, the strands

@@ -216,6 +216,7 @@ fn volumetric_occlusion_darkens_the_inner_hair() {
     println!(
         "occlusion keeps {all:.3} of the hair's brightness: darkest quarter {dark:.3}, brightest {bright:.3}"
     );
+    // Measured 0.879 (darkest quarter 0.680): the bound asks for a visible 3% at least.
     assert!(all < 0.97, "occlusion kept {all:.3} of the brightness");
     assert!(
         dark < bright,

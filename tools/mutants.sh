@@ -6,6 +6,7 @@
 #
 #   bash tools/mutants.sh                  # every group, every mutant (hours on 2 cores)
 #   MUTANTS_SHARD=1/10 bash tools/mutants.sh        # a 1-in-10 round-robin sample of each group
+#   MUTANTS_SAMPLE=25 bash tools/mutants.sh         # about 25 mutants of each group, evenly spaced
 #   bash tools/mutants.sh shade budget     # named groups only
 #
 # Groups (files -> tests): shade (src/shade -> unit tests, shading_twin), reference
@@ -44,12 +45,19 @@ groups=("$@")
 exclude_render='DensityVolumes::|check_sampling|SoftBudget::buffers|shadow_buffers|transient_buffers|frame_fields|TemporalState::|VolumePass|fn record|::record|descriptor'
 
 tree="$root/target/mutants-tree"
+# A previous run's build folder is kept (its sources are not: a stopped run may leave a mutant).
+kept="$root/target/mutants-build"
+[ -d "$tree/target" ] && { rm -rf "$kept"; mv "$tree/target" "$kept"; }
 rm -rf "$tree"
 git worktree prune
 git worktree add --detach "$tree" HEAD >/dev/null
 git diff HEAD | (cd "$tree" && git apply --allow-empty)
-mkdir -p "$tree/target"
-cp -a "$root/target/debug" "$tree/target/debug"
+if [ -d "$kept" ]; then
+    mv "$kept" "$tree/target"
+else
+    mkdir -p "$tree/target"
+    cp -a "$root/target/debug" "$tree/target/debug"
+fi
 
 for g in "${groups[@]}"; do
     [ -n "${files[$g]:-}" ] || { echo "mutants.sh: unknown group '$g'" >&2; exit 2; }
@@ -58,7 +66,14 @@ for g in "${groups[@]}"; do
     for f in ${files[$g]}; do args+=(--file "$f"); done
     for t in ${tests[$g]}; do args+=("--cargo-arg=$t"); done
     [ "$g" = render ] && args+=(--exclude-re "$exclude_render")
-    [ -n "${MUTANTS_SHARD:-}" ] && args+=(--shard "$MUTANTS_SHARD" --sharding round-robin)
+    shard=${MUTANTS_SHARD:-}
+    if [ -n "${MUTANTS_SAMPLE:-}" ]; then
+        listed=("${args[@]:8}")
+        total=$(cd "$tree" && cargo mutants --list "${listed[@]}" | grep -c .)
+        shard="1/$(( (total + MUTANTS_SAMPLE - 1) / MUTANTS_SAMPLE ))"
+        echo "$g: $total mutants, sampling $shard"
+    fi
+    [ -n "$shard" ] && args+=(--shard "$shard" --sharding round-robin)
     mkdir -p "$root/target/mutants/$g"
     cargo mutants "${args[@]}" >"$root/target/mutants/$g/log.txt" 2>&1 || true
     out="$root/target/mutants/$g/mutants.out"

@@ -224,6 +224,20 @@ pub(crate) mod tests {
         (sum * (std::f64::consts::PI / nt as f64) * (std::f64::consts::TAU / np as f64)) as f32
     }
 
+    /// Every model is reachable by its command-line name, and a wrong name names the choices.
+    #[test]
+    fn shading_models_parse_by_name() {
+        for (name, model) in [
+            ("placeholder", ShadingModel::Placeholder),
+            ("kajiya-kay", ShadingModel::KajiyaKay),
+            ("marschner", ShadingModel::Marschner),
+        ] {
+            assert_eq!(name.parse::<ShadingModel>(), Ok(model));
+        }
+        let err = "phong".parse::<ShadingModel>().unwrap_err();
+        assert!(err.contains("'phong'") && err.contains("marschner"), "{err}");
+    }
+
     #[test]
     fn marschner_lobes_conserve_energy_white_furnace() {
         for roughness in [0.1, 0.25, 0.5, 1.0] {
