@@ -440,6 +440,83 @@ pub fn exit_with_error(tool: &str, error: &dyn std::fmt::Display, code: i32) -> 
 mod tests {
     use super::*;
 
+    /// The size limit is inclusive: a file of exactly `max_bytes` is read, one byte more is
+    /// refused naming the limit, and a folder is refused before anything is read.
+    #[test]
+    fn inputs_are_read_up_to_their_limit_and_no_further() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("eight.bin");
+        std::fs::write(&f, b"12345678").unwrap();
+        assert_eq!(read_input(&f, 8).unwrap(), b"12345678");
+        let err = read_input(&f, 7).unwrap_err().to_string();
+        assert!(
+            err.contains("eight.bin") && err.contains("7-byte limit"),
+            "{err}"
+        );
+        let err = read_input(dir.path(), 1 << 20).unwrap_err().to_string();
+        assert!(err.contains("not a regular file"), "{err}");
+        std::fs::write(&f, [0xff, 0xfe]).unwrap();
+        assert!(
+            read_text_input(&f, 8)
+                .unwrap_err()
+                .to_string()
+                .contains("not UTF-8")
+        );
+    }
+
+    /// An output that is one of the run's inputs is refused; another file in the same folder
+    /// (same device, another inode) is not.
+    #[test]
+    fn an_output_may_not_overwrite_an_input() {
+        let dir = tempfile::tempdir().unwrap();
+        let (input, other) = (dir.path().join("in.obj"), dir.path().join("out.obj"));
+        std::fs::write(&input, b"v 0 0 0").unwrap();
+        std::fs::write(&other, b"old").unwrap();
+        let err = OutputPath::check(&input, &[&input])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("refusing to overwrite"), "{err}");
+        OutputPath::check(&other, &[&input]).unwrap();
+        let mut files = RunFiles::new();
+        files.input(&input);
+        files.output(&other, "--out").unwrap();
+        let err = files.output(&other, "--also").unwrap_err().to_string();
+        assert!(err.contains("also this run's output"), "{err}");
+    }
+
+    /// A staged folder appears with every written file on publish, and not at all when the
+    /// run is dropped before publishing.
+    #[test]
+    fn staged_folders_appear_whole_or_not_at_all() {
+        let dir = tempfile::tempdir().unwrap();
+        let names = ["a.png".to_string(), "b.csv".to_string()];
+        let target = dir.path().join("frames");
+        let mut staged =
+            StagedFolder::check(&target, &names, &mut RunFiles::new(), "--out").unwrap();
+        staged.write("a.png", b"A").unwrap();
+        drop(staged);
+        assert!(!target.exists());
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "staging left behind"
+        );
+        let mut staged =
+            StagedFolder::check(&target, &names, &mut RunFiles::new(), "--out").unwrap();
+        staged.write("a.png", b"A").unwrap();
+        staged.write("b.csv", b"B").unwrap();
+        staged.publish().unwrap();
+        assert_eq!(std::fs::read(target.join("a.png")).unwrap(), b"A");
+        assert_eq!(std::fs::read(target.join("b.csv")).unwrap(), b"B");
+        // Into an existing folder: the files move in, the staging folder goes.
+        let mut staged =
+            StagedFolder::check(&target, &names, &mut RunFiles::new(), "--out").unwrap();
+        staged.write("b.csv", b"C").unwrap();
+        staged.publish().unwrap();
+        assert_eq!(std::fs::read(target.join("b.csv")).unwrap(), b"C");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
     #[test]
     fn outputs_written_together_appear_all_or_none() {
         let dir = tempfile::tempdir().unwrap();

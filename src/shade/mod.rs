@@ -235,7 +235,10 @@ pub(crate) mod tests {
             assert_eq!(name.parse::<ShadingModel>(), Ok(model));
         }
         let err = "phong".parse::<ShadingModel>().unwrap_err();
-        assert!(err.contains("'phong'") && err.contains("marschner"), "{err}");
+        assert!(
+            err.contains("'phong'") && err.contains("marschner"),
+            "{err}"
+        );
     }
 
     #[test]
