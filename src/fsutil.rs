@@ -484,6 +484,22 @@ mod tests {
         assert!(err.contains("also this run's output"), "{err}");
     }
 
+    /// Character devices are written in place, after the files: `/dev/null` is accepted as an
+    /// output, and a write to `/dev/full` (always "no space left") fails the run.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn devices_are_outputs_written_in_place() {
+        let null = OutputPath::check(Path::new("/dev/null"), &[]).unwrap();
+        assert_eq!(null.kind, OutputKind::Device);
+        let full = OutputPath::check(Path::new("/dev/full"), &[]).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let file = OutputPath::check(&dir.path().join("a.txt"), &[]).unwrap();
+        write_together(&[(&null, b"n"), (&file, b"a")]).unwrap();
+        assert_eq!(std::fs::read(dir.path().join("a.txt")).unwrap(), b"a");
+        let err = write_together(&[(&full, b"f")]).unwrap_err().to_string();
+        assert!(err.contains("/dev/full"), "{err}");
+    }
+
     /// A staged folder appears with every written file on publish, and not at all when the
     /// run is dropped before publishing.
     #[test]
