@@ -10,9 +10,11 @@
 #   bash tools/mutants.sh shade budget     # named groups only
 #
 # Groups (files -> tests): shade (src/shade -> unit tests, shading_twin), reference
-# (src/reference -> unit tests, generator), bake (src/bake -> unit tests, bake_file, bake_cli,
-# deform, generator), render (the CPU halves of soft.rs, temporal.rs, volume.rs -> unit tests),
-# io (budget.rs, fsutil.rs -> unit tests, bake_cli, export).
+# (src/reference -> unit tests, generator, gpu_oracle), bake (src/bake -> unit tests,
+# bake_file, bake_cli, deform, generator, hair_mesh_update), render (the CPU halves of soft.rs,
+# temporal.rs, volume.rs -> unit tests, volume), io (budget.rs, fsutil.rs -> unit tests,
+# bake_cli, export). A CPU twin's first guard is its GPU comparison (gpu_oracle, shading_twin,
+# hair_mesh_update, volume: a few seconds each on lavapipe), so those run with their group.
 #
 # Runs in place in a scratch worktree (target/mutants-tree, with a copy of target/debug so the
 # dependencies are not rebuilt), so the checkout can be edited meanwhile. Installs cargo-mutants
@@ -29,11 +31,11 @@ declare -A files tests
 files[shade]="src/shade/*.rs"
 tests[shade]="--lib --test=shading_twin"
 files[reference]="src/reference/*.rs"
-tests[reference]="--lib --test=generator"
+tests[reference]="--lib --test=generator --test=gpu_oracle"
 files[bake]="src/bake/*.rs"
-tests[bake]="--lib --test=bake_file --test=bake_cli --test=deform --test=generator"
+tests[bake]="--lib --test=bake_file --test=bake_cli --test=deform --test=generator --test=hair_mesh_update"
 files[render]="src/render/soft.rs src/render/temporal.rs src/render/volume.rs"
-tests[render]="--lib"
+tests[render]="--lib --test=volume"
 files[io]="src/budget.rs src/fsutil.rs"
 tests[io]="--lib --test=bake_cli --test=export"
 
@@ -77,7 +79,7 @@ for g in "${groups[@]}"; do
     mkdir -p "$root/target/mutants/$g"
     cargo mutants "${args[@]}" >"$root/target/mutants/$g/log.txt" 2>&1 || true
     out="$root/target/mutants/$g/mutants.out"
-    count() { [ -f "$out/$1.txt" ] && grep -c . "$out/$1.txt" || echo 0; }
+    count() { if [ -f "$out/$1.txt" ]; then grep -c . "$out/$1.txt" || true; else echo 0; fi; }
     caught=$(count caught) missed=$(count missed) timeout=$(count timeout) unviable=$(count unviable)
     echo "$g: caught $caught, missed $missed, timeout $timeout, unviable $unviable"
 done
