@@ -100,6 +100,14 @@ impl Estimate {
         self
     }
 
+    /// Bytes of the parts named `name` (0 when there is none).
+    pub fn part(&self, name: &str) -> u64 {
+        self.parts
+            .iter()
+            .filter(|p| p.0 == name)
+            .fold(0u64, |a, p| a.saturating_add(p.1))
+    }
+
     /// Sum of the parts, bytes (saturating).
     pub fn total(&self) -> u64 {
         self.parts.iter().fold(0u64, |a, p| a.saturating_add(p.1))

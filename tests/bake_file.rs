@@ -86,3 +86,30 @@ fn rejects_damaged_files() {
         );
     }
 }
+
+/// The bake's memory estimate counts each of the five textures at exactly the bytes the bake
+/// makes (the parts a budget is checked against before the bake allocates them).
+#[test]
+fn memory_estimate_counts_the_textures_exactly() {
+    for name in ["small_patch.obj", "triangle_tuft.obj", "head_long.obj"] {
+        let b = baked(name);
+        let slice = b.info.slice_texels() as u64;
+        let e = hairmesh::bake::memory_estimate(1, b.info.layers as u64, slice);
+        let bytes = |n: usize, each: usize| (n * each) as u64;
+        assert_eq!(
+            e.part("hair mesh texture"),
+            bytes(b.position.len(), 8),
+            "{name}"
+        );
+        assert_eq!(
+            e.part("uv and w textures"),
+            bytes(b.uv.len(), 4) + bytes(b.w.len(), 2),
+            "{name}"
+        );
+        assert_eq!(
+            e.part("u and v textures"),
+            bytes(b.u_dir.len(), 8) + bytes(b.v_dir.len(), 8),
+            "{name}"
+        );
+    }
+}

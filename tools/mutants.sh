@@ -7,7 +7,8 @@
 #   bash tools/mutants.sh                  # every group, every mutant (hours on 2 cores)
 #   MUTANTS_SHARD=1/10 bash tools/mutants.sh        # a 1-in-10 round-robin sample of each group
 #   MUTANTS_SAMPLE=25 bash tools/mutants.sh         # about 25 mutants of each group, evenly spaced
-#   bash tools/mutants.sh shade budget     # named groups only
+#   bash tools/mutants.sh shade io         # named groups only
+#   MUTANTS_ITERATE=1 bash tools/mutants.sh reference  # only what the last run did not catch
 #
 # Groups (files -> tests): shade (src/shade -> unit tests, shading_twin), reference
 # (src/reference -> unit tests, generator, gpu_oracle), bake (src/bake -> unit tests,
@@ -76,6 +77,8 @@ for g in "${groups[@]}"; do
         echo "$g: $total mutants, sampling $shard"
     fi
     [ -n "$shard" ] && args+=(--shard "$shard" --sharding round-robin)
+    # MUTANTS_ITERATE=1: test again only what the last run of the group did not catch.
+    [ -n "${MUTANTS_ITERATE:-}" ] && args+=(--iterate)
     mkdir -p "$root/target/mutants/$g"
     cargo mutants "${args[@]}" >"$root/target/mutants/$g/log.txt" 2>&1 || true
     out="$root/target/mutants/$g/mutants.out"
