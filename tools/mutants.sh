@@ -11,7 +11,7 @@
 #   MUTANTS_ITERATE=1 bash tools/mutants.sh reference  # only what the last run did not catch
 #
 # Groups (files -> tests): shade (src/shade -> unit tests, shading_twin), reference
-# (src/reference -> unit tests, generator, gpu_oracle), bake (src/bake -> unit tests,
+# (src/reference -> unit tests, generator, gpu_oracle, lhs, volume), bake (src/bake -> unit tests,
 # bake_file, bake_cli, deform, generator, hair_mesh_update), render (the CPU halves of soft.rs,
 # temporal.rs, volume.rs -> unit tests, volume), io (budget.rs, fsutil.rs -> unit tests,
 # bake_cli, export). A CPU twin's first guard is its GPU comparison (gpu_oracle, shading_twin,
@@ -32,7 +32,7 @@ declare -A files tests
 files[shade]="src/shade/*.rs"
 tests[shade]="--lib --test=shading_twin"
 files[reference]="src/reference/*.rs"
-tests[reference]="--lib --test=generator --test=gpu_oracle"
+tests[reference]="--lib --test=generator --test=gpu_oracle --test=lhs --test=volume"
 files[bake]="src/bake/*.rs"
 tests[bake]="--lib --test=bake_file --test=bake_cli --test=deform --test=generator --test=hair_mesh_update"
 files[render]="src/render/soft.rs src/render/temporal.rs src/render/volume.rs"

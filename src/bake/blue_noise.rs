@@ -247,8 +247,11 @@ mod tests {
             // distance is 2 r_max; Yuksel 2015 reports about 1.5 r_max for a final set.
             let norm = db[k] / r_max(domain.area(), k + 1);
             white_worst = white_worst.min(dw[k] / r_max(domain.area(), k + 1));
+            // Worst prefix measured 1.208 r_max (torus) and 1.236 (triangle), seeded, so
+            // deterministic; a wrong minimum radius in the weights (rmax / instead of *) reads
+            // 1.080, white noise far less.
             assert!(
-                norm > 1.0,
+                norm > 1.15,
                 "{domain:?} prefix {}: min distance {} is only {norm} r_max",
                 k + 1,
                 db[k]
@@ -257,6 +260,10 @@ mod tests {
                 worst_ratio = worst_ratio.min(db[k] / dw[k]);
             }
         }
+        let worst_norm = (1..n)
+            .map(|k| db[k] / r_max(domain.area(), k + 1))
+            .fold(f32::INFINITY, f32::min);
+        println!("{domain:?}: worst prefix min distance {worst_norm} r_max, ratio {worst_ratio}");
         assert!(
             worst_ratio > 4.0,
             "{domain:?}: blue noise prefix not clearly better than white ({worst_ratio})"
