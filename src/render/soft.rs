@@ -277,6 +277,15 @@ pub fn shadow_buffers(light: Option<(u32, ShadowMode)>) -> [TransientBuffer; 2] 
 mod tests {
     use super::*;
 
+    /// Each raster reaches the shaders as its own mode number (`FrameBlock::soft.x`).
+    #[test]
+    fn each_raster_has_its_shader_mode() {
+        use crate::render::shared::{RASTER_AUTO, RASTER_HARDWARE, RASTER_SOFTWARE};
+        assert_eq!(StrandRaster::Hardware.mode(), RASTER_HARDWARE);
+        assert_eq!(StrandRaster::Software { k: 4 }.mode(), RASTER_SOFTWARE);
+        assert_eq!(StrandRaster::Auto { k: 4 }.mode(), RASTER_AUTO);
+    }
+
     #[test]
     fn parses_and_rejects() {
         assert_eq!("hw".parse(), Ok(StrandRaster::Hardware));
