@@ -523,6 +523,25 @@ pub fn downsample(rgba: &[u8], size: (u32, u32), factor: u32) -> Vec<u8> {
 mod tests {
     use super::*;
 
+    /// Bilinear sampling weighs the four pixels around the point by their distances, pixel
+    /// centres at half-integers, and gives `None` where a neighbour is outside the image.
+    #[test]
+    fn luminance_is_sampled_bilinearly_between_pixel_centres() {
+        let (w, h) = (4u32, 3u32);
+        let grey = |x: u32, y: u32| (40 * x + 10 * y) as u8;
+        let image: Vec<u8> = (0..h)
+            .flat_map(|y| (0..w).flat_map(move |x| [grey(x, y), grey(x, y), grey(x, y), 255]))
+            .collect();
+        let lum = |x: u32, y: u32| luminance(&[grey(x, y), grey(x, y), grey(x, y), 255]);
+        let (fx, fy) = (0.25, 0.5);
+        let want = (lum(1, 1) * (1.0 - fx) + lum(2, 1) * fx) * (1.0 - fy)
+            + (lum(1, 2) * (1.0 - fx) + lum(2, 2) * fx) * fy;
+        let got = sample_luminance(&image, (w, h), Vec2::new(1.5 + fx, 1.5 + fy)).unwrap();
+        assert!((got - want).abs() < 1e-6, "{got} vs {want}");
+        assert!(sample_luminance(&image, (w, h), Vec2::new(0.2, 1.5)).is_none());
+        assert!(sample_luminance(&image, (w, h), Vec2::new(3.7, 1.5)).is_none());
+    }
+
     #[test]
     fn visibility_words_order_by_depth_and_round_trip() {
         let word = |depth: f32, id: u32, r: Vec2| VisibilityWord {
