@@ -434,6 +434,27 @@ fn job(e: &VolumeEntry, r: &CharacterRecord, (lo, hi): (Vec3, Vec3)) -> DensityJ
 mod tests {
     use super::*;
 
+    /// A character's hair spans its bounding sphere's projected diameter: `2 r / (2 d tan)`
+    /// of the screen height in perspective, `2 r / view height` of it in orthographic views.
+    #[test]
+    fn hair_pixels_is_the_projected_sphere() {
+        let mut r: CharacterRecord = bytemuck::Zeroable::zeroed();
+        r.model = Mat4::IDENTITY.to_cols_array_2d();
+        r.mesh.pos_extent = [4.0, 0.0, 0.0, 0.0];
+        r.model_scale = 1.0;
+        let mut block: FrameBlock = bytemuck::Zeroable::zeroed();
+        // Sphere at (2, 0, 0), radius 2, eye 10 away, 720 px high, inv_tan 1.
+        block.camera_pos = [2.0, 0.0, 10.0, 720.0];
+        block.light_dir[3] = 1.0;
+        assert!((hair_pixels(&r, &block) - 144.0).abs() < 1e-3);
+        block.camera_pos = [2.0, 0.0, 1.5, 720.0];
+        assert_eq!(hair_pixels(&r, &block), f32::INFINITY);
+        // Orthographic (inv_tan 0): a 4-unit-high view.
+        block.light_dir[3] = 0.0;
+        block.lod_ortho[0] = 4.0;
+        assert!((hair_pixels(&r, &block) - 720.0).abs() < 1e-3);
+    }
+
     #[test]
     fn the_tier_weight_falls_across_the_band() {
         let tier = VolumeTier::on();
