@@ -436,6 +436,20 @@ mod tests {
 
     /// A character's hair spans its bounding sphere's projected diameter: `2 r / (2 d tan)`
     /// of the screen height in perspective, `2 r / view height` of it in orthographic views.
+    /// The switch is measured with the look its doc names (what `bench volume-tier` and
+    /// `tests/volume_tier.rs` compare).
+    #[test]
+    fn the_switch_look_is_the_documented_one() {
+        let camera = super::super::Camera::look_at(Vec3::Z, Vec3::ZERO, 40.0);
+        let (view, opts) = switch_look(camera, VolumeTier::on());
+        assert_eq!(view.shading, crate::shade::ShadingModel::Marschner);
+        assert_eq!(view.shadows, super::super::ShadowMode::DeepOpacity);
+        assert_eq!(view.volumes, VolumeTier::on());
+        assert_eq!(opts.raster, super::super::StrandRaster::Auto { k: 8 });
+        assert_eq!(opts.light_raster, super::super::LightRaster::Software);
+        assert!(opts.read_image);
+    }
+
     #[test]
     fn hair_pixels_is_the_projected_sphere() {
         let mut r: CharacterRecord = bytemuck::Zeroable::zeroed();
