@@ -242,10 +242,12 @@ mod tests {
         let dw = prefix_min_distances(&white, domain);
         let mut worst_ratio = f32::INFINITY;
         let mut white_worst = f32::INFINITY;
+        let mut worst_norm = f32::INFINITY;
         for k in 1..n {
             // Normalise by the Poisson-disk radius of k+1 samples: the best possible minimum
             // distance is 2 r_max; Yuksel 2015 reports about 1.5 r_max for a final set.
             let norm = db[k] / r_max(domain.area(), k + 1);
+            worst_norm = worst_norm.min(norm);
             white_worst = white_worst.min(dw[k] / r_max(domain.area(), k + 1));
             // Worst prefix measured 1.208 r_max (torus) and 1.236 (triangle), seeded, so
             // deterministic; a wrong minimum radius in the weights (rmax / instead of *) reads
@@ -260,9 +262,6 @@ mod tests {
                 worst_ratio = worst_ratio.min(db[k] / dw[k]);
             }
         }
-        let worst_norm = (1..n)
-            .map(|k| db[k] / r_max(domain.area(), k + 1))
-            .fold(f32::INFINITY, f32::min);
         println!("{domain:?}: worst prefix min distance {worst_norm} r_max, ratio {worst_ratio}");
         assert!(
             worst_ratio > 4.0,

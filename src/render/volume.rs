@@ -434,8 +434,6 @@ fn job(e: &VolumeEntry, r: &CharacterRecord, (lo, hi): (Vec3, Vec3)) -> DensityJ
 mod tests {
     use super::*;
 
-    /// A character's hair spans its bounding sphere's projected diameter: `2 r / (2 d tan)`
-    /// of the screen height in perspective, `2 r / view height` of it in orthographic views.
     /// The switch is measured with the look its doc names (what `bench volume-tier` and
     /// `tests/volume_tier.rs` compare).
     #[test]
@@ -450,6 +448,8 @@ mod tests {
         assert!(opts.read_image);
     }
 
+    /// A character's hair spans its bounding sphere's projected diameter: `2 r / (2 d tan)`
+    /// of the screen height in perspective, `2 r / view height` of it in orthographic views.
     #[test]
     fn hair_pixels_is_the_projected_sphere() {
         let mut r: CharacterRecord = bytemuck::Zeroable::zeroed();
