@@ -18,8 +18,8 @@
 # bake_cli, export). A CPU twin's first guard is its GPU comparison (gpu_oracle, shading_twin,
 # hair_mesh_update, volume: a few seconds each on lavapipe), so those run with their group.
 #
-# Runs in place in a scratch worktree (target/mutants-tree, with a copy of target/debug so the
-# dependencies are not rebuilt), so the checkout can be edited meanwhile. Installs cargo-mutants
+# Runs in place in a scratch worktree (target/mutants-tree; builds in target/mutants-build,
+# seeded from target/debug and kept), so the checkout can be edited meanwhile. Installs cargo-mutants
 # (from crates.io, pinned) on first use. Results: target/mutants/<group>/mutants.out (caught.txt,
 # missed.txt, timeout.txt, unviable.txt) and a summary line per group on stdout.
 set -euo pipefail
@@ -49,31 +49,30 @@ groups=("$@")
 exclude_render='DensityVolumes::|check_sampling|SoftBudget::buffers|shadow_buffers|transient_buffers|frame_fields|TemporalState::|VolumePass|fn record|::record|descriptor'
 
 tree="$root/target/mutants-tree"
-# A previous run's build folder is kept (its sources are not: a stopped run may leave a mutant).
-kept="$root/target/mutants-build"
-[ -d "$tree/target" ] && { rm -rf "$kept"; mv "$tree/target" "$kept"; }
+# Builds go to one folder kept between runs (seeded once from target/debug, so the dependencies
+# are not rebuilt); the sources are a fresh worktree each run (a stopped run may leave a mutant).
+export CARGO_TARGET_DIR="$root/target/mutants-build"
+if [ ! -d "$CARGO_TARGET_DIR/debug" ]; then
+    mkdir -p "$CARGO_TARGET_DIR"
+    cp -a "$root/target/debug" "$CARGO_TARGET_DIR/debug"
+fi
 rm -rf "$tree"
 git worktree prune
 git worktree add --detach "$tree" HEAD >/dev/null
 git diff HEAD | (cd "$tree" && git apply --allow-empty)
-if [ -d "$kept" ]; then
-    mv "$kept" "$tree/target"
-else
-    mkdir -p "$tree/target"
-    cp -a "$root/target/debug" "$tree/target/debug"
-fi
 
 for g in "${groups[@]}"; do
     [ -n "${files[$g]:-}" ] || { echo "mutants.sh: unknown group '$g'" >&2; exit 2; }
+    # Which mutants (also what --list counts for a sample) and what tests them.
+    select=()
+    for f in ${files[$g]}; do select+=(--file "$f"); done
+    for t in ${tests[$g]}; do select+=("--cargo-arg=$t"); done
+    [ "$g" = render ] && select+=(--exclude-re "$exclude_render")
     args=(--in-place --dir "$tree" --output "$root/target/mutants/$g" --no-shuffle
-        --minimum-test-timeout 60)
-    for f in ${files[$g]}; do args+=(--file "$f"); done
-    for t in ${tests[$g]}; do args+=("--cargo-arg=$t"); done
-    [ "$g" = render ] && args+=(--exclude-re "$exclude_render")
+        --minimum-test-timeout 60 "${select[@]}")
     shard=${MUTANTS_SHARD:-}
     if [ -n "${MUTANTS_SAMPLE:-}" ]; then
-        listed=("${args[@]:8}")
-        total=$(cd "$tree" && cargo mutants --list "${listed[@]}" | grep -c .)
+        total=$(cd "$tree" && cargo mutants --list "${select[@]}" | grep -c .)
         shard="1/$(( (total + MUTANTS_SAMPLE - 1) / MUTANTS_SAMPLE ))"
         echo "$g: $total mutants, sampling $shard"
     fi
