@@ -26,6 +26,12 @@ vec2 kajiya_kay(vec3 t, vec3 l, vec3 v) {
     return vec2(sin_tl, pow(max(sin_tl * sin_tv - tl * tv, 0.0), KAJIYA_KAY_EXPONENT));
 }
 
+// The ambient light at a surface whose normal has world-up component `up`: sky above,
+// ground below (shade::hemisphere_ambient).
+vec3 hemisphere_ambient(float up) {
+    return AMBIENT * mix(GROUND_TINT, SKY_TINT, 0.5 + 0.5 * clamp(up, -1.0, 1.0));
+}
+
 float hair_fresnel(float eta, float cos_theta) {
     float f0 = (1.0 - eta) / (1.0 + eta);
     f0 *= f0;

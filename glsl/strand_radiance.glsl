@@ -10,9 +10,21 @@
 #include "volume_shading.glsl"
 #include "lod_appearance.glsl"
 
-// LIGHT_IRRADIANCE (the directional light) and AMBIENT (the sky) come from shared.glsl (Rust
-// twins in src/shade/mod.rs). With frame.shading.z on, Marschner adds dual scattering
-// (hair_shading.glsl) from the light; the ambient term is the sky in every model.
+// LIGHT_IRRADIANCE (the directional light) and AMBIENT, SKY_TINT, GROUND_TINT (the sky and
+// ground) come from shared.glsl (Rust twins in src/shade/mod.rs). With frame.shading.z on,
+// Marschner adds dual scattering (hair_shading.glsl) from the light; the ambient term is the
+// sky and ground in every model.
+
+// The sky and ground light reaching strand point `pos` of character `character`: a strand has
+// no normal, so the direction out of the character's hair (from the centre of its hair mesh's
+// box) stands for one: hair on the crown sees the sky, the ends under a bob the ground.
+vec3 hair_ambient(uint character, vec3 pos) {
+    CharacterRecord r = characters[character];
+    vec3 centre = (r.model * vec4(r.mesh.pos_origin.xyz + 0.5 * r.mesh.pos_extent.xyz, 1.0)).xyz;
+    vec3 out_dir = pos - centre;
+    float len = length(out_dir);
+    return hemisphere_ambient(len > 0.0 ? out_dir.y / len : 0.0);
+}
 
 // Radiance toward the eye at world point `pos` of a strand with unit-ish tangent `tangent`,
 // parameter `s` along it, base colour `base`, of character `character`, standing for
@@ -29,12 +41,12 @@ vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint 
     vec3 c;
     if (frame.shading.x == SHADING_KAJIYA_KAY) {
         vec2 kk = kajiya_kay(t, l, e);
-        c = (base * (AMBIENT * ambient + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
+        c = (base * (hair_ambient(character, pos) * ambient + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
     } else if (frame.shading.x == SHADING_MARSCHNER) {
         HairStyle s = characters[character].style;
         vec3 sc = dual_scattering(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees), arrival,
                                   frame.shading.z != 0u, cluster_crossings(thickness));
-        c = (sc * LIGHT_IRRADIANCE + base * (AMBIENT * ambient)) * root_shadow;
+        c = (sc * LIGHT_IRRADIANCE + base * (hair_ambient(character, pos) * ambient)) * root_shadow;
     } else {
         float tl = dot(t, l);
         float diffuse = sqrt(max(1.0 - tl * tl, 0.0));

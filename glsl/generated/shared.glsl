@@ -83,6 +83,9 @@
 #define MARSCHNER_ENERGY_SCALE 0.9
 #define LIGHT_IRRADIANCE 4.5
 #define AMBIENT 0.25
+#define PROP_ROUGHNESS 0.55
+#define PROP_IRRADIANCE 2.5
+#define PROP_AMBIENT 0.3
 #define FORWARD_DENSITY 0.7
 #define BACKWARD_DENSITY 0.7
 #define GAP_DENSITY 0.6
@@ -93,6 +96,8 @@
 #define MARCH_STEP_CELLS 1.0
 #define MARCH_MIN_TRANSMITTANCE 0.01
 #define STRAND_SHADOW_OPACITY 0.5
+#define SKY_TINT vec3(0.95, 1.1, 1.5)
+#define GROUND_TINT vec3(0.62, 0.56, 0.46)
 #define BINDING_FRAME 0
 #define BINDING_CHARACTERS 1
 #define BINDING_BUNDLES 2
@@ -214,6 +219,8 @@ struct FrameBlock {
     vec4 temporal_params;
     mat4 clip_to_prev;
     mat4 unjittered_view_proj;
+    mat4 body_view_proj;
+    vec4 body_shadow;
 };
 
 struct CharacterRecord {

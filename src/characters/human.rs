@@ -197,6 +197,15 @@ fn position_key(p: Vec3) -> [i32; 3] {
 
 /// Boundary loops of a triangle soup (edges used by one triangle), as ordered rings of
 /// positions.
+/// The rim of `eye`'s socket: the boundary loop of `triangles` within two eye radii of its
+/// centre (`None` if there is none).
+pub fn socket_rim(triangles: &[[Vec3; 3]], eye: &Eye) -> Option<Vec<Vec3>> {
+    boundary_loops(triangles).into_iter().find(|ring| {
+        ring.iter()
+            .all(|p| p.distance(eye.centre) < 2.0 * eye.radius)
+    })
+}
+
 fn boundary_loops(triangles: &[[Vec3; 3]]) -> Vec<Vec<Vec3>> {
     let key = position_key;
     let mut count: std::collections::HashMap<([i32; 3], [i32; 3]), i32> = Default::default();
@@ -379,15 +388,8 @@ mod tests {
     #[test]
     fn the_eyes_fill_their_sockets_and_the_mouth_is_closed() {
         let head = human_head().unwrap();
-        let loops = boundary_loops(&head.triangles);
         for eye in head.eyes.unwrap() {
-            let rim = loops
-                .iter()
-                .find(|ring| {
-                    ring.iter()
-                        .all(|p| p.distance(eye.centre) < 2.0 * eye.radius)
-                })
-                .expect("the eye's socket");
+            let rim = socket_rim(&head.triangles, &eye).expect("the eye's socket");
             let c = rim.iter().copied().sum::<Vec3>() / rim.len() as f32;
             let worst = rim
                 .iter()

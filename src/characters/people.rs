@@ -13,6 +13,7 @@ use crate::budget::MemoryBudget;
 use crate::error::{HairError, Result};
 use crate::model::gltf::{Character, parse_character};
 use crate::rng::Pcg32;
+use crate::shade::PROP_ROUGHNESS;
 
 /// The two figures, in [`Figure`] order.
 static FIGURES: OnceLock<std::result::Result<[Arc<Character>; 2], String>> = OnceLock::new();
@@ -136,49 +137,47 @@ pub fn far_lod(
 }
 
 /// The Sintel head above the neck and its eyes as skinned meshes bound wholly to
-/// [`head_shape_joint`] (canonical frame): the bust white (the person's skin tone tints it),
-/// the eyes' whites and irises in their own colours.
+/// [`head_shape_joint`] (canonical frame): the bust with the eyelids white (the person's skin
+/// tone tints it; the lash lines dark), the eyeballs banded pupil, iris and sclera, wet
+/// ([`super::eyes`]).
 fn head_meshes() -> Result<[crate::skin::SkinnedMesh; 2]> {
     let joint = head_shape_joint()? as u16;
     let head = super::human::human_head()?;
-    let bust = super::person::neck_up_mesh()?;
+    let mut bust = super::person::neck_up_mesh()?;
+    let mut bust_colors = vec![Vec3::ONE; bust.len()];
     let mut eyes = Vec::new();
     let mut eye_colors = Vec::new();
     let head_eyes = head
         .eyes
         .ok_or_else(|| HairError::invalid("hairmeshes/sintel_head.obj", "no eye sockets"))?;
     for eye in head_eyes {
-        let iris = eye.centre + Vec3::Z * (super::preset::IRIS_OFFSET * eye.radius);
-        for (centre, radius, color) in [
-            (eye.centre, eye.radius, super::preset::SCLERA_COLOR),
-            (
-                iris,
-                super::preset::IRIS_RADIUS * eye.radius,
-                super::preset::IRIS_COLOR,
-            ),
-        ] {
-            let mut tris = Vec::new();
-            super::person::ellipsoid(&mut tris, centre, Vec3::splat(radius), 10, 16);
-            let n = tris.len() * 3;
-            eyes.extend(super::human::smooth_prop_mesh(&tris));
-            let rgb = Vec3::new(color[0], color[1], color[2]);
-            eye_colors.extend(std::iter::repeat_n(rgb, n));
+        for (tri, color) in super::eyes::eyeball(&eye) {
+            eyes.extend(tri);
+            eye_colors.extend([Vec3::from(color); 3]);
+        }
+        let (skin, lashes) = super::eyes::lids(&eye);
+        for (tris, shade) in [(skin, 1.0), (lashes, LASH_LINE)] {
+            let verts = super::human::smooth_prop_mesh(&tris);
+            bust_colors.extend(std::iter::repeat_n(Vec3::splat(shade), verts.len()));
+            bust.extend(verts);
         }
     }
-    let white = vec![Vec3::ONE; bust.len()];
     Ok([
-        welded("head", &bust, &white, joint),
-        welded("eyes", &eyes, &eye_colors, joint),
+        welded("head", &bust, &bust_colors, (joint, PROP_ROUGHNESS)),
+        welded("eyes", &eyes, &eye_colors, (joint, super::eyes::EYE_ROUGHNESS)),
     ])
 }
 
-/// A triangle list of prop vertices as an indexed skinned mesh bound to `joint` (corners with
-/// the same position, normal and colour welded).
+/// The lash line's shade of the skin tone: lashes and the lid's shadowed edge.
+const LASH_LINE: f32 = 0.12;
+
+/// A triangle list of prop vertices as an indexed skinned mesh bound to `joint`, of GGX
+/// `roughness` (corners with the same position, normal and colour welded).
 fn welded(
     name: &str,
     list: &[crate::render::shared::PropVertex],
     colors: &[Vec3],
-    joint: u16,
+    (joint, roughness): (u16, f32),
 ) -> crate::skin::SkinnedMesh {
     use std::collections::HashMap;
     let mut index: HashMap<[u32; 9], u32> = HashMap::new();
@@ -194,6 +193,7 @@ fn welded(
                 position: p,
                 normal: n,
                 color: *c,
+                roughness,
                 joints: [joint, 0, 0, 0],
                 weights: [1.0, 0.0, 0.0, 0.0],
             });

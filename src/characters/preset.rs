@@ -87,16 +87,6 @@ pub mod prop_mesh {
     pub const TEAPOT: usize = 2;
 }
 
-/// Colour of the whites of the eyes.
-pub const SCLERA_COLOR: [f32; 4] = [0.64, 0.6, 0.56, 1.0];
-/// Colour of the irises (dark brown; the pupil is not drawn apart).
-pub const IRIS_COLOR: [f32; 4] = [0.1, 0.065, 0.04, 1.0];
-/// An iris is a sphere of this fraction of its eyeball's radius, its centre this far in front
-/// of the eyeball's (same unit), looking along +Z: the part outside the eyeball is a disc of
-/// 0.4 eyeball radii, half the socket's opening, as an iris is about half the eye's.
-pub const IRIS_RADIUS: f32 = 0.42;
-/// See [`IRIS_RADIUS`].
-pub const IRIS_OFFSET: f32 = 0.78;
 
 /// Pixels a far mesh's cell spans where the switch to it happens: the far version is drawn
 /// once a cell is under two pixels.

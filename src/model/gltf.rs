@@ -392,6 +392,7 @@ fn read_primitive(
         return Err(data.bad(format!("{at}: {} normals for {n} positions", normals.len())));
     }
     let colors = vertex_colors(data, prim, n, &at)?;
+    let roughness = material_roughness(data, prim, &at)?;
     let mut vertices = Vec::with_capacity(n);
     for k in 0..n {
         let mut j = [0u16; 4];
@@ -420,6 +421,7 @@ fn read_primitive(
             position: positions[k],
             normal: normals[k].normalize_or(Vec3::Y),
             color: colors[k],
+            roughness,
             joints: j,
             weights: w.map(|x| x / sum),
         });
@@ -437,6 +439,17 @@ fn read_primitive(
 
 /// Per-vertex linear colour: the material's base colour factor times its base colour texture
 /// (PNG, sRGB, bilinear at TEXCOORD_0, repeated) where there is one.
+/// The primitive's material roughness factor (1 where the file gives none, glTF's default);
+/// out of 0..=1 or not finite is an error naming the primitive. Kept above 0.05 (a mirror's
+/// highlight is a sub-pixel point).
+fn material_roughness(data: &Data, prim: &gltf::Primitive, at: &str) -> Result<f32> {
+    let r = prim.material().pbr_metallic_roughness().roughness_factor();
+    if !(0.0..=1.0).contains(&r) {
+        return Err(data.bad(format!("{at}: material roughness {r} is outside 0..=1")));
+    }
+    Ok(r.max(0.05))
+}
+
 fn vertex_colors(data: &Data, prim: &gltf::Primitive, n: usize, at: &str) -> Result<Vec<Vec3>> {
     let pbr = prim.material().pbr_metallic_roughness();
     let factor = Vec4::from(pbr.base_color_factor()).truncate();

@@ -216,6 +216,23 @@ pub const DEFAULT_LIGHT_DIR: Vec3 = Vec3::new(0.4, 1.0, 0.6);
 /// Direction toward the light of the crowd's look ([`View::crowd_look`]).
 pub const CROWD_LIGHT_DIR: Vec3 = Vec3::new(0.4, 1.0, 0.3);
 
+/// A portrait's key light for `camera` (unit, toward the light): from the camera's left,
+/// [`PORTRAIT_KEY_AZIMUTH`] round from the view axis and [`PORTRAIT_KEY_ELEVATION`] up, the
+/// classic three-quarter key that models a face (one side lit, the other in form shadow, the
+/// eyes catching the light below their upper lids).
+pub fn portrait_light(camera: &Camera) -> Vec3 {
+    let back = (camera.eye - camera.target).normalize_or(Vec3::Z);
+    let left = camera.up.cross(back).normalize_or(Vec3::X) * -1.0;
+    let up = back.cross(left) * -1.0;
+    let (az, el) = (PORTRAIT_KEY_AZIMUTH, PORTRAIT_KEY_ELEVATION);
+    (back * (az.cos() * el.cos()) + left * (az.sin() * el.cos()) + up * el.sin()).normalize()
+}
+
+/// Azimuth of [`portrait_light`] from the view axis, radians (40 degrees).
+pub const PORTRAIT_KEY_AZIMUTH: f32 = 0.70;
+/// Elevation of [`portrait_light`], radians (28 degrees).
+pub const PORTRAIT_KEY_ELEVATION: f32 = 0.49;
+
 /// Everything per-view a frame needs: camera, light, image size and LoD settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
@@ -355,6 +372,9 @@ impl View {
             soft: [0; 4],
             soft_params: [0.0; 4],
             soft_grid: [0; 4],
+            // Filled in by the renderer once the bodies' light view is fitted.
+            body_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
+            body_shadow: [0.0; 4],
         }
     }
 }
@@ -362,6 +382,20 @@ impl View {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The portrait key light comes from in front of the subject, above and from the camera's
+    /// left (the subject's right), at the stated angles.
+    #[test]
+    fn the_portrait_light_is_a_three_quarter_key() {
+        let cam = Camera::look_at(Vec3::new(0.0, 1.6, 0.8), Vec3::new(0.0, 1.52, 0.0), 35.0);
+        let l = portrait_light(&cam);
+        assert!((l.length() - 1.0).abs() < 1e-5);
+        assert!(l.z > 0.5 && l.x < -0.3 && l.y > 0.3, "{l}");
+        let back = (cam.eye - cam.target).normalize();
+        let off_axis = l.dot(back).acos();
+        let expected = (PORTRAIT_KEY_AZIMUTH.cos() * PORTRAIT_KEY_ELEVATION.cos()).acos();
+        assert!((off_axis - expected).abs() < 0.05, "{off_axis} vs {expected}");
+    }
 
     #[test]
     fn frustum_contains_target_not_behind() {
@@ -397,6 +431,6 @@ mod tests {
             (c[0], c[7], c[5]),
             (Vec3::ZERO, Vec3::ONE, Vec3::new(1.0, 0.0, 1.0))
         );
-        assert_eq!(size_of::<FrameBlock>(), 592);
+        assert_eq!(size_of::<FrameBlock>(), 672);
     }
 }

@@ -470,6 +470,9 @@ impl Renderer {
             (block.light_view_proj, block.shadow, block.shadow_params) =
                 l.shadow_fields(view.shadows);
         }
+        if let Some(b) = self.body_light_view(view, &block) {
+            (block.body_view_proj, block.body_shadow) = b.body_fields();
+        }
         let soft_light = (opts.light_raster == LightRaster::Software).then_some(self.soft_budget);
         let light_block = light.map(|l| l.frame_block(&block, &view.lod, soft_light));
         (block, light_block)
@@ -769,6 +772,31 @@ impl Renderer {
             .filter(|(lo, hi)| super::camera::box_in_frustum(&block.planes, *lo, *hi))
             .collect();
         LightView::fit(&bounds, view.light_dir, self.shadow.resolution())
+    }
+
+    /// The bodies' light view for `view`: fitted to the bodies in the camera's frustum. `None`
+    /// when shadows are off or no body is in view.
+    fn body_light_view(
+        &self,
+        view: &View,
+        block: &super::shared::FrameBlock,
+    ) -> Option<LightView> {
+        if view.shadows == ShadowMode::Off {
+            return None;
+        }
+        let model_of = |id| self.crowd.drawn_model(id);
+        let mut bodies = self.props.character_spheres(&model_of);
+        bodies.extend(self.skinned.character_spheres(&model_of));
+        let camera = (
+            glam::Mat4::from_cols_array_2d(&block.unjittered_view_proj),
+            glam::Vec3::from_slice(&block.camera_pos[..3]),
+        );
+        LightView::fit_bodies(
+            &bodies,
+            camera,
+            view.light_dir,
+            self.shadow.body_resolution(),
+        )
     }
 }
 

@@ -118,6 +118,21 @@ impl Props {
 }
 
 impl Props {
+    /// World bounding spheres of the props that move with characters, placed by `model_of`
+    /// (`None`: not drawn): what the bodies' shadow map is fitted to.
+    pub(super) fn character_spheres(
+        &self,
+        model_of: &impl Fn(CharacterId) -> Option<Mat4>,
+    ) -> Vec<(Vec3, f32)> {
+        self.attached
+            .iter()
+            .filter_map(|(id, mesh, inst)| {
+                let model = model_of(*id)? * Mat4::from_cols_array_2d(&inst.model);
+                Some(world_sphere(&model, self.bounds[*mesh]))
+            })
+            .collect()
+    }
+
     /// Replace the prop meshes (triangle lists) and clear the instances; returns the old
     /// vertex buffer (frames in flight may still read it).
     pub(super) fn set_meshes(
@@ -256,14 +271,21 @@ pub(super) fn far_choice(
     let Some((far, below)) = far else {
         return mesh;
     };
+    let (centre, radius) = world_sphere(model, (centre, radius));
+    let pixels = camera.pixels(centre, radius);
+    if pixels < below { far } else { mesh }
+}
+
+/// A bounding sphere (centre, radius) of a mesh placed at `model`, in world space (the
+/// radius scaled by the model's largest axis scale).
+pub(super) fn world_sphere(model: &Mat4, (centre, radius): (Vec3, f32)) -> (Vec3, f32) {
     let scale = model
         .x_axis
         .truncate()
         .length()
         .max(model.y_axis.truncate().length())
         .max(model.z_axis.truncate().length());
-    let pixels = camera.pixels(model.transform_point3(centre), radius * scale);
-    if pixels < below { far } else { mesh }
+    (model.transform_point3(centre), radius * scale)
 }
 
 /// A bounding sphere of a triangle list: the box's centre and the farthest vertex from it.

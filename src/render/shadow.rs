@@ -63,21 +63,13 @@ impl LightView {
         if bounds.is_empty() || resolution == 0 {
             return None;
         }
-        let dir = light_dir.try_normalize()?;
-        let forward = -dir;
-        let up_ref = if forward.y.abs() < 0.99 {
-            Vec3::Y
-        } else {
-            Vec3::Z
-        };
-        let side = forward.cross(up_ref).normalize();
-        let up = side.cross(forward);
+        let basis = LightBasis::new(light_dir)?;
         let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
         let mut diag_sum = 0.0;
         for (blo, bhi) in bounds {
             diag_sum += (*bhi - *blo).length();
             for c in box_corners(*blo, *bhi) {
-                let l = Vec3::new(c.dot(side), c.dot(up), c.dot(forward));
+                let l = basis.local(c);
                 lo = lo.min(l);
                 hi = hi.max(l);
             }
@@ -86,31 +78,81 @@ impl LightView {
             return None;
         }
         let size = (hi.x - lo.x).max(hi.y - lo.y).max(1e-4) * 1.02;
-        // Snap the centre to whole texels so the map does not shimmer as the crowd moves.
-        let texel = size / resolution as f32;
-        let cx = (((lo.x + hi.x) * 0.5) / texel).round() * texel;
-        let cy = (((lo.y + hi.y) * 0.5) / texel).round() * texel;
-        let near = lo.z - 0.02 * size;
-        let far = hi.z + 0.5 * size;
-        let range = far - near;
-        let rows = [
-            (side * (2.0 / size)).extend(-cx * 2.0 / size),
-            (up * (-2.0 / size)).extend(cy * 2.0 / size),
-            (forward / range).extend(-near / range),
-            Vec4::new(0.0, 0.0, 0.0, 1.0),
-        ];
-        let view_proj = Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
-        let mean_diag = diag_sum / bounds.len() as f32;
-        Some(LightView {
-            view_proj,
-            dir,
-            eye: side * cx + up * cy + forward * near,
-            size,
-            depth_range: range,
-            // Four layers span about a fifth of a character's hair box.
-            layer_spacing: (mean_diag * 0.05).max(texel),
-            resolution,
-        })
+        let mut view = basis.view((lo, hi), size, resolution);
+        // Four layers span about a fifth of a character's hair box.
+        view.layer_spacing = (diag_sum / bounds.len() as f32 * 0.05).max(view.texel());
+        Some(view)
+    }
+
+    /// The bodies' map (props that move with characters: heads, eyes, clothes), fitted to what
+    /// the camera sees of them: the light-space rectangle of `bodies` (world spheres, centre
+    /// and radius) in the camera's frustum (`view_proj`, eye at `eye`), cut down to the part of
+    /// the frustum in front of the farthest of them, so a portrait's map spans the head and
+    /// shoulders and a crowd's the crowd. Every body in that rectangle casts (the near plane
+    /// reaches the highest of them). The side snaps to steps of 2^(1/8) and the centre to whole
+    /// texels, so the map holds still while the camera moves a little. `None` when no body is
+    /// in view.
+    pub fn fit_bodies(
+        bodies: &[(Vec3, f32)],
+        (view_proj, eye): (Mat4, Vec3),
+        light_dir: Vec3,
+        resolution: u32,
+    ) -> Option<Self> {
+        let planes = frustum_planes(view_proj);
+        let seen = |&&(c, r): &&(Vec3, f32)| {
+            planes
+                .iter()
+                .all(|p| Vec3::from_slice(&p[..3]).dot(c) + p[3] >= -r)
+        };
+        let visible: Vec<(Vec3, f32)> = bodies.iter().filter(seen).copied().collect();
+        if visible.is_empty() || resolution == 0 {
+            return None;
+        }
+        let basis = LightBasis::new(light_dir)?;
+        let spread = |lo: &mut Vec3, hi: &mut Vec3, p: Vec3, r: f32| {
+            *lo = lo.min(p - Vec3::splat(r));
+            *hi = hi.max(p + Vec3::splat(r));
+        };
+        let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+        for &(c, r) in &visible {
+            spread(&mut lo, &mut hi, basis.local(c), r);
+        }
+        if let Some(slice) = frustum_slice(view_proj, eye, &visible) {
+            let (mut flo, mut fhi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+            for p in slice {
+                spread(&mut flo, &mut fhi, basis.local(p), 0.0);
+            }
+            let (clo, chi) = (lo.max(flo), hi.min(fhi));
+            if clo.x < chi.x && clo.y < chi.y {
+                (lo.x, lo.y, hi.x, hi.y) = (clo.x, clo.y, chi.x, chi.y);
+            }
+        }
+        // Casters outside the view that overhang the rectangle move the near plane up.
+        for &(c, r) in bodies {
+            let l = basis.local(c);
+            if l.x + r > lo.x && l.x - r < hi.x && l.y + r > lo.y && l.y - r < hi.y {
+                lo.z = lo.z.min(l.z - r);
+            }
+        }
+        if !(lo.is_finite() && hi.is_finite()) {
+            return None;
+        }
+        let side = (hi.x - lo.x).max(hi.y - lo.y).max(1e-3) * 1.02;
+        let size = 2f32.powf((side.log2() * 8.0).ceil() / 8.0);
+        Some(basis.view((lo, hi), size, resolution))
+    }
+
+    /// The bodies' map fields of a camera frame block: `(body_view_proj, body_shadow)`.
+    pub fn body_fields(&self) -> ([[f32; 4]; 4], [f32; 4]) {
+        (
+            self.view_proj.to_cols_array_2d(),
+            [
+                self.resolution as f32,
+                self.depth_range,
+                self.bias(),
+                self.texel(),
+            ],
+        )
     }
 
     /// World size of one texel.
@@ -174,6 +216,98 @@ impl LightView {
             ],
         )
     }
+}
+
+/// The light's orthonormal frame: `side` and `up` span the map, `forward` points away from
+/// the light.
+struct LightBasis {
+    dir: Vec3,
+    side: Vec3,
+    up: Vec3,
+    forward: Vec3,
+}
+
+impl LightBasis {
+    /// The frame of unit direction `light_dir` (toward the light); `None` for a zero vector.
+    fn new(light_dir: Vec3) -> Option<Self> {
+        let dir = light_dir.try_normalize()?;
+        let forward = -dir;
+        let up_ref = if forward.y.abs() < 0.99 {
+            Vec3::Y
+        } else {
+            Vec3::Z
+        };
+        let side = forward.cross(up_ref).normalize();
+        let up = side.cross(forward);
+        Some(LightBasis {
+            dir,
+            side,
+            up,
+            forward,
+        })
+    }
+
+    /// World point `p` in the light's frame (x side, y up, z depth away from the light).
+    fn local(&self, p: Vec3) -> Vec3 {
+        Vec3::new(p.dot(self.side), p.dot(self.up), p.dot(self.forward))
+    }
+
+    /// A square view of side `size` centred on the light-space box `(lo, hi)`: the centre
+    /// snapped to whole texels so the map does not shimmer as the crowd moves, the near plane
+    /// just in front of the box and the far plane half a view behind it, so the ground and
+    /// bodies below receive shadows.
+    fn view(&self, (lo, hi): (Vec3, Vec3), size: f32, resolution: u32) -> LightView {
+        let texel = size / resolution as f32;
+        let cx = (((lo.x + hi.x) * 0.5) / texel).round() * texel;
+        let cy = (((lo.y + hi.y) * 0.5) / texel).round() * texel;
+        let near = lo.z - 0.02 * size;
+        let far = hi.z + 0.5 * size;
+        let range = far - near;
+        let rows = [
+            (self.side * (2.0 / size)).extend(-cx * 2.0 / size),
+            (self.up * (-2.0 / size)).extend(cy * 2.0 / size),
+            (self.forward / range).extend(-near / range),
+            Vec4::new(0.0, 0.0, 0.0, 1.0),
+        ];
+        let view_proj = Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
+        LightView {
+            view_proj,
+            dir: self.dir,
+            eye: self.side * cx + self.up * cy + self.forward * near,
+            size,
+            depth_range: range,
+            layer_spacing: texel,
+            resolution,
+        }
+    }
+}
+
+/// The 8 corners of the part of the camera's frustum (`view_proj`, eye at `eye`) between its
+/// near plane and the far side of the farthest of `spheres`; `None` for views that are not
+/// perspective.
+fn frustum_slice(view_proj: Mat4, eye: Vec3, spheres: &[(Vec3, f32)]) -> Option<[Vec3; 8]> {
+    let inv = view_proj.inverse();
+    let unproject = |x: f32, y: f32, z: f32| inv.project_point3(Vec3::new(x, y, z));
+    let forward = (unproject(0.0, 0.0, 1.0) - unproject(0.0, 0.0, 0.0)).try_normalize()?;
+    let reach = spheres
+        .iter()
+        .map(|&(c, r)| (c - eye).dot(forward) + r)
+        .fold(0.0, f32::max);
+    let mut out = [Vec3::ZERO; 8];
+    for (k, (x, y)) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let near = unproject(x, y, 0.0);
+        let far = unproject(x, y, 1.0);
+        let depth = (far - eye).dot(forward);
+        if !(depth > 0.0 && near.is_finite() && far.is_finite()) {
+            return None;
+        }
+        out[2 * k] = near;
+        out[2 * k + 1] = eye + (far - eye) * (reach.max((near - eye).dot(forward)) / depth);
+    }
+    Some(out)
 }
 
 #[cfg(test)]

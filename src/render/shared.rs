@@ -523,6 +523,12 @@ pub struct FrameBlock {
     pub clip_to_prev: [[f32; 4]; 4],
     /// Temporal: the unjittered world to clip of this frame.
     pub unjittered_view_proj: [[f32; 4]; 4],
+    /// World to the light's clip space of the bodies' map (`render::shadow::LightView::fit_bodies`:
+    /// fitted to the bodies the camera sees; the light's prop pass draws with it).
+    pub body_view_proj: [[f32; 4]; 4],
+    /// Bodies' map: x resolution (0: no map this frame), y depth range (world units), z depth
+    /// bias (world units), w texel size (world units).
+    pub body_shadow: [f32; 4],
 }
 
 gpu_struct!(FrameBlock as "FrameBlock" {
@@ -531,6 +537,7 @@ gpu_struct!(FrameBlock as "FrameBlock" {
     light_view_proj: "mat4", shadow: "uvec4", shadow_params: "vec4", transparency: "uvec4",
     soft: "uvec4", soft_params: "vec4", soft_grid: "uvec4", temporal: "uvec4",
     temporal_params: "vec4", clip_to_prev: "mat4", unjittered_view_proj: "mat4",
+    body_view_proj: "mat4", body_shadow: "vec4",
 });
 
 /// One character: where its bundles and textures are, how it is placed and styled.
@@ -802,7 +809,7 @@ gpu_struct!(SkinRestVertex as "SkinRestVertex" {
 pub struct SkinnedVertex {
     /// Position, character frame.
     pub position: [f32; 3],
-    /// The rest vertex's packed colour.
+    /// The rest vertex's packed colour: RGBA8, linear RGB and the GGX roughness in alpha.
     pub color: u32,
     /// Unit normal.
     pub normal: [f32; 3],
@@ -1190,6 +1197,9 @@ fn float_constants() -> Vec<(&'static str, f32)> {
         ("MARSCHNER_ENERGY_SCALE", crate::shade::ENERGY_SCALE),
         ("LIGHT_IRRADIANCE", crate::shade::LIGHT_IRRADIANCE),
         ("AMBIENT", crate::shade::AMBIENT),
+        ("PROP_ROUGHNESS", crate::shade::PROP_ROUGHNESS),
+        ("PROP_IRRADIANCE", crate::shade::PROP_IRRADIANCE),
+        ("PROP_AMBIENT", crate::shade::PROP_AMBIENT),
         ("FORWARD_DENSITY", crate::shade::scattering::FORWARD_DENSITY),
         (
             "BACKWARD_DENSITY",
@@ -1212,6 +1222,14 @@ fn float_constants() -> Vec<(&'static str, f32)> {
     ]
 }
 
+/// Colour constants shared with GLSL.
+fn vec3_constants() -> Vec<(&'static str, [f32; 3])> {
+    vec![
+        ("SKY_TINT", crate::shade::SKY_TINT),
+        ("GROUND_TINT", crate::shade::GROUND_TINT),
+    ]
+}
+
 /// The GLSL include `shared.glsl`: constants, enum numbers, binding numbers and shared
 /// structs.
 pub fn glsl_header() -> String {
@@ -1229,6 +1247,9 @@ pub fn glsl_header() -> String {
     }
     for (name, v) in float_constants() {
         let _ = writeln!(out, "#define {name} {v:?}");
+    }
+    for (name, [x, y, z]) in vec3_constants() {
+        let _ = writeln!(out, "#define {name} vec3({x:?}, {y:?}, {z:?})");
     }
     let bindings = FrameBinding::ALL.iter().map(|(b, n)| (*b as u32, *n));
     let bindings = bindings

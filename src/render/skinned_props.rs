@@ -76,13 +76,14 @@ fn bounds(mesh: &SkinnedMesh) -> (Vec3, f32) {
     (centre, r * 1.2)
 }
 
-/// A rest vertex for the GPU.
+/// A rest vertex for the GPU: the colour packed as RGBA8 with the roughness in alpha.
 fn rest_vertex(v: &crate::skin::SkinVertex) -> SkinRestVertex {
     let c = v.color.clamp(Vec3::ZERO, Vec3::ONE) * 255.0 + 0.5;
+    let rough = v.roughness.clamp(0.0, 1.0) * 255.0 + 0.5;
     let j = v.joints.map(u32::from);
     SkinRestVertex {
         position: v.position.to_array(),
-        color: c.x as u32 | (c.y as u32) << 8 | (c.z as u32) << 16 | 255 << 24,
+        color: c.x as u32 | (c.y as u32) << 8 | (c.z as u32) << 16 | (rough as u32) << 24,
         normal: v.normal.to_array(),
         joints01: j[0] | j[1] << 16,
         weights: v.weights,
@@ -301,6 +302,26 @@ impl SkinnedProps {
             }
         }
         work
+    }
+
+    /// World bounding spheres of the drawn characters' (`model_of`: `None` hidden) skinned
+    /// meshes, each part at its body placement (bind-pose spheres, widened by a fifth for the
+    /// pose).
+    pub(super) fn character_spheres(
+        &self,
+        model_of: &impl Fn(CharacterId) -> Option<Mat4>,
+    ) -> Vec<(Vec3, f32)> {
+        let mut out = Vec::new();
+        for (id, w) in &self.wearers {
+            if model_of(*id).is_none() {
+                continue;
+            }
+            for &(mesh, _) in &w.parts {
+                let r = &self.meshes[mesh];
+                out.push(super::prop_table::world_sphere(&w.body, (r.centre, r.radius)));
+            }
+        }
+        out
     }
 
     /// The mesh an instance of `mesh` at `model` is drawn with.

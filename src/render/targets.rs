@@ -87,12 +87,18 @@ impl RenderTargets {
 /// Format of the deep opacity layers (one layer per channel, summed with additive blending).
 pub const SHADOW_LAYERS_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
+/// The bodies' map has this many times the hair maps' texels per side: it is fitted to the
+/// camera's view, and a portrait's chest shows its texels far larger than the hair shows the
+/// hair maps' (filtered, a shadow edge spans about three of them).
+pub const BODY_MAP_SCALE: u32 = 2;
+
 /// The light's maps (square, shared by the frames in flight; the frame graph orders each
 /// frame's use after the previous frame's reads): hair depth, prop depth and deep opacity layers.
 pub struct ShadowMaps {
     /// Depth of the hair nearest the light.
     pub hair_depth: Image,
-    /// Depth of the props nearest the light.
+    /// Depth of the props nearest the light, in the bodies' own view
+    /// (`LightView::fit_bodies`), [`BODY_MAP_SCALE`] times the hair maps' resolution.
     pub prop_depth: Image,
     /// Hair opacity per layer behind `hair_depth` (deep opacity mode).
     pub layers: Image,
@@ -109,15 +115,15 @@ impl ShadowMaps {
         let depth_usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
             | vk::ImageUsageFlags::SAMPLED
             | vk::ImageUsageFlags::TRANSFER_DST;
-        let depth = |name| {
+        let depth = |name, side| {
             Image::new(
                 ctx,
-                &ImageDesc::new_2d(name, DEPTH_FORMAT, resolution, resolution).usage(depth_usage),
+                &ImageDesc::new_2d(name, DEPTH_FORMAT, side, side).usage(depth_usage),
             )
         };
         Ok(ShadowMaps {
-            hair_depth: depth("shadow hair depth")?,
-            prop_depth: depth("shadow prop depth")?,
+            hair_depth: depth("shadow hair depth", resolution)?,
+            prop_depth: depth("shadow prop depth", resolution * BODY_MAP_SCALE)?,
             layers: Image::new(
                 ctx,
                 &ImageDesc::new_2d(
@@ -137,8 +143,13 @@ impl ShadowMaps {
         })
     }
 
-    /// Side in texels.
+    /// Side of the hair maps in texels.
     pub fn resolution(&self) -> u32 {
         self.hair_depth.desc.extent[0]
+    }
+
+    /// Side of the bodies' map in texels.
+    pub fn body_resolution(&self) -> u32 {
+        self.prop_depth.desc.extent[0]
     }
 }

@@ -62,8 +62,29 @@ pub fn melanin_color(eumelanin: f32, pheomelanin: f32) -> Vec3 {
 
 /// Irradiance of the directional light (perpendicular to it) in the physically based models.
 pub const LIGHT_IRRADIANCE: f32 = 4.5;
-/// Ambient (sky) radiance scale: strands add `colour * AMBIENT * ambient visibility`.
+/// Ambient radiance scale: strands add `colour * hemisphere_ambient(up) * ambient visibility`.
 pub const AMBIENT: f32 = 0.25;
+/// The ambient light's sky (relative to [`AMBIENT`], linear RGB): the blue of a clear sky.
+pub const SKY_TINT: [f32; 3] = [0.95, 1.1, 1.5];
+/// The ambient light's ground (relative to [`AMBIENT`]): sunlit grey ground, warm and darker
+/// than the sky, the light a face gets from below.
+pub const GROUND_TINT: [f32; 3] = [0.62, 0.56, 0.46];
+/// Props (bodies, ground): GGX roughness of skin and cloth.
+pub const PROP_ROUGHNESS: f32 = 0.55;
+/// Props: irradiance of the directional light.
+pub const PROP_IRRADIANCE: f32 = 2.5;
+/// Props: ambient scale (relative to the strands' [`AMBIENT`] they share the sky with).
+pub const PROP_AMBIENT: f32 = 0.3;
+
+/// The ambient light arriving at a surface whose normal has world-up component `up`: a
+/// hemisphere light, sky above and ground below, `AMBIENT * mix(ground, sky, (1 + up) / 2)`
+/// (the irradiance of a sky and ground of uniform radiance on a plane tilted `acos(up)`;
+/// glsl/hair_shading.glsl `hemisphere_ambient`). Strands, which have no normal, take the
+/// direction out of their character's hair.
+pub fn hemisphere_ambient(up: f32) -> Vec3 {
+    let t = 0.5 + 0.5 * up.clamp(-1.0, 1.0);
+    AMBIENT * Vec3::from(GROUND_TINT).lerp(Vec3::from(SKY_TINT), t)
+}
 
 /// Refractive index of hair keratin.
 pub const HAIR_ETA: f32 = 1.55;

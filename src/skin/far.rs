@@ -78,6 +78,7 @@ mod tests {
                     position: Vec3::new(x as f32, y as f32, 0.0) / n as f32,
                     normal: Vec3::Z,
                     color: Vec3::ONE,
+                    roughness: 0.5,
                     joints: [(x % 3) as u16, 0, 0, 0],
                     weights: [1.0, 0.0, 0.0, 0.0],
                 });

@@ -128,6 +128,9 @@ pub struct SkinVertex {
     pub normal: Vec3,
     /// Linear RGB colour (base colour factor times texture at the vertex).
     pub color: Vec3,
+    /// GGX roughness of the surface at the vertex (0.05..=1; glTF's roughness factor, the
+    /// eyes' wet 0.2, [`crate::shade::PROP_ROUGHNESS`] for skin and cloth).
+    pub roughness: f32,
     /// Up to four joints (indices into the skeleton).
     pub joints: [u16; 4],
     /// Their weights (sum 1).
@@ -256,6 +259,7 @@ mod tests {
             position: Vec3::new(0.0, 2.0, 0.0),
             normal: Vec3::X,
             color: Vec3::ONE,
+            roughness: crate::shade::PROP_ROUGHNESS,
             joints: [0, 1, 0, 0],
             weights: [0.5, 0.5, 0.0, 0.0],
         };

@@ -80,6 +80,11 @@ pub struct Args {
     /// looking into it) or front, side, back (a portrait of the first character's head).
     #[arg(long, default_value = "orbit", value_parser = ["orbit", "eye", "front", "side", "back"])]
     view: String,
+    /// Headless lighting: crowd (the sun high and to the side), portrait (a three-quarter key
+    /// from the camera's left, 28 degrees up) or auto (portrait for the front, side and back
+    /// views, else crowd).
+    #[arg(long, default_value = "auto", value_parser = ["auto", "crowd", "portrait"])]
+    light: String,
     /// Number of characters.
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=preset::MAX_CROWD as i64))]
     count: u32,
@@ -561,8 +566,16 @@ fn run(args: Args) -> Result<()> {
         };
         // Headless frames are 1/30 s apart in animation time.
         animation.advance(&mut renderer, 1.0 / 30.0, &camera, height)?;
+        let portrait = match args.light.as_str() {
+            "auto" => matches!(args.view.as_str(), "front" | "side" | "back"),
+            other => other == "portrait",
+        };
         let view = View {
-            light_dir: hairmesh::render::camera::CROWD_LIGHT_DIR,
+            light_dir: if portrait {
+                hairmesh::render::camera::portrait_light(&camera)
+            } else {
+                hairmesh::render::camera::CROWD_LIGHT_DIR
+            },
             lod,
             shading: args.shading,
             shadows: args.shadows,

@@ -171,7 +171,11 @@ pub fn vertex_pipeline(
     shaders: (&str, Option<&str>),
     target: DrawTarget,
 ) -> GpuResult<crate::vk::Pipeline> {
-    let opts = device_shader_options(ctx, 1);
+    let opts = match target {
+        // The light's prop pass draws the bodies' map, in its own view.
+        DrawTarget::ShadowDepth => device_shader_options(ctx, 1).define("BODY_MAP_PASS", 1),
+        _ => device_shader_options(ctx, 1),
+    };
     let v = compile(shaders.0, &opts)?;
     let f = shaders.1.map(|f| compile(f, &opts)).transpose()?;
     let mut desc = target
