@@ -40,6 +40,7 @@ uint ch_strands;    // N of eq. 8
 uint ch_emax;       // full-detail vertex level e
 bool ch_visible;
 bool ch_volume_only;  // drawn as its density volume alone: no strands
+float ch_strand_share;  // share of its strands drawn: 1 - the volume tier's weight (its band)
 
 void bind_character(uint c) {
     mesh = characters[c].mesh;
@@ -52,6 +53,8 @@ void bind_character(uint c) {
     ch_emax = characters[c].verts_log2;
     ch_visible = (characters[c].flags & CHARACTER_VISIBLE) != 0u;
     ch_volume_only = (characters[c].flags & CHARACTER_VOLUME_ONLY) != 0u;
+    // volume_shading.z is 0 unless the character's volume is built (render::volume).
+    ch_strand_share = clamp(1.0 - characters[c].volume_shading.z, 0.0, 1.0);
 }
 
 // The hair mesh texture is read where neighbouring invocations belong to different characters

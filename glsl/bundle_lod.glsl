@@ -93,15 +93,23 @@ BundleLod bundle_lod(uint g) {
     vec3 eye = frame.camera_pos.xyz;
     float d = length(eye - clamp(eye, lo, hi));
     float h = scale * desc.rest_size;
+    float delta = hash_f32(hash_u32(desc.local_index ^ 0x2545f491u) ^ style.seed);
     if (frame.counts.z == 0u) {
         r.soft = soft_raster(d, scale * style.strand_width, 1.0, h);
+        if (ch_strand_share < 1.0) {
+            float wanted = ch_strand_share * (float(count) + delta);
+            r.strands = wanted > 0.0 ? clamp(uint(ceil(wanted)), 1u, count) : 0u;
+            r.fade = r.strands > 1u && wanted < float(r.strands) ? wanted - float(r.strands - 1u) : 1.0;
+        }
         return r;
     }
-    // Strand LoD: eq. 7 and eq. 8 with a per-bundle increment delta_i, clamped to N_i.
+    // Strand LoD: eq. 7 and eq. 8 with a per-bundle increment delta_i, clamped to N_i. In the
+    // volume tier's band the level drops by the strands' share, the thickness does not: the
+    // strands thin out one by one (each fading as below) while the volume comes in under
+    // them, a blend with no screen-door pattern (CPU twin: LodView::strand_share).
     float ls = detail_level(h, d, frame.lod.x);
-    float delta = hash_f32(hash_u32(desc.local_index ^ 0x2545f491u) ^ style.seed);
-    float wanted = ls * (float(count) + delta);
-    r.strands = ls > 0.0 ? clamp(uint(ceil(wanted)), 1u, count) : 0u;
+    float wanted = ls * ch_strand_share * (float(count) + delta);
+    r.strands = wanted > 0.0 ? clamp(uint(ceil(wanted)), 1u, count) : 0u;
     // Stable LoD: the newest strand comes in as wide as eq. 8's fractional part, so a bundle's
     // strands fade in one by one as it nears instead of popping (CPU twin:
     // newest_strand_fade in src/reference/lod.rs).

@@ -16,7 +16,7 @@ void main() {
     // With MSAA a fragment runs for a pixel when the strip covers any of its samples: weigh
     // it by the samples it covers, so a strip adds the same opacity whatever the sample count.
     float a = strand_alpha() * float(bitCount(gl_SampleMaskIn[0])) / float(frame.transparency.z);
-    if (a < 0.5 / 255.0 || shown_as_volume()) {
+    if (a < 0.5 / 255.0) {
         return;
     }
     note_fragment(in_character, in_residual);

@@ -10,9 +10,6 @@
 layout(early_fragment_tests) in;
 
 void main() {
-    if (shown_as_volume()) {
-        return;
-    }
     note_fragment(in_character, in_residual);
     uint p = peel_pixel();
     float a = strand_alpha();

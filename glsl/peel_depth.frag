@@ -13,7 +13,7 @@ layout(location = 4) flat in uint in_character;
 void main() {
     uint p = peel_pixel();
     float z = gl_FragCoord.z;
-    if (z <= peel_depth[p] || z >= peel_depth[peel_pixels() + p] || volume_covers(uvec2(gl_FragCoord.xy), in_character)) {
+    if (z <= peel_depth[p] || z >= peel_depth[peel_pixels() + p]) {
         discard;
     }
 }

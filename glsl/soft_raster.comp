@@ -82,10 +82,6 @@ struct SegmentRaster {
 // The fragment of segment `s` in pixel `pixel` of the tile at `origin`: inserted when it lies
 // in front of the opaque depth and covers part of the pixel.
 void shade_pixel(SegmentRaster s, ivec2 pixel, ivec2 origin, uint k) {
-    // The volume tier's screen door: pixels showing the character's volume drop its strands.
-    if (volume_covers(uvec2(pixel), s.id)) {
-        return;
-    }
     vec2 pmin = vec2(pixel);
     // Depth and colour at the centre line point nearest the pixel centre.
     float u = clamp(dot(pmin + 0.5 - s.f.a, s.f.d) / s.f.len, 0.0, 1.0);

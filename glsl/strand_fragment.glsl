@@ -18,12 +18,6 @@ layout(location = 6) flat in float in_thickness;
 // Deformation residual of the strand here (temporal.glsl), pixels.
 layout(location = 7) in vec2 in_residual;
 
-// Whether this fragment's pixel shows its character's density volume instead (the volume
-// tier's screen-door blend, volume_shading.glsl): its strands are not drawn there.
-bool shown_as_volume() {
-    return volume_covers(uvec2(gl_FragCoord.xy), in_character);
-}
-
 // Radiance toward the eye of this fragment's strand.
 vec3 shade_strand() {
     return strand_radiance(in_tangent, in_s, in_pos, in_color, in_character, in_thickness);

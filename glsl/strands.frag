@@ -11,9 +11,6 @@
 layout(location = 0) out vec4 out_color;
 
 void main() {
-    if (shown_as_volume()) {
-        discard;
-    }
     note_fragment(in_character, in_residual);
     out_color = vec4(shade_strand(), 1.0);
 }

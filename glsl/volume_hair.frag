@@ -5,8 +5,9 @@
 // each step absorbs 1 - exp(-sigma ds) of what is left), and the strands are shaded once, at
 // the absorption-weighted mean point with the mean flow as tangent, lit through the light's
 // maps and, when the character has no strands in them (volume alone), through its own volume.
-// Written premultiplied over the target with the mean point's depth. Pixels the volume tier's
-// screen door gives the strands are dropped.
+// Written premultiplied over the target with the mean point's depth, at the volume tier's
+// weight (1 for hair drawn as its volume alone; in the switch band, where the strands thin
+// out, less).
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 #include "strand_radiance.glsl"
@@ -21,7 +22,8 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     uint c = in_character;
-    if (!volume_covers(uvec2(gl_FragCoord.xy), c)) {
+    float weight = volume_weight(c);
+    if (weight <= 0.0) {
         discard;
     }
     vec3 eye = frame.camera_pos.xyz;
@@ -83,9 +85,15 @@ void main() {
     HairStyle style = characters[c].style;
     vec3 base = vec3(style.color[0], style.color[1], style.color[2]);
     vec3 radiance = strand_radiance_lit(tangent, 1.0, point, base, c, 1.0, arrival, volume_ambient(c, point));
-    vec4 clip = frame.view_proj * vec4(point, 1.0);
+    // In the band the volume lies under the strands that remain: its depth is where the ray
+    // leaves the box, so strands drawn before (hardware) hide it and strands composited after
+    // (the software rasterizer's) are not hidden by it.
+    vec3 depth_point = weight < 1.0 ? eye + dir * t_exit : point;
+    vec4 clip = frame.view_proj * vec4(depth_point, 1.0);
     float depth = clamp(clip.z / clip.w, 0.0, 1.0);
     gl_FragDepth = depth;
     note_visible(uvec2(gl_FragCoord.xy), depth, c, vec2(0.0));
-    out_color = vec4(radiance * absorbed, absorbed);
+    // In the switch band the volume comes in at its weight under the strands thinning out
+    // (bundle_lod.glsl), so the two blend with no pattern.
+    out_color = vec4(radiance * absorbed, absorbed) * weight;
 }

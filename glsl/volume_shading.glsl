@@ -65,22 +65,6 @@ float volume_weight(uint c) {
     return volume_built(c) ? characters[c].volume_shading.z : 0.0;
 }
 
-// The 4x4 ordered-dither (Bayer) threshold of a pixel, in (0, 1). With temporal accumulation
-// the pattern moves with the frame's sub-pixel jitter (a different offset each frame), so the
-// history averages the screen door into a blend.
-const uint BAYER_4X4[16] = uint[16](0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
-float screen_door(uvec2 pixel) {
-    uvec2 shift = frame.temporal.y != 0u ? uvec2(ivec2(floor(frame.temporal_params.xy * 4.0 + 2.0))) : uvec2(0u);
-    uvec2 q = (pixel + shift) & 3u;
-    return (float(BAYER_4X4[q.y * 4u + q.x]) + 0.5) / 16.0;
-}
-
-// Whether pixel `pixel` shows character c's volume rather than its strands: the volume
-// tier's screen-door blend (every pixel at weight 1, none at 0).
-bool volume_covers(uvec2 pixel, uint c) {
-    return screen_door(pixel) < volume_weight(c);
-}
-
 // Where the ray g0 + t gd (grid coordinates; t in the units of gd's length) enters and
 // leaves character c's grid box [0, dims]: (t_enter, t_exit), no crossing when
 // t_exit <= t_enter.

@@ -144,6 +144,45 @@ mod tests {
         assert_eq!(newest_strand_fade(1e-4, n, delta), 1.0);
     }
 
+    /// In the volume tier's band the strands thin out in proportion to their share, one by
+    /// one and without widening (the volume comes in under them): a bundle's drawn width,
+    /// `(strands - 1 + fade) * thickness`, is its full width times the share (within one
+    /// strand), continuous in the share, with the thickness of the full level.
+    #[test]
+    fn the_band_thins_strands_by_their_share_without_widening_them() {
+        let mesh = crate::model::obj_io::parse_hair_mesh_obj(
+            "hairmeshes/small_patch.obj",
+            include_bytes!("../../hairmeshes/small_patch.obj"),
+        )
+        .unwrap();
+        let style = crate::HairStyle::default();
+        let baked = crate::bake(&mesh, &style, Default::default(), |_, _| {}).unwrap();
+        let view = |share: f32| LodView {
+            eye: Vec3::new(0.0, 0.0, 3.0),
+            resolution: 720.0,
+            fov_y: 0.8,
+            alpha_strands: 1.0,
+            alpha_verts: 1.0,
+            lambda: 0.5,
+            strand_share: share,
+        };
+        let width = |l: &BundleLod| (l.strands as f32 - 1.0 + l.fade) * l.thickness;
+        let full = bundle_lod(&baked, &style, 0, 64, 4, &view(1.0));
+        assert!(full.strands > 8, "{full:?}");
+        let mut prev = width(&full);
+        for k in (0..100).rev() {
+            let share = k as f32 / 100.0 + 0.005;
+            let l = bundle_lod(&baked, &style, 0, 64, 4, &view(share));
+            assert_eq!(l.thickness, full.thickness);
+            let w = width(&l);
+            assert!((w - width(&full) * share).abs() <= full.thickness * 1.01, "{share}: {w}");
+            // A 1% step of the share takes about 1% of the width off, never adds any.
+            let step = prev - w;
+            assert!(step > -1e-4 && step < width(&full) * 0.011 + 0.05 * full.thickness, "{share}: {prev} -> {w}");
+            prev = w;
+        }
+    }
+
     #[test]
     fn vertex_level_is_power_of_two_plus_one() {
         assert_eq!(vertex_level(1.0, 32), 5);
@@ -185,6 +224,10 @@ pub struct LodView {
     pub alpha_verts: f32,
     /// Geomorph window lambda.
     pub lambda: f32,
+    /// Share of the character's strands drawn: 1, or 1 minus the volume tier's weight in its
+    /// switch band, where strands thin out one by one (eq. 8's level times the share; widths
+    /// keep eq. 8's thickness) while the density volume comes in.
+    pub strand_share: f32,
 }
 
 /// One bundle's LoD decision (GLSL: `BundleLod`).
@@ -245,7 +288,8 @@ pub fn bundle_lod(
     let h = baked.bundles[b].rest_size;
     let ls = detail_level(h, view.resolution, d, view.fov_y, view.alpha_strands);
     let delta = bundle_delta(b as u32, style.seed);
-    let strands = strands_at_level(ls, n, delta);
+    let drawn = ls * view.strand_share.clamp(0.0, 1.0);
+    let strands = strands_at_level(drawn, n, delta);
     let lv = detail_level(h, view.resolution, d, view.fov_y, view.alpha_verts);
     let ns = 1u32 << e_max;
     let e = vertex_level(lv, ns);
@@ -255,6 +299,6 @@ pub fn bundle_lod(
         e,
         gamma,
         thickness: thickness_scale(ls, n),
-        fade: newest_strand_fade(ls, n, delta),
+        fade: newest_strand_fade(drawn, n, delta),
     }
 }

@@ -246,5 +246,6 @@ pub fn lod_view(cam: &Camera, size: u32) -> hairmesh::reference::lod::LodView {
         alpha_strands: lod.alpha_strands,
         alpha_verts: lod.alpha_verts,
         lambda: lod.lambda,
+        strand_share: 1.0,
     }
 }
