@@ -158,8 +158,11 @@ fn textures_are_paper_sized() {
         );
     }
     println!("100 people: {:.3} MiB", total as f64 / (1 << 20) as f64);
+    // 1.0 MiB until the short cuts got finer grids so their hair lies down (issue 44):
+    // measured 0.99 MiB before, 1.22 MiB after (buzz 5.9 -> 18.7 KB, short crop -> 18.6 KB,
+    // the parted fitted hair 13.7 -> 20.8 KB): 12.5 KB a person.
     assert!(
-        total <= 1 << 20,
+        total <= 1_300_000,
         "100 people take {total} bytes of textures"
     );
 }
