@@ -909,9 +909,12 @@ const MAX_TOTAL_RAISE_FITTED: f32 = 0.03;
 /// Deepest point inside the head [`lift_bundle_interiors`] lifts, metres.
 const MAX_INTERIOR_DEPTH: f32 = 0.02;
 
-/// Height the interpolated hair of the short families keeps above the head (negative: it
-/// may run this far under the skin, where the scalp hides it).
-const SHORT_HAIR_MARGIN: f32 = -0.0008;
+/// Height the interpolated hair of the short families keeps above the head once past the
+/// root (the margin grows from nothing at the root over the first segment): less than the
+/// other families' 2 mm so the strands leave at a shallower angle, enough that a bundle's
+/// middle covers the scalp (tests/scalp_coverage.rs: 98.7% for the buzz; 0.8 mm under the
+/// skin showed a bald spot per bundle).
+const SHORT_HAIR_MARGIN: f32 = 0.0018;
 
 /// Height the interpolated hair keeps above the head: 2 mm plus half of how far the style's
 /// curls and waves move strands off their bundle's curve (half: the offsets swing both ways,
@@ -1381,15 +1384,17 @@ mod tests {
 
     /// Short hair lies down: its strands leave the scalp at a shallow angle along the comb
     /// (as real short hair does), not standing out of it like a brush's bristles. Measured
-    /// (this test): buzz 9.9 degrees, short crop 20.5 (68 and 67 before: layer 1 lifted
-    /// 13 mm to keep the first half-segment's bundle interiors 2 mm off the scalp). Bound
-    /// 25 degrees: hair combed flat, where the old cuts stood at twice that.
+    /// (this test): buzz 30.8 degrees, short crop 29.9 (68 and 67 before: layer 1 lifted
+    /// 13 mm to keep the first half-segment's bundle interiors 2 mm off the scalp). With the
+    /// interiors let down to the skin they reached 10 and 21 degrees, but a buzz cut then
+    /// showed its scalp in a spot at every bundle's middle (63.7% covered from above,
+    /// tests/scalp_coverage.rs); 1.8 mm keeps 98.7%. Bound 35 degrees: half the old angle.
     #[test]
     fn short_hair_leaves_the_scalp_at_a_shallow_angle() {
         for family in [StyleFamily::Buzz, StyleFamily::ShortCrop] {
             let angle = root_angle(family);
             println!("{family:?}: first segments {angle:.1} degrees off the scalp");
-            assert!(angle < 25.0, "{family:?}: {angle:.1} degrees");
+            assert!(angle < 35.0, "{family:?}: {angle:.1} degrees");
         }
     }
 
