@@ -126,8 +126,17 @@ fn the_volume_matches_the_strands_at_the_switch_distance() {
         // Halfway across a band around the character's size.
         let (far, near) = (SWITCH_PIXELS - 10.0, SWITCH_PIXELS + 10.0);
         let half = frame(&ctx, name, camera, (tier(far, near, true), lod));
-        for (tag, img) in [("strands", &strands), ("volume", &volume), ("halfway", &half)] {
-            save_png(&output_dir().join(format!("volume-band-{short}-{tag}.png")), SIZE, SIZE, img);
+        for (tag, img) in [
+            ("strands", &strands),
+            ("volume", &volume),
+            ("halfway", &half),
+        ] {
+            save_png(
+                &output_dir().join(format!("volume-band-{short}-{tag}.png")),
+                SIZE,
+                SIZE,
+                img,
+            );
         }
         let (mean, p99) = character_flip(short, side, &strands, &volume);
         let (lod_mean, _) = flip_rgba(

@@ -24,6 +24,11 @@ pub const UPPER_LID_ELEVATION: f32 = 0.38;
 pub const LOWER_LID_ELEVATION: f32 = -0.5;
 /// The lids' shell radius in eyeball radii: just outside the eyeball, as lids rest on it.
 pub const LID_RADIUS: f32 = 1.02;
+// The upper lid covers the iris's top and leaves the pupil open; the lower meets the iris.
+const _: () =
+    assert!(UPPER_LID_ELEVATION < IRIS_HALF_ANGLE && UPPER_LID_ELEVATION > PUPIL_HALF_ANGLE);
+const _: () = assert!(LOWER_LID_ELEVATION <= -IRIS_HALF_ANGLE * 0.95);
+
 /// The eyeball's GGX roughness: a wet cornea, a small sharp highlight.
 pub const EYE_ROUGHNESS: f32 = 0.2;
 
@@ -102,13 +107,20 @@ pub fn lids(eye: &Eye) -> (Vec<[Vec3; 3]>, Vec<[Vec3; 3]>) {
         let rim = std::f32::consts::FRAC_PI_2 - edge * pole;
         let point = |angle: f32, s: usize| {
             let a = phi(s);
-            let d = Vec3::new(angle.sin() * a.cos(), pole * angle.cos(), angle.sin() * a.sin());
+            let d = Vec3::new(
+                angle.sin() * a.cos(),
+                pole * angle.cos(),
+                angle.sin() * a.sin(),
+            );
             eye.centre + d * r
         };
         let steps = 8;
         for k in 0..=steps {
             let (t0, t1) = if k < steps {
-                (rim * k as f32 / steps as f32, rim * (k + 1) as f32 / steps as f32)
+                (
+                    rim * k as f32 / steps as f32,
+                    rim * (k + 1) as f32 / steps as f32,
+                )
             } else {
                 (rim, rim + if pole > 0.0 { 0.1 } else { 0.04 })
             };
@@ -191,15 +203,15 @@ mod tests {
                 assert!(p.distance(eye.centre) > eye.radius * 1.01);
             }
         }
-        let rim = super::super::human::socket_rim(&head.triangles, &eye)
-            .expect("the eye's socket rim");
+        let rim =
+            super::super::human::socket_rim(&head.triangles, &eye).expect("the eye's socket rim");
         let lid = eye.radius * LID_RADIUS;
         let mut covered = 0;
         let (mut lo, mut hi) = (f32::MAX, 0.0f32);
         for p in &rim {
             let d = (*p - eye.centre).normalize();
             let elevation = d.y.asin();
-            if elevation > UPPER_LID_ELEVATION || elevation < LOWER_LID_ELEVATION {
+            if !(LOWER_LID_ELEVATION..=UPPER_LID_ELEVATION).contains(&elevation) {
                 covered += 1;
                 let r = p.distance(eye.centre) / lid;
                 (lo, hi) = (lo.min(r), hi.max(r));
@@ -208,7 +220,5 @@ mod tests {
         println!("rim under the lids at {lo:.3}-{hi:.3} of the lid shell's radius");
         assert!(lo > 0.7 && hi < 1.0, "{lo}-{hi}");
         assert!(covered >= 3, "{covered} of {} rim points", rim.len());
-        assert!(UPPER_LID_ELEVATION < IRIS_HALF_ANGLE && UPPER_LID_ELEVATION > PUPIL_HALF_ANGLE);
-        assert!(LOWER_LID_ELEVATION <= -IRIS_HALF_ANGLE * 0.95);
     }
 }

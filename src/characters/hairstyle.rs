@@ -1053,10 +1053,9 @@ fn covers_face(cols: &Columns, face: &Face, in_front: &impl Fn(Vec3) -> bool) ->
         (0..=4).any(|i| {
             (0..=4).any(|j| {
                 let (s, t) = (i as f32 / 4.0, j as f32 / 4.0);
-                let p = layer[quad[0] as usize].lerp(layer[quad[1] as usize], s).lerp(
-                    layer[quad[3] as usize].lerp(layer[quad[2] as usize], s),
-                    t,
-                );
+                let p = layer[quad[0] as usize]
+                    .lerp(layer[quad[1] as usize], s)
+                    .lerp(layer[quad[3] as usize].lerp(layer[quad[2] as usize], s), t);
                 in_front(p)
             })
         })
@@ -1091,7 +1090,11 @@ fn part_around_face(cols: &mut Columns, head: &PlacedHead) {
     // The side a column falls to: where its layers lie on average (a column rooted on the
     // midline falls to one side or the other).
     let lean = |cols: &Columns, i: u32| {
-        cols.layers.iter().skip(1).map(|l| canonical(l[i as usize]).x).sum::<f32>()
+        cols.layers
+            .iter()
+            .skip(1)
+            .map(|l| canonical(l[i as usize]).x)
+            .sum::<f32>()
     };
     let mut side: Vec<f32> = (0..cols.uv.len() as u32)
         .map(|i| lean(cols, i).signum())
@@ -1111,7 +1114,11 @@ fn part_around_face(cols: &mut Columns, head: &PlacedHead) {
         for k in 0..v.len() {
             let (a, b) = (v[k], v[(k + 1) % v.len()]);
             let (xa, xb) = (root_x[k], root_x[(k + 1) % v.len()]);
-            if xa > 0.0 { right.push(a) } else { left.push(a) }
+            if xa > 0.0 {
+                right.push(a)
+            } else {
+                left.push(a)
+            }
             if (xa > 0.0) != (xb > 0.0) {
                 let t = (xa / (xa - xb)).clamp(0.0, 1.0);
                 let (r_copy, l_copy) = (cols.between(a, b, t), cols.between(a, b, t));
@@ -1223,7 +1230,11 @@ fn fitted_sintel_parted(
     if part {
         part_around_face(&mut cols, &head);
     }
-    let Columns { mut layers, uv, faces } = cols;
+    let Columns {
+        mut layers,
+        uv,
+        faces,
+    } = cols;
     let own = style_for(StyleFamily::Fitted, seed, rng);
     let style = HairStyle {
         seed,
@@ -1241,13 +1252,7 @@ fn fitted_sintel_parted(
     // No hairline thinning: the fit's border follows the Sintel guide strands, whose roots
     // already thin out there (20 bundles are too coarse to thin them further without showing
     // scalp from above: 97.0% covered with the border thinned, 98.9% without).
-    let mesh = HairMesh::new(
-        format!("Fitted #{seed}"),
-        layers,
-        None,
-        uv,
-        faces,
-    )?;
+    let mesh = HairMesh::new(format!("Fitted #{seed}"), layers, None, uv, faces)?;
     Ok(Hairstyle {
         family: StyleFamily::Fitted,
         mesh,
@@ -1439,15 +1444,27 @@ mod tests {
                     q.z > 0.1 && q.x.abs() < 0.03 && (1.5..1.58).contains(&q.y)
                 })
                 .count();
-            (crate::fit::metric::compare(&input, &strands, diagonal, 0.05 * diagonal), over_face)
+            (
+                crate::fit::metric::compare(&input, &strands, diagonal, 0.05 * diagonal),
+                over_face,
+            )
         };
         let (before, over_before) = fidelity(false);
         let (after, over_after) = fidelity(true);
         println!("unparted: {before}; {over_before} points over the eyes");
         println!("parted:   {after}; {over_after} points over the eyes");
-        assert!(after.two_sided.0 <= before.two_sided.0, "{after} vs {before}");
-        assert!(after.coverage > before.coverage - 0.05, "{after} vs {before}");
-        assert!(over_after * 10 < over_before.max(1), "{over_after} vs {over_before}");
+        assert!(
+            after.two_sided.0 <= before.two_sided.0,
+            "{after} vs {before}"
+        );
+        assert!(
+            after.coverage > before.coverage - 0.05,
+            "{after} vs {before}"
+        );
+        assert!(
+            over_after * 10 < over_before.max(1),
+            "{over_after} vs {over_before}"
+        );
     }
 
     #[test]

@@ -164,7 +164,12 @@ fn head_meshes() -> Result<[crate::skin::SkinnedMesh; 2]> {
     }
     Ok([
         welded("head", &bust, &bust_colors, (joint, PROP_ROUGHNESS)),
-        welded("eyes", &eyes, &eye_colors, (joint, super::eyes::EYE_ROUGHNESS)),
+        welded(
+            "eyes",
+            &eyes,
+            &eye_colors,
+            (joint, super::eyes::EYE_ROUGHNESS),
+        ),
     ])
 }
 

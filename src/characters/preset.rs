@@ -87,7 +87,6 @@ pub mod prop_mesh {
     pub const TEAPOT: usize = 2;
 }
 
-
 /// Pixels a far mesh's cell spans where the switch to it happens: the far version is drawn
 /// once a cell is under two pixels.
 pub const FAR_CELL_PIXELS: f32 = 2.0;

@@ -175,10 +175,16 @@ mod tests {
             let l = bundle_lod(&baked, &style, 0, 64, 4, &view(share));
             assert_eq!(l.thickness, full.thickness);
             let w = width(&l);
-            assert!((w - width(&full) * share).abs() <= full.thickness * 1.01, "{share}: {w}");
+            assert!(
+                (w - width(&full) * share).abs() <= full.thickness * 1.01,
+                "{share}: {w}"
+            );
             // A 1% step of the share takes about 1% of the width off, never adds any.
             let step = prev - w;
-            assert!(step > -1e-4 && step < width(&full) * 0.011 + 0.05 * full.thickness, "{share}: {prev} -> {w}");
+            assert!(
+                step > -1e-4 && step < width(&full) * 0.011 + 0.05 * full.thickness,
+                "{share}: {prev} -> {w}"
+            );
             prev = w;
         }
     }

@@ -394,7 +394,10 @@ mod tests {
         let back = (cam.eye - cam.target).normalize();
         let off_axis = l.dot(back).acos();
         let expected = (PORTRAIT_KEY_AZIMUTH.cos() * PORTRAIT_KEY_ELEVATION.cos()).acos();
-        assert!((off_axis - expected).abs() < 0.05, "{off_axis} vs {expected}");
+        assert!(
+            (off_axis - expected).abs() < 0.05,
+            "{off_axis} vs {expected}"
+        );
     }
 
     #[test]

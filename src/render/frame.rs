@@ -776,11 +776,7 @@ impl Renderer {
 
     /// The bodies' light view for `view`: fitted to the bodies in the camera's frustum. `None`
     /// when shadows are off or no body is in view.
-    fn body_light_view(
-        &self,
-        view: &View,
-        block: &super::shared::FrameBlock,
-    ) -> Option<LightView> {
+    fn body_light_view(&self, view: &View, block: &super::shared::FrameBlock) -> Option<LightView> {
         if view.shadows == ShadowMode::Off {
             return None;
         }

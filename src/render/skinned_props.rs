@@ -318,7 +318,10 @@ impl SkinnedProps {
             }
             for &(mesh, _) in &w.parts {
                 let r = &self.meshes[mesh];
-                out.push(super::prop_table::world_sphere(&w.body, (r.centre, r.radius)));
+                out.push(super::prop_table::world_sphere(
+                    &w.body,
+                    (r.centre, r.radius),
+                ));
             }
         }
         out
