@@ -30,8 +30,9 @@ float box_weight(int i, float f) {
 // that slides with the point: 4x4 depth comparisons weighted (1 - f, 1, 1, f) per axis by the
 // point's position within its texel, so an edge is a smooth ramp three texels wide and not a
 // staircase of texels (the CPU twin is render::shadow::box_pcf_weights). Texels off the map
-// count as lit.
-float body_visibility(vec3 p) {
+// count as lit. Unfiltered (strands: a strand is thinner than a texel, and its many fragments
+// or vertices average the edge anyway), one comparison at the nearest texel.
+float body_visibility(vec3 p, bool filtered) {
     float res = frame.body_shadow.x;
     if (res <= 0.0) {
         return 1.0;
@@ -45,6 +46,11 @@ float body_visibility(vec3 p) {
     vec2 f = st - base;
     float z = c.z * frame.body_shadow.y - frame.body_shadow.z;
     int side = int(res);
+    if (!filtered) {
+        ivec2 t = ivec2(floor(st + 0.5));
+        bool off = any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, ivec2(side)));
+        return off || z <= texelFetch(shadow_prop_depth, t, 0).r * frame.body_shadow.y ? 1.0 : 0.0;
+    }
     float lit = 0.0;
     for (int j = -1; j <= 2; j++) {
         float wy = box_weight(j, f.y);
@@ -111,7 +117,7 @@ vec3 light_arrival_with(vec3 p, float offset, float body, bool slide) {
 
 // light_arrival_with at a strand point (no surface to lift off).
 vec3 light_arrival(vec3 p, float offset) {
-    return light_arrival_with(p, offset, body_visibility(p), false);
+    return light_arrival_with(p, offset, body_visibility(p, false), false);
 }
 
 // How the light reaches a point `p` of an opaque surface with unit normal `n`: the bodies'
@@ -119,7 +125,7 @@ vec3 light_arrival(vec3 p, float offset) {
 // acne on slopes without the light leaking under contacts), the hair maps two biases toward
 // the light.
 vec3 light_arrival_surface(vec3 p, vec3 n) {
-    float body = body_visibility(p + n * (1.5 * frame.body_shadow.w));
+    float body = body_visibility(p + n * (1.5 * frame.body_shadow.w), true);
     return light_arrival_with(p, 2.0 * frame.shadow_params.w, body, true);
 }
 

@@ -87,10 +87,11 @@ impl RenderTargets {
 /// Format of the deep opacity layers (one layer per channel, summed with additive blending).
 pub const SHADOW_LAYERS_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
-/// The bodies' map has this many times the hair maps' texels per side: it is fitted to the
-/// camera's view, and a portrait's chest shows its texels far larger than the hair shows the
-/// hair maps' (filtered, a shadow edge spans about three of them).
-pub const BODY_MAP_SCALE: u32 = 2;
+/// The bodies' map has this many times the hair maps' texels per side. Fitted to the camera's
+/// view, it is fine enough at the hair maps' resolution (a portrait's shadow edge spans about
+/// three texels, 5 mm); twice that cost the 100-people crowd 7% of its frame (the ground's
+/// depth into 4x the texels) for edges a person does not see at crowd distance.
+pub const BODY_MAP_SCALE: u32 = 1;
 
 /// The light's maps (square, shared by the frames in flight; the frame graph orders each
 /// frame's use after the previous frame's reads): hair depth, prop depth and deep opacity layers.
