@@ -37,6 +37,15 @@ bool soft_raster(float d, float width, float thickness, float cap) {
     return drawn <= frame.soft_params.x * pixel;
 }
 
+// Eq. 8's strand count for `wanted` strands (its level times N + delta), clamped to
+// 1..=count (0 when nothing is wanted). Stable LoD: the newest strand comes in as wide as the
+// fractional part, so a bundle's strands fade in one by one as it nears instead of popping
+// (CPU twin: strands_at_level and newest_strand_fade in src/reference/lod.rs).
+void set_strands(inout BundleLod r, float wanted, uint count) {
+    r.strands = wanted > 0.0 ? clamp(uint(ceil(wanted)), 1u, count) : 0u;
+    r.fade = r.strands > 1u && wanted < float(r.strands) ? wanted - float(r.strands - 1u) : 1.0;
+}
+
 bool box_visible(vec3 lo, vec3 hi) {
     for (int p = 0; p < 6; p++) {
         vec4 pl = frame.planes[p];
@@ -97,23 +106,16 @@ BundleLod bundle_lod(uint g) {
     if (frame.counts.z == 0u) {
         r.soft = soft_raster(d, scale * style.strand_width, 1.0, h);
         if (ch_strand_share < 1.0) {
-            float wanted = ch_strand_share * (float(count) + delta);
-            r.strands = wanted > 0.0 ? clamp(uint(ceil(wanted)), 1u, count) : 0u;
-            r.fade = r.strands > 1u && wanted < float(r.strands) ? wanted - float(r.strands - 1u) : 1.0;
+            set_strands(r, ch_strand_share * (float(count) + delta), count);
         }
         return r;
     }
     // Strand LoD: eq. 7 and eq. 8 with a per-bundle increment delta_i, clamped to N_i. In the
     // volume tier's band the level drops by the strands' share, the thickness does not: the
-    // strands thin out one by one (each fading as below) while the volume comes in under
+    // strands thin out one by one (each fading as set_strands says) while the volume comes in under
     // them, a blend with no screen-door pattern (CPU twin: LodView::strand_share).
     float ls = detail_level(h, d, frame.lod.x);
-    float wanted = ls * ch_strand_share * (float(count) + delta);
-    r.strands = wanted > 0.0 ? clamp(uint(ceil(wanted)), 1u, count) : 0u;
-    // Stable LoD: the newest strand comes in as wide as eq. 8's fractional part, so a bundle's
-    // strands fade in one by one as it nears instead of popping (CPU twin:
-    // newest_strand_fade in src/reference/lod.rs).
-    r.fade = r.strands > 1u && wanted < float(r.strands) ? wanted - float(r.strands - 1u) : 1.0;
+    set_strands(r, ls * ch_strand_share * (float(count) + delta), count);
     r.thickness = min(1.0 / max(ls, 1e-6), float(count));
     // Vertex LoD: eq. 9, 10, 12.
     float lv = detail_level(h, d, frame.lod.y);

@@ -2,8 +2,9 @@
 // Props: static triangle lists pulled from the prop vertex buffer (the ground, heads), or
 // skinned meshes (bodies, clothes): their triangle list indexes the instance's posed vertices,
 // written this frame by skin.comp. One instance record (transform, colour) per placed prop;
-// the colour multiplies a skinned vertex's own (whose alpha is its roughness). The light's prop pass (BODY_MAP_PASS) draws
-// into the bodies' map, fitted to the camera's view (render::shadow::LightView::fit_bodies).
+// the colour multiplies a skinned vertex's own (whose alpha is its roughness). The light's
+// prop pass (BODY_MAP_PASS) draws into the bodies' map, fitted to the camera's view
+// (render::shadow::LightView::fit_bodies).
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 

@@ -1,8 +1,8 @@
 // Light transmittance at a world point from the light's maps (src/render/shadow.rs):
 // opaque props (bodies) by filtered depth comparison in their own camera-fitted map, hair by
-// deep opacity layers (mode 1, Yuksel and Keyser
-// 2008) or by the approximate deep shadow estimate (mode 2, seed 002: strands in front
-// counted from the depth difference), 3x3 texels averaged.
+// deep opacity layers (mode 1, Yuksel and Keyser 2008) or by the approximate deep shadow
+// estimate (mode 2, seed 002: strands in front counted from the depth difference), 3x3 texels
+// averaged.
 // Requires bindings.glsl. Used by strands.frag and props.frag.
 #ifndef SHADOW_LOOKUP_GLSL
 #define SHADOW_LOOKUP_GLSL
@@ -20,7 +20,7 @@ float deep_opacity(vec4 layers, float dz) {
 }
 
 // Weight of tap `i` (-1..=2) of a 3x3-texel box sliding with fraction `f` of the point's
-// texel: (1 - f, 1, 1, f), summing to 3 (render::shadow::box_pcf_weights).
+// texel: (1 - f, 1, 1, f), summing to 3 (CPU twin: render::shadow::box_pcf_weights).
 float box_weight(int i, float f) {
     return i == -1 ? 1.0 - f : (i == 2 ? f : 1.0);
 }
@@ -129,9 +129,5 @@ vec3 light_arrival_surface(vec3 p, vec3 n) {
     return light_arrival_with(p, 2.0 * frame.shadow_params.w, body, true);
 }
 
-// Transmittance of the light to `p` (light_arrival's direct fraction).
-float light_transmittance(vec3 p, float offset) {
-    return light_arrival(p, offset).x;
-}
 
 #endif

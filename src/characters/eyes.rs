@@ -134,7 +134,7 @@ pub fn lids(eye: &Eye) -> (Vec<[Vec3; 3]>, Vec<[Vec3; 3]>) {
                 } else {
                     ([a, c, b], [b, c, d])
                 };
-                if k > 0 || k == steps {
+                if k > 0 {
                     target.push(quad0);
                 }
                 target.push(quad1);

@@ -185,6 +185,13 @@ enum Comb {
     Tie,
 }
 
+impl Comb {
+    /// Standing hair (mohawk, afro): it leaves the scalp at once instead of lying on it.
+    fn stands(self) -> bool {
+        matches!(self, Comb::Out | Comb::Crest)
+    }
+}
+
 /// What the gathered hair does after the tie.
 #[derive(Clone, Copy, PartialEq)]
 enum TieKind {
@@ -730,13 +737,13 @@ impl ColumnPlan<'_> {
         let bangs = self.bangs;
         let steer = |p: Vec3, on_scalp: bool| {
             let mut a = Vec3::NEG_Y * gravity;
-            if on_scalp && !bangs && !matches!(comb, Comb::Out | Comb::Crest) {
+            if on_scalp && !bangs && !comb.stands() {
                 let n = (p - settle.head.centre()).normalize_or(Vec3::Y);
                 a += comb_direction(comb, settle.head, p, n, None) * COMB_PULL;
             }
             a
         };
-        let lies = !matches!(comb, Comb::Out | Comb::Crest);
+        let lies = !comb.stands();
         let path = settle.walk(root, dir, length, hem_y, lies, self.lift(edge), steer);
         resample(&path, cut.layers, cut.spacing)
     }
@@ -869,7 +876,7 @@ fn grown(
         .map(|k| columns.iter().map(|c| c[k]).collect())
         .collect();
     // Hair that lies on the scalp; standing hair (mohawk, afro) leaves it at once.
-    if !matches!(cut.comb, Comb::Out | Comb::Crest) {
+    if !cut.comb.stands() {
         lift_bundle_interiors(&mut layers, &faces, &head, margin, MAX_TOTAL_RAISE);
     }
     let uv = roots.iter().map(|r| r.uv).collect();
@@ -1068,10 +1075,10 @@ fn covers_face(cols: &Columns, face: &Face, in_front: &impl Fn(Vec3) -> bool) ->
 /// side into one down the middle, where the source strands have none. So (1) every bundle
 /// whose columns fall both sides of the face's midline (canonical x = 0, by where their
 /// layers lie on average) and reaches in front of the face is cut where that average
-/// crosses it, the new columns on the cut doubled, one copy per side: a parting; (2) every layer point (roots stay) in front of the face shield
-/// ([`FACE_SHIELD`], from the brows to the chin, its full width above its middle) within
-/// its width at that height plus [`FACE_CLEARANCE`] moves sideways out of it, to its
-/// column's side.
+/// crosses it, the new columns on the cut doubled, one copy per side: a parting; (2) every
+/// layer point (roots stay) in front of the face shield ([`FACE_SHIELD`], from the brows to
+/// the chin, its full width above its middle) within its width at that height plus
+/// [`FACE_CLEARANCE`] moves sideways out of it, to its column's side.
 fn part_around_face(cols: &mut Columns, head: &PlacedHead) {
     let (c, r) = FACE_SHIELD;
     let canonical = |p: Vec3| head.to_canonical.transform_point3(p);
@@ -1089,56 +1096,17 @@ fn part_around_face(cols: &mut Columns, head: &PlacedHead) {
     };
     // The side a column falls to: where its layers lie on average (a column rooted on the
     // midline falls to one side or the other).
-    let lean = |cols: &Columns, i: u32| {
-        cols.layers
-            .iter()
-            .skip(1)
-            .map(|l| canonical(l[i as usize]).x)
-            .sum::<f32>()
-    };
-    let mut side: Vec<f32> = (0..cols.uv.len() as u32)
-        .map(|i| lean(cols, i).signum())
+    let lean: Vec<f32> = (0..cols.uv.len())
+        .map(|i| cols.layers.iter().skip(1).map(|l| canonical(l[i]).x).sum())
         .collect();
-    let faces = std::mem::take(&mut cols.faces);
-    for face in faces {
-        let v = face.vertices().to_vec();
-        let root_x: Vec<f32> = v.iter().map(|&i| lean(cols, i)).collect();
-        let crosses = root_x.iter().any(|&x| x > 0.0) && root_x.iter().any(|&x| x < 0.0);
-        if !crosses || !covers_face(cols, &face, &in_front) {
+    let mut side: Vec<f32> = lean.iter().map(|x| x.signum()).collect();
+    for face in std::mem::take(&mut cols.faces) {
+        let x: Vec<f32> = face.vertices().iter().map(|&i| lean[i as usize]).collect();
+        let crosses = x.iter().any(|&x| x > 0.0) && x.iter().any(|&x| x < 0.0);
+        if crosses && covers_face(cols, &face, &in_front) {
+            cut_at_midline(cols, &face, &x, head, &mut side);
+        } else {
             cols.faces.push(face);
-            continue;
-        }
-        // Walk the polygon, cutting each edge that crosses x = 0; each side's polygon gets
-        // its own copy of the cut's columns.
-        let (mut right, mut left) = (Vec::new(), Vec::new());
-        for k in 0..v.len() {
-            let (a, b) = (v[k], v[(k + 1) % v.len()]);
-            let (xa, xb) = (root_x[k], root_x[(k + 1) % v.len()]);
-            if xa > 0.0 {
-                right.push(a)
-            } else {
-                left.push(a)
-            }
-            if (xa > 0.0) != (xb > 0.0) {
-                let t = (xa / (xa - xb)).clamp(0.0, 1.0);
-                let (r_copy, l_copy) = (cols.between(a, b, t), cols.between(a, b, t));
-                // The interpolated column is a chord: its root goes onto the scalp, its
-                // layers outside the head.
-                for k in [r_copy, l_copy] {
-                    let root = &mut cols.layers[0][k as usize];
-                    let (theta, phi) = head.angles(*root);
-                    *root = head.surface(theta, phi);
-                    for layer in cols.layers.iter_mut().skip(1) {
-                        layer[k as usize] = head.push_out(layer[k as usize], 0.004);
-                    }
-                }
-                side.extend([1.0, -1.0]);
-                right.push(r_copy);
-                left.push(l_copy);
-            }
-        }
-        for poly in [right, left] {
-            cols.faces.extend(fan(&poly));
         }
     }
     for layer in cols.layers.iter_mut().skip(1) {
@@ -1150,6 +1118,50 @@ fn part_around_face(cols: &mut Columns, head: &PlacedHead) {
             let moved = Vec3::new(s * half, q.y, q.z);
             *p = head.push_out(head.to_person.transform_point3(moved), 0.004);
         }
+    }
+}
+
+/// Cut `face` where its columns' lean `x` (one per corner) crosses 0: walk the polygon,
+/// cutting each edge that crosses, each side's polygon getting its own copy of the cut's
+/// columns (their roots on the scalp, their layers outside the head; `side` gets +1 and -1
+/// for them). Both polygons go to `cols.faces`.
+fn cut_at_midline(
+    cols: &mut Columns,
+    face: &Face,
+    x: &[f32],
+    head: &PlacedHead,
+    side: &mut Vec<f32>,
+) {
+    let v = face.vertices();
+    let (mut right, mut left) = (Vec::new(), Vec::new());
+    for k in 0..v.len() {
+        let (a, b) = (v[k], v[(k + 1) % v.len()]);
+        let (xa, xb) = (x[k], x[(k + 1) % v.len()]);
+        if xa > 0.0 {
+            right.push(a)
+        } else {
+            left.push(a)
+        }
+        if (xa > 0.0) != (xb > 0.0) {
+            let t = (xa / (xa - xb)).clamp(0.0, 1.0);
+            let (r_copy, l_copy) = (cols.between(a, b, t), cols.between(a, b, t));
+            // The interpolated column is a chord: its root goes onto the scalp, its layers
+            // outside the head.
+            for k in [r_copy, l_copy] {
+                let root = &mut cols.layers[0][k as usize];
+                let (theta, phi) = head.angles(*root);
+                *root = head.surface(theta, phi);
+                for layer in cols.layers.iter_mut().skip(1) {
+                    layer[k as usize] = head.push_out(layer[k as usize], 0.004);
+                }
+            }
+            side.extend([1.0, -1.0]);
+            right.push(r_copy);
+            left.push(l_copy);
+        }
+    }
+    for poly in [right, left] {
+        cols.faces.extend(fan(&poly));
     }
 }
 

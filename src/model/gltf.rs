@@ -437,8 +437,6 @@ fn read_primitive(
     })
 }
 
-/// Per-vertex linear colour: the material's base colour factor times its base colour texture
-/// (PNG, sRGB, bilinear at TEXCOORD_0, repeated) where there is one.
 /// The primitive's material roughness factor (1 where the file gives none, glTF's default);
 /// out of 0..=1 or not finite is an error naming the primitive. Kept above 0.05 (a mirror's
 /// highlight is a sub-pixel point).
@@ -450,6 +448,8 @@ fn material_roughness(data: &Data, prim: &gltf::Primitive, at: &str) -> Result<f
     Ok(r.max(0.05))
 }
 
+/// Per-vertex linear colour: the material's base colour factor times its base colour texture
+/// (PNG, sRGB, bilinear at TEXCOORD_0, repeated) where there is one.
 fn vertex_colors(data: &Data, prim: &gltf::Primitive, n: usize, at: &str) -> Result<Vec<Vec3>> {
     let pbr = prim.material().pbr_metallic_roughness();
     let factor = Vec4::from(pbr.base_color_factor()).truncate();

@@ -218,6 +218,16 @@ impl LightView {
     }
 }
 
+/// Weights of the bodies' map filter (`body_visibility` in `glsl/shadow_lookup.glsl`) along one
+/// axis: the 4 depth comparisons at texel offsets -1..=2 from the texel below a point at
+/// fraction `f` (0..1) of the way to the next texel centre. A 3x3-texel box sliding with the
+/// point, `(1 - f, 1, 1, f)`, summing to 3: the filtered visibility is continuous as the point
+/// crosses texels, so a shadow edge is a ramp three texels wide instead of a staircase.
+pub fn box_pcf_weights(f: f32) -> [f32; 4] {
+    let f = f.clamp(0.0, 1.0);
+    [1.0 - f, 1.0, 1.0, f]
+}
+
 /// The light's orthonormal frame: `side` and `up` span the map, `forward` points away from
 /// the light.
 struct LightBasis {
@@ -313,6 +323,46 @@ fn frustum_slice(view_proj: Mat4, eye: Vec3, spheres: &[(Vec3, f32)]) -> Option<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sliding box turns a shadow edge into a continuous ramp three texels wide: the
+    /// filtered visibility of a point moving across a straight edge (texels at or beyond 0 in
+    /// shadow) never jumps by more than the step's share of the ramp, and runs from lit to
+    /// shadowed over 3 texels. (A fixed 3x3 box, `[1, 1, 1, 0]` whatever `f`, jumps by a
+    /// third at every texel.)
+    #[test]
+    fn the_body_map_filter_ramps_across_an_edge() {
+        let visibility = |x: f32| {
+            // Texel centres at k + 0.5; the point's texel below and its fraction.
+            let st = x - 0.5;
+            let (base, f) = (st.floor(), st - st.floor());
+            let w = box_pcf_weights(f);
+            let lit: f32 = (0..4)
+                .map(|i| {
+                    let texel = base as i32 + i - 1;
+                    if texel < 0 { w[i as usize] } else { 0.0 }
+                })
+                .sum();
+            lit / 3.0
+        };
+        let steps = 1000;
+        let (from, to) = (-3.0f32, 3.0f32);
+        let mut prev = visibility(from);
+        assert_eq!(prev, 1.0);
+        for k in 1..=steps {
+            let x = from + (to - from) * k as f32 / steps as f32;
+            let v = visibility(x);
+            assert!(v <= prev + 1e-6, "{x}: {prev} -> {v}");
+            assert!(prev - v < 0.01, "{x}: jumps {prev} -> {v}");
+            prev = v;
+        }
+        assert_eq!(prev, 0.0);
+        // The ramp is centred on the edge (x = 0) and three texels wide.
+        assert_eq!(visibility(-1.5), 1.0);
+        assert!(visibility(-1.4) < 1.0);
+        assert_eq!(visibility(1.5), 0.0);
+        assert!((visibility(0.0) - 0.5).abs() < 1e-6);
+        assert_eq!(box_pcf_weights(0.3).iter().sum::<f32>(), 3.0);
+    }
 
     #[test]
     fn light_view_contains_the_bounds_and_orders_depth_from_the_light() {
