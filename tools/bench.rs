@@ -611,9 +611,9 @@ fn timed_frames(
     Ok((reports, median(walls)))
 }
 
-/// Median GPU ms of each pass of `first` over `reports`.
+/// Median GPU ms of each pass of `first` over `reports`, then of the part no scope covers.
 fn median_passes<'a>(first: &'a FrameReport, reports: &[FrameReport]) -> Vec<(&'a str, f64)> {
-    first
+    let mut out: Vec<(&str, f64)> = first
         .pass_ms
         .iter()
         .map(|(name, _)| {
@@ -623,7 +623,15 @@ fn median_passes<'a>(first: &'a FrameReport, reports: &[FrameReport]) -> Vec<(&'
                 .collect();
             (*name, median(ms))
         })
-        .collect()
+        .collect();
+    let unscoped: Vec<f64> = reports
+        .iter()
+        .filter_map(FrameReport::unscoped_ms)
+        .collect();
+    if !unscoped.is_empty() {
+        out.push(("unscoped", median(unscoped)));
+    }
+    out
 }
 
 /// RGBA images of `size` laid out side by side, one row of the picture per row given.

@@ -401,8 +401,11 @@ fn print_report(
     for (pass, ms) in &out.pass_ms {
         outln!("  gpu {pass:<10} {ms:9.3} ms")?;
     }
+    if let Some(ms) = out.unscoped_ms() {
+        outln!("  gpu (no scope) {ms:9.3} ms of the frame no pass scope covers")?;
+    }
     outln!(
-        "  total gpu  {:9.3} ms; wall (incl. setup, shader compile) {:.2} s",
+        "  total gpu  {:9.3} ms (first to last command); wall (incl. setup, shader compile) {:.2} s",
         out.gpu_ms(),
         wall
     )

@@ -185,7 +185,7 @@ impl Renderer {
             temporal,
             transients,
         };
-        let frame_graph = self.record(i, work, opts, &mut target)?;
+        let (frame_graph, unscoped_commands) = self.record(i, work, opts, &mut target)?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
         let (width, height) = self.targets.size();
         let pending = Pending {
@@ -199,6 +199,7 @@ impl Renderer {
             frame_graph,
             volume_characters: (work_draw.alone, work_draw.blended),
             probe_roots: opts.probe_roots.then_some(self.crowd.bundle_count()),
+            unscoped_commands,
         };
         self.hand_over(i, pending, target)?;
         self.remember_frame(&records, &motion, temporal);
@@ -540,15 +541,16 @@ impl Renderer {
 
     /// Record frame slot `i` into `target`'s command buffer: build the frame graph (hair mesh
     /// updates, LHS skinning, the frame's passes, overlay, readbacks, presentation, or a host
-    /// frame's depth and composite) and run it. Returns the graph's description when `opts`
-    /// asks for it.
+    /// frame's depth and composite) and run it, between the frame's outer timestamps. Returns
+    /// the graph's description when `opts` asks for it, and the commands recorded outside
+    /// every timing scope.
     fn record(
         &mut self,
         i: usize,
         work: FrameWork,
         opts: &FrameOptions,
         target: &mut FrameTarget,
-    ) -> GpuResult<Option<String>> {
+    ) -> GpuResult<(Option<String>, u32)> {
         let FrameSlot {
             cmd,
             profiler,
@@ -573,6 +575,7 @@ impl Renderer {
         if let Some(q) = mesh_query.as_mut() {
             q.reset(&mut rec);
         }
+        profiler.begin_frame(&mut rec);
         let jobs = self.crowd.update_jobs(i, &work.pose_updates);
         let simulated: Vec<SimulatedCharacter> = self
             .crowd
@@ -635,6 +638,8 @@ impl Renderer {
             passes.add_composite(&mut g, &r, i, res)?;
         }
         let result = g.run(&mut rec, profiler, &mut self.transients);
+        profiler.end_frame(&mut rec);
+        let unscoped = rec.unscoped_commands();
         let released = self.transients.take_released();
         retired.extend(released.into_iter().map(Retired::Resource));
         let description = result?;
@@ -642,7 +647,7 @@ impl Renderer {
         if let FrameTarget::Own(_) = target {
             cmd.end()?;
         }
-        Ok(description)
+        Ok((description, unscoped))
     }
 
     /// Submit slot `i` (own frames), or leave it to the host: the slot's fence stays

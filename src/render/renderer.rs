@@ -574,13 +574,16 @@ impl Renderer {
                 (Some(q), RenderPath::Mesh) => q.result()?,
                 _ => None,
             };
+            let times = slot.profiler.results()?;
             self.completed.push_back(FrameReport {
                 frame: p.frame,
                 path: p.path,
                 width: p.width,
                 height: p.height,
                 stats: args.stats,
-                pass_ms: slot.profiler.results()?,
+                pass_ms: times.scopes,
+                frame_ms: times.frame_ms,
+                unscoped_commands: p.unscoped_commands,
                 mesh_primitives,
                 record_ms: p.record_ms,
                 rgba,

@@ -39,8 +39,15 @@ pub struct FrameReport {
     pub height: u32,
     /// What the GPU generated.
     pub stats: FrameStats,
-    /// GPU milliseconds per pass.
+    /// GPU milliseconds per timing scope (a pass, or passes grouped under one name; scopes
+    /// of one name summed), in the order they first ran.
     pub pass_ms: Vec<(&'static str, f64)>,
+    /// GPU milliseconds from the frame's first command to its last (an outer pair of
+    /// timestamps); `None` where the device could not time it.
+    pub frame_ms: Option<f64>,
+    /// Commands the frame recorded outside every timing scope (0: the scopes account for all
+    /// its work).
+    pub unscoped_commands: u32,
     /// Mesh path: `MESH_PRIMITIVES_GENERATED_EXT` where the device supports it.
     pub mesh_primitives: Option<u64>,
     /// CPU milliseconds spent recording the frame's commands.
@@ -62,9 +69,36 @@ pub struct FrameReport {
 }
 
 impl FrameReport {
-    /// Total GPU milliseconds.
+    /// GPU milliseconds of the whole frame: the outer pair, else the sum of the scopes.
     pub fn gpu_ms(&self) -> f64 {
+        self.frame_ms.unwrap_or_else(|| self.scoped_ms())
+    }
+
+    /// The sum of the timing scopes.
+    pub fn scoped_ms(&self) -> f64 {
         self.pass_ms.iter().map(|p| p.1).sum()
+    }
+
+    /// The part of the frame no scope covers (barrier waits and work between scopes).
+    pub fn unscoped_ms(&self) -> Option<f64> {
+        self.frame_ms.map(|f| (f - self.scoped_ms()).max(0.0))
+    }
+
+    /// `name=ms` per scope, then `unscoped=ms` (and the commands recorded outside every
+    /// scope, where there were any), joined with `sep`: what every tool prints per frame.
+    pub fn scope_summary(&self, sep: &str) -> String {
+        let mut parts: Vec<String> = self
+            .pass_ms
+            .iter()
+            .map(|(n, ms)| format!("{n}={ms:.2}"))
+            .collect();
+        if let Some(u) = self.unscoped_ms() {
+            parts.push(format!("unscoped={u:.2}"));
+        }
+        if self.unscoped_commands > 0 {
+            parts.push(format!("unscoped commands={}", self.unscoped_commands));
+        }
+        parts.join(sep)
     }
 }
 
@@ -82,6 +116,8 @@ pub(crate) struct Pending {
     pub volume_characters: (u32, u32),
     /// The frame probed roots (`FrameOptions::probe_roots`) of this many bundles.
     pub probe_roots: Option<u32>,
+    /// Commands recorded outside every timing scope.
+    pub unscoped_commands: u32,
 }
 
 /// One frame in flight.

@@ -90,6 +90,8 @@ impl CommandBuffer {
             ctx: &self.ctx,
             raw: self.raw,
             rendering: false,
+            open_scopes: 0,
+            unscoped: 0,
         })
     }
 
@@ -193,6 +195,10 @@ pub struct CommandRecorder<'a> {
     ctx: &'a Context,
     raw: vk::CommandBuffer,
     rendering: bool,
+    /// Timing scopes open now ([`super::Profiler::begin`] opens one).
+    open_scopes: u32,
+    /// Commands recorded while no timing scope was open.
+    unscoped: u32,
 }
 
 impl<'a> CommandRecorder<'a> {
@@ -204,6 +210,8 @@ impl<'a> CommandRecorder<'a> {
             ctx,
             raw,
             rendering: false,
+            open_scopes: 0,
+            unscoped: 0,
         }
     }
 }
@@ -213,8 +221,32 @@ impl CommandRecorder<'_> {
         self.raw
     }
 
+    /// Count a command: one recorded while no timing scope is open is work the frame report
+    /// could not attribute ([`Self::unscoped_commands`]).
+    fn count_command(&mut self) {
+        if self.open_scopes == 0 {
+            self.unscoped += 1;
+        }
+    }
+
+    /// A timing scope opened (`true`) or closed.
+    pub(crate) fn scope_changed(&mut self, open: bool) {
+        if open {
+            self.open_scopes += 1;
+        } else {
+            self.open_scopes = self.open_scopes.saturating_sub(1);
+        }
+    }
+
+    /// Commands recorded so far outside every timing scope (a frame's passes record none:
+    /// the frame graph opens a scope around each pass that is not in one).
+    pub fn unscoped_commands(&self) -> u32 {
+        self.unscoped
+    }
+
     /// Bind `pipeline` and its descriptor sets (set `i` = `sets[i]`).
     pub fn bind(&mut self, pipeline: &Pipeline, sets: &[&DescriptorSet]) {
+        self.count_command();
         let raw_sets: Vec<vk::DescriptorSet> = sets.iter().map(|s| s.raw()).collect();
         // SAFETY: recording; the sets were created from the pipeline's set layouts.
         unsafe {
@@ -236,6 +268,7 @@ impl CommandRecorder<'_> {
 
     /// Set push constants of `pipeline` (all stages, offset 0).
     pub fn push_constants<T: Pod>(&mut self, pipeline: &Pipeline, data: &T) {
+        self.count_command();
         let bytes = bytemuck::bytes_of(data);
         // Past the layout's range is undefined behaviour in the driver: never let it through.
         assert!(
@@ -258,12 +291,14 @@ impl CommandRecorder<'_> {
 
     /// Dispatch a bound compute pipeline.
     pub fn dispatch(&mut self, x: u32, y: u32, z: u32) {
+        self.count_command();
         // SAFETY: recording with a bound compute pipeline.
         unsafe { self.ctx.device.cmd_dispatch(self.raw, x, y, z) };
     }
 
     /// Dispatch with `VkDispatchIndirectCommand` at `offset` of `args`.
     pub fn dispatch_indirect(&mut self, args: &Buffer, offset: u64) {
+        self.count_command();
         // SAFETY: recording; the buffer has INDIRECT_BUFFER usage (checked by validation).
         unsafe {
             self.ctx
@@ -274,6 +309,7 @@ impl CommandRecorder<'_> {
 
     /// Draw `vertices` vertices of one instance (no vertex input; shaders pull their data).
     pub fn draw(&mut self, vertices: u32) {
+        self.count_command();
         // SAFETY: recording inside a rendering instance with a bound graphics pipeline.
         unsafe { self.ctx.device.cmd_draw(self.raw, vertices, 1, 0, 0) };
     }
@@ -287,6 +323,7 @@ impl CommandRecorder<'_> {
         first_vertex: u32,
         first_instance: u32,
     ) {
+        self.count_command();
         // SAFETY: recording inside a rendering instance with a bound graphics pipeline.
         unsafe {
             self.ctx
@@ -297,6 +334,7 @@ impl CommandRecorder<'_> {
 
     /// Draw with one `VkDrawIndirectCommand` at `offset` of `args`.
     pub fn draw_indirect(&mut self, args: &Buffer, offset: u64) {
+        self.count_command();
         // SAFETY: recording inside a rendering instance.
         unsafe {
             self.ctx
@@ -307,6 +345,7 @@ impl CommandRecorder<'_> {
 
     /// Launch task workgroups of a bound task/mesh pipeline.
     pub fn draw_mesh_tasks(&mut self, x: u32, y: u32, z: u32) -> GpuResult<()> {
+        self.count_command();
         let ext = self
             .ctx
             .mesh_ext
@@ -321,6 +360,7 @@ impl CommandRecorder<'_> {
     /// Begin dynamic rendering into `color` and `depth` over their full extent, with viewport
     /// and scissor covering it.
     pub fn begin_rendering(&mut self, color: Attachment, depth: Attachment) {
+        self.count_command();
         let color_att = [attachment_info(
             &color,
             vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
@@ -338,6 +378,7 @@ impl CommandRecorder<'_> {
     /// Begin dynamic rendering into `depth` only (shadow maps), viewport and scissor covering
     /// it.
     pub fn begin_rendering_depth(&mut self, depth: Attachment) {
+        self.count_command();
         let att = attachment_info(&depth, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
         let area = full_area(depth.image);
         let info = vk::RenderingInfo::default()
@@ -350,6 +391,7 @@ impl CommandRecorder<'_> {
     /// Begin dynamic rendering into `color` only (overlays such as the control panel, the deep
     /// opacity layers), viewport and scissor covering it.
     pub fn begin_rendering_color(&mut self, color: Attachment) {
+        self.count_command();
         let atts = [attachment_info(
             &color,
             vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
@@ -365,6 +407,7 @@ impl CommandRecorder<'_> {
     /// Begin dynamic rendering with no attachments over `width x height` (draws whose shaders
     /// only write buffers, such as the software rasterizer's mesh-shader segment pass).
     pub fn begin_rendering_empty(&mut self, width: u32, height: u32) {
+        self.count_command();
         let area = vk::Rect2D {
             offset: vk::Offset2D::default(),
             extent: vk::Extent2D { width, height },
@@ -398,6 +441,7 @@ impl CommandRecorder<'_> {
     /// End the rendering instance begun last.
     pub fn end_rendering(&mut self) {
         if self.rendering {
+            self.count_command();
             // SAFETY: matches begin_rendering.
             unsafe { self.ctx.device.cmd_end_rendering(self.raw) };
             self.rendering = false;
@@ -407,12 +451,14 @@ impl CommandRecorder<'_> {
     /// A global memory dependency between buffer uses, for one-off submissions outside a
     /// frame (uploads, readbacks of tests).
     pub fn barrier(&mut self, prev: &[Access], next: &[Access]) {
+        self.count_command();
         self.pipeline_barrier(Some((prev, next)), &[]);
     }
 
     /// An image dependency and layout transition from use `prev` to `next`, for one-off
     /// submissions outside a frame (uploads, texture readbacks).
     pub fn image_barrier(&mut self, image: &Image, prev: Access, next: Access) {
+        self.count_command();
         let b = ImageBarrier {
             image: BarrierImage::Image(image),
             prev: vec![prev],
@@ -432,6 +478,7 @@ impl CommandRecorder<'_> {
         memory: Option<(&[Access], &[Access])>,
         images: &[ImageBarrier],
     ) {
+        self.count_command();
         let mesh = self.ctx.info.mesh_shader;
         let keep = |list: &[Access]| -> Vec<Access> {
             list.iter()
@@ -499,6 +546,7 @@ impl CommandRecorder<'_> {
     /// Scale-blit all of 2D image `src` (in [`Access::TransferRead`]) onto swapchain image
     /// `dst` (in [`Access::TransferWrite`]), linear filtering.
     pub fn blit_to_swapchain(&mut self, src: &Image, dst: &SwapchainImage) {
+        self.count_command();
         let [w, h, _] = src.desc.extent;
         let layers = vk::ImageSubresourceLayers::default()
             .aspect_mask(vk::ImageAspectFlags::COLOR)
@@ -538,6 +586,7 @@ impl CommandRecorder<'_> {
 
     /// Fill `size` bytes at `offset` of `buffer` with the word `value`.
     pub fn fill_buffer(&mut self, buffer: &Buffer, offset: u64, size: u64, value: u32) {
+        self.count_command();
         // SAFETY: recording outside rendering; range checked by validation (multiple of 4).
         unsafe {
             self.ctx
@@ -555,6 +604,7 @@ impl CommandRecorder<'_> {
         dst_offset: u64,
         size: u64,
     ) {
+        self.count_command();
         let region = [vk::BufferCopy {
             src_offset,
             dst_offset,
@@ -570,11 +620,13 @@ impl CommandRecorder<'_> {
 
     /// Copy tightly packed texels from `src` into all of `dst` (in [`Access::TransferWrite`]).
     pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
+        self.count_command();
         self.copy_buffer_to_image_at(src, 0, dst);
     }
 
     /// [`Self::copy_buffer_to_image`] with the texels from byte `offset` of `src`.
     pub fn copy_buffer_to_image_at(&mut self, src: &Buffer, offset: u64, dst: &Image) {
+        self.count_command();
         let region = [whole_image_copy(dst).buffer_offset(offset)];
         // SAFETY: the image is in TRANSFER_DST_OPTIMAL; the buffer size is checked by the caller.
         unsafe {
@@ -590,12 +642,14 @@ impl CommandRecorder<'_> {
 
     /// Copy all of 2D image `src` (in [`Access::TransferRead`]) into `dst`, tightly packed.
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
+        self.count_command();
         self.copy_image_to_buffer_at(src, dst, 0);
     }
 
     /// Copy all of 2D image `src` (in [`Access::TransferRead`]) into `dst` from byte `offset`,
     /// tightly packed (depth images: their depth values).
     pub fn copy_image_to_buffer_at(&mut self, src: &Image, dst: &Buffer, offset: u64) {
+        self.count_command();
         let region = [whole_image_copy(src).buffer_offset(offset)];
         // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer size is checked by the caller.
         unsafe {

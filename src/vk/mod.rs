@@ -26,7 +26,7 @@ pub use descriptor::{BindingDesc, DescriptorKind, DescriptorSet, DescriptorSetLa
 pub use device::create_host_device;
 pub use image::{Image, ImageDesc, Sampler};
 pub use pipeline::{BlendMode, CullMode, DepthMode, GraphicsDesc, Pipeline, PipelineLayout};
-pub use profiler::{MeshPrimitivesQuery, Profiler};
+pub use profiler::{FrameTimes, MeshPrimitivesQuery, Profiler};
 pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainImage};
 pub use sync::{Fence, Semaphore};
 #[cfg(feature = "window")]

@@ -1,5 +1,6 @@
-//! GPU timestamps per pass and mesh-primitive counts, one query pool per frame in flight,
-//! reset at the start of every frame.
+//! GPU timestamps: an outer pair around every frame and one pair per timing scope (a pass or
+//! a group of passes), plus mesh-primitive counts; one query pool per frame in flight, reset at
+//! the start of every frame.
 
 use std::sync::Arc;
 
@@ -8,39 +9,61 @@ use ash::vk;
 use super::command::CommandRecorder;
 use super::{Context, GpuResult, VkContext};
 
-/// Most timed passes in one frame.
-pub const MAX_TIMED_PASSES: u32 = 32;
+/// Most timing scopes in one frame; scopes past it are not timed (their commands count as
+/// unscoped, so the frame report shows the loss).
+pub const MAX_TIMED_PASSES: u32 = 126;
 
-/// Timestamp queries: `begin(name)` / `end()` pairs around the passes of one frame.
+/// Queries 0 and 1 are the frame's outer pair; scope `i` is `2 + 2i` and `3 + 2i`.
+const QUERIES: u32 = 2 + 2 * MAX_TIMED_PASSES;
+
+/// A frame's timestamps, read back after it completed.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameTimes {
+    /// From the frame's first command to its last (the outer pair), milliseconds; `None`
+    /// where the frame was not bracketed.
+    pub frame_ms: Option<f64>,
+    /// Milliseconds per scope name, in the order each name first opened (scopes of one name
+    /// summed).
+    pub scopes: Vec<(&'static str, f64)>,
+}
+
+/// Timestamp queries: `begin_frame`, then `begin(name)` / `end()` pairs, then `end_frame`.
 pub struct Profiler {
     ctx: Arc<Context>,
     pool: vk::QueryPool,
     names: Vec<&'static str>,
+    /// Outer pair written this frame: (begin, end).
+    framed: (bool, bool),
+    open: bool,
 }
 
 impl Profiler {
-    /// Room for [`MAX_TIMED_PASSES`] passes.
+    /// Room for the frame's pair and [`MAX_TIMED_PASSES`] scopes.
     pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
         let info = vk::QueryPoolCreateInfo::default()
             .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(MAX_TIMED_PASSES * 2);
+            .query_count(QUERIES);
         // SAFETY: valid create info.
         let pool = unsafe { ctx.device.create_query_pool(&info, None) }.ctx("create query pool")?;
         Ok(Profiler {
             ctx: ctx.clone(),
             pool,
             names: Vec::new(),
+            framed: (false, false),
+            open: false,
         })
     }
 
     /// Reset every query (record first in the frame, outside rendering).
     pub fn reset(&mut self, rec: &mut CommandRecorder) {
         self.names.clear();
+        self.framed = (false, false);
+        self.open = false;
         // SAFETY: recording outside rendering; the range is the whole pool.
         unsafe {
             self.ctx
                 .device
-                .cmd_reset_query_pool(rec.raw(), self.pool, 0, MAX_TIMED_PASSES * 2)
+                .cmd_reset_query_pool(rec.raw(), self.pool, 0, QUERIES)
         };
     }
 
@@ -56,51 +79,93 @@ impl Profiler {
         };
     }
 
-    /// Timestamp the start of pass `name`. Passes past [`MAX_TIMED_PASSES`] are not timed.
+    /// Timestamp the frame's start (after [`Self::reset`], before its first command).
+    pub fn begin_frame(&mut self, rec: &mut CommandRecorder) {
+        if !self.framed.0 {
+            self.framed.0 = true;
+            self.stamp(rec, 0);
+        }
+    }
+
+    /// Timestamp the frame's end (after its last command).
+    pub fn end_frame(&mut self, rec: &mut CommandRecorder) {
+        if self.framed.0 && !self.framed.1 {
+            self.framed.1 = true;
+            self.stamp(rec, 1);
+        }
+    }
+
+    /// Whether a scope is open now.
+    pub fn scope_open(&self) -> bool {
+        self.open
+    }
+
+    /// Timestamp the start of scope `name` (scopes do not nest: an open one is ended first).
+    /// Scopes past [`MAX_TIMED_PASSES`] are not timed.
     pub fn begin(&mut self, rec: &mut CommandRecorder, name: &'static str) {
+        if self.open {
+            self.end(rec);
+        }
         if self.names.len() as u32 >= MAX_TIMED_PASSES {
             return;
         }
         self.names.push(name);
-        self.stamp(rec, (self.names.len() as u32 - 1) * 2);
+        self.open = true;
+        rec.scope_changed(true);
+        self.stamp(rec, 2 + (self.names.len() as u32 - 1) * 2);
     }
 
-    /// Timestamp the end of the pass begun last.
+    /// Timestamp the end of the open scope.
     pub fn end(&mut self, rec: &mut CommandRecorder) {
-        if let Some(n) = self.names.len().checked_sub(1) {
-            self.stamp(rec, n as u32 * 2 + 1);
+        if !self.open {
+            return;
         }
+        self.open = false;
+        rec.scope_changed(false);
+        self.stamp(rec, 3 + (self.names.len() as u32 - 1) * 2);
     }
 
-    /// `(pass, milliseconds)` after the frame completed.
-    pub fn results(&self) -> GpuResult<Vec<(&'static str, f64)>> {
-        let n = self.names.len();
-        if n == 0 {
-            return Ok(Vec::new());
-        }
-        let mut data = vec![0u64; n * 2];
-        // SAFETY: the frame's submission completed; WAIT makes the results available.
-        unsafe {
-            self.ctx.device.get_query_pool_results(
-                self.pool,
-                0,
-                &mut data,
-                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-            )
-        }
-        .ctx("query results")?;
-        let period = self.ctx.info.timestamp_period as f64;
-        Ok(self
-            .names
-            .iter()
-            .enumerate()
-            .map(|(i, name)| {
-                (
-                    *name,
-                    data[2 * i + 1].saturating_sub(data[2 * i]) as f64 * period / 1e6,
+    /// Read `count` written queries from `first`.
+    fn read(&self, first: u32, count: usize) -> GpuResult<Vec<u64>> {
+        let mut data = vec![0u64; count];
+        if count > 0 {
+            // SAFETY: the frame's submission completed and these queries were written this
+            // frame (an unwritten one would never become available); WAIT makes them so.
+            unsafe {
+                self.ctx.device.get_query_pool_results(
+                    self.pool,
+                    first,
+                    &mut data,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
                 )
-            })
-            .collect())
+            }
+            .ctx("query results")?;
+        }
+        Ok(data)
+    }
+
+    /// The frame's timestamps after it completed.
+    pub fn results(&self) -> GpuResult<FrameTimes> {
+        let period = self.ctx.info.timestamp_period as f64;
+        let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * period / 1e6;
+        // A scope still open at the end of recording has no end stamp: not read.
+        let closed = self.names.len() - usize::from(self.open);
+        let data = self.read(2, 2 * closed)?;
+        let mut scopes: Vec<(&'static str, f64)> = Vec::new();
+        for (i, name) in self.names[..closed].iter().enumerate() {
+            let t = ms(data[2 * i], data[2 * i + 1]);
+            match scopes.iter_mut().find(|s| s.0 == *name) {
+                Some(s) => s.1 += t,
+                None => scopes.push((name, t)),
+            }
+        }
+        let frame_ms = if self.framed.0 && self.framed.1 {
+            let pair = self.read(0, 2)?;
+            Some(ms(pair[0], pair[1]))
+        } else {
+            None
+        };
+        Ok(FrameTimes { frame_ms, scopes })
     }
 }
 

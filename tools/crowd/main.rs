@@ -519,7 +519,7 @@ fn run(args: Args) -> Result<()> {
     let mut animation = scene.animation(&mut renderer, &args)?;
     let csv_path = args.out.join("stats.csv");
     let mut csv = String::from(
-        "frame,gpu_ms,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
+        "frame,gpu_ms,unscoped_ms,unscoped_commands,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
     );
     outln!(
         "device: {} ({}); {} characters ({}), generated and baked in {generate_s:.2} s, textures {:.1} MiB",
@@ -606,14 +606,11 @@ fn run(args: Args) -> Result<()> {
             );
         }
         let s = report.stats;
-        let passes: Vec<String> = report
-            .pass_ms
-            .iter()
-            .map(|(n, ms)| format!("{n}={ms:.2}"))
-            .collect();
         csv.push_str(&format!(
-            "{f},{:.3},{:.3},{wall_ms:.1},{:.3},{},{root_gap:.6},{},{},{},{},{},{}\n",
+            "{f},{:.3},{:.3},{},{:.3},{wall_ms:.1},{:.3},{},{root_gap:.6},{},{},{},{},{},{}\n",
             report.gpu_ms(),
+            report.unscoped_ms().unwrap_or(f64::NAN),
+            report.unscoped_commands,
             report.record_ms,
             animation.stats.simulate_ms,
             animation.stats.simulated,
@@ -622,7 +619,7 @@ fn run(args: Args) -> Result<()> {
             s.triangles_drawn,
             s.vertex_slots_written,
             s.vertex_slots_demanded,
-            passes.join(" ")
+            report.scope_summary(" ")
         ));
         outln!(
             "frame {f}: {:?} path, {} strands, {} triangles, volumes {} alone + {} blended, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
@@ -632,7 +629,7 @@ fn run(args: Args) -> Result<()> {
             report.volume_characters.0,
             report.volume_characters.1,
             report.gpu_ms(),
-            passes.join(", "),
+            report.scope_summary(", "),
             report.record_ms,
             animation.stats.path,
             animation.stats.simulate_ms,

@@ -184,6 +184,24 @@ enum Node<'a> {
     EndScope,
 }
 
+/// The name of the last barriers of a frame, which return fixed-state images to their use.
+const RETURN_FIXED: &str = "(return fixed images)";
+
+/// Open a scope named `name` where a profiler runs and no scope is open; whether it did.
+fn open_own_scope(
+    profiler: Option<&mut Profiler>,
+    rec: &mut CommandRecorder,
+    name: &'static str,
+) -> bool {
+    match profiler {
+        Some(p) if !p.scope_open() => {
+            p.begin(rec, name);
+            true
+        }
+        _ => false,
+    }
+}
+
 /// One frame's passes and resources; see the module documentation.
 pub struct FrameGraph<'a> {
     resources: Vec<Resource<'a>>,
@@ -511,6 +529,9 @@ impl<'a> FrameGraph<'a> {
                 }
                 Node::Pass { name, uses, record } => {
                     count += 1;
+                    // A pass outside every scope is timed on its own: no pass escapes the
+                    // frame report.
+                    let own = open_own_scope(profiler.as_deref_mut(), rec, name);
                     let plan = self.plan(name, &uses)?;
                     if self.describe {
                         self.describe_pass(&mut text, count, name, &uses, &plan);
@@ -519,10 +540,22 @@ impl<'a> FrameGraph<'a> {
                     if let Some(record) = record {
                         record(rec, &resources)?;
                     }
+                    if own && let Some(p) = profiler.as_deref_mut() {
+                        p.end(rec);
+                    }
                 }
             }
         }
-        self.finish(rec, &mut text, count, &resources.bound)?;
+        if let Some(p) = profiler.as_deref_mut() {
+            p.end(rec);
+        }
+        if let Some(plan) = self.finish(&mut text, count)? {
+            let own = open_own_scope(profiler.as_deref_mut(), rec, RETURN_FIXED);
+            plan.record(rec, &resources.bound);
+            if own && let Some(p) = profiler.as_deref_mut() {
+                p.end(rec);
+            }
+        }
         drop(resources);
         if self.describe {
             self.describe_transients(&mut text, &realized, pool.as_deref());
@@ -544,14 +577,8 @@ impl<'a> FrameGraph<'a> {
         Ok(self.describe.then_some(text))
     }
 
-    /// Return fixed-state images to their use.
-    fn finish(
-        &mut self,
-        rec: &mut CommandRecorder,
-        text: &mut String,
-        count: usize,
-        bound: &[Bound],
-    ) -> GpuResult<()> {
+    /// The barriers that return fixed-state images to their use, if any are needed.
+    fn finish(&mut self, text: &mut String, count: usize) -> GpuResult<Option<Plan>> {
         let back: Vec<Use> = self
             .resources
             .iter()
@@ -567,14 +594,13 @@ impl<'a> FrameGraph<'a> {
             })
             .collect();
         if back.is_empty() {
-            return Ok(());
+            return Ok(None);
         }
-        let plan = self.plan("(return fixed images)", &back)?;
+        let plan = self.plan(RETURN_FIXED, &back)?;
         if self.describe {
-            self.describe_pass(text, count + 1, "(return fixed images)", &back, &plan);
+            self.describe_pass(text, count + 1, RETURN_FIXED, &back, &plan);
         }
-        plan.record(rec, bound);
-        Ok(())
+        Ok(Some(plan))
     }
 
     /// The barriers before pass `pass` with `uses`, updating the trackers. A transient's
