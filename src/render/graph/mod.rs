@@ -552,7 +552,7 @@ impl<'a> FrameGraph<'a> {
         if let Some(plan) = self.finish(&mut text, count)? {
             let own = open_own_scope(profiler.as_deref_mut(), rec, RETURN_FIXED);
             plan.record(rec, &resources.bound);
-            if own && let Some(p) = profiler.as_deref_mut() {
+            if own && let Some(p) = profiler {
                 p.end(rec);
             }
         }
