@@ -100,6 +100,12 @@ vec3 light_arrival_with(vec3 p, float offset, float body, bool slide) {
             float w = slide ? box_weight(dx, f.x) * box_weight(dy, f.y) : 1.0;
             ivec2 t = clamp(base + ivec2(dx, dy), ivec2(0), ivec2(res - 1));
             float dz = max(z - texelFetch(shadow_hair_depth, t, 0).r * range, 0.0);
+            // No hair in front of the point: opacity 0 in both modes, so the layers and the
+            // exponential are skipped (most texels of a frame; the result is the same).
+            if (dz <= 0.0) {
+                sum += w;
+                continue;
+            }
             float opacity;
             if (mode == SHADOW_DEEP_OPACITY) {
                 opacity = deep_opacity(texelFetch(shadow_layers, t, 0), dz);

@@ -33,6 +33,8 @@ use std::time::Instant;
 
 #[path = "bench/animate.rs"]
 mod animate;
+#[path = "bench/compare.rs"]
+mod compare;
 #[path = "bench/defaults.rs"]
 mod defaults;
 #[path = "bench/paper.rs"]
@@ -171,6 +173,10 @@ enum Cmd {
     /// hair's luminance between frames moved along the true motion, ours over the
     /// reference's, FLIP against the reference, and the accumulation's GPU ms.
     Temporal(temporal::TemporalArgs),
+    /// The regression harness: build REV's crowd in target/compare, run a fixed set of
+    /// frames (bare strands soft and hw on both paths at 20K and 100K, the full look, the
+    /// people crowd at 100 and 1000) alternating old and new, print new/old per row.
+    Compare(compare::CompareArgs),
     /// Copies of one hair mesh in wind, simulated and re-textured every frame (30 Hz), for
     /// each character count and dynamics path: CPU and GPU ms of the dynamics, GPU ms of the
     /// texture rebuild and of the frame; optionally a strip of frames.
@@ -721,6 +727,7 @@ fn run(args: Args) -> Result<()> {
             volumes,
         })?,
         Cmd::Temporal(args) => temporal::bench_temporal(args)?,
+        Cmd::Compare(args) => compare::bench_compare(args)?,
         Cmd::Fuzz { iterations, seed } => {
             outln!("| reader | inputs | accepted | rejected | panics | slowest ms | seconds |")?;
             outln!("|---|---|---|---|---|---|---|")?;

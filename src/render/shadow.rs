@@ -23,6 +23,12 @@ pub const SHADOW_LAYERS: u32 = 4;
 /// Opacity of one strand to the light: fibres pass part of the light (the TT lobe), so one
 /// strand does not block it all.
 pub const STRAND_SHADOW_OPACITY: f32 = 0.5;
+
+/// The light's passes choose strand and vertex level of detail with eq. 7's alphas times this
+/// (paper 003 sec. 3.6): as if the map had this share of its resolution. Shadows are soft and
+/// the thick-strand term keeps each bundle's coverage, so the light draws fewer, thicker
+/// strands than the camera for the same bundle.
+pub const LIGHT_LOD_SCALE: f32 = 0.5;
 pub use super::settings::{DEFAULT_SHADOW_RESOLUTION, ShadowMode};
 
 impl std::str::FromStr for ShadowMode {
@@ -191,7 +197,12 @@ impl LightView {
             light_dir: self.dir.extend(0.0).to_array(),
             viewport: [res, res, 1.0 / res, 1.0 / res],
             planes: frustum_planes(self.view_proj),
-            lod: [lod.alpha_strands, lod.alpha_verts, lod.lambda, 0.0],
+            lod: [
+                lod.alpha_strands * LIGHT_LOD_SCALE,
+                lod.alpha_verts * LIGHT_LOD_SCALE,
+                lod.lambda,
+                0.0,
+            ],
             lod_ortho: [self.size, 0.0, 0.0, 0.0],
             soft,
             soft_params: [0.0; 4],
