@@ -30,7 +30,8 @@ void main() {
         position = v.position.xyz;
         normal = v.normal.xyz;
     } else {
-        SkinnedVertex v = skinned[inst.skin.x + skin_indices[gl_VertexIndex]];
+        // Skinned meshes are drawn indexed: gl_VertexIndex is the mesh's own index.
+        SkinnedVertex v = skinned[inst.skin.x + uint(gl_VertexIndex)];
         position = v.position;
         normal = v.normal;
         vec4 packed = unpackUnorm4x8(v.color);

@@ -625,7 +625,9 @@ impl Renderer {
             i,
         );
         let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
+        let skin_indices = self.skinned.indices.as_ref();
         let mut inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
+        inputs.props.skin_indices = skin_indices;
         if opts.probe_roots {
             let probe = g.import_buffer("root probe", root_probe);
             inputs.probe = Some((probe, work.bundles));
@@ -901,7 +903,10 @@ fn frame_inputs<'a>(
         bundles: work.bundles,
         path: work.path,
         clear,
-        props: work.props,
+        props: super::passes::props::PropList {
+            draws: work.props,
+            skin_indices: None,
+        },
         skin: work.skin,
         probe: None,
         shadow: work.shadows,

@@ -126,7 +126,9 @@ impl SkinnedProps {
             indices.extend_from_slice(&m.indices);
         }
         let upload = |name, bytes: &[u8]| {
-            Buffer::device_local_with_data(ctx, name, vk::BufferUsageFlags::STORAGE_BUFFER, bytes)
+            // The indices are the skinned draws' index buffer too.
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::INDEX_BUFFER;
+            Buffer::device_local_with_data(ctx, name, usage, bytes)
         };
         let (new_rest, new_indices) = if ranges.is_empty() {
             (None, None)

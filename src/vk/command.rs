@@ -332,6 +332,33 @@ impl CommandRecorder<'_> {
         };
     }
 
+    /// Draw `indices` 32-bit indices of `index` from `first_index`, `instances` instances from
+    /// `first_instance` (no vertex input: the shader reads its vertex by `gl_VertexIndex`, the
+    /// index, so the device can reuse a shaded vertex that several triangles share).
+    pub fn draw_indexed_instanced(
+        &mut self,
+        index: &Buffer,
+        (first_index, indices): (u32, u32),
+        (first_instance, instances): (u32, u32),
+    ) {
+        self.count_command();
+        // SAFETY: recording inside a rendering instance; the buffer has INDEX_BUFFER usage
+        // (checked by validation) and the range lies within it (the caller's mesh table).
+        unsafe {
+            self.ctx
+                .device
+                .cmd_bind_index_buffer(self.raw, index.raw(), 0, vk::IndexType::UINT32);
+            self.ctx.device.cmd_draw_indexed(
+                self.raw,
+                indices,
+                instances,
+                first_index,
+                0,
+                first_instance,
+            )
+        };
+    }
+
     /// Draw with one `VkDrawIndirectCommand` at `offset` of `args`.
     pub fn draw_indirect(&mut self, args: &Buffer, offset: u64) {
         self.count_command();

@@ -38,7 +38,7 @@ use crate::vk::{
     shader::{ShaderOptions, compile},
 };
 use compute_generate::{ComputeGenerate, GenerateView};
-use props::{PropDraw, PropPass};
+use props::{PropList, PropPass};
 use scalp::ScalpPass;
 use shadow::{ShadowDraw, ShadowPass};
 use strands::StrandDraw;
@@ -524,7 +524,7 @@ pub struct FrameInputs<'a> {
     /// Clear colour, or `None` to draw over the previous contents.
     pub clear: Option<[f32; 4]>,
     /// Props to draw (bodies, ground).
-    pub props: &'a [PropDraw],
+    pub props: PropList<'a>,
     /// Skinning jobs and the most vertices of one (0 jobs: no skinning pass).
     pub skin: (u32, u32),
     /// The root probe's output and the bundles to probe, when the frame probes roots.

@@ -24,6 +24,15 @@ pub struct PropDraw {
     pub skinned: bool,
 }
 
+/// A frame's prop draws and the skinned meshes' index buffer they index.
+#[derive(Clone, Copy, Default)]
+pub struct PropList<'a> {
+    /// The draws.
+    pub draws: &'a [PropDraw],
+    /// Every skinned mesh's triangle list (`PropDraw::first_vertex` counts into it).
+    pub skin_indices: Option<&'a crate::vk::Buffer>,
+}
+
 /// The prop pipeline.
 pub struct PropPass {
     pipeline: Pipeline,
@@ -42,19 +51,30 @@ impl PropPass {
         })
     }
 
-    /// Draw `draws` (inside rendering).
-    pub fn record(&self, rec: &mut CommandRecorder, sets: PassSets, draws: &[PropDraw]) {
-        if draws.is_empty() {
+    /// Draw `props` (inside rendering): static meshes as vertex ranges, skinned ones indexed,
+    /// so a posed vertex that several triangles share is shaded once where the device keeps
+    /// it (lavapipe does: about 6 index reads per vertex in the people's meshes).
+    pub fn record(&self, rec: &mut CommandRecorder, sets: PassSets, props: PropList) {
+        if props.draws.is_empty() {
             return;
         }
         rec.bind(&self.pipeline, &sets.both());
-        for d in draws {
-            rec.draw_instanced(
-                d.vertex_count,
-                d.instance_count,
-                d.first_vertex,
-                d.first_instance,
-            );
+        for d in props.draws {
+            match (d.skinned, props.skin_indices) {
+                (true, Some(index)) => rec.draw_indexed_instanced(
+                    index,
+                    (d.first_vertex, d.vertex_count),
+                    (d.first_instance, d.instance_count),
+                ),
+                // A skinned draw without its indices cannot happen (the table made both).
+                (true, None) => {}
+                (false, _) => rec.draw_instanced(
+                    d.vertex_count,
+                    d.instance_count,
+                    d.first_vertex,
+                    d.first_instance,
+                ),
+            }
         }
     }
 }

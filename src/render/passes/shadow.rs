@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use super::props::{PropDraw, PropPass};
+use super::props::{PropList, PropPass};
 use super::strands::{StrandDraw, StrandUse, strand_uses};
 use super::{DrawTarget, FrameRes, PassSets};
 use crate::render::RenderPath;
@@ -25,7 +25,7 @@ pub struct ShadowDraw<'a> {
     /// Generation path (compute: the vertex pool already holds the light's strands).
     pub path: RenderPath,
     /// Props (bodies) that cast shadows.
-    pub props: &'a [PropDraw],
+    pub props: PropList<'a>,
 }
 
 /// Pipelines of the light's passes.
