@@ -10,7 +10,6 @@
 
 layout(set = SET_FRAME, binding = BINDING_PROP_VERTICES, std430) readonly buffer PropVertices { PropVertex prop_vertices[]; };
 layout(set = SET_FRAME, binding = BINDING_PROP_INSTANCES, std430) readonly buffer PropInstances { PropInstance prop_instances[]; };
-layout(set = SET_FRAME, binding = BINDING_SKIN_INDICES, std430) readonly buffer SkinIndices { uint skin_indices[]; };
 layout(set = SET_FRAME, binding = BINDING_SKINNED_VERTICES, std430) readonly buffer Posed { SkinnedVertex skinned[]; };
 
 layout(location = 0) out vec3 out_normal;

@@ -16,7 +16,7 @@ use super::host::{DepthMapping, HostImage};
 use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::host_targets::{HostTargetPasses, HostTargetRes};
 use super::passes::output::{FrameOutputs, add_outputs};
-use super::passes::props::PropDraw;
+use super::passes::props::{PropDraw, PropList};
 use super::passes::temporal::TemporalWork;
 use super::passes::write_address_table;
 use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets};
@@ -625,9 +625,11 @@ impl Renderer {
             i,
         );
         let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
-        let skin_indices = self.skinned.indices.as_ref();
-        let mut inputs = frame_inputs(&work, sets, clear, size, mesh_query.as_mut());
-        inputs.props.skin_indices = skin_indices;
+        let props = PropList {
+            draws: work.props,
+            skin_indices: self.skinned.indices.as_ref(),
+        };
+        let mut inputs = frame_inputs(&work, (sets, props), clear, size, mesh_query.as_mut());
         if opts.probe_roots {
             let probe = g.import_buffer("root probe", root_probe);
             inputs.probe = Some((probe, work.bundles));
@@ -752,7 +754,6 @@ impl Renderer {
                     prop_vertices: self.props.vertices.as_ref(),
                     skin: [
                         self.skinned.rest.as_ref(),
-                        self.skinned.indices.as_ref(),
                         Some(&slot.skin_matrices),
                         Some(&slot.skin_jobs),
                         Some(&slot.skinned),
@@ -889,10 +890,10 @@ pub(super) fn image_readback(ctx: &Arc<Context>, bytes: u64) -> GpuResult<Buffer
     )
 }
 
-/// What the frame's passes draw, from the frame's work and slot.
+/// What the frame's passes draw: the frame's work, its sets and props, and the slot's query.
 fn frame_inputs<'a>(
     work: &FrameWork<'a>,
-    (sets, light_sets): (PassSets<'a>, PassSets<'a>),
+    ((sets, light_sets), props): ((PassSets<'a>, PassSets<'a>), PropList<'a>),
     clear: Option<[f32; 4]>,
     size: (u32, u32),
     mesh_query: Option<&'a mut crate::vk::MeshPrimitivesQuery>,
@@ -903,10 +904,7 @@ fn frame_inputs<'a>(
         bundles: work.bundles,
         path: work.path,
         clear,
-        props: super::passes::props::PropList {
-            draws: work.props,
-            skin_indices: None,
-        },
+        props,
         skin: work.skin,
         probe: None,
         shadow: work.shadows,

@@ -226,8 +226,8 @@ pub enum FrameBinding {
     SegmentMotion = 31,
     /// `SkinRestVertex[]`: every skinned mesh's vertices at bind time.
     SkinRest = 32,
-    /// `uint[]`: every skinned mesh's triangle list (indices into its own vertices).
-    SkinIndices = 33,
+    // 33 was the skinned meshes' indices, read by props.vert until the skinned props were
+    // drawn indexed (the indices are the index buffer now).
     /// `mat4[]`: this frame's skin matrices, character after character.
     SkinMatrices = 34,
     /// `SkinJob[]`: this frame's skinned mesh instances.
@@ -242,7 +242,7 @@ pub enum FrameBinding {
 
 impl FrameBinding {
     /// Every binding, with its GLSL macro name.
-    pub const ALL: [(FrameBinding, &'static str); 38] = [
+    pub const ALL: [(FrameBinding, &'static str); 37] = [
         (FrameBinding::Frame, "BINDING_FRAME"),
         (FrameBinding::Characters, "BINDING_CHARACTERS"),
         (FrameBinding::Bundles, "BINDING_BUNDLES"),
@@ -276,7 +276,6 @@ impl FrameBinding {
         (FrameBinding::VertexMotion, "BINDING_VERTEX_MOTION"),
         (FrameBinding::SegmentMotion, "BINDING_SEGMENT_MOTION"),
         (FrameBinding::SkinRest, "BINDING_SKIN_REST"),
-        (FrameBinding::SkinIndices, "BINDING_SKIN_INDICES"),
         (FrameBinding::SkinMatrices, "BINDING_SKIN_MATRICES"),
         (FrameBinding::SkinJobs, "BINDING_SKIN_JOBS"),
         (FrameBinding::SkinnedVertices, "BINDING_SKINNED_VERTICES"),

@@ -36,9 +36,9 @@ pub struct FrameBuffers<'a> {
     pub bundle_table: Option<&'a Buffer>,
     /// The prop meshes, once set.
     pub prop_vertices: Option<&'a Buffer>,
-    /// Skinned meshes' rest vertices and indices, once set; the frame slot's skin matrices,
-    /// skinning jobs and posed vertices.
-    pub skin: [Option<&'a Buffer>; 5],
+    /// Skinned meshes' rest vertices, once set; the frame slot's skin matrices, skinning jobs
+    /// and posed vertices.
+    pub skin: [Option<&'a Buffer>; 4],
     /// The frame slot's root probe output.
     pub root_probe: &'a Buffer,
     /// The light's maps.
@@ -228,10 +228,9 @@ impl Workspace {
                 FrameBinding::PropVertices => prop_vertices,
                 FrameBinding::PropInstances => frame.prop_instances,
                 FrameBinding::SkinRest => frame.skin[0].unwrap_or(&self.placeholder),
-                FrameBinding::SkinIndices => frame.skin[1].unwrap_or(&self.placeholder),
-                FrameBinding::SkinMatrices => frame.skin[2].unwrap_or(&self.placeholder),
-                FrameBinding::SkinJobs => frame.skin[3].unwrap_or(&self.placeholder),
-                FrameBinding::SkinnedVertices => frame.skin[4].unwrap_or(&self.placeholder),
+                FrameBinding::SkinMatrices => frame.skin[1].unwrap_or(&self.placeholder),
+                FrameBinding::SkinJobs => frame.skin[2].unwrap_or(&self.placeholder),
+                FrameBinding::SkinnedVertices => frame.skin[3].unwrap_or(&self.placeholder),
                 FrameBinding::RootProbe => frame.root_probe,
                 FrameBinding::OitNodes
                 | FrameBinding::OitTail

@@ -478,14 +478,12 @@ impl CommandRecorder<'_> {
     /// A global memory dependency between buffer uses, for one-off submissions outside a
     /// frame (uploads, readbacks of tests).
     pub fn barrier(&mut self, prev: &[Access], next: &[Access]) {
-        self.count_command();
         self.pipeline_barrier(Some((prev, next)), &[]);
     }
 
     /// An image dependency and layout transition from use `prev` to `next`, for one-off
     /// submissions outside a frame (uploads, texture readbacks).
     pub fn image_barrier(&mut self, image: &Image, prev: Access, next: Access) {
-        self.count_command();
         let b = ImageBarrier {
             image: BarrierImage::Image(image),
             prev: vec![prev],
@@ -647,7 +645,6 @@ impl CommandRecorder<'_> {
 
     /// Copy tightly packed texels from `src` into all of `dst` (in [`Access::TransferWrite`]).
     pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
-        self.count_command();
         self.copy_buffer_to_image_at(src, 0, dst);
     }
 
@@ -669,7 +666,6 @@ impl CommandRecorder<'_> {
 
     /// Copy all of 2D image `src` (in [`Access::TransferRead`]) into `dst`, tightly packed.
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
-        self.count_command();
         self.copy_image_to_buffer_at(src, dst, 0);
     }
 
