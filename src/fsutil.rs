@@ -8,10 +8,19 @@
 //! socket or block device is refused; a character device (`/dev/null`) is written in place;
 //! a regular file or a new path is written atomically (temporary file next to it, synced,
 //! renamed), so a failed run never leaves a half-written file. Tools write only after their
-//! work (and the GPU frame's validation) succeeded.
+//! work (and the GPU frame's validation) succeeded. An output's folders that do not exist yet
+//! are made when it is written (as `mkdir -p` would) and removed again if the write fails.
+//!
+//! **Staged paths** (temporary files, staging folders, folders made for outputs) are listed
+//! until they are published, so an interrupted run removes them ([`remove_staged_then`], called
+//! by `cli`'s signal handler). **Publishing** (the renames that put a run's outputs in place)
+//! holds this process's staging list and an exclusive lock (`flock`) on each output folder:
+//! two runs writing the same outputs publish one after the other, never interleaved, so the
+//! outputs are all from one run.
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 use crate::error::{HairError, Result};
 
@@ -73,6 +82,45 @@ enum OutputKind {
 pub struct OutputPath {
     path: PathBuf,
     kind: OutputKind,
+    /// Folders above the path that do not exist yet, outermost first: made when it is written.
+    missing: Vec<PathBuf>,
+}
+
+/// Whether `e` says the path does not exist (or lies below a file: the folder check above it
+/// names that file).
+fn absent(e: &std::io::Error) -> bool {
+    matches!(
+        e.kind(),
+        std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+    )
+}
+
+/// The folders of `folder` and above that do not exist, outermost first, up to the nearest
+/// one that does; refused when that one is not a folder. `what` names the output.
+fn missing_folders(folder: &Path, what: &str) -> Result<Vec<PathBuf>> {
+    let mut missing = Vec::new();
+    let mut at = folder;
+    loop {
+        match std::fs::metadata(at) {
+            Ok(m) if m.is_dir() => break,
+            Ok(_) => {
+                return Err(HairError::invalid(
+                    what,
+                    format!("{} is not a folder", at.display()),
+                ));
+            }
+            Err(e) if absent(&e) => {
+                missing.push(at.to_path_buf());
+                match at.parent() {
+                    Some(p) if !p.as_os_str().is_empty() => at = p,
+                    _ => break,
+                }
+            }
+            Err(e) => return Err(HairError::io(at, e)),
+        }
+    }
+    missing.reverse();
+    Ok(missing)
 }
 
 #[cfg(unix)]
@@ -93,17 +141,14 @@ impl OutputPath {
         let name = path.display().to_string();
         let refuse = |why: &str| Err(HairError::invalid(&name, format!("output {why}")));
         let kind = match std::fs::symlink_metadata(path) {
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Err(e) if absent(&e) => {
                 if path.file_name().is_none() {
                     return refuse("is not a file path");
-                }
-                let parent = parent_folder(path);
-                if !std::fs::metadata(parent).is_ok_and(|m| m.is_dir()) {
-                    return refuse(&format!("folder {} does not exist", parent.display()));
                 }
                 return Ok(OutputPath {
                     path: path.to_path_buf(),
                     kind: OutputKind::Atomic,
+                    missing: missing_folders(parent_folder(path), &name)?,
                 });
             }
             Err(e) => return Err(HairError::io(path, e)),
@@ -130,6 +175,7 @@ impl OutputPath {
         Ok(OutputPath {
             path: path.to_path_buf(),
             kind,
+            missing: Vec::new(),
         })
     }
 
@@ -141,7 +187,7 @@ impl OutputPath {
     /// Write `bytes` by the policy of this module.
     pub fn write(&self, bytes: &[u8]) -> Result<()> {
         match self.kind {
-            OutputKind::Atomic => write_atomic(&self.path, bytes),
+            OutputKind::Atomic => write_together(&[(self, bytes)]),
             OutputKind::Device => std::fs::OpenOptions::new()
                 .write(true)
                 .open(&self.path)
@@ -220,22 +266,160 @@ impl RunFiles {
     }
 }
 
+/// A path this process staged and has not published.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Staged {
+    /// A temporary file.
+    File(PathBuf),
+    /// A staging folder and everything in it.
+    Tree(PathBuf),
+    /// A folder made for an output: removed only while empty (another run may use it too).
+    Folder(PathBuf),
+}
+
+impl Staged {
+    fn remove(&self) {
+        let _ = match self {
+            Staged::File(p) => std::fs::remove_file(p),
+            Staged::Tree(p) => std::fs::remove_dir_all(p),
+            Staged::Folder(p) => std::fs::remove_dir(p),
+        };
+    }
+}
+
+/// Every path this process staged and has not published, in the order they were made.
+static STAGED: Mutex<Vec<Staged>> = Mutex::new(Vec::new());
+
+/// The staging list (a panic while it was held left it consistent: entries are whole).
+fn staged_list() -> MutexGuard<'static, Vec<Staged>> {
+    STAGED.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Add `entry` to the staging list.
+fn track(entry: Staged) {
+    staged_list().push(entry);
+}
+
+/// Remove and delete `entries` (newest first), and take them off the staging list.
+fn discard(entries: &[Staged]) {
+    let mut list = staged_list();
+    for e in entries.iter().rev() {
+        e.remove();
+        list.retain(|x| x != e);
+    }
+}
+
+/// Remove every path this process staged and has not published (newest first), then call
+/// `then` with their number while still holding the list, so no publish starts or half-ends:
+/// the signal handler's cleanup (`cli::clean_up_on_signals`), which exits in `then`.
+pub fn remove_staged_then(then: impl FnOnce(usize) -> std::convert::Infallible) -> ! {
+    let mut list = staged_list();
+    let n = list.len();
+    for e in list.drain(..).rev() {
+        e.remove();
+    }
+    match then(n) {}
+}
+
+/// Make `folders` (outermost first), listing each as staged: an interrupted or failed run
+/// removes them again (when empty).
+fn make_folders(folders: &[PathBuf]) -> Result<Vec<Staged>> {
+    let mut made = Vec::new();
+    for f in folders {
+        track(Staged::Folder(f.clone()));
+        made.push(Staged::Folder(f.clone()));
+        match std::fs::create_dir(f) {
+            Ok(()) => {}
+            // Another run made it meanwhile: not ours to remove.
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && f.is_dir() => {
+                discard_entry(made.pop().as_ref());
+            }
+            Err(e) => {
+                discard(&made);
+                return Err(HairError::io(f, e));
+            }
+        }
+    }
+    Ok(made)
+}
+
+/// Take one entry off the staging list without removing its path.
+fn discard_entry(entry: Option<&Staged>) {
+    if let Some(e) = entry {
+        let mut list = staged_list();
+        if let Some(i) = list.iter().rposition(|x| x == e) {
+            list.remove(i);
+        }
+    }
+}
+
+/// A publish in progress: this process's staging list (a signal's cleanup waits for it) and an
+/// exclusive lock on every output folder (another run's publish waits for it).
+struct Publish {
+    list: MutexGuard<'static, Vec<Staged>>,
+    _locks: Vec<std::fs::File>,
+}
+
+impl Publish {
+    /// Lock the staging list, then `folders` (sorted, so two runs cannot deadlock).
+    fn begin<'a>(folders: impl IntoIterator<Item = &'a Path>) -> Result<Self> {
+        let list = staged_list();
+        let mut keys: Vec<PathBuf> = folders
+            .into_iter()
+            .map(|f| std::fs::canonicalize(f).unwrap_or_else(|_| f.to_path_buf()))
+            .collect();
+        keys.sort();
+        keys.dedup();
+        let mut locks = Vec::new();
+        for k in keys {
+            let f = std::fs::File::open(&k).map_err(|e| HairError::io(&k, e))?;
+            f.lock().map_err(|e| HairError::io(&k, e))?;
+            locks.push(f);
+        }
+        Ok(Publish {
+            list,
+            _locks: locks,
+        })
+    }
+
+    /// `entries` are published: off the staging list, left in place.
+    fn keep(&mut self, entries: &[Staged]) {
+        self.list.retain(|x| !entries.contains(x));
+    }
+
+    /// Tests: wait between two renames of a publish, so two runs' publishes would interleave
+    /// without the lock (`HAIRMESH_TEST_PUBLISH_PAUSE_MS`).
+    fn test_pause() {
+        if let Some(ms) = std::env::var("HAIRMESH_TEST_PUBLISH_PAUSE_MS")
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok())
+        {
+            std::thread::sleep(std::time::Duration::from_millis(ms.min(60_000)));
+        }
+    }
+}
+
 /// A folder of outputs written over a long run (frames) that appear only if the run succeeds:
 /// every file's path is checked first ([`RunFiles::output`]), files go to a hidden staging
 /// folder beside the target as they are made, and [`StagedFolder::publish`] moves them in at
-/// the end. Dropped without publishing (an error, a panic), the staging folder is removed:
-/// a failed run leaves the target as it was, and creates nothing.
+/// the end. Dropped without publishing (an error, a panic) or interrupted (a signal), the
+/// staging folder is removed, with the folders made for it: a failed run leaves the target as
+/// it was, and creates nothing.
 pub struct StagedFolder {
     target: PathBuf,
     staging: PathBuf,
     existed: bool,
-    created: bool,
+    /// Folders above the target that do not exist yet, outermost first.
+    missing: Vec<PathBuf>,
+    /// What this run made so far (folders above, the staging folder), oldest first.
+    made: Vec<Staged>,
     written: Vec<String>,
 }
 
 impl StagedFolder {
-    /// Check folder `target` (existing, or new in an existing folder) and the files `names`
-    /// in it as outputs of `files`' run; `what` names the folder in errors (a flag).
+    /// Check folder `target` (existing, or new: its missing folders are made when the first
+    /// file is written) and the files `names` in it as outputs of `files`' run; `what` names
+    /// the folder in errors (a flag).
     pub fn check(
         target: &Path,
         names: &[String],
@@ -246,19 +430,18 @@ impl StagedFolder {
         let existed = match std::fs::symlink_metadata(target) {
             Ok(m) if m.is_dir() => true,
             Ok(_) => return Err(HairError::invalid(name, "not a folder")),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
+            Err(e) if absent(&e) => false,
             Err(e) => return Err(HairError::io(target, e)),
         };
         let leaf = target
             .file_name()
             .ok_or_else(|| HairError::invalid(&name, "not a folder path"))?;
         let parent = parent_folder(target);
-        if !existed && !parent.is_dir() {
-            return Err(HairError::invalid(
-                name,
-                format!("folder {} does not exist", parent.display()),
-            ));
-        }
+        let missing = if existed {
+            Vec::new()
+        } else {
+            missing_folders(parent, &name)?
+        };
         // Nothing lies in a folder that does not exist yet: only an existing one's entries
         // can be links, folders or inputs.
         if existed {
@@ -275,7 +458,8 @@ impl StagedFolder {
             target: target.to_path_buf(),
             staging,
             existed,
-            created: false,
+            missing,
+            made: Vec::new(),
             written: Vec::new(),
         })
     }
@@ -289,21 +473,28 @@ impl StagedFolder {
         Ok(())
     }
 
-    /// Create the staging folder on first use.
+    /// Make the missing folders and the staging folder on first use.
     fn ensure_staging(&mut self) -> Result<()> {
-        if !self.created {
-            std::fs::create_dir(&self.staging).map_err(|e| HairError::io(&self.staging, e))?;
-            self.created = true;
+        if self.made.iter().any(|m| matches!(m, Staged::Tree(_))) {
+            return Ok(());
         }
-        Ok(())
+        self.made = make_folders(&std::mem::take(&mut self.missing))?;
+        let tree = Staged::Tree(self.staging.clone());
+        track(tree.clone());
+        self.made.push(tree);
+        std::fs::create_dir(&self.staging).map_err(|e| HairError::io(&self.staging, e))
     }
 
     /// Move every written file into the target folder (the whole staging folder when the
     /// target did not exist).
     pub fn publish(mut self) -> Result<()> {
         self.ensure_staging()?;
+        let mut publish = Publish::begin([parent_folder(&self.target)])?;
         if self.existed {
-            for n in &self.written {
+            for (k, n) in self.written.iter().enumerate() {
+                if k == 1 {
+                    Publish::test_pause();
+                }
                 let (from, to) = (self.staging.join(n), self.target.join(n));
                 std::fs::rename(&from, &to).map_err(|e| HairError::io(&to, e))?;
             }
@@ -312,16 +503,14 @@ impl StagedFolder {
             std::fs::rename(&self.staging, &self.target)
                 .map_err(|e| HairError::io(&self.target, e))?;
         }
-        self.created = false;
+        publish.keep(&std::mem::take(&mut self.made));
         Ok(())
     }
 }
 
 impl Drop for StagedFolder {
     fn drop(&mut self) {
-        if self.created {
-            let _ = std::fs::remove_dir_all(&self.staging);
-        }
+        discard(&self.made);
     }
 }
 
@@ -339,12 +528,17 @@ fn is_char_device(_: &std::fs::Metadata) -> bool {
 /// Write `bytes` to `path` atomically: a temporary file in the same folder, synced, then renamed.
 /// Tools go through [`OutputPath`], which decides when this is the right way to write.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = stage(path, bytes)?;
-    publish_staged(&tmp, path)
+    let out = OutputPath {
+        path: path.to_path_buf(),
+        kind: OutputKind::Atomic,
+        missing: Vec::new(),
+    };
+    write_together(&[(&out, bytes)])
 }
 
-/// Write `bytes` to a hidden temporary file beside `path` (synced), to be renamed onto it.
-fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
+/// Write `bytes` to a hidden temporary file beside `path` (synced, listed as staged), to be
+/// renamed onto it.
+fn stage(path: &Path, bytes: &[u8]) -> Result<Staged> {
     let dir = parent_folder(path);
     let file_name = path
         .file_name()
@@ -354,52 +548,70 @@ fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
         file_name.to_string_lossy(),
         std::process::id()
     ));
+    let entry = Staged::File(tmp.clone());
+    track(entry.clone());
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()
     })();
     if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
+        discard(std::slice::from_ref(&entry));
         return Err(HairError::io(path, e));
     }
-    Ok(tmp)
+    Ok(entry)
 }
 
-fn publish_staged(tmp: &Path, path: &Path) -> Result<()> {
-    std::fs::rename(tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(tmp);
-        HairError::io(path, e)
-    })
-}
-
-/// Write several outputs of one run all or none: every file is staged (written and synced
-/// beside its path) before the first is renamed into place, so a full disk or a failing
-/// write leaves no output of the run behind. Devices (`/dev/null`) are written last.
+/// Write several outputs of one run all or none: their missing folders are made and every
+/// file is staged (written and synced beside its path) before the first is renamed into place,
+/// so a full disk or a failing write leaves no output of the run behind (and no folder it made);
+/// the renames hold the output folders' locks ([`Publish`]). Devices (`/dev/null`) are written
+/// last.
 pub fn write_together(outputs: &[(&OutputPath, &[u8])]) -> Result<()> {
-    let mut staged: Vec<(PathBuf, &Path)> = Vec::new();
+    let mut made: Vec<Staged> = Vec::new();
+    let mut staged: Vec<(Staged, &Path)> = Vec::new();
+    let fail = |made: &[Staged], staged: &[(Staged, &Path)], e| {
+        let files: Vec<Staged> = staged.iter().map(|(s, _)| s.clone()).collect();
+        discard(&files);
+        discard(made);
+        Err(e)
+    };
     for (out, bytes) in outputs {
         if matches!(out.kind, OutputKind::Atomic) {
+            let missing: Vec<PathBuf> = out
+                .missing
+                .iter()
+                .filter(|f| !f.is_dir())
+                .cloned()
+                .collect();
+            match make_folders(&missing) {
+                Ok(m) => made.extend(m),
+                Err(e) => return fail(&made, &staged, e),
+            }
             match stage(&out.path, bytes) {
                 Ok(tmp) => staged.push((tmp, &out.path)),
-                Err(e) => {
-                    for (tmp, _) in &staged {
-                        let _ = std::fs::remove_file(tmp);
-                    }
-                    return Err(e);
-                }
+                Err(e) => return fail(&made, &staged, e),
             }
         }
     }
-    let mut renamed = staged.into_iter();
-    while let Some((tmp, path)) = renamed.next() {
-        if let Err(e) = publish_staged(&tmp, path) {
-            for (tmp, _) in renamed {
-                let _ = std::fs::remove_file(&tmp);
-            }
-            return Err(e);
+    let mut publish = match Publish::begin(staged.iter().map(|(_, p)| parent_folder(p))) {
+        Ok(p) => p,
+        Err(e) => return fail(&made, &staged, e),
+    };
+    for (k, (tmp, path)) in staged.iter().enumerate() {
+        if k == 1 {
+            Publish::test_pause();
+        }
+        let Staged::File(from) = tmp else { continue };
+        if let Err(e) = std::fs::rename(from, path) {
+            drop(publish);
+            return fail(&made, &staged[k..], HairError::io(*path, e));
         }
     }
+    let files: Vec<Staged> = staged.into_iter().map(|(s, _)| s).collect();
+    publish.keep(&files);
+    publish.keep(&made);
+    drop(publish);
     for (out, bytes) in outputs {
         if !matches!(out.kind, OutputKind::Atomic) {
             out.write(bytes)?;

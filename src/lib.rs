@@ -11,6 +11,7 @@ pub mod animate;
 pub mod bake;
 pub mod budget;
 pub mod characters;
+pub mod cli;
 pub mod dynamics;
 pub mod error;
 pub mod fit;

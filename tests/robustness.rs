@@ -104,9 +104,10 @@ fn outputs_never_replace_inputs_links_or_special_files() {
     let fifo = dir.path().join("pipe.hmb");
     mkfifo(&fifo);
     assert_fails(&bake(&[s(&obj), "-o", s(&fifo)]), "FIFO");
-    // A missing output folder is named.
-    let nowhere = dir.path().join("no/such/out.hmb");
-    assert_fails(&bake(&[s(&obj), "-o", s(&nowhere)]), "does not exist");
+    // An output below a file is refused naming it; a missing folder is made only when the
+    // run succeeds (`cli::output_folders_are_made_and_removed_on_failure`).
+    let below_file = dir.path().join("m.obj/out.hmb");
+    assert_fails(&bake(&[s(&obj), "-o", s(&below_file)]), "is not a folder");
     assert_eq!(std::fs::read(&obj).unwrap(), obj_bytes);
     assert_eq!(std::fs::read(&hmb).unwrap(), hmb_bytes);
     assert_eq!(std::fs::read(&style).unwrap(), style_bytes);
@@ -484,10 +485,6 @@ fn every_tool_answers_help_and_version() {
         0,
         "files created"
     );
-    let missing = dir.path().join("missing");
-    let o = run(env!("CARGO_BIN_EXE_make-hairmeshes"), &[s(&missing)]);
-    assert_fails(&o, "missing");
-    assert!(!missing.exists());
 }
 
 /// crowd checks every frame's path before the first frame, and its flags before any work.
@@ -530,12 +527,15 @@ fn crowd_outputs_are_checked_before_the_first_frame() {
         assert_fails(&crowd(&args), "--volume-band");
     }
     assert!(!new.exists());
-    let deep = dir.path().join("no/such/folder");
+    std::fs::write(dir.path().join("file"), b"x").unwrap();
     assert_fails(
-        &crowd(&["--count", "1", "--out", s(&deep)]),
-        "does not exist",
+        &crowd(&["--count", "1", "--out", s(&dir.path().join("file/sub"))]),
+        "is not a folder",
     );
 }
+
+#[path = "robustness/cli.rs"]
+mod cli;
 
 /// What one tool writes, the next reads: `fit` refuses a model whose hair mesh `bake` could
 /// not read back (coordinates past the OBJ limit), naming the input, and writes nothing.

@@ -45,8 +45,18 @@ struct Args {
     memory_budget_mib: MemoryBudget,
 }
 
-fn run(args: Args) -> Result<()> {
+fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     let start = Instant::now();
+    for id in ["step", "gravity"] {
+        parsed
+            .unused_unless(
+                id,
+                parsed.args.extrude.is_some(),
+                "it shapes --extrude, not given",
+            )
+            .map_err(anyhow::Error::msg)?;
+    }
+    let args = parsed.args;
     if !(args.step.is_finite() && args.step > 0.0 && args.step <= 1e3) {
         bail!("--step {} must be in (0, 1000]", args.step);
     }
@@ -162,7 +172,9 @@ fn run(args: Args) -> Result<()> {
 }
 
 fn main() {
-    if let Err(e) = run(Args::parse()) {
+    let parsed = hairmesh::cli::parse::<Args>("bake");
+    hairmesh::cli::clean_up_on_signals("bake");
+    if let Err(e) = run(parsed) {
         hairmesh::fsutil::exit_with_error("bake", &e, 1);
     }
 }

@@ -123,11 +123,11 @@ enum Cmd {
     /// skinning vs static strands per model, crowd LoD on/off, near/mid/far LoD, GPU bytes.
     Paper {
         /// small (lavapipe: about a minute per scenario) or full (the paper's counts).
-        #[arg(long, default_value = "small")]
+        #[arg(long, default_value = "small", value_parser = ["small", "full"])]
         scale: String,
         /// One scenario: models (a, d), crowd (b), distance (c), storage (d for the crowd's
         /// generated styles), or all.
-        #[arg(long, default_value = "all")]
+        #[arg(long, default_value = "all", value_parser = ["all", "models", "crowd", "distance", "storage", "teapots"])]
         scenario: String,
         /// Write every measurement here as CSV.
         #[arg(long)]
@@ -162,7 +162,7 @@ enum Cmd {
         #[arg(long, default_value_t = hairmesh::render::soft::AUTO_SPLIT_PIXELS)]
         auto_split: f32,
         /// Only these columns: hw-opaque, hw-oit, soft, auto (default all).
-        #[arg(long, value_delimiter = ',')]
+        #[arg(long, value_delimiter = ',', value_parser = ["hw-opaque", "hw-oit", "soft", "auto"])]
         draws: Vec<String>,
         /// Choose the GPU by name substring.
         #[arg(long)]
@@ -668,8 +668,36 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    if let Err(e) = run(Args::parse()) {
+    let parsed = hairmesh::cli::parse::<Args>("bench");
+    hairmesh::cli::clean_up_on_signals("bench");
+    if let Err(e) = check_unused(&parsed)
+        .map_err(anyhow::Error::msg)
+        .and_then(|()| run(parsed.args))
+    {
         hairmesh::fsutil::exit_with_error("bench", &e, 1);
+    }
+}
+
+/// Refuse every flag given that another flag of its subcommand makes unused.
+fn check_unused(p: &hairmesh::cli::Parsed<Args>) -> Result<(), String> {
+    match &p.args.cmd {
+        Cmd::Crowd {
+            compare_defaults,
+            volume_tier,
+            ..
+        } => {
+            let why = "--compare-defaults and --volume-tier choose their own rasterizers";
+            p.unused_unless("draw", !compare_defaults && !volume_tier, why)?;
+            p.unused_unless(
+                "picture",
+                !compare_defaults,
+                "--compare-defaults writes no picture",
+            )
+        }
+        Cmd::Animate { strip, .. } => {
+            p.unused_unless("strip_frames", strip.is_some(), "--strip is not given")
+        }
+        _ => Ok(()),
     }
 }
 

@@ -82,7 +82,9 @@ fn run(args: Args) -> Result<()> {
 }
 
 fn main() {
-    if let Err(e) = run(Args::parse()) {
+    let parsed = hairmesh::cli::parse::<Args>("export");
+    hairmesh::cli::clean_up_on_signals("export");
+    if let Err(e) = run(parsed.args) {
         let _ = std::io::stdout().flush();
         hairmesh::fsutil::exit_with_error("export", &e, 1);
     }

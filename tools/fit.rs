@@ -59,7 +59,13 @@ struct Args {
     memory_budget_mib: MemoryBudget,
 }
 
-fn run(args: Args) -> Result<()> {
+fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
+    for id in ["validation", "device", "picture"] {
+        parsed
+            .unused_unless(id, parsed.args.report, "it applies to --report, not given")
+            .map_err(anyhow::Error::msg)?;
+    }
+    let args = parsed.args;
     let mut inputs = vec![args.strands.as_path()];
     if let Some(h) = &args.head {
         inputs.push(h.as_path());
@@ -262,7 +268,9 @@ fn report(
 }
 
 fn main() {
-    if let Err(e) = run(Args::parse()) {
+    let parsed = hairmesh::cli::parse::<Args>("fit");
+    hairmesh::cli::clean_up_on_signals("fit");
+    if let Err(e) = run(parsed) {
         let _ = std::io::stdout().flush();
         hairmesh::fsutil::exit_with_error("fit", &e, 1);
     }

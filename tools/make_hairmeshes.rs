@@ -250,7 +250,9 @@ const STYLES: &[(&str, &str)] = &[
 ];
 
 fn main() {
-    if let Err(e) = run() {
+    let parsed = hairmesh::cli::parse::<Args>("make-hairmeshes");
+    hairmesh::cli::clean_up_on_signals("make-hairmeshes");
+    if let Err(e) = run(parsed.args) {
         hairmesh::fsutil::exit_with_error("make-hairmeshes", &e, 1);
     }
 }
@@ -260,10 +262,10 @@ fn main() {
 #[derive(Parser)]
 #[command(version, about)]
 struct Args {
-    /// Existing folder to write into.
+    /// Folder to write into (made if it does not exist).
     #[arg(default_value = "hairmeshes")]
     out_dir: PathBuf,
-    /// Existing folder to write into (instead of OUT_DIR).
+    /// Folder to write into, instead of OUT_DIR (made if it does not exist).
     #[arg(short = 'o', long = "out", conflicts_with = "out_dir")]
     out: Option<PathBuf>,
     /// A head to grow hair on: an OBJ (all of it is the head; a bust is fine) or a glTF
@@ -282,11 +284,12 @@ struct Args {
     seed: u32,
 }
 
-fn run() -> Result<()> {
-    let args = Args::parse();
+fn run(args: Args) -> Result<()> {
     let out = args.out.as_ref().unwrap_or(&args.out_dir);
-    if !out.is_dir() {
-        anyhow::bail!("{}: not an existing folder", out.display());
+    // A folder that does not exist yet is made when the files are written (and removed
+    // again if writing them fails); an existing file is refused.
+    if out.exists() && !out.is_dir() {
+        anyhow::bail!("{}: not a folder", out.display());
     }
     match &args.head {
         Some(head) => grow_on_head(&args, head, out),

@@ -15,8 +15,10 @@ use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::{Mat4, Vec3};
 use hairmesh::budget::{self, Estimate, MemoryBudget};
+use hairmesh::cli::Parsed;
 use hairmesh::fsutil::RunFiles;
 use hairmesh::outln;
+use hairmesh::render::FrameSettings;
 use hairmesh::render::scene::{SceneDesc, load_mesh};
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, LodSettings, RenderPath, Renderer, RendererDesc,
@@ -224,7 +226,18 @@ struct Inputs {
     look: hairmesh::render::scene::LookDesc,
 }
 
-fn load_inputs(args: &Args) -> Result<Inputs> {
+/// One character as the flags or the scene name it, not yet loaded.
+struct PlannedCharacter {
+    mesh: PathBuf,
+    style: Option<PathBuf>,
+    params: StrandParams,
+    model: Mat4,
+}
+
+/// The run's inputs as the flags and the scene file describe them: read the scene (small),
+/// check the memory of every mesh it names, and list every file the run reads; no mesh is
+/// loaded yet.
+fn plan_inputs(args: &Args) -> Result<(Inputs, Vec<PlannedCharacter>)> {
     let mut inputs = Inputs {
         characters: Vec::new(),
         files: Vec::new(),
@@ -233,6 +246,7 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
         size: parse_size(&args.size)?,
         look: Default::default(),
     };
+    let mut planned = Vec::new();
     if let Some(scene_path) = &args.scene {
         let scene = SceneDesc::load(scene_path)?;
         inputs.files.push(scene_path.clone());
@@ -251,26 +265,14 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
         }
         inputs.look = scene.look.clone();
         check_scene_memory(args, scene_path, &scene, inputs.size)?;
-        // A mesh named by many characters is loaded once.
-        let mut loaded = HashMap::new();
         for c in &scene.characters {
             inputs.files.extend(hairmesh::render::scene::mesh_inputs(
                 &c.mesh,
                 c.style.as_deref(),
             ));
-            let key = (c.mesh.clone(), c.style.clone());
-            let (baked, style) = match loaded.get(&key) {
-                Some(hit) => Clone::clone(hit),
-                None => {
-                    let (b, s) = load_mesh(&c.mesh, c.style.as_deref(), args.memory_budget_mib)?;
-                    let hit = (Rc::new(b), s);
-                    loaded.insert(key, hit.clone());
-                    hit
-                }
-            };
-            inputs.characters.push(Character {
-                baked,
-                style,
+            planned.push(PlannedCharacter {
+                mesh: c.mesh.clone(),
+                style: c.style.clone(),
                 params: StrandParams {
                     strands_per_bundle: c.strands_per_bundle,
                     verts_log2: c.verts_log2,
@@ -292,10 +294,9 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
             mesh,
             &image_estimate(w, h).and(mesh_estimate(&[mesh.as_path()])),
         )?;
-        let (baked, style) = load_mesh(mesh, args.style.as_deref(), args.memory_budget_mib)?;
-        inputs.characters.push(Character {
-            baked: Rc::new(baked),
-            style,
+        planned.push(PlannedCharacter {
+            mesh: mesh.clone(),
+            style: args.style.clone(),
             params: StrandParams {
                 strands_per_bundle: args.strands_per_bundle,
                 verts_log2: args.verts_log2,
@@ -303,26 +304,57 @@ fn load_inputs(args: &Args) -> Result<Inputs> {
             model: Mat4::IDENTITY,
         });
     }
-    Ok(inputs)
+    Ok((inputs, planned))
+}
+
+/// Load (and bake) every planned character; a mesh named by many characters is loaded once.
+fn load_characters(args: &Args, planned: Vec<PlannedCharacter>) -> Result<Vec<Character>> {
+    let mut loaded = HashMap::new();
+    let mut characters = Vec::with_capacity(planned.len());
+    for c in planned {
+        let key = (c.mesh.clone(), c.style.clone());
+        let (baked, style) = match loaded.get(&key) {
+            Some(hit) => Clone::clone(hit),
+            None => {
+                let (b, s) = load_mesh(&c.mesh, c.style.as_deref(), args.memory_budget_mib)?;
+                let hit = (Rc::new(b), s);
+                loaded.insert(key, hit.clone());
+                hit
+            }
+        };
+        characters.push(Character {
+            baked,
+            style,
+            params: c.params,
+            model: c.model,
+        });
+    }
+    Ok(characters)
+}
+
+/// `--camera` with `--fov`, checked before any work (`None`: not given).
+fn flag_camera(args: &Args) -> Result<Option<Camera>> {
+    hairmesh::render::camera::validate_camera(Vec3::ZERO, Vec3::Z, args.fov)
+        .map_err(|e| anyhow::anyhow!("--fov: {e}"))?;
+    let Some(c) = &args.camera else {
+        return Ok(None);
+    };
+    let (eye, target) = c
+        .split_once(':')
+        .with_context(|| format!("--camera '{c}': expected eye:target"))?;
+    Camera::checked(
+        parse_vec3("--camera", eye)?,
+        parse_vec3("--camera", target)?,
+        args.fov,
+    )
+    .map(Some)
+    .map_err(|e| anyhow::anyhow!("--camera: {e}"))
 }
 
 /// `--camera`, else the scene's camera, else a view framing every character.
-fn pick_camera(args: &Args, inputs: &Inputs) -> Result<Camera> {
-    hairmesh::render::camera::validate_camera(Vec3::ZERO, Vec3::Z, args.fov)
-        .map_err(|e| anyhow::anyhow!("--fov: {e}"))?;
-    if let Some(c) = &args.camera {
-        let (eye, target) = c
-            .split_once(':')
-            .with_context(|| format!("--camera '{c}': expected eye:target"))?;
-        return Camera::checked(
-            parse_vec3("--camera", eye)?,
-            parse_vec3("--camera", target)?,
-            args.fov,
-        )
-        .map_err(|e| anyhow::anyhow!("--camera: {e}"));
-    }
-    if let Some(c) = inputs.scene_camera {
-        return Ok(c);
+fn pick_camera(args: &Args, flag: Option<Camera>, inputs: &Inputs) -> Camera {
+    if let Some(c) = flag.or(inputs.scene_camera) {
+        return c;
     }
     let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
     for c in &inputs.characters {
@@ -334,12 +366,77 @@ fn pick_camera(args: &Args, inputs: &Inputs) -> Result<Camera> {
             hi = hi.max(p);
         }
     }
-    Ok(Camera::framing(
-        lo,
-        hi,
-        hairmesh::render::DEFAULT_VIEW_DIR,
-        args.fov,
-    ))
+    Camera::framing(lo, hi, hairmesh::render::DEFAULT_VIEW_DIR, args.fov)
+}
+
+/// The frame's look: each flag, else the scene's `[look]`, else the default.
+struct Look {
+    msaa: u32,
+    transparency: hairmesh::render::Transparency,
+    shading: hairmesh::shade::ShadingModel,
+    shadows: hairmesh::render::ShadowMode,
+    temporal: hairmesh::render::Temporal,
+    lod_appearance: bool,
+    multiple_scattering: bool,
+}
+
+impl Look {
+    fn resolve(args: &Args, look: &hairmesh::render::scene::LookDesc) -> Self {
+        Look {
+            msaa: args.msaa.or(look.msaa).unwrap_or(1),
+            transparency: args
+                .transparency
+                .or(look.transparency_mode())
+                .unwrap_or_default(),
+            shading: args
+                .shading
+                .or(look.shading_model())
+                .unwrap_or(hairmesh::shade::ShadingModel::Marschner),
+            shadows: args.shadows.or(look.shadow_mode()).unwrap_or_default(),
+            temporal: args.temporal.or(look.temporal_mode()).unwrap_or_default(),
+            lod_appearance: args.lod_appearance.or(look.lod_appearance).unwrap_or(true),
+            multiple_scattering: args
+                .multiple_scattering
+                .or(look.multiple_scattering)
+                .unwrap_or(false),
+        }
+    }
+}
+
+/// Refuse every flag given that another flag (or the scene) makes unused.
+fn check_unused(p: &Parsed<Args>, inputs: &Inputs, look: &Look) -> Result<(), String> {
+    let a = &p.args;
+    let scene = a.scene.is_some();
+    p.unused_unless("style", !scene, "--scene names each character's style")?;
+    p.unused_unless(
+        "strands_per_bundle",
+        !scene,
+        "--scene gives each character's strands_per_bundle",
+    )?;
+    p.unused_unless(
+        "fov",
+        a.camera.is_some() || inputs.scene_camera.is_none(),
+        "the scene's camera has its own field of view (give --camera to use --fov)",
+    )?;
+    for id in [
+        "lod_alpha_strands",
+        "lod_alpha_verts",
+        "lod_lambda",
+        "lod_appearance",
+    ] {
+        p.unused_unless(id, a.lod, "--lod is off")?;
+    }
+    p.unused_unless(
+        "multiple_scattering",
+        look.shading == hairmesh::shade::ShadingModel::Marschner,
+        "it is part of the marschner shading",
+    )?;
+    p.unused_unless(
+        "shadow_draw",
+        look.shadows != hairmesh::render::ShadowMode::Off,
+        "shadows are off",
+    )?;
+    Ok(())
 }
 
 fn print_report(
@@ -411,42 +508,41 @@ fn print_report(
     )
 }
 
-fn run(args: Args) -> Result<()> {
-    let lod = lod_settings(&args)?;
-    // Static and LHS frames draw what a compute frame generated first (asked for below).
-    let path = args.path.map(|p| match p {
-        RenderPath::Mesh => RenderPath::Mesh,
-        _ => RenderPath::Compute,
-    });
-    // Load and validate every input, and the output path, before touching the GPU.
-    let inputs = load_inputs(&args)?;
-    let camera = pick_camera(&args, &inputs)?;
+/// Everything checked before the first mesh is loaded: the flags, the scene, the output, the
+/// device's MSAA and storage limits. Returns the device and the checked output.
+fn check_before_work(
+    parsed: &Parsed<Args>,
+    inputs: &Inputs,
+    look: &Look,
+) -> Result<(Arc<Context>, hairmesh::fsutil::OutputPath, FrameSettings)> {
+    let args = &parsed.args;
+    check_unused(parsed, inputs, look).map_err(anyhow::Error::msg)?;
+    let settings = FrameSettings {
+        path: args.path.unwrap_or(RenderPath::Compute),
+        raster: args.draw.unwrap_or_default(),
+        transparency: look.transparency,
+        msaa: look.msaa,
+        light_raster: args.shadow_draw.unwrap_or_default(),
+    };
+    if let Err(why) = settings.check_combination() {
+        bail!(
+            "--draw / --shadow-draw / --msaa {} / --transparency / --path: {why}",
+            look.msaa
+        );
+    }
+    if let Some(l) = &args.light {
+        let d = parse_vec3("--light", l)?;
+        hairmesh::render::camera::validate_light(d).map_err(|e| anyhow::anyhow!("--light: {e}"))?;
+    }
     let output = RunFiles::new()
         .inputs(inputs.files.iter().map(PathBuf::as_path))
         .output(&args.output, "-o")?;
-    let (width, height) = inputs.size;
-
-    let start = Instant::now();
     let ctx = Arc::new(Context::new(
         &ContextDesc::default()
             .validation(args.validation)
             .device(args.device.clone()),
     )?);
-    let msaa = args.msaa.or(inputs.look.msaa).unwrap_or(1);
-    let transparency = args
-        .transparency
-        .or(inputs.look.transparency_mode())
-        .unwrap_or_default();
-    let settings = hairmesh::render::FrameSettings {
-        path: args.path.unwrap_or(RenderPath::Compute),
-        raster: args.draw.unwrap_or_default(),
-        transparency,
-        msaa,
-        light_raster: args.shadow_draw.unwrap_or_default(),
-    };
-    if let Err(why) = settings.check_combination() {
-        anyhow::bail!("--draw / --shadow-draw / --msaa {msaa} / --transparency / --path: {why}");
-    }
+    let msaa = look.msaa;
     hairmesh::render::check_msaa(&ctx, msaa).map_err(|why| {
         let flag = if args.msaa.is_some() {
             "--msaa"
@@ -455,13 +551,41 @@ fn run(args: Args) -> Result<()> {
         };
         anyhow::anyhow!("{flag} {msaa}: {why}")
     })?;
+    let (w, h) = inputs.size;
+    hairmesh::render::passes::check_frame_storage(
+        ctx.info.max_storage_buffer_range,
+        inputs.size,
+        look.transparency,
+        look.temporal != hairmesh::render::Temporal::Off,
+        settings.raster.uses_software() || args.draw.is_none(),
+    )
+    .map_err(|why| anyhow::anyhow!("--size {w}x{h}: {why}"))?;
+    Ok((ctx, output, settings))
+}
+
+fn run(parsed: Parsed<Args>) -> Result<()> {
+    let args = &parsed.args;
+    let lod = lod_settings(args)?;
+    // Static and LHS frames draw what a compute frame generated first (asked for below).
+    let path = args.path.map(|p| match p {
+        RenderPath::Mesh => RenderPath::Mesh,
+        _ => RenderPath::Compute,
+    });
+    let (mut inputs, planned) = plan_inputs(args)?;
+    let look = Look::resolve(args, &inputs.look);
+    let flag_camera = flag_camera(args)?;
+    let (ctx, output, settings) = check_before_work(&parsed, &inputs, &look)?;
+    let start = Instant::now();
+    inputs.characters = load_characters(args, planned)?;
+    let camera = pick_camera(args, flag_camera, &inputs);
+    let (width, height) = inputs.size;
     let mut renderer = Renderer::new(
         &ctx,
         &RendererDesc::default()
             .size(width, height)
             .path(path)
             .vertex_pool_bytes(args.vertex_pool_mib << 20)
-            .msaa(msaa)
+            .msaa(look.msaa)
             .max_characters(inputs.characters.len().max(1) as u32),
     )?;
     for c in &inputs.characters {
@@ -470,38 +594,38 @@ fn run(args: Args) -> Result<()> {
     let settings = settings.with_fastest((args.draw, args.shadow_draw), &renderer.caps());
     let view = View {
         light_dir: match &args.light {
-            Some(l) => {
-                let d = parse_vec3("--light", l)?;
-                hairmesh::render::camera::validate_light(d)
-                    .map_err(|e| anyhow::anyhow!("--light: {e}"))?;
-                d
-            }
+            Some(l) => parse_vec3("--light", l)?,
             None => inputs.light,
         },
         lod,
-        shading: args
-            .shading
-            .or(inputs.look.shading_model())
-            .unwrap_or(hairmesh::shade::ShadingModel::Marschner),
-        shadows: args
-            .shadows
-            .or(inputs.look.shadow_mode())
-            .unwrap_or_default(),
-        transparency,
-        temporal: args
-            .temporal
-            .or(inputs.look.temporal_mode())
-            .unwrap_or_default(),
-        lod_appearance: args
-            .lod_appearance
-            .or(inputs.look.lod_appearance)
-            .unwrap_or(true),
-        multiple_scattering: args
-            .multiple_scattering
-            .or(inputs.look.multiple_scattering)
-            .unwrap_or(false),
+        shading: look.shading,
+        shadows: look.shadows,
+        transparency: look.transparency,
+        temporal: look.temporal,
+        lod_appearance: look.lod_appearance,
+        multiple_scattering: look.multiple_scattering,
         ..View::new(camera)
     };
+    render_and_write(
+        &parsed,
+        &ctx,
+        (&mut renderer, &inputs, settings),
+        &view,
+        (output, start),
+    )
+}
+
+/// Render the frame (repeated, then the static or LHS second frame where asked), print the
+/// report and write the image.
+fn render_and_write(
+    parsed: &Parsed<Args>,
+    ctx: &Context,
+    (renderer, inputs, settings): (&mut Renderer, &Inputs, FrameSettings),
+    view: &View,
+    (output, start): (hairmesh::fsutil::OutputPath, Instant),
+) -> Result<()> {
+    let args = &parsed.args;
+    let (width, height) = inputs.size;
     let second = args
         .path
         .filter(|p| matches!(p, RenderPath::Static | RenderPath::Lhs));
@@ -571,7 +695,9 @@ fn run(args: Args) -> Result<()> {
 }
 
 fn main() {
-    if let Err(e) = run(Args::parse()) {
+    let parsed = hairmesh::cli::parse::<Args>("render");
+    hairmesh::cli::clean_up_on_signals("render");
+    if let Err(e) = run(parsed) {
         hairmesh::fsutil::exit_with_error("render", &e, 1);
     }
 }

@@ -432,3 +432,31 @@ impl ShadowMode {
         }
     }
 }
+
+/// What a user changes to make transient buffer `name` smaller: its contents in a user's
+/// words and the flags (scene keys have the same names) that size it.
+pub fn transient_in_user_terms(name: &str) -> (&'static str, &'static str) {
+    match name {
+        "oit nodes" | "oit tail" => (
+            "per-pixel fragment lists",
+            "lower --size, or K of --transparency oit:K",
+        ),
+        "peel depth" | "peel accumulation" => ("depth peeling layers", "lower --size"),
+        "visibility" | "motion" | "frame colour" | "vertex motion" | "segment motion" => (
+            "temporal accumulation's history",
+            "lower --size, or use --temporal off",
+        ),
+        "soft tiles" | "soft depth" => (
+            "the software rasterizer's per-pixel depth",
+            "lower --size, or use --draw hw",
+        ),
+        "soft segments" | "soft entries" => (
+            "the software rasterizer's budget",
+            "use fewer strands, or --draw hw",
+        ),
+        "soft shadow depth" | "soft shadow layers" => {
+            ("the software shadow maps", "use --shadow-draw hw")
+        }
+        _ => ("frame storage", "lower --size"),
+    }
+}

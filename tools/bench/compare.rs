@@ -241,21 +241,40 @@ fn flip_mean(old: &image::RgbImage, new: &image::RgbImage) -> Option<f64> {
     Some(nv_flip::FlipPool::from_image(&err).mean() as f64)
 }
 
+/// Whether row `name` is chosen by `pattern`: its whole name, or its first words
+/// (`people` and `people 100` choose `people 100`; `people 10` does not).
+fn row_matches(name: &str, pattern: &str) -> bool {
+    let pattern = pattern.trim();
+    !pattern.is_empty()
+        && (name == pattern
+            || name
+                .strip_prefix(pattern)
+                .is_some_and(|r| r.starts_with(' ')))
+}
+
 /// Per row and build: what each run measured.
 type Samples = Vec<[Vec<Measured>; 2]>;
 
 /// Build both, run every row `runs` times alternating, print the table.
 pub fn bench_compare(args: CompareArgs) -> Result<()> {
-    let rows: Vec<Row> = rows(args.quick)
-        .into_iter()
-        .filter(|r| args.rows.is_empty() || args.rows.iter().any(|p| r.name.starts_with(p)))
-        .collect();
-    if rows.is_empty() {
+    let all = rows(args.quick);
+    if let Some(p) = args
+        .rows
+        .iter()
+        .find(|p| !all.iter().any(|r| row_matches(&r.name, p)))
+    {
         bail!(
-            "--rows {}: matches no row (bare, full, people)",
-            args.rows.join(",")
+            "--rows {p}: matches no row; rows: {}",
+            all.iter()
+                .map(|r| r.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
+    let rows: Vec<Row> = all
+        .into_iter()
+        .filter(|r| args.rows.is_empty() || args.rows.iter().any(|p| row_matches(&r.name, p)))
+        .collect();
     let (sha, old) = build_control(&args.against)?;
     let new = build_current()?;
     let mut samples: Samples = rows.iter().map(|_| [Vec::new(), Vec::new()]).collect();

@@ -134,10 +134,40 @@ fn crowd_scene(ctx: &Arc<Context>, a: &RasterArgs) -> Result<Scene> {
 }
 
 /// Run the comparison and print the table.
+/// Every `--scenes` name chooses a scene (a prefix of its printed name), checked before any
+/// scene is built.
+fn check_scene_names(a: &RasterArgs) -> Result<()> {
+    let (baked, style) = load_mesh(
+        std::path::Path::new("hairmeshes/head_long.obj"),
+        None,
+        Default::default(),
+    )?;
+    let strands = strands_per_bundle_for(&baked, &style, a.strands as u64).1;
+    let names = [
+        "head near".to_string(),
+        "head mid".into(),
+        "head far".into(),
+        format!("{}K strands", strands.div_ceil(1000)),
+        format!("crowd of {}", a.crowd),
+    ];
+    if let Some(n) = a
+        .scenes
+        .iter()
+        .find(|n| !names.iter().any(|s| s.starts_with(n.as_str())))
+    {
+        bail!(
+            "--scenes {n}: chooses no scene; scenes: {}",
+            names.join(", ")
+        );
+    }
+    Ok(())
+}
+
 pub fn bench_raster(a: RasterArgs) -> Result<()> {
     if a.crowd == 0 || a.crowd > 1024 {
         bail!("--crowd: 1..=1024 characters");
     }
+    check_scene_names(&a)?;
     let ctx = Arc::new(Context::new(
         &ContextDesc::default().device(a.device.clone()),
     )?);

@@ -35,10 +35,10 @@ pub struct TemporalArgs {
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=10000))]
     warmup: u32,
     /// Reference samples per pixel per side (1..=8).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     supersample: u32,
     /// Scenarios: orbit, dolly, crowd.
-    #[arg(long, value_delimiter = ',', default_value = "orbit,dolly,crowd")]
+    #[arg(long, value_delimiter = ',', default_value = "orbit,dolly,crowd", value_parser = ["orbit", "dolly", "crowd"])]
     scenarios: Vec<String>,
     /// How our frames' strands are rasterized: hw, soft[:K] or auto[:K].
     #[arg(long, default_value = "hw")]

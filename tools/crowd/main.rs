@@ -479,14 +479,75 @@ fn parse_generated_path(s: &str) -> Result<RenderPath, String> {
     }
 }
 
-fn run(args: Args) -> Result<()> {
-    check_memory(&args)?;
-    let volumes = args.volume_tier()?;
-    let scene = Scene::build(&args)?;
-    if !args.headless {
-        return window::run(args, scene);
+/// Refuse every flag given that another flag makes unused (issue 46: a flag with no effect is
+/// an error naming why, not silently ignored).
+fn check_unused(p: &hairmesh::cli::Parsed<Args>) -> Result<(), String> {
+    let a = &p.args;
+    for id in ["frames", "out", "view", "light", "orbit"] {
+        p.unused_unless(id, a.headless, "it applies to --headless runs only")?;
     }
-    let (width, height) = parse_size(&args.size)?;
+    for id in ["exit_after_frames", "test_resize", "present_mode"] {
+        p.unused_unless(
+            id,
+            !a.headless,
+            "it applies to the window, and --headless opens none",
+        )?;
+    }
+    p.unused_unless("volume_band", a.volumes, "--volumes is off")?;
+    p.unused_unless("wind_dir", a.wind > 0.0, "--wind is 0")?;
+    for id in ["wind", "dynamics", "dynamics_schedule"] {
+        p.unused_unless(id, a.animate, "--animate is off")?;
+    }
+    p.unused_unless(
+        "preset",
+        a.character.is_none(),
+        "--character fills the crowd",
+    )?;
+    p.unused_unless(
+        "family",
+        a.character.is_some() || a.preset != Preset::Teapots,
+        "--preset teapots has no people",
+    )?;
+    p.unused_unless(
+        "multiple_scattering",
+        a.shading == hairmesh::shade::ShadingModel::Marschner,
+        "it is part of --shading marschner",
+    )?;
+    p.unused_unless("lod_appearance", a.lod, "--lod is off")?;
+    p.unused_unless(
+        "shadow_draw",
+        a.shadows != hairmesh::render::ShadowMode::Off,
+        "--shadows is off",
+    )?;
+    Ok(())
+}
+
+/// What the checks of the flags produced.
+struct Checked {
+    volumes: hairmesh::render::VolumeTier,
+    /// The headless run's staged output folder (`None`: a window).
+    out: Option<StagedFolder>,
+}
+
+/// Every check of the flags that needs no device, before any work: unused flags, sizes, the
+/// memory estimate, the volume band, wind, the settings' combination and the output folder
+/// (its frame names; created when the first frame is written).
+fn check_args(p: &hairmesh::cli::Parsed<Args>) -> Result<Checked> {
+    check_unused(p).map_err(anyhow::Error::msg)?;
+    let args = &p.args;
+    check_memory(args)?;
+    let volumes = args.volume_tier()?;
+    let wind_dir = hairmesh::render::scene::parse_vec3(&args.wind_dir)
+        .map_err(|e| anyhow::anyhow!("--wind-dir {}: {e}", args.wind_dir))?;
+    if !(0.0..=100.0).contains(&args.wind) {
+        bail!("--wind {}: must be 0..=100", args.wind);
+    }
+    if args.wind > 0.0 && !(wind_dir.is_finite() && wind_dir.length() > 0.0) {
+        bail!(
+            "--wind-dir {}: must be a finite, non-zero direction",
+            args.wind_dir
+        );
+    }
     let settings = hairmesh::render::FrameSettings {
         path: args.path.unwrap_or(RenderPath::Compute),
         raster: args.draw.unwrap_or_default(),
@@ -499,10 +560,41 @@ fn run(args: Args) -> Result<()> {
     }
     // Every output of the run is checked before the first frame, and they appear only when
     // the whole run succeeded.
-    let frame_name = |f: u32| format!("frame_{f:05}.png");
-    let mut names: Vec<String> = (0..args.frames).map(frame_name).collect();
-    names.push("stats.csv".into());
-    let mut out = StagedFolder::check(&args.out, &names, &mut RunFiles::new(), "--out")?;
+    let out = if args.headless {
+        let mut names: Vec<String> = (0..args.frames).map(frame_name).collect();
+        names.push("stats.csv".into());
+        Some(StagedFolder::check(
+            &args.out,
+            &names,
+            &mut RunFiles::new(),
+            "--out",
+        )?)
+    } else {
+        None
+    };
+    Ok(Checked { volumes, out })
+}
+
+/// A headless frame's file name.
+fn frame_name(f: u32) -> String {
+    format!("frame_{f:05}.png")
+}
+
+fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
+    let Checked { volumes, out } = check_args(&parsed)?;
+    let args = parsed.args;
+    let scene = Scene::build(&args)?;
+    let Some(mut out) = out else {
+        return window::run(args, scene);
+    };
+    let (width, height) = parse_size(&args.size)?;
+    let settings = hairmesh::render::FrameSettings {
+        path: args.path.unwrap_or(RenderPath::Compute),
+        raster: args.draw.unwrap_or_default(),
+        transparency: args.transparency,
+        msaa: args.msaa,
+        light_raster: args.shadow_draw.unwrap_or_default(),
+    };
     let generate_s = scene.generate_s;
     let characters = &scene.characters;
     let ctx = Arc::new(Context::new(
@@ -648,7 +740,9 @@ fn run(args: Args) -> Result<()> {
 }
 
 fn main() {
-    if let Err(e) = run(Args::parse()) {
+    let parsed = hairmesh::cli::parse::<Args>("crowd");
+    hairmesh::cli::clean_up_on_signals("crowd");
+    if let Err(e) = run(parsed) {
         let _ = std::io::stdout().flush();
         hairmesh::fsutil::exit_with_error("crowd", &e, 1);
     }

@@ -49,7 +49,9 @@ const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 const VERTEX_FLOATS: usize = 8;
 
 fn main() -> std::process::ExitCode {
-    match run(Args::parse()) {
+    let parsed = hairmesh::cli::parse::<Args>("embed");
+    hairmesh::cli::clean_up_on_signals("embed");
+    match run(parsed.args) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("embed: {e:#}");
@@ -60,6 +62,8 @@ fn main() -> std::process::ExitCode {
 
 fn run(args: Args) -> Result<()> {
     let (w, h) = parse_size(&args.size)?;
+    // The output is checked (and refused where it cannot be written) before any work.
+    let output = hairmesh::fsutil::RunFiles::new().output(&args.out, "--out")?;
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("hairmeshes");
     let head = hairmesh::model::obj_io::load_triangles(&root.join("sintel_head.obj"))?;
     let (baked, style) =
@@ -87,10 +91,8 @@ fn run(args: Args) -> Result<()> {
         .chunks(4)
         .flat_map(|p| [p[2], p[1], p[0], 255])
         .collect();
-    image::RgbaImage::from_raw(w, h, rgba)
-        .context("image size")?
-        .save(&args.out)
-        .with_context(|| format!("{}: writing the picture", args.out.display()))?;
+    let png = hairmesh::fsutil::encode_png(&args.out.display().to_string(), w, h, rgba)?;
+    output.write(&png)?;
     println!(
         "{}: {w}x{h}, the engine's floor and head, the hair of sintel.obj over them: {shown} hair pixels shown, {hidden} hidden by the engine's geometry ({})",
         args.out.display(),

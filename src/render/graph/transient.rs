@@ -112,8 +112,9 @@ impl TransientPool {
     pub fn check(&self, desc: &TransientBuffer) -> GpuResult<()> {
         let limit = self.ctx.info.max_storage_buffer_range;
         if desc.usage.contains(vk::BufferUsageFlags::STORAGE_BUFFER) && desc.bytes > limit {
+            let (what, remedy) = crate::render::settings::transient_in_user_terms(desc.name);
             return Err(GpuError::Unsupported(format!(
-                "{} needs {} bytes this frame, more than the device's maxStorageBufferRange ({limit}); lower the budget or the image size",
+                "this frame's {what} ({}) needs {} bytes, more than the {limit} this device's largest storage buffer holds; {remedy}",
                 desc.name, desc.bytes
             )));
         }

@@ -381,6 +381,37 @@ pub struct FrameTransients {
     pub motion: bool,
 }
 
+/// Refuse, before any work, a `width x height` frame whose per-pixel buffers (fragment lists
+/// of `transparency`, temporal history when `temporal`, the software rasterizer's depth when
+/// `soft`) need more than `limit` bytes (the device's `maxStorageBufferRange`): one line in
+/// the settings' terms, never only a buffer's name.
+pub fn check_frame_storage(
+    limit: u64,
+    (width, height): (u32, u32),
+    transparency: Transparency,
+    temporal: bool,
+    soft: bool,
+) -> Result<(), String> {
+    let work = temporal.then_some(temporal::TemporalWork {
+        accumulate: true,
+        vertex_slots: 0,
+    });
+    let camera = soft.then_some(SoftBudget::EMPTY);
+    let t = FrameTransients::new(transparency, (camera, None), (width, height), work);
+    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    match t.buffers().find(|b| b.bytes > limit) {
+        None => Ok(()),
+        Some(b) => {
+            let (what, remedy) = super::settings::transient_in_user_terms(b.name);
+            Err(format!(
+                "a {width}x{height} image with transparency {transparency} needs {:.2} GiB of {what}, more than the {:.2} GiB this device's largest storage buffer holds; {remedy}",
+                gib(b.bytes),
+                gib(limit)
+            ))
+        }
+    }
+}
+
 impl FrameTransients {
     /// The transients of a frame at `size`, whose per-pixel buffers are those of
     /// `transparency` (the software rasterizer composites through a k-buffer), with the
