@@ -486,11 +486,11 @@ impl StagedFolder {
     }
 
     /// Move every written file into the target folder (the whole staging folder when the
-    /// target did not exist).
+    /// target does not exist, also when another run made it after the check).
     pub fn publish(mut self) -> Result<()> {
         self.ensure_staging()?;
         let mut publish = Publish::begin([parent_folder(&self.target)])?;
-        if self.existed {
+        if self.existed || self.target.is_dir() {
             for (k, n) in self.written.iter().enumerate() {
                 if k == 1 {
                     Publish::test_pause();

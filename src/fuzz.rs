@@ -17,7 +17,7 @@ use std::time::Instant;
 use crate::rng::Pcg32;
 
 /// The readers under test.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Reader {
     /// `obj_io::parse_hair_mesh_obj` (+ `bake` of small accepted meshes) and `parse_scalp`.
     Obj,
@@ -38,11 +38,15 @@ pub enum Reader {
     SceneFiles,
     /// `model::gltf::parse_character` (glTF characters) on the shipped man.
     Gltf,
+    /// The same reader on a `.gltf` document whose buffer is a file beside it: the JSON
+    /// mutated (the buffer's `uri` and `byteLength` included), or the `.bin` file mutated
+    /// (bytes changed, cut short, grown).
+    GltfExternal,
 }
 
 impl Reader {
     /// Every reader.
-    pub const ALL: [Reader; 9] = [
+    pub const ALL: [Reader; 10] = [
         Reader::Obj,
         Reader::Style,
         Reader::Scene,
@@ -52,6 +56,7 @@ impl Reader {
         Reader::Head,
         Reader::SceneFiles,
         Reader::Gltf,
+        Reader::GltfExternal,
     ];
 }
 
@@ -417,6 +422,7 @@ fn run_one(reader: Reader, input: &[u8]) -> Result<bool, String> {
             let budget = crate::budget::MemoryBudget::default();
             crate::model::gltf::parse_character("fuzz.glb", input, None, budget).is_ok()
         }
+        Reader::GltfExternal => external_gltf(input),
         Reader::Hair => crate::model::hair_file::HairFile::parse("fuzz.hair", input).is_ok(),
         Reader::Tfx => match crate::model::strands::StrandModel::from_tfx("fuzz.tfx", input) {
             Ok(m) if m.point_count() <= 4096 => {
@@ -502,6 +508,79 @@ fn mutate_glb(rng: &mut Pcg32, seed: &[u8]) -> Vec<u8> {
     }
 }
 
+/// The GLB seed split into a `.gltf` document whose buffer is the file `bin_name` beside it,
+/// and that file's bytes.
+fn external_seed(bin_name: &str) -> (String, &'static [u8]) {
+    let json_len = u32::from_le_bytes([GLB_SEED[12], GLB_SEED[13], GLB_SEED[14], GLB_SEED[15]]);
+    let json = std::str::from_utf8(&GLB_SEED[20..20 + json_len as usize]).unwrap_or("");
+    let bin = GLB_SEED
+        .get(20 + json_len as usize + 8..)
+        .unwrap_or_default();
+    let with_uri = json.replacen(
+        "\"buffers\":[{",
+        &format!("\"buffers\":[{{\"uri\":\"{bin_name}\","),
+        1,
+    );
+    (with_uri, bin)
+}
+
+/// A mutated external-buffer glTF: tag 0 and a mutated document over the pristine `man.bin`,
+/// or tag 1 and mutated bytes of `mutated.bin` under the pristine document.
+fn mutate_external_gltf(rng: &mut Pcg32) -> Vec<u8> {
+    if below(rng, 3) > 0 {
+        let (json, _) = external_seed("man.bin");
+        let text = json.replace(",\"", ",\n\"");
+        let mut out = vec![0u8];
+        out.extend(mutate_text(rng, &text).into_iter().filter(|&b| b != b'\n'));
+        return out;
+    }
+    let (_, bin) = external_seed("mutated.bin");
+    let mut out = vec![1u8];
+    match below(rng, 3) {
+        0 => {
+            out.extend_from_slice(bin);
+            for _ in 0..1 + below(rng, 16) {
+                let at = 1 + below(rng, bin.len());
+                out[at] = rng.next_u32() as u8;
+            }
+        }
+        1 => out.extend_from_slice(&bin[..below(rng, bin.len())]),
+        _ => {
+            out.extend_from_slice(bin);
+            out.resize(out.len() + 1 + below(rng, 4096), 0xff);
+        }
+    }
+    out
+}
+
+/// The folder the external-buffer inputs are read from (removed after the campaign):
+/// `man.bin` (pristine) written when missing; `mutated.bin` rewritten per input.
+fn external_dir() -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("hairmesh-fuzz-{}", std::process::id()));
+    if !dir.join("man.bin").is_file() {
+        let _ = std::fs::create_dir_all(&dir);
+        let _ = std::fs::write(dir.join("man.bin"), external_seed("man.bin").1);
+    }
+    dir
+}
+
+/// Parse one external-buffer input (see [`mutate_external_gltf`]).
+fn external_gltf(input: &[u8]) -> bool {
+    let dir = external_dir();
+    let budget = crate::budget::MemoryBudget::default();
+    let json = match input.split_first() {
+        Some((0, doc)) => doc.to_vec(),
+        Some((_, bin)) => {
+            if std::fs::write(dir.join("mutated.bin"), bin).is_err() {
+                return false;
+            }
+            external_seed("mutated.bin").0.into_bytes()
+        }
+        None => return false,
+    };
+    crate::model::gltf::parse_character("fuzz.gltf", &json, Some(&dir), budget).is_ok()
+}
+
 /// Run `iterations` mutated inputs through `reader`, seeded with `seed`.
 pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
     let mut rng = Pcg32::new(seed ^ (reader as u64) << 32);
@@ -531,6 +610,7 @@ pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
             }
             Reader::SceneFiles => mutate_text(&mut rng, SCENE_FILES_SEED),
             Reader::Gltf => mutate_glb(&mut rng, GLB_SEED),
+            Reader::GltfExternal => mutate_external_gltf(&mut rng),
         };
         let start = Instant::now();
         let outcome = run_one(reader, &input);
@@ -541,6 +621,9 @@ pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
             Ok(false) => report.rejected += 1,
             Err(msg) => report.panics.push((i, msg)),
         }
+    }
+    if reader == Reader::GltfExternal {
+        let _ = std::fs::remove_dir_all(external_dir());
     }
     report
 }

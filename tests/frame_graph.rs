@@ -183,8 +183,11 @@ fn a_buffer_past_the_device_limit_is_refused_before_allocating() {
     let pool = TransientPool::new(&ctx);
     let too_big = ctx.info.max_storage_buffer_range + 1;
     let err = pool.check(&scratch(too_big)).unwrap_err().to_string();
+    // Named in the user's terms (what grows it, the flag that shrinks it) with the buffer.
     assert!(
-        err.contains("scratch needs") && err.contains("maxStorageBufferRange"),
+        err.contains("(scratch) needs")
+            && err.contains("largest storage buffer")
+            && err.contains("--size"),
         "{err}"
     );
     assert_eq!(pool.bytes(), 0);

@@ -42,7 +42,7 @@ fn check(reader: Reader) {
     let base = LIVE.load(Ordering::Relaxed);
     PEAK.store(base, Ordering::Relaxed);
     // The glTF seed is a whole character (470 KB, 14,000 vertices): fewer, slower inputs.
-    let batch = if reader == Reader::Gltf {
+    let batch = if matches!(reader, Reader::Gltf | Reader::GltfExternal) {
         BATCH / 10
     } else {
         BATCH
@@ -117,4 +117,9 @@ fn fuzz_scene_files_reader() {
 #[test]
 fn fuzz_gltf_reader() {
     check(Reader::Gltf);
+}
+
+#[test]
+fn fuzz_gltf_external_buffer_reader() {
+    check(Reader::GltfExternal);
 }

@@ -118,6 +118,9 @@ enum Cmd {
         /// Campaign seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Only these readers (default: every one).
+        #[arg(long, value_delimiter = ',')]
+        readers: Vec<hairmesh::fuzz::Reader>,
     },
     /// The paper's comparison in one run: hair mesh (mesh and compute paths) vs linear hair
     /// skinning vs static strands per model, crowd LoD on/off, near/mid/far LoD, GPU bytes.
@@ -756,10 +759,18 @@ fn run(args: Args) -> Result<()> {
         })?,
         Cmd::Temporal(args) => temporal::bench_temporal(args)?,
         Cmd::Compare(args) => compare::bench_compare(args)?,
-        Cmd::Fuzz { iterations, seed } => {
+        Cmd::Fuzz {
+            iterations,
+            seed,
+            readers,
+        } => {
             outln!("| reader | inputs | accepted | rejected | panics | slowest ms | seconds |")?;
             outln!("|---|---|---|---|---|---|---|")?;
-            for reader in hairmesh::fuzz::Reader::ALL {
+            let all = hairmesh::fuzz::Reader::ALL;
+            for reader in all
+                .into_iter()
+                .filter(|r| readers.is_empty() || readers.contains(r))
+            {
                 let start = Instant::now();
                 let r = hairmesh::fuzz::campaign(reader, iterations, seed);
                 outln!(

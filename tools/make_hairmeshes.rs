@@ -301,16 +301,26 @@ fn run(args: Args) -> Result<()> {
 /// `<family>.toml` each, in the head file's frame and units, all checked before any is
 /// written.
 fn grow_on_head(args: &Args, head: &Path, out: &Path) -> Result<()> {
-    let any = read_head(head, &args.joint)?;
     let families = match args.family.is_empty() {
         true => StyleFamily::PEOPLE.to_vec(),
         false => args.family.clone(),
     };
+    // The whole list and every output are checked before the head is read.
+    if families.contains(&StyleFamily::Fur) {
+        anyhow::bail!("--family fur grows on balls and teapots, not on heads");
+    }
+    let mut run = hairmesh::fsutil::RunFiles::new();
+    run.input(head);
+    let mut checked = Vec::new();
+    for family in &families {
+        let path = out.join(format!("{}.obj", family.name()));
+        let obj = run.output(&path, "--family")?;
+        let style = run.output(&path.with_extension("toml"), "--family")?;
+        checked.push((obj, style));
+    }
+    let any = read_head(head, &args.joint)?;
     let mut files: Vec<(OutputPath, Vec<u8>, String)> = Vec::new();
-    for family in families {
-        if family == StyleFamily::Fur {
-            anyhow::bail!("--family fur grows on balls and teapots, not on heads");
-        }
+    for (family, (obj_out, style_out)) in families.into_iter().zip(checked) {
         let hair = any.grow(family, args.seed)?;
         let name = family.name();
         let path = out.join(format!("{name}.obj"));
@@ -327,11 +337,11 @@ fn grow_on_head(args: &Args, head: &Path, out: &Path) -> Result<()> {
             hair.mesh.faces.len(),
             hair.mesh.layer_count()
         );
-        files.push((OutputPath::check(&path, &[head])?, bytes, line));
+        files.push((obj_out, bytes, line));
         let style = path.with_extension("toml");
         let text = format!("# {comment}\n{}", toml::to_string(&hair.style)?);
         let line = format!("{}: style", style.display());
-        files.push((OutputPath::check(&style, &[head])?, text.into_bytes(), line));
+        files.push((style_out, text.into_bytes(), line));
     }
     for (_, _, line) in &files {
         hairmesh::outln!("{line}")?;

@@ -551,6 +551,14 @@ fn check_before_work(
         };
         anyhow::anyhow!("{flag} {msaa}: {why}")
     })?;
+    let range = ctx.info.max_storage_buffer_range;
+    if args.vertex_pool_mib << 20 > range {
+        bail!(
+            "--vertex-pool-mib {}: more than the {} MiB this device's largest storage buffer holds",
+            args.vertex_pool_mib,
+            range >> 20
+        );
+    }
     let (w, h) = inputs.size;
     hairmesh::render::passes::check_frame_storage(
         ctx.info.max_storage_buffer_range,

@@ -674,7 +674,7 @@ fn check_desc(ctx: &Context, desc: &RendererDesc) -> GpuResult<SoftBudget> {
     let range = ctx.info.max_storage_buffer_range;
     if desc.vertex_pool_bytes < size_of::<HairVertex>() as u64 || desc.vertex_pool_bytes > range {
         return Err(GpuError::Unsupported(format!(
-            "vertex pool of {} bytes: must be {}..={range} (maxStorageBufferRange of {})",
+            "--vertex-pool-mib: a vertex pool of {} bytes must be {}..={range} bytes, the largest storage buffer {} holds",
             desc.vertex_pool_bytes,
             size_of::<HairVertex>(),
             ctx.info.name

@@ -575,6 +575,21 @@ fn check_args(p: &hairmesh::cli::Parsed<Args>) -> Result<Checked> {
     Ok(Checked { volumes, out })
 }
 
+/// The flags against the device: MSAA it offers, and per-pixel storage its largest buffer
+/// holds at `--size` (named as flags, never as buffers).
+fn check_device_limits(ctx: &Context, args: &Args, (w, h): (u32, u32)) -> Result<()> {
+    hairmesh::render::check_msaa(ctx, args.msaa)
+        .map_err(|why| anyhow::anyhow!("--msaa {}: {why}", args.msaa))?;
+    hairmesh::render::passes::check_frame_storage(
+        ctx.info.max_storage_buffer_range,
+        (w, h),
+        args.transparency,
+        args.temporal != hairmesh::render::Temporal::Off,
+        args.draw.is_none_or(|d| d.uses_software()),
+    )
+    .map_err(|why| anyhow::anyhow!("--size {w}x{h}: {why}"))
+}
+
 /// A headless frame's file name.
 fn frame_name(f: u32) -> String {
     format!("frame_{f:05}.png")
@@ -583,11 +598,19 @@ fn frame_name(f: u32) -> String {
 fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     let Checked { volumes, out } = check_args(&parsed)?;
     let args = parsed.args;
-    let scene = Scene::build(&args)?;
     let Some(mut out) = out else {
+        let scene = Scene::build(&args)?;
         return window::run(args, scene);
     };
     let (width, height) = parse_size(&args.size)?;
+    // The device's limits are checked before the crowd is built.
+    let ctx = Arc::new(Context::new(
+        &ContextDesc::default()
+            .validation(args.validation)
+            .device(args.device.clone()),
+    )?);
+    check_device_limits(&ctx, &args, (width, height))?;
+    let scene = Scene::build(&args)?;
     let settings = hairmesh::render::FrameSettings {
         path: args.path.unwrap_or(RenderPath::Compute),
         raster: args.draw.unwrap_or_default(),
@@ -597,11 +620,6 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     };
     let generate_s = scene.generate_s;
     let characters = &scene.characters;
-    let ctx = Arc::new(Context::new(
-        &ContextDesc::default()
-            .validation(args.validation)
-            .device(args.device.clone()),
-    )?);
     let mut renderer = scene.renderer(&ctx, &args, width, height)?;
     let settings = hairmesh::render::FrameSettings {
         path: renderer.default_path(),

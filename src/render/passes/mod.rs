@@ -398,15 +398,18 @@ pub fn check_frame_storage(
     });
     let camera = soft.then_some(SoftBudget::EMPTY);
     let t = FrameTransients::new(transparency, (camera, None), (width, height), work);
-    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    let size = |b: u64| match b {
+        0..0x4000_0000 => format!("{} MiB", b.div_ceil(1 << 20)),
+        _ => format!("{:.1} GiB", b as f64 / (1u64 << 30) as f64),
+    };
     match t.buffers().find(|b| b.bytes > limit) {
         None => Ok(()),
         Some(b) => {
             let (what, remedy) = super::settings::transient_in_user_terms(b.name);
             Err(format!(
-                "a {width}x{height} image with transparency {transparency} needs {:.2} GiB of {what}, more than the {:.2} GiB this device's largest storage buffer holds; {remedy}",
-                gib(b.bytes),
-                gib(limit)
+                "a {width}x{height} image with transparency {transparency} needs {} of {what}, more than the {} this device's largest storage buffer holds; {remedy}",
+                size(b.bytes),
+                size(limit)
             ))
         }
     }
