@@ -581,37 +581,65 @@ fn external_gltf(input: &[u8]) -> bool {
     crate::model::gltf::parse_character("fuzz.gltf", &json, Some(&dir), budget).is_ok()
 }
 
-/// Run `iterations` mutated inputs through `reader`, seeded with `seed`.
-pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
-    let mut rng = Pcg32::new(seed ^ (reader as u64) << 32);
-    let hmb = (reader == Reader::Hmb).then(hmb_seed);
-    let hair = hair_seeds();
-    let mut report = FuzzReport::default();
-    for i in 0..iterations {
-        let input = match reader {
-            Reader::Obj => {
-                let seed = *pick(&mut rng, &OBJ_SEEDS);
-                mutate_text(&mut rng, seed)
+/// The mutated inputs of one campaign, in order.
+struct Inputs {
+    reader: Reader,
+    rng: Pcg32,
+    hmb: Option<Vec<u8>>,
+    hair: [Vec<u8>; 2],
+}
+
+impl Inputs {
+    fn new(reader: Reader, seed: u64) -> Self {
+        Inputs {
+            reader,
+            rng: Pcg32::new(seed ^ (reader as u64) << 32),
+            hmb: (reader == Reader::Hmb).then(hmb_seed),
+            hair: hair_seeds(),
+        }
+    }
+
+    fn next_input(&mut self) -> Vec<u8> {
+        let rng = &mut self.rng;
+        match self.reader {
+            Reader::Obj | Reader::Head => {
+                let seed = *pick(rng, &OBJ_SEEDS);
+                mutate_text(rng, seed)
             }
             Reader::Style => {
-                let seed = *pick(&mut rng, &STYLE_SEEDS);
-                mutate_text(&mut rng, seed)
+                let seed = *pick(rng, &STYLE_SEEDS);
+                mutate_text(rng, seed)
             }
-            Reader::Scene => mutate_text(&mut rng, SCENE_SEED),
-            Reader::Hmb => mutate_hmb(&mut rng, hmb.as_deref().unwrap_or_default()),
+            Reader::Scene => mutate_text(rng, SCENE_SEED),
+            Reader::Hmb => mutate_hmb(rng, self.hmb.as_deref().unwrap_or_default()),
             Reader::Hair => {
-                let seed = pick(&mut rng, &hair).clone();
-                mutate_hair(&mut rng, &seed)
+                let seed = pick(rng, &self.hair).clone();
+                mutate_hair(rng, &seed)
             }
-            Reader::Tfx => mutate_tfx(&mut rng, &tfx_seed()),
-            Reader::Head => {
-                let seed = *pick(&mut rng, &OBJ_SEEDS);
-                mutate_text(&mut rng, seed)
-            }
-            Reader::SceneFiles => mutate_text(&mut rng, SCENE_FILES_SEED),
-            Reader::Gltf => mutate_glb(&mut rng, GLB_SEED),
-            Reader::GltfExternal => mutate_external_gltf(&mut rng),
-        };
+            Reader::Tfx => mutate_tfx(rng, &tfx_seed()),
+            Reader::SceneFiles => mutate_text(rng, SCENE_FILES_SEED),
+            Reader::Gltf => mutate_glb(rng, GLB_SEED),
+            Reader::GltfExternal => mutate_external_gltf(rng),
+        }
+    }
+}
+
+/// Input `index` (from 0) of the campaign of `reader` seeded with `seed`: the bytes a finding
+/// names, to reproduce it alone (`bench fuzz --save-input`).
+pub fn nth_input(reader: Reader, seed: u64, index: u64) -> Vec<u8> {
+    let mut inputs = Inputs::new(reader, seed);
+    for _ in 0..index {
+        inputs.next_input();
+    }
+    inputs.next_input()
+}
+
+/// Run `iterations` mutated inputs through `reader`, seeded with `seed`.
+pub fn campaign(reader: Reader, iterations: u64, seed: u64) -> FuzzReport {
+    let mut inputs = Inputs::new(reader, seed);
+    let mut report = FuzzReport::default();
+    for i in 0..iterations {
+        let input = inputs.next_input();
         let start = Instant::now();
         let outcome = run_one(reader, &input);
         report.slowest_ms = report.slowest_ms.max(start.elapsed().as_secs_f64() * 1e3);

@@ -67,6 +67,21 @@ fn the_walk_keeps_feet_on_the_ground() {
     );
 }
 
+/// `glb` with its JSON chunk replaced by `edit` of it (padded, lengths rewritten).
+fn with_json(glb: &[u8], edit: impl Fn(&str) -> String) -> Vec<u8> {
+    let len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json = edit(std::str::from_utf8(&glb[20..20 + len]).unwrap());
+    let padded = format!("{json:<width$}", width = json.len().div_ceil(4) * 4);
+    let mut out = glb[..12].to_vec();
+    out.extend((padded.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(padded.as_bytes());
+    out.extend(&glb[20 + len..]);
+    let total = out.len() as u32;
+    out[8..12].copy_from_slice(&total.to_le_bytes());
+    out
+}
+
 /// Broken files: one line naming the file and the cause.
 #[test]
 fn broken_files_are_refused_in_one_line() {
@@ -80,23 +95,23 @@ fn broken_files_are_refused_in_one_line() {
         "{text}"
     );
     // The JSON chunk with an accessor's count made absurd: refused by the bounds check.
-    let mut json_len = [0u8; 4];
-    json_len.copy_from_slice(&bytes[12..16]);
-    let len = u32::from_le_bytes(json_len) as usize;
-    let json = std::str::from_utf8(&bytes[20..20 + len]).unwrap();
-    let bad = json.replacen("\"count\":", "\"count\":9", 1);
-    let mut out = bytes[..12].to_vec();
-    let padded = format!("{bad:<width$}", width = bad.len().div_ceil(4) * 4);
-    out.extend((padded.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(padded.as_bytes());
-    out.extend(&bytes[20 + len..]);
-    let total = out.len() as u32;
-    out[8..12].copy_from_slice(&total.to_le_bytes());
+    let out = with_json(&bytes, |json| json.replacen("\"count\":", "\"count\":9", 1));
     let e = parse_character("man.glb", &out, None, budget)
         .unwrap_err()
         .to_string();
     assert!(e.contains("accessor") && !e.contains('\n'), "{e}");
+    // A node hierarchy with a cycle (the fuzzer's hang: walking up the parents never ended)
+    // and a node with two parents: refused, naming the node.
+    for (from, to, names) in [
+        ("\"children\":[3]", "\"children\":[3,0]", "ancestor"),
+        ("\"children\":[3]", "\"children\":[3,5]", "child of nodes"),
+    ] {
+        let out = with_json(&bytes, |json| json.replacen(from, to, 1));
+        let e = parse_character("man.glb", &out, None, budget)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(names) && !e.contains('\n'), "{e}");
+    }
     // A tiny budget is refused before reading.
     let tiny = MemoryBudget::from_mib(1, "--memory-budget-mib").unwrap();
     let e = parse_character("man.glb", &bytes, None, tiny)

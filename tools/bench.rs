@@ -121,6 +121,13 @@ enum Cmd {
         /// Only these readers (default: every one).
         #[arg(long, value_delimiter = ',')]
         readers: Vec<hairmesh::fuzz::Reader>,
+        /// Instead of a campaign: write input N (from 0) of the one --readers campaign to
+        /// --to, to reproduce a finding alone.
+        #[arg(long, value_name = "N", requires = "to")]
+        save_input: Option<u64>,
+        /// Where --save-input writes the input.
+        #[arg(long, requires = "save_input")]
+        to: Option<PathBuf>,
     },
     /// The paper's comparison in one run: hair mesh (mesh and compute paths) vs linear hair
     /// skinning vs static strands per model, crowd LoD on/off, near/mid/far LoD, GPU bytes.
@@ -760,9 +767,27 @@ fn run(args: Args) -> Result<()> {
         Cmd::Temporal(args) => temporal::bench_temporal(args)?,
         Cmd::Compare(args) => compare::bench_compare(args)?,
         Cmd::Fuzz {
+            save_input: Some(index),
+            to: Some(to),
+            readers,
+            seed,
+            ..
+        } => {
+            let [reader] = readers[..] else {
+                bail!("--save-input: name one reader with --readers");
+            };
+            let out = OutputPath::check(&to, &[])?;
+            out.write(&hairmesh::fuzz::nth_input(reader, seed, index))?;
+            outln!(
+                "wrote input {index} of the {reader:?} campaign (seed {seed}) to {}",
+                to.display()
+            )?;
+        }
+        Cmd::Fuzz {
             iterations,
             seed,
             readers,
+            ..
         } => {
             outln!("| reader | inputs | accepted | rejected | panics | slowest ms | seconds |")?;
             outln!("|---|---|---|---|---|---|---|")?;

@@ -233,15 +233,40 @@ fn character_skin(doc: &gltf::Document) -> std::result::Result<gltf::Skin<'_>, S
         .ok_or_else(|| "no skin: the character's meshes must be skinned".to_string())
 }
 
-/// The parent of every node (`None` for scene roots).
-fn parents(doc: &gltf::Document) -> Vec<Option<usize>> {
-    let mut parent = vec![None; doc.nodes().len()];
+/// The parent of every node (`None` for scene roots). A hierarchy that is not a forest is
+/// refused (glTF 2.0, 3.5.3 "Transformations": a node is the child of at most one node and no
+/// node is its own ancestor): walking up from a node must end.
+fn parents(doc: &gltf::Document) -> std::result::Result<Vec<Option<usize>>, String> {
+    let mut parent: Vec<Option<usize>> = vec![None; doc.nodes().len()];
     for n in doc.nodes() {
         for c in n.children() {
-            parent[c.index()] = Some(n.index());
+            if let Some(other) = parent[c.index()].replace(n.index()) {
+                return Err(format!(
+                    "node {} is a child of nodes {other} and {}",
+                    c.index(),
+                    n.index()
+                ));
+            }
         }
     }
-    parent
+    // 0 not seen, 1 on the current walk up, 2 known to reach a root: every node is walked once.
+    let mut state = vec![0u8; parent.len()];
+    for start in 0..parent.len() {
+        let mut at = Some(start);
+        let mut walked = Vec::new();
+        while let Some(n) = at.filter(|&n| state[n] != 2) {
+            if state[n] == 1 {
+                return Err(format!("node {n} is its own ancestor"));
+            }
+            state[n] = 1;
+            walked.push(n);
+            at = parent[n];
+        }
+        for n in walked {
+            state[n] = 2;
+        }
+    }
+    Ok(parent)
 }
 
 /// Local transform of a node.
@@ -264,7 +289,7 @@ fn read_skeleton(data: &Data, doc: &gltf::Document, skin: &gltf::Skin) -> Result
             nodes.len()
         )));
     }
-    let parent = parents(doc);
+    let parent = parents(doc).map_err(|e| data.bad(e))?;
     let is_joint = |n: usize| nodes.contains(&n);
     let depth = |mut n: usize| {
         let mut d = 0;
