@@ -82,6 +82,11 @@ vec3 light_arrival_with(vec3 p, float offset, float body, bool slide) {
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || c.z < 0.0 || c.z > 1.0) {
         return vec3(body, body, 0.0);
     }
+    // Wholly behind bodies: no light arrives, directly or scattered through hair (x and y are
+    // 0, and dual scattering's every term carries one of them), so the hair taps are skipped.
+    if (body <= 0.0) {
+        return vec3(0.0);
+    }
     int res = int(frame.shadow.y);
     vec2 st = uv * float(res) - (slide ? 0.5 : 0.0);
     ivec2 base = ivec2(floor(st));

@@ -24,6 +24,11 @@ shared vec3 st[MAX_ENTRIES];   // tangents
 shared vec3 sd[MAX_ENTRIES];
 #endif
 
+// Per strand of the workgroup, what is constant along it (strand_info) and its root offset
+// (root_bulge: twelve texel fetches), made once per strand instead of once per vertex.
+shared StrandInfo s_info[S];
+shared vec3 s_root_offset[S];
+
 // Strands one workgroup builds for strands of `segments` segments.
 uint strands_per_group(uint segments) {
     return max(S / segments, 1u);
@@ -64,10 +69,12 @@ vec3 coarse_tangent_at(uint base, uint k, uint segments) {
     return coarse_tangent_at_even(base, k, segments);
 }
 
-// Shared entry idx: vertex k of strand si, world space; with `moving`, also its displacement
-// to the previous pose (the same strand from the previous texture set: same seed and root).
-void place_vertex(uint idx, StrandInfo si, uint k, uint segments, bool moving) {
-    vec3 now = (model * vec4(strand_vertex(si, k, segments), 1.0)).xyz;
+// Shared entry idx: vertex k of strand j of the workgroup (s_info / s_root_offset), world space;
+// with `moving`, also its displacement to the previous pose (the same strand from the previous
+// texture set: same seed and root; its root offset from those textures).
+void place_vertex(uint idx, uint j, uint k, uint segments, bool moving) {
+    StrandInfo si = s_info[j];
+    vec3 now = (model * vec4(strand_vertex_offset(si, s_root_offset[j], k, segments), 1.0)).xyz;
     sp[idx] = now;
 #ifdef VISIBILITY
     if (moving) {
@@ -101,22 +108,27 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
 #else
     bool moving = false;
 #endif
+    if (t < per) {
+        StrandInfo si = strand_info(bundle, first + t);
+        s_info[t] = si;
+        s_root_offset[t] = root_bulge(root_cell(si.origin), si.local);
+    }
+    barrier();
     if (per == 1u) {
-        StrandInfo si = strand_info(bundle, first);
         uint n = segments / S;
         for (uint i = 0u; i < n; i++) {
             uint k = t * n + i + 1u;
-            place_vertex(k, si, k, segments, moving);
+            place_vertex(k, 0u, k, segments, moving);
         }
         if (t == 0u) {
-            place_vertex(0u, si, 0u, segments, moving);
+            place_vertex(0u, 0u, 0u, segments, moving);
         }
     } else {
         uint j = t / segments;
         uint k = t % segments + 1u;
-        place_vertex(j * stride + k, strand_info(bundle, first + j), k, segments, moving);
+        place_vertex(j * stride + k, j, k, segments, moving);
         if (t < per) {
-            place_vertex(t * stride, strand_info(bundle, first + t), 0u, segments, moving);
+            place_vertex(t * stride, t, 0u, segments, moving);
         }
     }
     barrier();

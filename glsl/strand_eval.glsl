@@ -184,16 +184,17 @@ StrandInfo strand_info(uint g, uint strand) {
     return si;
 }
 
-// Position of vertex k of `segments` (k = 0 is the root: one lookup, no styling).
-vec3 strand_vertex(StrandInfo si, uint k, uint segments) {
+// strand_vertex with the strand's root offset `root_offset` (root_bulge of its cell and local
+// coordinate) given: the strand builders compute it once per strand, not per vertex.
+vec3 strand_vertex_offset(StrandInfo si, vec3 root_offset, uint k, uint segments) {
     if (k == 0u || !si.kept) {
-        return root_point(si.coord) + root_bulge(root_cell(si.origin), si.local);
+        return root_point(si.coord) + root_offset;
     }
     float s = float(k) / float(segments);
     float r = s * si.span;
     // Curved roots over the first segment only (src/reference/root_surface.rs).
     float fade = root_bulge_fade(r);
-    vec3 bulge = fade > 0.0 ? root_bulge(root_cell(si.origin), si.local) * fade : vec3(0.0);
+    vec3 bulge = fade > 0.0 ? root_offset * fade : vec3(0.0);
     vec3 p = curve_point(si.coord, r);
     if (style.clump_strength > 0.0) {
         vec3 c = curve_point(si.centre_coord, r);
@@ -204,6 +205,11 @@ vec3 strand_vertex(StrandInfo si, uint k, uint segments) {
     styling_frame(si.coord, r, fu, fv, fw, w);
     vec3 off = styling_offset(si.key, s, w);
     return p + fu * off.x + fv * off.y + fw * off.z + bulge;
+}
+
+// Position of vertex k of `segments` (k = 0 is the root: one lookup, no styling).
+vec3 strand_vertex(StrandInfo si, uint k, uint segments) {
+    return strand_vertex_offset(si, root_bulge(root_cell(si.origin), si.local), k, segments);
 }
 
 // Tangents from positions (sec. 3.5): central differences, eq. 5 / eq. 6 at the ends.

@@ -105,6 +105,14 @@ fn broken_files_are_refused_in_one_line() {
     for (from, to, names) in [
         ("\"children\":[3]", "\"children\":[3,0]", "ancestor"),
         ("\"children\":[3]", "\"children\":[3,5]", "child of nodes"),
+        // Animation channels the gltf crate's validation passes and its accessors unwrap
+        // (panics the fuzzer found): an unknown target path, a target node that does not exist.
+        ("\"path\":\"rotation\"", "\"path\":\"twist\"", "target path"),
+        (
+            "\"target\":{\"node\":",
+            "\"target\":{\"node\":9999,\"x\":",
+            "node 9999",
+        ),
     ] {
         let out = with_json(&bytes, |json| json.replacen(from, to, 1));
         let e = parse_character("man.glb", &out, None, budget)

@@ -70,6 +70,7 @@ pub fn parse_character(
     let gltf = gltf::Gltf::from_slice(bytes)
         .map_err(|e| bad(format!("not a valid glTF 2.0 file: {e}")))?;
     let doc = &gltf.document;
+    check_channels(doc.as_json()).map_err(bad)?;
     budget.check(
         name,
         "reading the character",
@@ -231,6 +232,28 @@ fn character_skin(doc: &gltf::Document) -> std::result::Result<gltf::Skin<'_>, S
         .find_map(|n| n.mesh().and(n.skin()))
         .or_else(|| doc.skins().next())
         .ok_or_else(|| "no skin: the character's meshes must be skinned".to_string())
+}
+
+/// What the gltf crate's validation leaves out and its accessors unwrap (a panic the fuzzer
+/// found): every animation channel targets a node that exists, with a path glTF 2.0 names.
+fn check_channels(root: &gltf::json::Root) -> std::result::Result<(), String> {
+    use gltf::json::validation::Checked;
+    for (a, anim) in root.animations.iter().enumerate() {
+        for (c, ch) in anim.channels.iter().enumerate() {
+            let node = ch.target.node.value();
+            if node >= root.nodes.len() {
+                return Err(format!(
+                    "animation {a} channel {c} targets node {node}, which does not exist"
+                ));
+            }
+            if !matches!(ch.target.path, Checked::Valid(_)) {
+                return Err(format!(
+                    "animation {a} channel {c}: its target path is not translation, rotation, scale or weights"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The parent of every node (`None` for scene roots). A hierarchy that is not a forest is
