@@ -672,6 +672,51 @@ fn write_png(out: &OutputPath, rgba: Vec<u8>, width: u32, height: u32) -> Result
     Ok(())
 }
 
+/// `bench fuzz`: a campaign per chosen reader (every one when none is named), one table row
+/// each; or, with `save`, input N of the one named reader written to a file.
+fn bench_fuzz(
+    iterations: u64,
+    seed: u64,
+    readers: &[hairmesh::fuzz::Reader],
+    save: Option<(u64, PathBuf)>,
+) -> Result<()> {
+    if let Some((index, to)) = save {
+        let [reader] = readers[..] else {
+            bail!("--save-input: name one reader with --readers");
+        };
+        let out = OutputPath::check(&to, &[])?;
+        out.write(&hairmesh::fuzz::nth_input(reader, seed, index))?;
+        outln!(
+            "wrote input {index} of the {reader:?} campaign (seed {seed}) to {}",
+            to.display()
+        )?;
+        return Ok(());
+    }
+    outln!("| reader | inputs | accepted | rejected | panics | slowest ms | seconds |")?;
+    outln!("|---|---|---|---|---|---|---|")?;
+    let all = hairmesh::fuzz::Reader::ALL;
+    for reader in all
+        .into_iter()
+        .filter(|r| readers.is_empty() || readers.contains(r))
+    {
+        let start = Instant::now();
+        let r = hairmesh::fuzz::campaign(reader, iterations, seed);
+        outln!(
+            "| {reader:?} | {} | {} | {} | {} | {:.1} | {:.1} |",
+            r.inputs,
+            r.accepted,
+            r.rejected,
+            r.panics.len(),
+            r.slowest_ms,
+            start.elapsed().as_secs_f64()
+        )?;
+        for (i, msg) in r.panics.iter().take(5) {
+            outln!("  panic at input {i}: {msg}")?;
+        }
+    }
+    Ok(())
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -767,51 +812,12 @@ fn run(args: Args) -> Result<()> {
         Cmd::Temporal(args) => temporal::bench_temporal(args)?,
         Cmd::Compare(args) => compare::bench_compare(args)?,
         Cmd::Fuzz {
-            save_input: Some(index),
-            to: Some(to),
-            readers,
-            seed,
-            ..
-        } => {
-            let [reader] = readers[..] else {
-                bail!("--save-input: name one reader with --readers");
-            };
-            let out = OutputPath::check(&to, &[])?;
-            out.write(&hairmesh::fuzz::nth_input(reader, seed, index))?;
-            outln!(
-                "wrote input {index} of the {reader:?} campaign (seed {seed}) to {}",
-                to.display()
-            )?;
-        }
-        Cmd::Fuzz {
             iterations,
             seed,
             readers,
-            ..
-        } => {
-            outln!("| reader | inputs | accepted | rejected | panics | slowest ms | seconds |")?;
-            outln!("|---|---|---|---|---|---|---|")?;
-            let all = hairmesh::fuzz::Reader::ALL;
-            for reader in all
-                .into_iter()
-                .filter(|r| readers.is_empty() || readers.contains(r))
-            {
-                let start = Instant::now();
-                let r = hairmesh::fuzz::campaign(reader, iterations, seed);
-                outln!(
-                    "| {reader:?} | {} | {} | {} | {} | {:.1} | {:.1} |",
-                    r.inputs,
-                    r.accepted,
-                    r.rejected,
-                    r.panics.len(),
-                    r.slowest_ms,
-                    start.elapsed().as_secs_f64()
-                )?;
-                for (i, msg) in r.panics.iter().take(5) {
-                    outln!("  panic at input {i}: {msg}")?;
-                }
-            }
-        }
+            save_input,
+            to,
+        } => bench_fuzz(iterations, seed, &readers, save_input.zip(to))?,
         Cmd::Crowd {
             counts,
             width,

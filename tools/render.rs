@@ -649,10 +649,10 @@ fn render_and_write(
         describe_frame: args.print_frame,
         ..Default::default()
     };
-    let mut out = renderer.render_one(&view, &opts)?;
+    let mut out = renderer.render_one(view, &opts)?;
     // Later frames report steady-state timings (the first includes shader JIT on lavapipe).
     for _ in 1..args.repeat {
-        out = renderer.render_one(&view, &opts)?;
+        out = renderer.render_one(view, &opts)?;
     }
     if let Some(second) = second {
         outln!(
@@ -670,7 +670,7 @@ fn render_and_write(
             )?;
         }
         out = renderer.render_one(
-            &view,
+            view,
             &FrameOptions {
                 path: Some(second),
                 read_image: true,
@@ -695,7 +695,7 @@ fn render_and_write(
     let rgba = out.rgba.clone().context("no image read back")?;
     let png =
         hairmesh::fsutil::encode_png(&args.output.display().to_string(), width, height, rgba)?;
-    print_report(&ctx, &args, (inputs.characters.len(), settings), &out, wall)?;
+    print_report(ctx, args, (inputs.characters.len(), settings), &out, wall)?;
     // The last line comes before the file: a stdout that fails leaves no output behind.
     outln!("writing {}", args.output.display())?;
     output.write(&png)?;

@@ -308,9 +308,12 @@ fn an_interrupted_crowd_leaves_nothing() {
     assert_eq!(std::fs::read_dir(&existing).unwrap().count(), 1);
 }
 
+/// The OBJ and style a `fit` run writes.
+type FitOutputs = (Vec<u8>, Vec<u8>);
+
 /// A `.hair` model of the small patch, and the outputs `fit --bundles N` makes of it
 /// (reference copies written elsewhere).
-fn fit_inputs(dir: &Path) -> (std::path::PathBuf, [(Vec<u8>, Vec<u8>); 2]) {
+fn fit_inputs(dir: &Path) -> (std::path::PathBuf, [FitOutputs; 2]) {
     let obj = dir.join("m.obj");
     let hair = dir.join("few.hair");
     let o = run(

@@ -446,6 +446,18 @@ fn check_memory(args: &Args) -> Result<()> {
 }
 
 impl Args {
+    /// The frame settings the flags ask for (the path and rasterizers the device picks are
+    /// filled in once the renderer exists).
+    fn frame_settings(&self) -> hairmesh::render::FrameSettings {
+        hairmesh::render::FrameSettings {
+            path: self.path.unwrap_or(RenderPath::Compute),
+            raster: self.draw.unwrap_or_default(),
+            transparency: self.transparency,
+            msaa: self.msaa,
+            light_raster: self.shadow_draw.unwrap_or_default(),
+        }
+    }
+
     /// The view's volume tier from `--volumes` and `--volume-band`.
     fn volume_tier(&self) -> Result<hairmesh::render::VolumeTier> {
         use hairmesh::render::VolumeTier;
@@ -548,13 +560,7 @@ fn check_args(p: &hairmesh::cli::Parsed<Args>) -> Result<Checked> {
             args.wind_dir
         );
     }
-    let settings = hairmesh::render::FrameSettings {
-        path: args.path.unwrap_or(RenderPath::Compute),
-        raster: args.draw.unwrap_or_default(),
-        transparency: args.transparency,
-        msaa: args.msaa,
-        light_raster: args.shadow_draw.unwrap_or_default(),
-    };
+    let settings = args.frame_settings();
     if let Err(why) = settings.check_combination() {
         bail!("--draw / --msaa {} / --transparency: {why}", args.msaa);
     }
@@ -611,13 +617,7 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     )?);
     check_device_limits(&ctx, &args, (width, height))?;
     let scene = Scene::build(&args)?;
-    let settings = hairmesh::render::FrameSettings {
-        path: args.path.unwrap_or(RenderPath::Compute),
-        raster: args.draw.unwrap_or_default(),
-        transparency: args.transparency,
-        msaa: args.msaa,
-        light_raster: args.shadow_draw.unwrap_or_default(),
-    };
+    let settings = args.frame_settings();
     let generate_s = scene.generate_s;
     let characters = &scene.characters;
     let mut renderer = scene.renderer(&ctx, &args, width, height)?;
