@@ -565,7 +565,7 @@ fn stage(path: &Path, bytes: &[u8]) -> Result<Staged> {
 /// Write several outputs of one run all or none: their missing folders are made and every
 /// file is staged (written and synced beside its path) before the first is renamed into place,
 /// so a full disk or a failing write leaves no output of the run behind (and no folder it made);
-/// the renames hold the output folders' locks ([`Publish`]). Devices (`/dev/null`) are written
+/// the renames hold the output folders' locks. Devices (`/dev/null`) are written
 /// last.
 pub fn write_together(outputs: &[(&OutputPath, &[u8])]) -> Result<()> {
     let mut made: Vec<Staged> = Vec::new();
