@@ -362,7 +362,7 @@ struct Publish {
 
 impl Publish {
     /// Lock the staging list, then `folders` (sorted, so two runs cannot deadlock).
-    fn begin<'a>(folders: impl IntoIterator<Item = &'a Path>) -> Result<Self> {
+    fn begin<'a>(folders: impl IntoIterator<Item = &'a Path>) -> Self {
         let list = staged_list();
         let mut keys: Vec<PathBuf> = folders
             .into_iter()
@@ -372,14 +372,19 @@ impl Publish {
         keys.dedup();
         let mut locks = Vec::new();
         for k in keys {
-            let f = std::fs::File::open(&k).map_err(|e| HairError::io(&k, e))?;
-            f.lock().map_err(|e| HairError::io(&k, e))?;
-            locks.push(f);
+            // A folder that cannot be opened for reading, or a file system without locks
+            // (some network and FUSE mounts), publishes unlocked: one run's outputs stay
+            // all-or-none, only concurrent runs are not ordered there.
+            if let Ok(f) = std::fs::File::open(&k)
+                && f.lock().is_ok()
+            {
+                locks.push(f);
+            }
         }
-        Ok(Publish {
+        Publish {
             list,
             _locks: locks,
-        })
+        }
     }
 
     /// `entries` are published: off the staging list, left in place.
@@ -489,7 +494,7 @@ impl StagedFolder {
     /// target does not exist, also when another run made it after the check).
     pub fn publish(mut self) -> Result<()> {
         self.ensure_staging()?;
-        let mut publish = Publish::begin([parent_folder(&self.target)])?;
+        let mut publish = Publish::begin([parent_folder(&self.target)]);
         if self.existed || self.target.is_dir() {
             for (k, n) in self.written.iter().enumerate() {
                 if k == 1 {
@@ -594,10 +599,7 @@ pub fn write_together(outputs: &[(&OutputPath, &[u8])]) -> Result<()> {
             }
         }
     }
-    let mut publish = match Publish::begin(staged.iter().map(|(_, p)| parent_folder(p))) {
-        Ok(p) => p,
-        Err(e) => return fail(&made, &staged, e),
-    };
+    let mut publish = Publish::begin(staged.iter().map(|(_, p)| parent_folder(p)));
     for (k, (tmp, path)) in staged.iter().enumerate() {
         if k == 1 {
             Publish::test_pause();
