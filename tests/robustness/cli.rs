@@ -178,6 +178,9 @@ fn refusals_name_flags_not_buffers() {
         "{err}"
     );
     assert!(!png.exists());
+    // The window's crowd too: the device's limits are checked before the crowd is built or a
+    // window opened (no display is needed to be refused).
+    refused_before_work(&crowd(&["--msaa", "64", "--count", "1"]), "--msaa 64");
 }
 
 /// Folders above an output are made as `mkdir -p` would, and removed again when the run fails.

@@ -604,11 +604,16 @@ fn frame_name(f: u32) -> String {
 fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     let Checked { volumes, out } = check_args(&parsed)?;
     let args = parsed.args;
+    let (width, height) = parse_size(&args.size)?;
     let Some(mut out) = out else {
+        // The window makes its own device once it exists; the flags are checked against the
+        // device before the crowd is built all the same.
+        let probe = Context::new(&ContextDesc::default().device(args.device.clone()))?;
+        check_device_limits(&probe, &args, (width, height))?;
+        drop(probe);
         let scene = Scene::build(&args)?;
         return window::run(args, scene);
     };
-    let (width, height) = parse_size(&args.size)?;
     // The device's limits are checked before the crowd is built.
     let ctx = Arc::new(Context::new(
         &ContextDesc::default()
