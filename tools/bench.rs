@@ -145,7 +145,7 @@ enum Cmd {
         /// Choose the GPU by name substring.
         #[arg(long)]
         device: Option<String>,
-        /// How every method's strands are rasterized: hw, soft[:K] or auto[:K] (the static
+        /// How every method's strands are rasterized: hw, soft, soft:K, auto or auto:K (the static
         /// and LHS paths give their stored strands to the software rasterizer too).
         #[arg(long, default_value = "hw")]
         draw: StrandRaster,
@@ -256,7 +256,7 @@ enum Cmd {
         /// Write the largest crowd's frame (mesh path or compute, LoD on) here.
         #[arg(long)]
         picture: Option<PathBuf>,
-        /// Strand rasterization: hw, soft[:K] or auto[:K] (see `render --help`).
+        /// Strand rasterization: hw, soft, soft:K, auto or auto:K (see `render --help`).
         #[arg(long, default_value = "hw")]
         draw: hairmesh::render::StrandRaster,
         /// Instead: the crowd's default look (Marschner, deep opacity shadows) with the old

@@ -40,7 +40,7 @@ pub struct TemporalArgs {
     /// Scenarios: orbit, dolly, crowd.
     #[arg(long, value_delimiter = ',', default_value = "orbit,dolly,crowd", value_parser = ["orbit", "dolly", "crowd"])]
     scenarios: Vec<String>,
-    /// How our frames' strands are rasterized: hw, soft[:K] or auto[:K].
+    /// How our frames' strands are rasterized: hw, soft, soft:K, auto or auto:K.
     #[arg(long, default_value = "hw")]
     draw: StrandRaster,
     /// Choose the GPU by name substring.

@@ -6,7 +6,7 @@
 //! Mouse: left-drag orbits (outside the panel), wheel zooms. Keys: W/A/S/D/Q/E move the orbit
 //! centre, Space pauses the automatic orbit, L toggles LoD, K cycles the shading model, M
 //! switches mesh / compute path,
-//! V cycles the present mode, [ and ] halve / double strands per bundle, - and = lower / raise
+//! V cycles the present mode, `[` and `]` halve / double strands per bundle, - and = lower / raise
 //! the vertex level, Escape closes. The title bar repeats the main figures.
 
 use std::sync::Arc;
