@@ -96,6 +96,19 @@ void main() {
     ivec2 texel = origin + ivec2(gl_LocalInvocationID.xy);
     bool inside = all(lessThan(texel, size));
     uint p = uint(texel.y) * uint(size.x) + uint(texel.x);
+    // A tile no segment reaches (most of the map): its texels' results are known, so they are
+    // written without the shared setup and its barriers (the branch is uniform: one tile per
+    // workgroup).
+    if (info.w == 0u) {
+        if (inside) {
+#ifdef OPACITY_PASS
+            soft_shadow_layers[p] = uvec2(0u);
+#else
+            soft_shadow_depth[p] = floatBitsToUint(1.0);
+#endif
+        }
+        return;
+    }
 #ifdef OPACITY_PASS
     for (uint i = 0u; i < 4u; i++) {
         s_layers[lp * 4u + i] = 0u;
