@@ -9,6 +9,9 @@
 #include "hair_shading.glsl"
 #include "temporal.glsl"
 
+// Depth is tested before shading (nothing here writes depth or discards), so hidden fragments
+// are not shaded: the visibility note would make the test late otherwise.
+layout(early_fragment_tests) in;
 layout(location = 0) in vec3 in_normal;
 layout(location = 1) flat in vec3 in_color;
 layout(location = 2) in vec3 in_pos;

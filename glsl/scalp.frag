@@ -3,6 +3,9 @@
 #include "bindings.glsl"
 #include "temporal.glsl"
 
+// Depth is tested before shading (nothing here writes depth or discards): the visibility
+// note would make the test late otherwise.
+layout(early_fragment_tests) in;
 layout(location = 0) in vec3 in_normal;
 layout(location = 1) flat in vec3 in_color;
 layout(location = 2) flat in uint in_character;

@@ -509,6 +509,9 @@ impl Renderer {
         let skin = self
             .skinned
             .frame_lists(moved, &camera, &mut prop_instances, &mut prop_draws);
+        // Bodies before the static props (the ground above all): what they hide of the ground
+        // is then never shaded.
+        prop_draws.sort_by_key(|d| !d.skinned);
         let (width, height) = self.targets.size();
         let slot = &mut self.frames[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;

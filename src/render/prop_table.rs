@@ -97,7 +97,17 @@ impl Props {
         for (mesh, inst) in &mut all {
             *mesh = self.mesh_for(*mesh, &Mat4::from_cols_array_2d(&inst.model), camera);
         }
-        all.sort_by_key(|(m, _)| *m);
+        // Each mesh's instances nearest first, so the depth test spares the shading of what
+        // nearer ones hide (props.frag tests depth before shading).
+        let distance = |i: &PropInstance| {
+            camera
+                .eye
+                .distance_squared(Vec3::from_slice(&i.model[3][..3]))
+        };
+        all.sort_by(|a, b| {
+            a.0.cmp(&b.0)
+                .then(distance(&a.1).total_cmp(&distance(&b.1)))
+        });
         let records = all.iter().map(|(_, i)| *i).collect();
         let mut draws: Vec<PropDraw> = Vec::new();
         for (k, (mesh, _)) in all.iter().enumerate() {

@@ -287,7 +287,16 @@ impl SkinnedProps {
                 work.widest = work.widest.max(r.vertex_count);
             }
         }
-        placed.sort_by_key(|(m, _)| *m);
+        // Each mesh's instances nearest first (as the static props'), for the depth test.
+        let distance = |i: &PropInstance| {
+            camera
+                .eye
+                .distance_squared(Vec3::from_slice(&i.model[3][..3]))
+        };
+        placed.sort_by(|a, b| {
+            a.0.cmp(&b.0)
+                .then(distance(&a.1).total_cmp(&distance(&b.1)))
+        });
         for (mesh, inst) in placed {
             let r = self.meshes[mesh];
             let k = records.len() as u32;
