@@ -97,17 +97,7 @@ impl Props {
         for (mesh, inst) in &mut all {
             *mesh = self.mesh_for(*mesh, &Mat4::from_cols_array_2d(&inst.model), camera);
         }
-        // Each mesh's instances nearest first, so the depth test spares the shading of what
-        // nearer ones hide (props.frag tests depth before shading).
-        let distance = |i: &PropInstance| {
-            camera
-                .eye
-                .distance_squared(Vec3::from_slice(&i.model[3][..3]))
-        };
-        all.sort_by(|a, b| {
-            a.0.cmp(&b.0)
-                .then(distance(&a.1).total_cmp(&distance(&b.1)))
-        });
+        sort_nearest_first(&mut all, camera.eye);
         let records = all.iter().map(|(_, i)| *i).collect();
         let mut draws: Vec<PropDraw> = Vec::new();
         for (k, (mesh, _)) in all.iter().enumerate() {
@@ -286,6 +276,16 @@ pub(super) fn far_choice(
     if pixels < below { far } else { mesh }
 }
 
+/// Order instances by mesh, each mesh's nearest `eye` first, so the depth test spares the
+/// shading of what nearer ones hide (`props.frag` tests depth before shading).
+pub(super) fn sort_nearest_first(instances: &mut [(usize, PropInstance)], eye: Vec3) {
+    let distance = |i: &PropInstance| eye.distance_squared(Vec3::from_slice(&i.model[3][..3]));
+    instances.sort_by(|a, b| {
+        a.0.cmp(&b.0)
+            .then(distance(&a.1).total_cmp(&distance(&b.1)))
+    });
+}
+
 /// A bounding sphere (centre, radius) of a mesh placed at `model`, in world space (the
 /// radius scaled by the model's largest axis scale).
 pub(super) fn world_sphere(model: &Mat4, (centre, radius): (Vec3, f32)) -> (Vec3, f32) {
@@ -315,6 +315,29 @@ pub fn bounding_sphere(vertices: &[PropVertex]) -> (Vec3, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Instances are grouped by mesh (one draw each), and within a mesh the nearest to the
+    /// eye comes first, wherever the eye is.
+    #[test]
+    fn each_meshs_instances_come_nearest_first() {
+        let at = |mesh: usize, x: f32| {
+            let model = Mat4::from_translation(Vec3::new(x, 0.0, 0.0)).to_cols_array_2d();
+            let inst = PropInstance {
+                model,
+                color: [0.0; 4],
+                clip_to_prev: model,
+                skin: [0; 4],
+            };
+            (mesh, inst)
+        };
+        let mut v = vec![at(1, 5.0), at(0, 9.0), at(1, 1.0), at(0, 2.0), at(1, 3.0)];
+        sort_nearest_first(&mut v, Vec3::ZERO);
+        let order: Vec<(usize, f32)> = v.iter().map(|(m, i)| (*m, i.model[3][0])).collect();
+        assert_eq!(order, [(0, 2.0), (0, 9.0), (1, 1.0), (1, 3.0), (1, 5.0)]);
+        sort_nearest_first(&mut v, Vec3::new(10.0, 0.0, 0.0));
+        let order: Vec<(usize, f32)> = v.iter().map(|(m, i)| (*m, i.model[3][0])).collect();
+        assert_eq!(order, [(0, 9.0), (0, 2.0), (1, 5.0), (1, 3.0), (1, 1.0)]);
+    }
 
     fn triangle(at: Vec3) -> Vec<PropVertex> {
         [Vec3::ZERO, Vec3::X, Vec3::Y]

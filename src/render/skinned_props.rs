@@ -287,16 +287,7 @@ impl SkinnedProps {
                 work.widest = work.widest.max(r.vertex_count);
             }
         }
-        // Each mesh's instances nearest first (as the static props'), for the depth test.
-        let distance = |i: &PropInstance| {
-            camera
-                .eye
-                .distance_squared(Vec3::from_slice(&i.model[3][..3]))
-        };
-        placed.sort_by(|a, b| {
-            a.0.cmp(&b.0)
-                .then(distance(&a.1).total_cmp(&distance(&b.1)))
-        });
+        super::prop_table::sort_nearest_first(&mut placed, camera.eye);
         for (mesh, inst) in placed {
             let r = self.meshes[mesh];
             let k = records.len() as u32;
