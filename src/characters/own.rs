@@ -82,24 +82,18 @@ impl OwnCharacter {
         self.head.grow(family, seed)
     }
 
-    /// Its meshes, then the far version of each in the same order (a mesh that clustering
-    /// would empty, as an iris smaller than a cell, is its own far version): what
-    /// `Renderer::set_skinned_meshes` takes.
+    /// Its meshes, then [`super::people::FAR_LEVELS`] far versions of each in the same order
+    /// (a mesh that clustering would empty, as an iris smaller than a cell, keeps the level
+    /// before): what `Renderer::set_skinned_meshes` takes.
     pub fn skinned_meshes(&self) -> Vec<SkinnedMesh> {
-        let mut all = self.character.meshes.clone();
-        let far: Vec<SkinnedMesh> = all
-            .iter()
-            .map(|m| {
-                let far = crate::skin::far::far_mesh(m, self.far_cell(m));
-                if far.indices.is_empty() {
-                    m.clone()
-                } else {
-                    far
-                }
-            })
-            .collect();
-        all.extend(far);
-        all
+        let cells = self.far_cells();
+        super::people::with_far_levels(self.character.meshes.clone(), |k| cells[k])
+    }
+
+    /// Each mesh's far cell ([`Self::far_cell`]).
+    fn far_cells(&self) -> Vec<f32> {
+        let meshes = &self.character.meshes;
+        meshes.iter().map(|m| self.far_cell(m)).collect()
     }
 
     /// Clustering cell of a mesh's far version: the people's head cell for small meshes
@@ -117,13 +111,9 @@ impl OwnCharacter {
     /// When each mesh switches to its far version (as the people's do:
     /// [`super::people::skinned_lods`]).
     pub fn skinned_lods(&self) -> Vec<PropLod> {
+        let cells = self.far_cells();
         let n = self.character.meshes.len();
-        self.character
-            .meshes
-            .iter()
-            .enumerate()
-            .map(|(k, m)| super::people::far_lod(m, (k, n + k), self.far_cell(m)))
-            .collect()
+        super::people::far_level_lods(&self.character.meshes, n, |k| cells[k])
     }
 
     /// The parts a copy wears: every mesh, in its own colours.
@@ -209,8 +199,12 @@ mod tests {
         println!("walk speed {speed} m/s");
         assert!((0.8..1.4).contains(&speed), "{speed}");
         let meshes = own.skinned_meshes();
-        assert_eq!(meshes.len(), 2 * own.character.meshes.len());
-        assert_eq!(own.skinned_lods().len(), own.character.meshes.len());
+        let levels = super::super::people::FAR_LEVELS;
+        assert_eq!(meshes.len(), (1 + levels) * own.character.meshes.len());
+        assert_eq!(
+            own.skinned_lods().len(),
+            levels * own.character.meshes.len()
+        );
         let c = own.colliders().unwrap();
         assert!(matches!(c.last(), Some(Collider::Head { .. })));
         let (m, head) = own.pose(0.3);

@@ -63,8 +63,13 @@ pub fn figures() -> Result<&'static [Arc<Character>; 2]> {
 /// figures' parts.
 pub const HEAD_MESH: usize = 2 * PARTS.len();
 /// Index of the first far mesh in [`skinned_meshes`]: far versions follow the near ones in
-/// the same order.
+/// the same order, level after level ([`FAR_LEVELS`]), so mesh `k`'s level `j` is at
+/// `j * FAR_MESHES + k`.
 pub const FAR_MESHES: usize = HEAD_MESH + 2;
+/// Far levels of every skinned mesh: level `j` (1 the first) is clustered at the mesh's far
+/// cell times `2^(j-1)`, so each level is drawn where its cell spans about
+/// [`super::preset::FAR_CELL_PIXELS`] and a crowd's far people cost what they cover.
+pub const FAR_LEVELS: usize = 3;
 /// Vertex clustering cell of far bodies and clothes, metres.
 pub const FAR_BODY_CELL: f32 = 0.04;
 /// Vertex clustering cell of far heads and eyes, metres.
@@ -86,8 +91,9 @@ fn far_cell(k: usize) -> f32 {
 }
 
 /// Every figure's meshes, figure after figure (mesh `k` of figure `f` at
-/// `f * PARTS.len() + k`), the head's bust and eyes ([`HEAD_MESH`]), then the far version of
-/// each in the same order ([`FAR_MESHES`]): what `Renderer::set_skinned_meshes` takes.
+/// `f * PARTS.len() + k`), the head's bust and eyes ([`HEAD_MESH`]), then [`FAR_LEVELS`] far
+/// versions of each in the same order ([`FAR_MESHES`]): what `Renderer::set_skinned_meshes`
+/// takes.
 pub fn skinned_meshes() -> Result<Vec<crate::skin::SkinnedMesh>> {
     let mut near = Vec::new();
     for c in figures()? {
@@ -97,23 +103,57 @@ pub fn skinned_meshes() -> Result<Vec<crate::skin::SkinnedMesh>> {
         }
     }
     near.extend(head_meshes()?);
-    let far: Vec<_> = near
-        .iter()
-        .enumerate()
-        .map(|(k, m)| crate::skin::far::far_mesh(m, far_cell(k)))
-        .collect();
-    near.extend(far);
-    Ok(near)
+    Ok(with_far_levels(near, far_cell))
 }
 
-/// Far versions of [`skinned_meshes`]: a mesh switches to its far version where a cell spans
-/// under [`super::preset::FAR_CELL_PIXELS`] (as the static props do).
+/// `near` followed by [`FAR_LEVELS`] levels of far versions of every mesh, level `j`
+/// clustered at `cell(k) * 2^(j-1)` for mesh `k`; where clustering would empty a mesh (an
+/// iris smaller than a cell), the level keeps the level before.
+pub fn with_far_levels(
+    near: Vec<crate::skin::SkinnedMesh>,
+    cell: impl Fn(usize) -> f32,
+) -> Vec<crate::skin::SkinnedMesh> {
+    let n = near.len();
+    let mut all = near;
+    for level in 1..=FAR_LEVELS {
+        for k in 0..n {
+            let coarser = (1u32 << (level - 1)) as f32;
+            let far = crate::skin::far::far_mesh(&all[k], cell(k) * coarser);
+            let kept = match far.indices.is_empty() {
+                true => all[(level - 1) * n + k].clone(),
+                false => far,
+            };
+            all.push(kept);
+        }
+    }
+    all
+}
+
+/// When each level of [`with_far_levels`]'s `meshes` (`n` near ones, clustered at `cell`)
+/// switches to the next: once the next level's cell spans under
+/// [`super::preset::FAR_CELL_PIXELS`].
+pub fn far_level_lods(
+    meshes: &[crate::skin::SkinnedMesh],
+    n: usize,
+    cell: impl Fn(usize) -> f32,
+) -> Vec<crate::render::prop_table::PropLod> {
+    let mut out = Vec::new();
+    for level in 0..FAR_LEVELS {
+        for k in 0..n.min(meshes.len()) {
+            let coarser = (1u32 << level) as f32;
+            let to = ((level * n + k), ((level + 1) * n + k));
+            out.push(far_lod(&meshes[k], to, cell(k) * coarser));
+        }
+    }
+    out
+}
+
+/// Far versions of [`skinned_meshes`]: a mesh switches to its next far level where that
+/// level's cell spans under [`super::preset::FAR_CELL_PIXELS`] (as the static props do).
 pub fn skinned_lods(
     meshes: &[crate::skin::SkinnedMesh],
 ) -> Vec<crate::render::prop_table::PropLod> {
-    (0..FAR_MESHES.min(meshes.len()))
-        .map(|k| far_lod(&meshes[k], (k, FAR_MESHES + k), far_cell(k)))
-        .collect()
+    far_level_lods(meshes, FAR_MESHES, far_cell)
 }
 
 /// Bind-pose box of `mesh`.
@@ -556,20 +596,32 @@ mod tests {
             assert!(matches!(c.last(), Some(Collider::Head { .. })));
         }
         let meshes = skinned_meshes().unwrap();
-        assert_eq!(meshes.len(), 2 * FAR_MESHES);
-        // Far versions never have more triangles; the bodies, clothes and head lose most.
-        let (mut near_all, mut far_all) = (0, 0);
-        for k in 0..FAR_MESHES {
-            let (near, far) = (&meshes[k], &meshes[FAR_MESHES + k]);
-            println!(
-                "{}: {} -> {} triangles",
-                near.name,
-                near.indices.len() / 3,
-                far.indices.len() / 3
+        assert_eq!(meshes.len(), (1 + FAR_LEVELS) * FAR_MESHES);
+        // Each level never has more triangles than the one before; the bodies, clothes and
+        // head lose most at each level.
+        let triangles = |level: usize| {
+            let range = level * FAR_MESHES..(level + 1) * FAR_MESHES;
+            meshes[range]
+                .iter()
+                .map(|m| m.indices.len() / 3)
+                .sum::<usize>()
+        };
+        for level in 1..=FAR_LEVELS {
+            for k in 0..FAR_MESHES {
+                let near = &meshes[(level - 1) * FAR_MESHES + k];
+                let far = &meshes[level * FAR_MESHES + k];
+                println!(
+                    "{} level {level}: {} triangles",
+                    near.name,
+                    far.indices.len() / 3
+                );
+                assert!(far.indices.len() <= near.indices.len(), "{}", near.name);
+            }
+            let (near_all, far_all) = (triangles(level - 1), triangles(level));
+            assert!(
+                far_all * 2 < near_all,
+                "level {level}: {far_all} of {near_all}"
             );
-            assert!(far.indices.len() <= near.indices.len(), "{}", near.name);
-            (near_all, far_all) = (near_all + near.indices.len(), far_all + far.indices.len());
         }
-        assert!(far_all * 3 < near_all, "{far_all} of {near_all}");
     }
 }

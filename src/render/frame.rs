@@ -43,11 +43,18 @@ struct DensityWork {
     draw: super::volume::TierDraw,
 }
 
+/// One frame's prop draws: the camera's, and the light's (the same props, bodies at the
+/// far level the light's map needs).
+pub(super) struct PropDraws {
+    camera: Vec<PropDraw>,
+    light: Vec<PropDraw>,
+}
+
 /// What one frame draws (beyond the options the caller gave).
 pub(super) struct FrameWork<'a> {
     path: RenderPath,
     bundles: u32,
-    props: &'a [PropDraw],
+    props: &'a PropDraws,
     /// Skinning jobs this frame and the most vertices of one.
     skin: (u32, u32),
     /// Shadow mode, when shadows are on and there is hair to shadow.
@@ -481,7 +488,8 @@ impl Renderer {
 
     /// Write slot `i`'s frame blocks, `records`, prop instances (with their motion where
     /// the frame has motion vectors) and skinning jobs and matrices, and size its readbacks;
-    /// returns this frame's prop draws and its skinning jobs and widest job.
+    /// returns this frame's prop draws (the camera's and the light's) and its skinning jobs
+    /// and widest job.
     fn write_slot(
         &mut self,
         i: usize,
@@ -489,7 +497,7 @@ impl Renderer {
         records: &[super::shared::CharacterRecord],
         motion: Option<&FrameMotion>,
         opts: &FrameOptions,
-    ) -> GpuResult<(Vec<PropDraw>, (u32, u32))> {
+    ) -> GpuResult<(PropDraws, (u32, u32))> {
         let crowd = &self.crowd;
         let still = glam::Mat4::IDENTITY;
         let moved = |id: super::crowd::CharacterId| {
@@ -504,14 +512,24 @@ impl Renderer {
             eye: glam::Vec3::from_slice(&block.camera_pos[..3]),
             height: block.camera_pos[3],
             cot_half_fov: block.light_dir[3],
+            texel: 0.0,
         };
+        // The bodies' light map sees far bodies at its own texel size.
+        let body_texel = block.body_shadow[3];
+        let light =
+            (body_texel > 0.0).then(|| super::prop_table::Projection::orthographic(body_texel));
         let (mut prop_instances, mut prop_draws) = self.props.frame_lists(&moved, world, &camera);
-        let skin = self
-            .skinned
-            .frame_lists(moved, &camera, &mut prop_instances, &mut prop_draws);
+        let mut light_draws = prop_draws.clone();
+        let skin = self.skinned.frame_lists(
+            moved,
+            (&camera, light.as_ref()),
+            &mut prop_instances,
+            (&mut prop_draws, &mut light_draws),
+        );
         // Bodies before the static props (the ground above all): what they hide of the ground
         // is then never shaded.
         prop_draws.sort_by_key(|d| !d.skinned);
+        light_draws.sort_by_key(|d| !d.skinned);
         let (width, height) = self.targets.size();
         let slot = &mut self.frames[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;
@@ -539,7 +557,11 @@ impl Renderer {
             opts.read_motion,
             pixels * 16,
         )?;
-        Ok((prop_draws, (skin.jobs.len() as u32, skin.widest)))
+        let draws = PropDraws {
+            camera: prop_draws,
+            light: light_draws,
+        };
+        Ok((draws, (skin.jobs.len() as u32, skin.widest)))
     }
 
     /// Record frame slot `i` into `target`'s command buffer: build the frame graph (hair mesh
@@ -628,10 +650,11 @@ impl Renderer {
             i,
         );
         let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
-        let props = PropList {
-            draws: work.props,
-            skin_indices: self.skinned.indices.as_ref(),
-        };
+        let skin_indices = self.skinned.indices.as_ref();
+        let props = [&work.props.camera, &work.props.light].map(|draws| PropList {
+            draws,
+            skin_indices,
+        });
         let mut inputs = frame_inputs(&work, (sets, props), clear, size, mesh_query.as_mut());
         if opts.probe_roots {
             let probe = g.import_buffer("root probe", root_probe);
@@ -731,12 +754,13 @@ impl Renderer {
         if slot.records.size < slots as u64 * size_of::<super::shared::CharacterRecord>() as u64 {
             slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
         }
-        let (skinned, matrices, posed) = self.skinned.capacity();
-        let instances = (self.props.instances.len() + self.props.attached.len()) as u32 + skinned;
+        let skin = self.skinned.capacity();
+        let instances =
+            (self.props.instances.len() + self.props.attached.len()) as u32 + skin.instances;
         if slot.prop_instances.size < instances as u64 * size_of::<PropInstance>() as u64 {
             slot.prop_instances = prop_instance_buffer(&self.ctx, instances.next_power_of_two())?;
         }
-        grow_skin_buffers(&self.ctx, slot, (skinned, matrices, posed))?;
+        grow_skin_buffers(&self.ctx, slot, skin)?;
         let probe_bytes = self.crowd.bundle_count() as u64 * 16;
         if slot.root_probe.size < probe_bytes {
             slot.root_probe =
@@ -854,8 +878,9 @@ fn add_host_start<'a>(
 fn grow_skin_buffers(
     ctx: &Arc<Context>,
     slot: &mut FrameSlot,
-    (jobs, matrices, posed): (u32, u32, u32),
+    skin: super::skinned_props::SkinCapacity,
 ) -> GpuResult<()> {
+    let (jobs, matrices, posed) = (skin.jobs, skin.matrices, skin.vertices);
     use super::shared::{SkinJob, SkinnedVertex};
     use super::slots::{host_table, skinned_buffer};
     let job_bytes = jobs as u64 * size_of::<SkinJob>() as u64;
@@ -896,7 +921,7 @@ pub(super) fn image_readback(ctx: &Arc<Context>, bytes: u64) -> GpuResult<Buffer
 /// What the frame's passes draw: the frame's work, its sets and props, and the slot's query.
 fn frame_inputs<'a>(
     work: &FrameWork<'a>,
-    ((sets, light_sets), props): ((PassSets<'a>, PassSets<'a>), PropList<'a>),
+    ((sets, light_sets), [props, light_props]): ((PassSets<'a>, PassSets<'a>), [PropList<'a>; 2]),
     clear: Option<[f32; 4]>,
     size: (u32, u32),
     mesh_query: Option<&'a mut crate::vk::MeshPrimitivesQuery>,
@@ -908,6 +933,7 @@ fn frame_inputs<'a>(
         path: work.path,
         clear,
         props,
+        light_props,
         skin: work.skin,
         probe: None,
         shadow: work.shadows,

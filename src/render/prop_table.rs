@@ -24,20 +24,36 @@ pub struct PropLod {
     pub below_pixels: f32,
 }
 
-/// How many pixels a sphere spans in a perspective view: eye, image height and
-/// `1 / tan(fov_y / 2)` (from the frame block; 0 for orthographic views, which pick no far
-/// meshes).
+/// How many pixels a sphere spans in a view: a perspective view's eye, image height and
+/// `1 / tan(fov_y / 2)` (from the frame block; 0 for an orthographic view), or an
+/// orthographic view's texel size (`texel`; 0 for perspective views). An orthographic view
+/// without a texel size picks no far meshes.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Projection {
     pub(super) eye: Vec3,
     pub(super) height: f32,
     pub(super) cot_half_fov: f32,
+    /// World size of one texel of an orthographic view (the light's maps); 0: perspective.
+    pub(super) texel: f32,
 }
 
 impl Projection {
-    /// Diameter in pixels of a sphere of `radius` at `centre` (infinite at the eye or in
-    /// orthographic views).
+    /// An orthographic view (a light's map) whose texels are `texel` world units wide.
+    pub(super) fn orthographic(texel: f32) -> Self {
+        Projection {
+            eye: Vec3::ZERO,
+            height: 0.0,
+            cot_half_fov: 0.0,
+            texel,
+        }
+    }
+
+    /// Diameter in pixels of a sphere of `radius` at `centre` (infinite at the eye, and in
+    /// orthographic views without a texel size).
     pub(super) fn pixels(&self, centre: Vec3, radius: f32) -> f32 {
+        if self.texel > 0.0 {
+            return 2.0 * radius / self.texel;
+        }
         let d = centre.distance(self.eye);
         if self.cot_half_fov <= 0.0 || d <= radius {
             return f32::INFINITY;
@@ -64,7 +80,7 @@ impl Props {
     /// The mesh an instance of `mesh` at `model` is drawn with: its far version where the
     /// camera sees it small.
     fn mesh_for(&self, mesh: usize, model: &Mat4, camera: &Projection) -> usize {
-        far_choice(mesh, self.far[mesh], self.bounds[mesh], model, camera)
+        far_choice(mesh, &self.far, self.bounds[mesh], model, camera)
     }
 
     /// This frame's instance records (sorted by mesh) and one draw per mesh: the world props
@@ -189,9 +205,8 @@ impl Props {
         Ok(())
     }
 
-    /// Give meshes far versions (replacing earlier ones); refuses unknown meshes, a mesh that
-    /// is its own far version, a far version with one of its own, and thresholds that are
-    /// not finite and non-negative.
+    /// Give meshes far versions (replacing earlier ones; chains allowed), checked by
+    /// [`far_table`].
     pub(super) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
         self.far = far_table(lods, self.meshes.len())?;
         Ok(())
@@ -228,17 +243,21 @@ impl Props {
 }
 
 /// The far version table of `n` meshes from `lods`: refuses unknown meshes, a mesh that is
-/// its own far version, a far version with one of its own, and thresholds that are not
-/// finite and non-negative.
+/// its own far version, a mesh with two far versions, chains of far versions that loop or
+/// whose thresholds grow, and thresholds that are not finite and non-negative. A far version
+/// may have a far version of its own (a chain of coarser and coarser levels).
 pub(super) fn far_table(lods: &[PropLod], n: usize) -> GpuResult<Vec<Option<(usize, f32)>>> {
+    let mut far = vec![None; n];
     for l in lods {
         let bad = if l.mesh >= n || l.far_mesh >= n {
             Some(format!("no prop mesh {}", l.mesh.max(l.far_mesh)))
-        } else if l.mesh == l.far_mesh || lods.iter().any(|o| o.mesh == l.far_mesh) {
+        } else if l.mesh == l.far_mesh {
             Some(format!(
-                "prop mesh {} cannot be a far version and have one",
-                l.far_mesh
+                "prop mesh {} cannot be its own far version",
+                l.mesh
             ))
+        } else if far[l.mesh].is_some() {
+            Some(format!("prop mesh {} has two far versions", l.mesh))
         } else if !(l.below_pixels.is_finite() && l.below_pixels >= 0.0) {
             Some(format!(
                 "far prop threshold {} is not a finite pixel count",
@@ -250,30 +269,50 @@ pub(super) fn far_table(lods: &[PropLod], n: usize) -> GpuResult<Vec<Option<(usi
         if let Some(e) = bad {
             return Err(GpuError::Unsupported(e));
         }
-    }
-    let mut far = vec![None; n];
-    for l in lods {
         far[l.mesh] = Some((l.far_mesh, l.below_pixels));
+    }
+    for start in 0..n {
+        // A chain longer than n meshes visits one twice.
+        let (mut mesh, mut steps) = (start, 0);
+        while let Some((next, below)) = far[mesh] {
+            let grows = far[next].is_some_and(|(_, b)| b > below);
+            if steps > n || grows {
+                return Err(GpuError::Unsupported(format!(
+                    "the far versions of prop mesh {start} loop or switch later than their \
+                     parent ({})",
+                    if grows { "threshold grows" } else { "loop" }
+                )));
+            }
+            (mesh, steps) = (next, steps + 1);
+        }
     }
     Ok(far)
 }
 
 /// The mesh an instance of `mesh` (bounding sphere `(centre, radius)` in its own frame) at
-/// `model` is drawn with: `far`'s mesh where `camera` sees the sphere, scaled by the model's
-/// largest axis, smaller than `far`'s pixel threshold.
+/// `model` is drawn with: down `far`'s chain of far versions while `camera` sees the sphere,
+/// scaled by the model's largest axis, smaller than the next version's pixel threshold.
 pub(super) fn far_choice(
     mesh: usize,
-    far: Option<(usize, f32)>,
+    far: &[Option<(usize, f32)>],
     (centre, radius): (Vec3, f32),
     model: &Mat4,
     camera: &Projection,
 ) -> usize {
-    let Some((far, below)) = far else {
+    if far[mesh].is_none() {
         return mesh;
-    };
+    }
     let (centre, radius) = world_sphere(model, (centre, radius));
     let pixels = camera.pixels(centre, radius);
-    if pixels < below { far } else { mesh }
+    let mut drawn = mesh;
+    // far_table refuses loops, so this ends within far.len() steps.
+    while let Some((next, below)) = far[drawn] {
+        if pixels >= below {
+            break;
+        }
+        drawn = next;
+    }
+    drawn
 }
 
 /// Order instances by mesh, each mesh's nearest `eye` first, so the depth test spares the
@@ -374,6 +413,7 @@ mod tests {
             eye: Vec3::new(0.5, 0.5, 0.0),
             height: 720.0,
             cot_half_fov: 1.0 / 30f32.to_radians().tan(),
+            texel: 0.0,
         };
         let at = |d: f32| Mat4::from_translation(Vec3::new(0.0, 0.0, -d));
         let d50 = r * 720.0 * camera.cot_half_fov / 50.0;
@@ -412,18 +452,26 @@ mod tests {
         ] {
             assert!(props.set_lods(&[bad]).is_err(), "{bad:?}");
         }
-        let chain = [
-            PropLod {
-                mesh: 0,
-                far_mesh: 1,
-                below_pixels: 1.0,
-            },
-            PropLod {
-                mesh: 1,
-                far_mesh: 2,
-                below_pixels: 1.0,
-            },
-        ];
-        assert!(props.set_lods(&chain).is_err());
+        let lod = |mesh, far_mesh, below_pixels| PropLod {
+            mesh,
+            far_mesh,
+            below_pixels,
+        };
+        // A chain of levels: 0 -> 1 below 50 pixels, 1 -> 2 below 20.
+        props.set_lods(&[lod(0, 1, 50.0), lod(1, 2, 20.0)]).unwrap();
+        let d20 = d50 * 2.5;
+        assert_eq!(props.mesh_for(0, &at(d50 * 0.99), &camera), 0);
+        assert_eq!(props.mesh_for(0, &at(d50 * 1.01), &camera), 1);
+        assert_eq!(props.mesh_for(0, &at(d20 * 0.99), &camera), 1);
+        assert_eq!(props.mesh_for(0, &at(d20 * 1.01), &camera), 2);
+        // A level drawn directly follows its own chain.
+        assert_eq!(props.mesh_for(1, &at(d20 * 1.01), &camera), 2);
+        for bad in [
+            vec![lod(0, 1, 20.0), lod(1, 2, 50.0)],
+            vec![lod(0, 1, 50.0), lod(1, 0, 50.0)],
+            vec![lod(0, 1, 50.0), lod(0, 2, 20.0)],
+        ] {
+            assert!(props.set_lods(&bad).is_err(), "{bad:?}");
+        }
     }
 }

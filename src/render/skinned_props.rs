@@ -12,7 +12,7 @@ use glam::{Mat4, Vec3};
 use super::crowd::CharacterId;
 use super::passes::props::PropDraw;
 use super::prop_table::{Projection, PropLod};
-use super::shared::{PropInstance, SkinJob, SkinRestVertex};
+use super::shared::{PropInstance, SKIN_GROUP_SIZE, SkinJob, SkinRestVertex};
 use crate::skin::SkinnedMesh;
 use crate::vk::{Buffer, Context, GpuError, GpuResult};
 
@@ -47,6 +47,34 @@ pub(super) struct SkinWork {
     pub vertices: u32,
     /// The most vertices of any job (the pass's dispatch width).
     pub widest: u32,
+}
+
+/// Upper bounds of a frame's skinning ([`SkinnedProps::capacity`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct SkinCapacity {
+    pub instances: u32,
+    pub jobs: u32,
+    pub matrices: u32,
+    pub vertices: u32,
+}
+
+/// Skin mesh `r` into the next `r.vertex_count` posed vertices with the matrices from
+/// `matrix_first`: one job per [`SKIN_GROUP_SIZE`] vertices, so the dispatch (a workgroup
+/// row per job, as wide as the widest job) has no idle workgroups where near and far
+/// meshes, thousands and tens of vertices, share a frame.
+fn push_jobs(work: &mut SkinWork, r: &MeshRange, matrix_first: u32) {
+    let mut first = 0;
+    while first < r.vertex_count {
+        let count = (r.vertex_count - first).min(SKIN_GROUP_SIZE);
+        work.jobs.push(SkinJob {
+            rest_first: r.rest_first + first,
+            vertex_count: count,
+            matrix_first,
+            out_first: work.vertices + first,
+        });
+        work.widest = work.widest.max(count);
+        first += count;
+    }
 }
 
 /// Skinned meshes and the characters wearing them.
@@ -225,37 +253,46 @@ impl SkinnedProps {
             .map(|w| (w.body, w.matrices.as_slice()))
     }
 
-    /// Upper bounds of a frame's instances, matrices and posed vertices.
-    pub(super) fn capacity(&self) -> (u32, u32, u32) {
-        let mut out = (0u32, 0u32, 0u32);
+    /// Upper bounds of a frame's instances, skinning jobs, matrices and posed vertices.
+    pub(super) fn capacity(&self) -> SkinCapacity {
+        let mut out = SkinCapacity::default();
         for w in self.wearers.values() {
-            out.0 += w.parts.len() as u32;
-            out.1 += w.joints as u32;
-            out.2 += w
-                .parts
-                .iter()
-                .map(|(m, _)| self.meshes[*m].vertex_count)
-                .sum::<u32>();
+            out.instances += w.parts.len() as u32;
+            out.matrices += w.joints as u32;
+            // Twice each instance: the camera's and the light's.
+            out.instances += w.parts.len() as u32;
+            for (m, _) in &w.parts {
+                // Far versions have no more vertices than their mesh, and the light's own
+                // version, when it has one, is at least the first far one.
+                let light = self.far[*m].map_or(0, |(far, _)| self.meshes[far].vertex_count);
+                for vertices in [self.meshes[*m].vertex_count, light] {
+                    out.jobs += vertices.div_ceil(SKIN_GROUP_SIZE);
+                    out.vertices += vertices;
+                }
+            }
         }
         out
     }
 
     /// This frame's skinning work, instances (appended to `records`, with their motion) and
     /// draws, for the characters `model_of` draws (`None`: hidden; the second matrix is the
-    /// character's clip-space motion, which the body shares), each at its body placement; far
-    /// versions where `camera` sees a mesh small. Characters are taken in slot order, so
-    /// frames are repeatable.
+    /// character's clip-space motion, which the body shares), each at its body placement:
+    /// the camera's (`draws`; far versions where `camera` sees a mesh small) and the light's
+    /// (`light_draws`; coarser far versions where `light`'s map sees a body smaller than the
+    /// camera does, posed alongside). Characters are taken in slot order, so frames are
+    /// repeatable.
     pub(super) fn frame_lists(
         &self,
         model_of: impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
-        camera: &Projection,
+        (camera, light): (&Projection, Option<&Projection>),
         records: &mut Vec<PropInstance>,
-        draws: &mut Vec<PropDraw>,
+        (draws, light_draws): (&mut Vec<PropDraw>, &mut Vec<PropDraw>),
     ) -> SkinWork {
         let mut work = SkinWork::default();
         let mut ids: Vec<&CharacterId> = self.wearers.keys().collect();
         ids.sort_by_key(|id| id.slot());
         let mut placed: Vec<(usize, PropInstance)> = Vec::new();
+        let mut cast: Vec<(usize, PropInstance)> = Vec::new();
         for id in ids {
             let w = &self.wearers[id];
             let Some((_, clip_to_prev)) = model_of(*id) else {
@@ -265,43 +302,37 @@ impl SkinnedProps {
             let matrix_first = work.matrices.len() as u32;
             work.matrices
                 .extend(w.matrices.iter().map(|m| m.to_cols_array_2d()));
-            for &(mesh, color) in &w.parts {
-                let mesh = self.mesh_for(mesh, &model, camera);
+            let mut pose = |mesh: usize, color| {
                 let r = self.meshes[mesh];
-                work.jobs.push(SkinJob {
-                    rest_first: r.rest_first,
-                    vertex_count: r.vertex_count,
-                    matrix_first,
-                    out_first: work.vertices,
-                });
-                placed.push((
-                    mesh,
-                    PropInstance {
-                        model: model.to_cols_array_2d(),
-                        color,
-                        clip_to_prev: clip_to_prev.to_cols_array_2d(),
-                        skin: [work.vertices, 0, 0, 0],
-                    },
-                ));
+                push_jobs(&mut work, &r, matrix_first);
+                let inst = PropInstance {
+                    model: model.to_cols_array_2d(),
+                    color,
+                    clip_to_prev: clip_to_prev.to_cols_array_2d(),
+                    skin: [work.vertices, 0, 0, 0],
+                };
                 work.vertices += r.vertex_count;
-                work.widest = work.widest.max(r.vertex_count);
+                (mesh, inst)
+            };
+            for &(mesh, color) in &w.parts {
+                let seen = pose(self.mesh_for(mesh, &model, camera), color);
+                placed.push(seen);
+                // The light's map draws the camera's version, or a coarser one of its own.
+                let lit = light.map_or(seen.0, |l| self.coarser_for(mesh, seen.0, &model, l));
+                cast.push(if lit == seen.0 {
+                    seen
+                } else {
+                    pose(lit, color)
+                });
             }
         }
         super::prop_table::sort_nearest_first(&mut placed, camera.eye);
-        for (mesh, inst) in placed {
-            let r = self.meshes[mesh];
-            let k = records.len() as u32;
-            records.push(inst);
-            match draws.last_mut() {
-                Some(d) if d.first_vertex == r.index_first && d.skinned => d.instance_count += 1,
-                _ => draws.push(PropDraw {
-                    first_vertex: r.index_first,
-                    vertex_count: r.index_count,
-                    first_instance: k,
-                    instance_count: 1,
-                    skinned: true,
-                }),
-            }
+        self.push_draws(&placed, records, draws);
+        if light.is_some() {
+            cast.sort_by_key(|(mesh, _)| *mesh);
+            self.push_draws(&cast, records, light_draws);
+        } else {
+            light_draws.extend(draws.iter().filter(|d| d.skinned).copied());
         }
         work
     }
@@ -329,9 +360,40 @@ impl SkinnedProps {
         out
     }
 
+    /// Append `placed` (mesh, instance) to `records` and one draw per run of the same mesh to
+    /// `draws`.
+    fn push_draws(
+        &self,
+        placed: &[(usize, PropInstance)],
+        records: &mut Vec<PropInstance>,
+        draws: &mut Vec<PropDraw>,
+    ) {
+        for &(mesh, inst) in placed {
+            let r = self.meshes[mesh];
+            let k = records.len() as u32;
+            records.push(inst);
+            match draws.last_mut() {
+                Some(d) if d.first_vertex == r.index_first && d.skinned => d.instance_count += 1,
+                _ => draws.push(PropDraw {
+                    first_vertex: r.index_first,
+                    vertex_count: r.index_count,
+                    first_instance: k,
+                    instance_count: 1,
+                    skinned: true,
+                }),
+            }
+        }
+    }
+
     /// The mesh an instance of `mesh` at `model` is drawn with.
     fn mesh_for(&self, mesh: usize, model: &Mat4, camera: &Projection) -> usize {
+        self.coarser_for(mesh, mesh, model, camera)
+    }
+
+    /// The version of `mesh` at `model` that `view` needs, starting from `drawn` (`mesh` or
+    /// one of its far versions): `drawn` or a coarser one down its chain.
+    fn coarser_for(&self, mesh: usize, drawn: usize, model: &Mat4, view: &Projection) -> usize {
         let r = self.meshes[mesh];
-        super::prop_table::far_choice(mesh, self.far[mesh], (r.centre, r.radius), model, camera)
+        super::prop_table::far_choice(drawn, &self.far, (r.centre, r.radius), model, view)
     }
 }

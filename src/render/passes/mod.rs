@@ -559,6 +559,8 @@ pub struct FrameInputs<'a> {
     pub clear: Option<[f32; 4]>,
     /// Props to draw (bodies, ground).
     pub props: PropList<'a>,
+    /// The props the light's bodies map draws (the same, bodies at the light's far level).
+    pub light_props: PropList<'a>,
     /// Skinning jobs and the most vertices of one (0 jobs: no skinning pass).
     pub skin: (u32, u32),
     /// The root probe's output and the bundles to probe, when the frame probes roots.
@@ -931,7 +933,7 @@ impl FramePasses {
             sets: inp.light_sets,
             bundles: inp.bundles,
             path: inp.path,
-            props: inp.props,
+            props: inp.light_props,
         };
         if soft_light {
             let soft = self.soft.as_ref().ok_or_else(no_soft)?;
