@@ -139,10 +139,10 @@ pub fn far_level_lods(
 ) -> Vec<crate::render::prop_table::PropLod> {
     let mut out = Vec::new();
     for level in 0..FAR_LEVELS {
-        for k in 0..n.min(meshes.len()) {
+        for (k, mesh) in meshes.iter().take(n).enumerate() {
             let coarser = (1u32 << level) as f32;
             let to = ((level * n + k), ((level + 1) * n + k));
-            out.push(far_lod(&meshes[k], to, cell(k) * coarser));
+            out.push(far_lod(mesh, to, cell(k) * coarser));
         }
     }
     out

@@ -95,6 +95,15 @@ impl CharacterId {
     pub fn slot(&self) -> u32 {
         self.slot
     }
+
+    /// The id of slot `slot`, generation 0 (unit tests of the tables keyed by it).
+    #[cfg(test)]
+    pub(super) fn test_id(slot: u32) -> Self {
+        CharacterId {
+            slot,
+            generation: 0,
+        }
+    }
 }
 
 /// Uniform scale of a character transform: the length of its x axis (widths and styling

@@ -397,3 +397,84 @@ impl SkinnedProps {
         super::prop_table::far_choice(drawn, &self.far, (r.centre, r.radius), model, view)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A mesh of `vertices` vertices and as many triangles, its indices from `index_first`.
+    fn range(rest_first: u32, vertices: u32, index_first: u32) -> MeshRange {
+        MeshRange {
+            rest_first,
+            vertex_count: vertices,
+            index_first,
+            index_count: 3 * vertices,
+            centre: Vec3::ZERO,
+            radius: 1.0,
+        }
+    }
+
+    /// One character wearing mesh 0 (200 vertices), whose far levels 1 (40) and 2 (8) take
+    /// over below 50 and 20 pixels: the camera sees it at 100 pixels (near), the light's map
+    /// at `light_pixels`.
+    fn frame(light_pixels: Option<f32>) -> (SkinWork, Vec<PropInstance>, [Vec<PropDraw>; 2]) {
+        let mut props = SkinnedProps {
+            meshes: vec![range(0, 200, 0), range(200, 40, 600), range(240, 8, 720)],
+            far: vec![Some((1, 50.0)), Some((2, 20.0)), None],
+            ..Default::default()
+        };
+        let id = CharacterId::test_id(0);
+        props.set_wearer(id, &[(0, [1.0; 4])], 2).unwrap();
+        let cot = 1.0;
+        let camera = Projection {
+            eye: Vec3::new(0.0, 0.0, 720.0 * cot / 100.0),
+            height: 720.0,
+            cot_half_fov: cot,
+            texel: 0.0,
+        };
+        let light = light_pixels.map(|p| Projection::orthographic(2.0 / p));
+        let (mut records, mut draws, mut light_draws) = (Vec::new(), Vec::new(), Vec::new());
+        let work = props.frame_lists(
+            |_| Some((Mat4::IDENTITY, Mat4::IDENTITY)),
+            (&camera, light.as_ref()),
+            &mut records,
+            (&mut draws, &mut light_draws),
+        );
+        let capacity = props.capacity();
+        assert!(work.jobs.len() as u32 <= capacity.jobs && work.vertices <= capacity.vertices);
+        assert!(records.len() as u32 <= capacity.instances);
+        (work, records, [draws, light_draws])
+    }
+
+    /// The light's map draws the level its texels need, posed into vertices of its own, or
+    /// the camera's posed mesh when that is as coarse; jobs are at most a workgroup wide and
+    /// cover every posed vertex once.
+    #[test]
+    fn the_light_draws_its_own_far_level_and_jobs_fit_a_workgroup() {
+        let (work, records, [camera, light]) = frame(Some(10.0));
+        assert_eq!((camera.len(), light.len()), (1, 1));
+        assert_eq!(camera[0].first_vertex, 0, "the camera sees the near mesh");
+        assert_eq!(light[0].first_vertex, 720, "the light's 10 texels: level 2");
+        assert_eq!(work.vertices, 208);
+        let light_record = records[light[0].first_instance as usize];
+        assert_eq!(light_record.skin[0], 200, "posed after the camera's");
+        let mut covered = vec![0u32; work.vertices as usize];
+        for j in &work.jobs {
+            assert!(j.vertex_count <= SKIN_GROUP_SIZE && j.vertex_count > 0);
+            for k in 0..j.vertex_count {
+                covered[(j.out_first + k) as usize] += 1;
+            }
+        }
+        assert!(covered.iter().all(|&n| n == 1), "{covered:?}");
+        assert!(work.widest <= SKIN_GROUP_SIZE);
+        // A light map that sees it as large as the camera does: the camera's posed mesh.
+        let (work, records, [camera, light]) = frame(Some(200.0));
+        assert_eq!(light[0].first_vertex, camera[0].first_vertex);
+        assert_eq!(work.vertices, 200);
+        let (cam, lit) = (camera[0].first_instance, light[0].first_instance);
+        assert_eq!(records[cam as usize].skin, records[lit as usize].skin);
+        // No light view: the light draws what the camera does.
+        let (_, _, [camera, light]) = frame(None);
+        assert_eq!(camera, light);
+    }
+}
