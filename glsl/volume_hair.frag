@@ -34,10 +34,9 @@ void main() {
     vec2 span = volume_span(c, g0, gd);
     float t_enter = span.x;
     float t_exit = span.y;
-    // Two-sided boxes: keep the face the ray enters by (the far one with the eye inside).
-    float t_frag = distance(in_world, eye);
-    bool front = abs(t_frag - t_enter) <= abs(t_frag - t_exit);
-    if (t_exit <= max(t_enter, 0.0) || front != (t_enter > 0.0)) {
+    // Only the box's far side is rasterized (front faces culled): each pixel it covers once,
+    // the eye outside the box or inside it.
+    if (t_exit <= max(t_enter, 0.0)) {
         discard;
     }
     float scale = characters[c].model_scale;

@@ -82,6 +82,9 @@ pub enum CullMode {
     None,
     /// Cull back faces (counter-clockwise front).
     Back,
+    /// Cull front faces (counter-clockwise front): the far side of a closed mesh, each pixel
+    /// it covers once whether the eye is outside or inside.
+    Front,
 }
 
 /// How to build a graphics pipeline.
@@ -156,6 +159,7 @@ fn raster_state(cull: CullMode) -> vk::PipelineRasterizationStateCreateInfo<'sta
         .cull_mode(match cull {
             CullMode::None => vk::CullModeFlags::NONE,
             CullMode::Back => vk::CullModeFlags::BACK,
+            CullMode::Front => vk::CullModeFlags::FRONT,
         })
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0)

@@ -11,7 +11,9 @@ use std::sync::Arc;
 use super::{DrawTarget, FrameRes, PassSets, TargetFormats, device_shader_options};
 use crate::render::graph::FrameGraph;
 use crate::vk::shader::compile;
-use crate::vk::{Access, Attachment, BlendMode, Context, GpuResult, Pipeline, PipelineLayout};
+use crate::vk::{
+    Access, Attachment, BlendMode, Context, CullMode, GpuResult, Pipeline, PipelineLayout,
+};
 
 /// Vertices of one character's box.
 const BOX_VERTICES: u32 = 36;
@@ -34,6 +36,7 @@ impl VolumeHairDraw {
         let desc = DrawTarget::Camera(targets)
             .graphics_desc("volume hair")
             .blend(BlendMode::PremultipliedOver)
+            .cull(CullMode::Front)
             .stage(ash::vk::ShaderStageFlags::VERTEX, &v)
             .stage(ash::vk::ShaderStageFlags::FRAGMENT, &f);
         Ok(VolumeHairDraw {
