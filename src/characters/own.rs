@@ -83,11 +83,11 @@ impl OwnCharacter {
     }
 
     /// Its meshes, then [`super::people::FAR_LEVELS`] far versions of each in the same order
-    /// (a mesh that clustering would empty, as an iris smaller than a cell, keeps the level
-    /// before): what `Renderer::set_skinned_meshes` takes.
+    /// (a level that clustering empties, as an iris smaller than a cell, draws nothing):
+    /// what `Renderer::set_skinned_meshes` takes.
     pub fn skinned_meshes(&self) -> Vec<SkinnedMesh> {
         let cells = self.far_cells();
-        super::people::with_far_levels(self.character.meshes.clone(), |k| cells[k])
+        super::people::with_far_levels(self.character.meshes.clone(), |k| plan(cells[k]))
     }
 
     /// Each mesh's far cell ([`Self::far_cell`]).
@@ -113,7 +113,7 @@ impl OwnCharacter {
     pub fn skinned_lods(&self) -> Vec<PropLod> {
         let cells = self.far_cells();
         let n = self.character.meshes.len();
-        super::people::far_level_lods(&self.character.meshes, n, |k| cells[k])
+        super::people::far_level_lods(&self.character.meshes, n, |k| plan(cells[k]))
     }
 
     /// The parts a copy wears: every mesh, in its own colours.
@@ -179,6 +179,15 @@ fn lowest_leaves(s: &crate::skin::Skeleton) -> Vec<usize> {
     leaves.sort_by(|&a, &b| globals[a].w_axis.y.total_cmp(&globals[b].w_axis.y));
     leaves.truncate(2);
     leaves
+}
+
+/// Every level for a mesh of the character's own: its head is part of its body, so they
+/// coarsen together.
+fn plan(cell: f32) -> super::people::FarPlan {
+    super::people::FarPlan {
+        cell,
+        levels: super::people::FAR_LEVELS,
+    }
 }
 
 #[cfg(test)]

@@ -1,30 +1,34 @@
 //! Far versions of skinned meshes: vertex clustering (Rossignac and Borrel 1993), as
 //! `characters::far_mesh` does for static props, carrying skinning data. Vertices are snapped
-//! to `cell`-sized cubes at bind time; each cell keeps the vertex nearest its mean (its joints,
-//! weights and colour, so the far mesh skins like the near one), triangles whose corners fall
-//! into fewer than three cells vanish, duplicates are dropped, and normals are the kept
-//! vertices' own.
+//! to `cell`-sized cubes at bind time; each cell keeps the vertex nearest its mean (its joints
+//! and weights, so the far mesh skins like the near one) with the mean colour and roughness of
+//! the cell's vertices (a dark lash line or pupil does not paint a whole cell), triangles
+//! whose corners fall into fewer than three cells vanish, duplicates are dropped, and normals
+//! are the kept vertices' own.
 
 use std::collections::{HashMap, HashSet};
 
 use glam::Vec3;
 
-use super::SkinnedMesh;
+use super::{SkinVertex, SkinnedMesh};
 
 /// The far version of `mesh` with vertices clustered into `cell`-sized cubes.
 pub fn far_mesh(mesh: &SkinnedMesh, cell: f32) -> SkinnedMesh {
     let cell_of = |p: Vec3| (p / cell).floor().as_ivec3().to_array();
-    let mut sums: HashMap<[i32; 3], (Vec3, f32)> = HashMap::new();
+    // Per cell: position sum, count, colour sum, roughness sum.
+    let mut sums: HashMap<[i32; 3], (Vec3, f32, Vec3, f32)> = HashMap::new();
     for v in &mesh.vertices {
         let e = sums.entry(cell_of(v.position)).or_default();
         e.0 += v.position;
         e.1 += 1.0;
+        e.2 += v.color;
+        e.3 += v.roughness;
     }
     // The representative of each cell: the vertex nearest its mean (lowest index on ties).
     let mut best: HashMap<[i32; 3], (f32, usize)> = HashMap::new();
     for (k, v) in mesh.vertices.iter().enumerate() {
         let c = cell_of(v.position);
-        let (sum, n) = sums[&c];
+        let (sum, n, ..) = sums[&c];
         let d = v.position.distance_squared(sum / n);
         let e = best.entry(c).or_insert((f32::INFINITY, usize::MAX));
         if d < e.0 {
@@ -48,7 +52,12 @@ pub fn far_mesh(mesh: &SkinnedMesh, cell: f32) -> SkinnedMesh {
             let rep = best[&c].1;
             let next = vertices.len() as u32;
             let i = *remap.entry(rep).or_insert_with(|| {
-                vertices.push(mesh.vertices[rep]);
+                let (_, n, color, roughness) = sums[&c];
+                vertices.push(SkinVertex {
+                    color: color / n,
+                    roughness: roughness / n,
+                    ..mesh.vertices[rep]
+                });
                 next
             });
             indices.push(i);
@@ -64,10 +73,11 @@ pub fn far_mesh(mesh: &SkinnedMesh, cell: f32) -> SkinnedMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::skin::SkinVertex;
 
     /// A finely tessellated square loses most of its triangles, keeps its extent within a
-    /// cell, and every kept vertex is one of the original's (joints and weights included).
+    /// cell, every kept vertex is one of the original's (joints and weights included), and a
+    /// dark line one vertex wide darkens its cells by its share of their vertices instead of
+    /// painting them.
     #[test]
     fn clustering_keeps_skinning_data() {
         let n = 40;
@@ -77,7 +87,7 @@ mod tests {
                 vertices.push(SkinVertex {
                     position: Vec3::new(x as f32, y as f32, 0.0) / n as f32,
                     normal: Vec3::Z,
-                    color: Vec3::ONE,
+                    color: Vec3::splat(if y == n / 2 { 0.0 } else { 1.0 }),
                     roughness: 0.5,
                     joints: [(x % 3) as u16, 0, 0, 0],
                     weights: [1.0, 0.0, 0.0, 0.0],
@@ -105,8 +115,14 @@ mod tests {
         );
         assert!(!far.indices.is_empty());
         for v in &far.vertices {
-            assert!(mesh.vertices.contains(v));
+            let same = |w: &&SkinVertex| (w.position, w.joints) == (v.position, v.joints);
+            let original = mesh.vertices.iter().find(same).expect("an original vertex");
+            assert_eq!((original.normal, original.weights), (v.normal, v.weights));
+            // Cells of 4 x 4 vertices (5 x 4 at the line's): the line is at most a quarter.
+            assert!(v.color.x >= 0.74 && v.roughness == 0.5, "{v:?}");
         }
+        let darkest = far.vertices.iter().map(|v| v.color.x).fold(1.0, f32::min);
+        assert!(darkest < 0.9, "the line's cells darken: {darkest}");
         let max = far
             .vertices
             .iter()
