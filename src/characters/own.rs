@@ -35,9 +35,6 @@ pub struct OwnCharacter {
     walk_speed: Option<f32>,
 }
 
-/// Meshes whose bind-pose box is smaller than this (in head radii) get the far head cell.
-const SMALL_MESH_RADII: f32 = 4.0;
-
 impl OwnCharacter {
     /// Read the glTF character at `path`; `joint` names its head joint.
     pub fn load(path: &Path, joint: &str, budget: MemoryBudget) -> Result<Self> {
@@ -86,34 +83,25 @@ impl OwnCharacter {
     /// (a level that clustering empties, as an iris smaller than a cell, draws nothing):
     /// what `Renderer::set_skinned_meshes` takes.
     pub fn skinned_meshes(&self) -> Vec<SkinnedMesh> {
-        let cells = self.far_cells();
-        super::people::with_far_levels(self.character.meshes.clone(), |k| plan(cells[k]))
+        let plan = self.far_plan();
+        super::people::with_far_levels(self.character.meshes.clone(), |_| plan)
     }
 
-    /// Each mesh's far cell ([`Self::far_cell`]).
-    fn far_cells(&self) -> Vec<f32> {
-        let meshes = &self.character.meshes;
-        meshes.iter().map(|m| self.far_cell(m)).collect()
-    }
-
-    /// Clustering cell of a mesh's far version: the people's head cell for small meshes
-    /// (eyes, teeth), their body cell for the rest, in the character's units.
-    fn far_cell(&self, m: &SkinnedMesh) -> f32 {
-        let (lo, hi) = super::people::mesh_bounds(m);
-        let radius = super::person::CANONICAL_RADIUS * self.head.scale;
-        let cell = match (hi - lo).length() < SMALL_MESH_RADII * radius {
-            true => super::people::FAR_HEAD_CELL,
-            false => super::people::FAR_BODY_CELL,
-        };
-        cell * self.head.scale
+    /// How every mesh's far versions are made: the people's first far cell in the character's
+    /// units, and every level (its head is part of its body, so they coarsen together).
+    fn far_plan(&self) -> super::people::FarPlan {
+        super::people::FarPlan {
+            cell: super::people::FAR_CELL * self.head.scale,
+            levels: super::people::FAR_LEVELS,
+        }
     }
 
     /// When each mesh switches to its far version (as the people's do:
     /// [`super::people::skinned_lods`]).
     pub fn skinned_lods(&self) -> Vec<PropLod> {
-        let cells = self.far_cells();
+        let plan = self.far_plan();
         let n = self.character.meshes.len();
-        super::people::far_level_lods(&self.character.meshes, n, |k| plan(cells[k]))
+        super::people::far_level_lods(&self.character.meshes, n, |_| plan)
     }
 
     /// The parts a copy wears: every mesh, in its own colours.
@@ -179,15 +167,6 @@ fn lowest_leaves(s: &crate::skin::Skeleton) -> Vec<usize> {
     leaves.sort_by(|&a, &b| globals[a].w_axis.y.total_cmp(&globals[b].w_axis.y));
     leaves.truncate(2);
     leaves
-}
-
-/// Every level for a mesh of the character's own: its head is part of its body, so they
-/// coarsen together.
-fn plan(cell: f32) -> super::people::FarPlan {
-    super::people::FarPlan {
-        cell,
-        levels: super::people::FAR_LEVELS,
-    }
 }
 
 #[cfg(test)]

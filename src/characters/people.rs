@@ -70,10 +70,9 @@ pub const FAR_MESHES: usize = HEAD_MESH + 2;
 /// cell times `2^(j-1)`, so each level is drawn where its cell spans about
 /// [`super::preset::FAR_CELL_PIXELS`] and a crowd's far people cost what they cover.
 pub const FAR_LEVELS: usize = 4;
-/// Vertex clustering cell of far bodies and clothes, metres.
-pub const FAR_BODY_CELL: f32 = 0.02;
-/// Vertex clustering cell of far heads and eyes, metres.
-pub const FAR_HEAD_CELL: f32 = 0.02;
+/// Vertex clustering cell of the first far level of every skinned mesh (bodies, clothes, heads
+/// and eyes), metres.
+pub const FAR_CELL: f32 = 0.02;
 /// Far levels of the people's heads and eyes: one. Coarser heads shrink inside the body's
 /// own head and lose the lids, which then show through the face as dark bands (measured at
 /// 1000 people with four levels).
@@ -87,15 +86,13 @@ pub fn head_shape_joint() -> Result<usize> {
 
 /// Far plan of mesh `k` of [`skinned_meshes`]: its first far cell and its far levels.
 fn far_plan(k: usize) -> FarPlan {
-    match k >= HEAD_MESH {
-        true => FarPlan {
-            cell: FAR_HEAD_CELL,
-            levels: HEAD_FAR_LEVELS,
-        },
-        false => FarPlan {
-            cell: FAR_BODY_CELL,
-            levels: FAR_LEVELS,
-        },
+    let levels = match k >= HEAD_MESH {
+        true => HEAD_FAR_LEVELS,
+        false => FAR_LEVELS,
+    };
+    FarPlan {
+        cell: FAR_CELL,
+        levels,
     }
 }
 

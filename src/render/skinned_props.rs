@@ -257,10 +257,9 @@ impl SkinnedProps {
     pub(super) fn capacity(&self) -> SkinCapacity {
         let mut out = SkinCapacity::default();
         for w in self.wearers.values() {
-            out.instances += w.parts.len() as u32;
+            // Each part twice: the camera's instance and the light's.
+            out.instances += 2 * w.parts.len() as u32;
             out.matrices += w.joints as u32;
-            // Twice each instance: the camera's and the light's.
-            out.instances += w.parts.len() as u32;
             for (m, _) in &w.parts {
                 // Far versions have no more vertices than their mesh, and the light's own
                 // version, when it has one, is at least the first far one.
