@@ -539,6 +539,14 @@ impl Renderer {
         slot.records.write(0, bytemuck::cast_slice(records))?;
         slot.prop_instances
             .write(0, bytemuck::cast_slice(&prop_instances))?;
+        let posed_bytes = skin.vertices as u64 * size_of::<super::shared::SkinnedVertex>() as u64;
+        if posed_bytes > slot.skinned.size {
+            return Err(GpuError::Unsupported(format!(
+                "this frame poses {} body vertices ({posed_bytes} bytes), more than one storage \
+                 buffer of this device holds ({} bytes): fewer or farther characters",
+                skin.vertices, slot.skinned.size
+            )));
+        }
         if !skin.jobs.is_empty() {
             slot.skin_jobs.write(0, bytemuck::cast_slice(&skin.jobs))?;
             slot.skin_matrices
@@ -880,9 +888,9 @@ fn grow_skin_buffers(
     slot: &mut FrameSlot,
     skin: super::skinned_props::SkinCapacity,
 ) -> GpuResult<()> {
-    let (jobs, matrices, posed) = (skin.jobs, skin.matrices, skin.vertices);
     use super::shared::{SkinJob, SkinnedVertex};
     use super::slots::{host_table, skinned_buffer};
+    let (jobs, matrices) = (skin.jobs, skin.matrices);
     let job_bytes = jobs as u64 * size_of::<SkinJob>() as u64;
     if slot.skin_jobs.size < job_bytes {
         slot.skin_jobs = host_table(ctx, "skin jobs", job_bytes.next_power_of_two())?;
@@ -891,8 +899,14 @@ fn grow_skin_buffers(
     if slot.skin_matrices.size < matrix_bytes {
         slot.skin_matrices = host_table(ctx, "skin matrices", matrix_bytes.next_power_of_two())?;
     }
-    if slot.skinned.size < posed as u64 * size_of::<SkinnedVertex>() as u64 {
-        slot.skinned = skinned_buffer(ctx, posed.next_power_of_two())?;
+    // The bound assumes every part near; a crowd's frame poses far fewer. The buffer is one
+    // storage binding, so it stops at the device's range (write_slot refuses a frame that
+    // needs more).
+    let vertex = size_of::<SkinnedVertex>() as u64;
+    let most = (ctx.info.max_storage_buffer_range / vertex).min(u32::MAX as u64) as u32;
+    let posed = skin.vertices.next_power_of_two().min(most);
+    if slot.skinned.size < posed as u64 * vertex {
+        slot.skinned = skinned_buffer(ctx, posed)?;
     }
     Ok(())
 }
