@@ -41,6 +41,10 @@ fn parser_errors_are_one_line_naming_the_flag() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("'-5'"));
     refused_before_work(&crowd(&["--headless", "--count", "-5"]), "--count");
     refused_before_work(&crowd(&["--headless", "--wind", "-1"]), "--wind");
+    refused_before_work(
+        &crowd(&["--headless", "--lod-alpha-strands", "NaN"]),
+        "--lod-alpha-strands",
+    );
     // A missing required flag, an unknown one (with clap's suggestion), a bad choice (with the
     // possible values), a missing value, a missing subcommand.
     refused_before_work(&run(env!("CARGO_BIN_EXE_bake"), &["x.obj"]), "--output");
@@ -67,7 +71,7 @@ fn flags_without_effect_are_refused() {
     let (dir, obj, _) = workspace();
     let out = dir.path().join("frames");
     let png = dir.path().join("o.png");
-    let crowd_cases: [(&[&str], &str); 8] = [
+    let crowd_cases: [(&[&str], &str); 9] = [
         (
             &["--volumes", "off", "--volume-band", "64,40"],
             "--volume-band",
@@ -88,6 +92,10 @@ fn flags_without_effect_are_refused() {
             "--lod-appearance",
         ),
         (&["--preset", "teapots", "--family", "bob"], "--family"),
+        (
+            &["--lod", "off", "--lod-alpha-verts", "0.2"],
+            "--lod-alpha-verts",
+        ),
     ];
     for (extra, flag) in crowd_cases {
         let args = [&["--headless", "--count", "1", "--out", s(&out)], extra].concat();

@@ -436,11 +436,7 @@ impl App {
             egui_state,
             pending_free: Vec::new(),
             visible: self.scene.character_count(),
-            lod: if self.args.lod {
-                LodSettings::default()
-            } else {
-                LodSettings::off()
-            },
+            lod: self.args.lod_settings(),
         };
         let side = (self.scene.character_count() as f32).sqrt().ceil();
         let acquire = (0..hairmesh::render::FRAMES_IN_FLIGHT)
