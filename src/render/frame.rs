@@ -514,10 +514,14 @@ impl Renderer {
             cot_half_fov: block.light_dir[3],
             texel: 0.0,
         };
-        // The bodies' light map sees far bodies at its own texel size.
+        // The bodies' light map sees far bodies at its own texel size, a pixel being as many
+        // texels as its filter blurs together.
         let body_texel = block.body_shadow[3];
-        let light =
-            (body_texel > 0.0).then(|| super::prop_table::Projection::orthographic(body_texel));
+        let light = (body_texel > 0.0).then(|| {
+            super::prop_table::Projection::orthographic(
+                body_texel * super::shadow::LIGHT_FAR_TEXELS_PER_PIXEL,
+            )
+        });
         let (mut prop_instances, mut prop_draws) = self.props.frame_lists(&moved, world, &camera);
         let mut light_draws = prop_draws.clone();
         let skin = self.skinned.frame_lists(
