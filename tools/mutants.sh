@@ -8,6 +8,7 @@
 #   bash tools/mutants.sh                  # every group, every mutant (hours on 2 cores)
 #   MUTANTS_SHARD=1/10 bash tools/mutants.sh        # a 1-in-10 round-robin sample of each group
 #   MUTANTS_SAMPLE=25 bash tools/mutants.sh         # about 25 mutants of each group, evenly spaced
+#   MUTANTS_SAMPLE=20 MUTANTS_OFFSET=5 bash tools/mutants.sh   # another sample, disjoint from shard 1
 #   bash tools/mutants.sh shade io         # named groups only
 #   MUTANTS_ITERATE=1 bash tools/mutants.sh reference  # only what the last run did not catch
 #
@@ -73,7 +74,10 @@ for g in "${groups[@]}"; do
     shard=${MUTANTS_SHARD:-}
     if [ -n "${MUTANTS_SAMPLE:-}" ]; then
         total=$(cd "$tree" && cargo mutants --list "${select[@]}" | grep -c .)
-        shard="1/$(( (total + MUTANTS_SAMPLE - 1) / MUTANTS_SAMPLE ))"
+        k=$(( (total + MUTANTS_SAMPLE - 1) / MUTANTS_SAMPLE ))
+        # MUTANTS_OFFSET picks another of the k round-robin shards: a sample independent of
+        # the ones before (the 2026-12-05 sample was shard 1).
+        shard="$(( ${MUTANTS_OFFSET:-1} % k ))/$k"
         echo "$g: $total mutants, sampling $shard"
     fi
     [ -n "$shard" ] && args+=(--shard "$shard" --sharding round-robin)
