@@ -50,11 +50,11 @@ groups=("$@")
 exclude_render='DensityVolumes::|check_sampling|SoftBudget::buffers|shadow_buffers|transient_buffers|frame_fields|TemporalState::|VolumePass|fn record|::record|descriptor'
 
 tree="$root/target/mutants-tree"
-# Builds go to one folder kept between runs (seeded once from target/debug, so the dependencies
+# Builds go to one folder kept between runs (seeded once from target/debug where there is one, so the dependencies
 # are not rebuilt); the sources are a fresh worktree each run (a stopped run may leave a mutant).
 export CARGO_TARGET_DIR="$root/target/mutants-build"
-if [ ! -d "$CARGO_TARGET_DIR/debug" ]; then
-    mkdir -p "$CARGO_TARGET_DIR"
+mkdir -p "$CARGO_TARGET_DIR"
+if [ ! -d "$CARGO_TARGET_DIR/debug" ] && [ -d "$root/target/debug" ]; then
     cp -a "$root/target/debug" "$CARGO_TARGET_DIR/debug"
 fi
 rm -rf "$tree"

@@ -77,6 +77,9 @@ pub struct DepthMapping {
     pub host: DepthRow,
     /// The renderer's.
     pub ours: DepthRow,
+    /// Metres the host's surfaces are moved away from the camera, along view-space depth
+    /// ([`HostFrame::depth_slack`]).
+    pub slack: f32,
 }
 
 impl DepthMapping {
@@ -84,7 +87,7 @@ impl DepthMapping {
     /// is its background; clamped to `[0, 1]`: host geometry nearer than the near plane hides
     /// everything behind it).
     pub fn convert(&self, d: f32) -> f32 {
-        match self.host.view_z(d) {
+        match self.moved_host().view_z(d) {
             Some(z) => self.ours.depth(z).clamp(0.0, 1.0),
             None => 1.0,
         }
@@ -92,7 +95,17 @@ impl DepthMapping {
 
     /// The push constants of `glsl/host_depth.frag`.
     pub fn constants(&self) -> [[f32; 4]; 2] {
-        [self.host.coefficients, self.ours.coefficients]
+        [self.moved_host().coefficients, self.ours.coefficients]
+    }
+
+    /// The host's depth row with its surfaces `slack` farther away: `d(z + slack)` as a row in
+    /// `z`, `(a z + (a s + b)) / (c z + (c s + e))`, so its inverse gives `z - slack`.
+    fn moved_host(&self) -> DepthRow {
+        let [a, b, c, e] = self.host.coefficients;
+        let s = self.slack;
+        DepthRow {
+            coefficients: [a, a * s + b, c, c * s + e],
+        }
     }
 }
 
@@ -149,6 +162,7 @@ impl HostCamera {
             depth: DepthMapping {
                 host: DepthRow::of(proj),
                 ours,
+                slack: 0.0,
             },
             reversed,
             planes: (near, host_far),
@@ -281,6 +295,11 @@ pub struct HostFrame<'a> {
     /// The depth the hair is hidden behind (sampled: created with `SAMPLED` usage, one sample
     /// per pixel); `None`: nothing hides the hair.
     pub depth: Option<HostImage<'a>>,
+    /// Metres (world units) the host's depth is pushed away from the camera before it hides
+    /// hair: hair that lies on a host's scalp closer than its triangles' sag (hair grown on a
+    /// smooth head sits a fraction of a millimetre above it; the mesh's flat triangles cut
+    /// through that) is not hidden by it. 0: exact; the Bevy plugin uses 4 mm.
+    pub depth_slack: f32,
 }
 
 impl Renderer {
@@ -312,6 +331,12 @@ impl Renderer {
                     .into(),
             ));
         }
+        if !(0.0..1e3).contains(&frame.depth_slack) {
+            return Err(refuse(format!(
+                "depth slack {} is not a distance in 0..1000",
+                frame.depth_slack
+            )));
+        }
         let images = std::iter::once(&frame.color).chain(frame.depth.as_ref());
         if images.into_iter().any(|i| i.after == Access::Nothing) {
             return Err(refuse("an image cannot be handed back unused".into()));
@@ -332,10 +357,11 @@ impl Renderer {
         passes.bind(frame.slot, depth_image, self.targets.output())?;
         // The renderer's depth range: the host's near plane, and far enough for the hair.
         let size = (width, height);
-        let host = frame
+        let mut host = frame
             .camera
             .view(size, self.hair_far(frame.camera.eye()))
             .map_err(refuse)?;
+        host.depth.slack = frame.depth_slack;
         let view = View {
             camera: host.camera,
             ..*look
@@ -400,6 +426,29 @@ mod tests {
     fn clip_to_pixel(m: Mat4, p: Vec3) -> Vec2 {
         let c = m * p.extend(1.0);
         Vec2::new(c.x, c.y) / c.w
+    }
+
+    #[test]
+    fn slack_moves_host_surfaces_away_along_view_depth() {
+        let host = host_matrices(true, true);
+        let mut v = host.view((1500, 1000), 20.0).unwrap();
+        let p = Vec3::new(0.0, 1.4, 0.0);
+        let c = host.proj * host.view * p.extend(1.0);
+        let d = c.z / c.w;
+        let exact = v.depth.convert(d);
+        v.depth.slack = 0.01;
+        let z = host.view.transform_point3(p).z;
+        // The renderer's depth of the point 1 cm farther along view-space depth.
+        let moved = v.depth.ours.depth(z - 0.01);
+        assert!((v.depth.convert(d) - moved).abs() < 1e-6);
+        assert!(v.depth.convert(d) > exact);
+        let row = DepthRow {
+            coefficients: v.depth.constants()[0],
+        };
+        assert!(
+            (row.view_z(d).unwrap() - (z - 0.01)).abs() < 1e-5,
+            "the shader gets it"
+        );
     }
 
     #[test]

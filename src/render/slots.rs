@@ -21,7 +21,7 @@ pub const FRAMES_IN_FLIGHT: usize = 2;
 /// A resource released once the frame it was retired with has completed.
 pub enum Retired {
     /// Any GPU object (buffer, image, set...): dropped.
-    Resource(Box<dyn Any>),
+    Resource(Box<dyn Any + Send>),
     /// A character slot: reusable.
     CharacterSlot(u32),
 }

@@ -81,6 +81,28 @@ pub(super) fn pick_physical(
     Ok((physical, name, queue_family as u32))
 }
 
+/// The first queue family of `physical` with graphics, compute and timestamps.
+#[cfg(feature = "wgpu")]
+pub(super) fn graphics_family(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    name: &str,
+) -> GpuResult<u32> {
+    // SAFETY: valid physical device.
+    let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+    families
+        .iter()
+        .position(|f| {
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+                && f.timestamp_valid_bits > 0
+        })
+        .map(|i| i as u32)
+        .ok_or_else(|| {
+            GpuError::Unsupported(format!("{name}: no graphics+compute queue with timestamps"))
+        })
+}
+
 /// Optional features found on the device (the required ones are checked).
 pub(super) struct DeviceFeatures {
     mesh: bool,
@@ -92,6 +114,14 @@ pub(super) struct DeviceFeatures {
     /// `shaderInt64`, `shaderBufferInt64Atomics` and `shaderSharedInt64Atomics` (the
     /// k-buffer's and the software rasterizer's 64-bit `atomicMin`).
     int64_atomics: bool,
+}
+
+impl DeviceFeatures {
+    /// Task and mesh shaders (`VK_EXT_mesh_shader`).
+    #[cfg(feature = "wgpu")]
+    pub(super) fn has_mesh(&self) -> bool {
+        self.mesh
+    }
 }
 
 /// Query features; fails with the name of the first missing required feature.
@@ -195,42 +225,253 @@ fn create_device(
     if f.mesh && !extra.contains(&ash::ext::mesh_shader::NAME) {
         ext_names.push(ash::ext::mesh_shader::NAME.as_ptr());
     }
-    let mut enable13 = vk::PhysicalDeviceVulkan13Features::default()
-        .dynamic_rendering(true)
-        .synchronization2(true)
-        .maintenance4(f.maintenance4);
-    let mut enable12 = vk::PhysicalDeviceVulkan12Features::default()
-        .host_query_reset(f.host_query_reset)
-        .runtime_descriptor_array(true)
-        .descriptor_binding_partially_bound(true)
-        .descriptor_binding_sampled_image_update_after_bind(true)
-        .descriptor_binding_update_unused_while_pending(true)
-        .shader_sampled_image_array_non_uniform_indexing(true)
-        .buffer_device_address(true)
-        .shader_buffer_int64_atomics(f.int64_atomics)
-        .shader_shared_int64_atomics(f.int64_atomics);
-    let mut enable_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default()
-        .mesh_shader(true)
-        .task_shader(true)
-        .mesh_shader_queries(f.mesh_queries);
-    let enable_base = vk::PhysicalDeviceFeatures::default()
-        .pipeline_statistics_query(f.pipeline_statistics)
-        .fragment_stores_and_atomics(f.fragment_stores)
-        .shader_int64(f.int64_atomics);
-    let mut device_info = vk::DeviceCreateInfo::default()
+    let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queue_info)
-        .enabled_extension_names(&ext_names)
-        .enabled_features(&enable_base)
-        .push_next(&mut enable13)
-        .push_next(&mut enable12);
-    if f.mesh {
-        device_info = device_info.push_next(&mut enable_mesh);
+        .enabled_extension_names(&ext_names);
+    create_with_features(instance, physical, info, f)
+}
+
+/// The feature structures the renderer adds to a device's create info, one per kind it may
+/// have to append (kept here so that they outlive the create call).
+#[derive(Default)]
+struct FeatureChain {
+    core: vk::PhysicalDeviceFeatures,
+    indexing: vk::PhysicalDeviceDescriptorIndexingFeatures<'static>,
+    address: vk::PhysicalDeviceBufferDeviceAddressFeatures<'static>,
+    atomics: vk::PhysicalDeviceShaderAtomicInt64Features<'static>,
+    query_reset: vk::PhysicalDeviceHostQueryResetFeatures<'static>,
+    rendering: vk::PhysicalDeviceDynamicRenderingFeatures<'static>,
+    sync2: vk::PhysicalDeviceSynchronization2Features<'static>,
+    maintenance4: vk::PhysicalDeviceMaintenance4Features<'static>,
+    mesh: vk::PhysicalDeviceMeshShaderFeaturesEXT<'static>,
+}
+
+/// Create the device of `info` with the renderer's features `f` turned on as well: every
+/// feature structure already in `info`'s chain (a host's, e.g. wgpu's) gets the renderer's
+/// bits of its kind, and the kinds it lacks are appended, so that no structure appears twice
+/// and the Vulkan 1.2/1.3 aggregates never sit beside their parts (both invalid). Nothing the
+/// host turned on is turned off.
+pub(super) fn create_with_features(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    mut info: vk::DeviceCreateInfo<'_>,
+    f: &DeviceFeatures,
+) -> GpuResult<ash::Device> {
+    let mut chain = FeatureChain::default();
+    if !info.p_enabled_features.is_null() {
+        // SAFETY: a non-null p_enabled_features points at the host's structure.
+        chain.core = unsafe { *info.p_enabled_features };
     }
-    // SAFETY: every pointer in device_info lives until the call returns.
-    unsafe { instance.create_device(physical, &device_info, None) }.map_err(|result| GpuError::Vk {
+    let mut core_in_chain = false;
+    let mut found = FoundKinds::default();
+    let mut tail: *mut vk::BaseOutStructure = std::ptr::null_mut();
+    let mut node = info.p_next as *mut vk::BaseOutStructure;
+    while !node.is_null() {
+        // SAFETY: every structure of a valid pNext chain starts with sType and pNext, and
+        // the host's structures outlive this call; each is written through its own pointer.
+        unsafe {
+            core_in_chain |= enable_in(node, f, &mut found);
+            tail = node;
+            node = (*node).p_next;
+        }
+    }
+    enable_core(&mut chain.core, f);
+    let appended = append_missing(&mut chain, f, &found);
+    if !appended.is_null() {
+        if tail.is_null() {
+            info.p_next = appended as *const std::ffi::c_void;
+        } else {
+            // SAFETY: `tail` is the chain's last structure (see above).
+            unsafe { (*tail).p_next = appended };
+        }
+    }
+    if !core_in_chain {
+        info.p_enabled_features = &chain.core;
+    }
+    // SAFETY: every pointer in `info` (the host's and `chain`'s) lives until the call returns.
+    unsafe { instance.create_device(physical, &info, None) }.map_err(|result| GpuError::Vk {
         what: "create device",
         result,
     })
+}
+
+/// Which kinds of feature structure a create info's chain already holds.
+#[derive(Default)]
+struct FoundKinds {
+    vulkan12: bool,
+    vulkan13: bool,
+    indexing: bool,
+    address: bool,
+    atomics: bool,
+    query_reset: bool,
+    rendering: bool,
+    sync2: bool,
+    maintenance4: bool,
+    mesh: bool,
+}
+
+/// Turn the renderer's bits on in the structure at `node` if it is a feature structure of a
+/// kind the renderer uses, noting its kind in `found`; true for `PhysicalDeviceFeatures2`.
+///
+/// # Safety
+/// `node` points at a live, writable structure of a pNext chain.
+unsafe fn enable_in(
+    node: *mut vk::BaseOutStructure,
+    f: &DeviceFeatures,
+    found: &mut FoundKinds,
+) -> bool {
+    use vk::StructureType as S;
+    let on = vk::TRUE;
+    let int64 = if f.int64_atomics { on } else { vk::FALSE };
+    // SAFETY (each cast): the structure's sType names its type.
+    unsafe {
+        match (*node).s_type {
+            S::PHYSICAL_DEVICE_FEATURES_2 => {
+                enable_core(
+                    &mut (*(node as *mut vk::PhysicalDeviceFeatures2)).features,
+                    f,
+                );
+                return true;
+            }
+            S::PHYSICAL_DEVICE_VULKAN_1_2_FEATURES => {
+                let v = &mut *(node as *mut vk::PhysicalDeviceVulkan12Features);
+                v.runtime_descriptor_array = on;
+                v.descriptor_binding_partially_bound = on;
+                v.descriptor_binding_sampled_image_update_after_bind = on;
+                v.descriptor_binding_update_unused_while_pending = on;
+                v.shader_sampled_image_array_non_uniform_indexing = on;
+                v.buffer_device_address = on;
+                v.shader_buffer_int64_atomics |= int64;
+                v.shader_shared_int64_atomics |= int64;
+                v.host_query_reset |= f.host_query_reset as u32;
+                found.vulkan12 = true;
+            }
+            S::PHYSICAL_DEVICE_VULKAN_1_3_FEATURES => {
+                let v = &mut *(node as *mut vk::PhysicalDeviceVulkan13Features);
+                v.dynamic_rendering = on;
+                v.synchronization2 = on;
+                v.maintenance4 |= f.maintenance4 as u32;
+                found.vulkan13 = true;
+            }
+            S::PHYSICAL_DEVICE_DESCRIPTOR_INDEXING_FEATURES => {
+                enable_indexing(&mut *(node as *mut vk::PhysicalDeviceDescriptorIndexingFeatures));
+                found.indexing = true;
+            }
+            S::PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES => {
+                (*(node as *mut vk::PhysicalDeviceBufferDeviceAddressFeatures))
+                    .buffer_device_address = on;
+                found.address = true;
+            }
+            S::PHYSICAL_DEVICE_SHADER_ATOMIC_INT64_FEATURES => {
+                let v = &mut *(node as *mut vk::PhysicalDeviceShaderAtomicInt64Features);
+                v.shader_buffer_int64_atomics |= int64;
+                v.shader_shared_int64_atomics |= int64;
+                found.atomics = true;
+            }
+            S::PHYSICAL_DEVICE_HOST_QUERY_RESET_FEATURES => {
+                (*(node as *mut vk::PhysicalDeviceHostQueryResetFeatures)).host_query_reset |=
+                    f.host_query_reset as u32;
+                found.query_reset = true;
+            }
+            S::PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES => {
+                (*(node as *mut vk::PhysicalDeviceDynamicRenderingFeatures)).dynamic_rendering = on;
+                found.rendering = true;
+            }
+            S::PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES => {
+                (*(node as *mut vk::PhysicalDeviceSynchronization2Features)).synchronization2 = on;
+                found.sync2 = true;
+            }
+            S::PHYSICAL_DEVICE_MAINTENANCE_4_FEATURES => {
+                (*(node as *mut vk::PhysicalDeviceMaintenance4Features)).maintenance4 |=
+                    f.maintenance4 as u32;
+                found.maintenance4 = true;
+            }
+            S::PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT if f.mesh => {
+                enable_mesh(
+                    &mut *(node as *mut vk::PhysicalDeviceMeshShaderFeaturesEXT),
+                    f,
+                );
+                found.mesh = true;
+            }
+            _ => {}
+        }
+    }
+    false
+}
+
+/// The renderer's Vulkan 1.0 features, on top of what `core` has.
+fn enable_core(core: &mut vk::PhysicalDeviceFeatures, f: &DeviceFeatures) {
+    core.pipeline_statistics_query |= f.pipeline_statistics as u32;
+    core.fragment_stores_and_atomics |= f.fragment_stores as u32;
+    core.shader_int64 |= f.int64_atomics as u32;
+}
+
+/// Dynamic indexing of every character's textures in bindless arrays.
+fn enable_indexing(v: &mut vk::PhysicalDeviceDescriptorIndexingFeatures) {
+    v.runtime_descriptor_array = vk::TRUE;
+    v.descriptor_binding_partially_bound = vk::TRUE;
+    v.descriptor_binding_sampled_image_update_after_bind = vk::TRUE;
+    v.descriptor_binding_update_unused_while_pending = vk::TRUE;
+    v.shader_sampled_image_array_non_uniform_indexing = vk::TRUE;
+}
+
+/// Task and mesh shaders (and their statistics where the device counts them).
+fn enable_mesh(v: &mut vk::PhysicalDeviceMeshShaderFeaturesEXT, f: &DeviceFeatures) {
+    v.mesh_shader = vk::TRUE;
+    v.task_shader = vk::TRUE;
+    v.mesh_shader_queries |= f.mesh_queries as u32;
+}
+
+/// Link the structures of `chain` whose kinds `found` lacks; the first of them (null: none).
+fn append_missing(
+    chain: &mut FeatureChain,
+    f: &DeviceFeatures,
+    found: &FoundKinds,
+) -> *mut vk::BaseOutStructure<'static> {
+    let mut list: Vec<*mut vk::BaseOutStructure<'static>> = Vec::new();
+    let mut push = |p: *mut vk::BaseOutStructure<'static>| list.push(p);
+    if !found.vulkan12 {
+        if !found.indexing {
+            enable_indexing(&mut chain.indexing);
+            push(&mut chain.indexing as *mut _ as *mut _);
+        }
+        if !found.address {
+            chain.address.buffer_device_address = vk::TRUE;
+            push(&mut chain.address as *mut _ as *mut _);
+        }
+        if f.int64_atomics && !found.atomics {
+            chain.atomics.shader_buffer_int64_atomics = vk::TRUE;
+            chain.atomics.shader_shared_int64_atomics = vk::TRUE;
+            push(&mut chain.atomics as *mut _ as *mut _);
+        }
+        if f.host_query_reset && !found.query_reset {
+            chain.query_reset.host_query_reset = vk::TRUE;
+            push(&mut chain.query_reset as *mut _ as *mut _);
+        }
+    }
+    if !found.vulkan13 {
+        if !found.rendering {
+            chain.rendering.dynamic_rendering = vk::TRUE;
+            push(&mut chain.rendering as *mut _ as *mut _);
+        }
+        if !found.sync2 {
+            chain.sync2.synchronization2 = vk::TRUE;
+            push(&mut chain.sync2 as *mut _ as *mut _);
+        }
+        if f.maintenance4 && !found.maintenance4 {
+            chain.maintenance4.maintenance4 = vk::TRUE;
+            push(&mut chain.maintenance4 as *mut _ as *mut _);
+        }
+    }
+    if f.mesh && !found.mesh {
+        enable_mesh(&mut chain.mesh, f);
+        push(&mut chain.mesh as *mut _ as *mut _);
+    }
+    for pair in list.windows(2) {
+        // SAFETY: both point into `chain`, alive for the caller's create call.
+        unsafe { (*pair[0]).p_next = pair[1] };
+    }
+    list.first().copied().unwrap_or(std::ptr::null_mut())
 }
 
 /// Create a device for a host ([`super::HostDevice`]) on `physical` with one queue of

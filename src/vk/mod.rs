@@ -15,6 +15,8 @@ pub mod swapchain;
 pub mod sync;
 #[cfg(feature = "window")]
 pub mod ui;
+#[cfg(feature = "wgpu")]
+pub mod wgpu_host;
 
 pub use access::Access;
 pub use buffer::{Buffer, BufferDesc};
@@ -31,6 +33,8 @@ pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainImage};
 pub use sync::{Fence, Semaphore};
 #[cfg(feature = "window")]
 pub use ui::UiRenderer;
+#[cfg(feature = "wgpu")]
+pub use wgpu_host::{WgpuDesc, WgpuDevice};
 
 /// Errors of the GPU layer.
 #[derive(Debug, thiserror::Error)]

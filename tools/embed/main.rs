@@ -174,6 +174,7 @@ fn draw(
                     before: Access::DepthAttachment,
                     after: Access::DepthAttachment,
                 }),
+                depth_slack: 0.0,
             };
             let t = renderer.record_host_frame(&look, &opts, frame)?;
             ticket = Some(t);

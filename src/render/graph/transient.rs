@@ -89,7 +89,7 @@ pub struct TransientPool {
     ctx: Arc<Context>,
     buffers: Vec<PooledBuffer>,
     images: Vec<PooledImage>,
-    released: Vec<Box<dyn Any>>,
+    released: Vec<Box<dyn Any + Send>>,
 }
 
 fn same_image(a: &ImageDesc, b: &ImageDesc) -> bool {
@@ -226,7 +226,7 @@ impl TransientPool {
     }
 
     /// The objects replaced since the last call, for the current frame's deferred release.
-    pub fn take_released(&mut self) -> Vec<Box<dyn Any>> {
+    pub fn take_released(&mut self) -> Vec<Box<dyn Any + Send>> {
         std::mem::take(&mut self.released)
     }
 

@@ -29,10 +29,17 @@ const HOST_DEPTH_BINDING: u32 = 0;
 const HAIR_BINDING: u32 = 1;
 
 /// The host frame passes' pipelines and per-slot sets.
+///
+/// The host's depth and the renderer's output sit in separate sets: a frame without host
+/// depth binds no set that still names an earlier frame's depth (which the host may have
+/// destroyed since).
 pub struct HostTargetPasses {
     ctx: Arc<Context>,
+    /// The composite's layout (the renderer's output).
     layout: Arc<PipelineLayout>,
-    /// One set per frame slot, rewritten when the slot records a host frame.
+    /// Per frame slot: the host's depth.
+    depth_sets: Vec<DescriptorSet>,
+    /// Per frame slot: the renderer's output.
     sets: Vec<DescriptorSet>,
     sampler: Sampler,
     depth: Pipeline,
@@ -52,9 +59,12 @@ pub struct HostTargetRes<'a> {
 impl HostTargetPasses {
     /// Compile the depth pass for the renderer's `targets`.
     pub fn new(ctx: &Arc<Context>, targets: TargetFormats) -> GpuResult<Self> {
-        let bindings = [HOST_DEPTH_BINDING, HAIR_BINDING]
-            .map(|b| BindingDesc::single(b, DescriptorKind::SampledImage));
-        let set_layout = DescriptorSetLayout::new(ctx, &bindings)?;
+        let set_layout = |b| {
+            DescriptorSetLayout::new(ctx, &[BindingDesc::single(b, DescriptorKind::SampledImage)])
+        };
+        let (depth_set_layout, set_layout) =
+            (set_layout(HOST_DEPTH_BINDING)?, set_layout(HAIR_BINDING)?);
+        let depth_layout = PipelineLayout::new(ctx, std::slice::from_ref(&depth_set_layout))?;
         let layout = PipelineLayout::new(ctx, std::slice::from_ref(&set_layout))?;
         let opts = super::device_shader_options(ctx, 1);
         let v = compile("fullscreen.vert", &opts)?;
@@ -64,14 +74,17 @@ impl HostTargetPasses {
             .depth(DepthMode::Replace)
             .stage(vk::ShaderStageFlags::VERTEX, &v)
             .stage(vk::ShaderStageFlags::FRAGMENT, &f);
-        let sets = (0..FRAMES_IN_FLIGHT)
-            .map(|_| DescriptorSet::new(ctx, "host frame set", &set_layout))
-            .collect::<GpuResult<_>>()?;
+        let sets = |name, layout| {
+            (0..FRAMES_IN_FLIGHT)
+                .map(|_| DescriptorSet::new(ctx, name, layout))
+                .collect::<GpuResult<Vec<_>>>()
+        };
         Ok(HostTargetPasses {
             ctx: ctx.clone(),
-            depth: Pipeline::graphics(ctx, &layout, &desc)?,
+            depth: Pipeline::graphics(ctx, &depth_layout, &desc)?,
             layout,
-            sets,
+            depth_sets: sets("host depth set", &depth_set_layout)?,
+            sets: sets("host composite set", &set_layout)?,
             sampler: Sampler::nearest_clamp(ctx)?,
             composite: HashMap::new(),
         })
@@ -127,11 +140,10 @@ impl HostTargetPasses {
     /// Point slot `slot`'s set at the host's depth and the renderer's `output` (the slot's last
     /// frame has completed).
     pub fn bind(&self, slot: usize, depth: Option<&Image>, output: &Image) -> GpuResult<()> {
-        let set = &self.sets[slot];
         if let Some(d) = depth {
-            set.write_image(HOST_DEPTH_BINDING, 0, d, &self.sampler)?;
+            self.depth_sets[slot].write_image(HOST_DEPTH_BINDING, 0, d, &self.sampler)?;
         }
-        set.write_image(HAIR_BINDING, 0, output, &self.sampler)
+        self.sets[slot].write_image(HAIR_BINDING, 0, output, &self.sampler)
     }
 
     /// Add the pass that fills the renderer's depth from the host's (`mapping`) and clears its
@@ -150,7 +162,7 @@ impl HostTargetPasses {
             .discard(r.color, Access::ColorAttachment)
             .discard(r.depth, Access::DepthAttachment)
             .read_some(host, Access::SampledRead);
-        let set = &self.sets[slot];
+        let set = &self.depth_sets[slot];
         p.record(move |rec, _| {
             let clear = host.is_none();
             rec.begin_rendering(

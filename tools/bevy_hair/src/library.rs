@@ -1,0 +1,192 @@
+//! The main world's half: hair loaded (and grown, and baked) off the main thread once per
+//! source, and placed every frame by its entity's transform or its head joint's.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use bevy::tasks::{AsyncComputeTaskPool, Task, block_on};
+use hairmesh::HairStyle;
+use hairmesh::bake::{BakeOptions, BakedHairMesh, bake};
+use hairmesh::budget::MemoryBudget;
+use hairmesh::characters::own::OwnCharacter;
+use hairmesh::render::StrandParams;
+
+use crate::{Hair, HairSource, to_glam};
+
+/// Vertices per strand at full detail, as `2^VERTS_LOG2` (the crowd's).
+const VERTS_LOG2: u32 = 5;
+
+/// Hair ready for the renderer: the baked hair mesh, its style, and for grown hair the head
+/// joint's inverse bind matrix (the hair is grown in the character's bind frame).
+pub struct LoadedHair {
+    /// The five textures' contents.
+    pub baked: BakedHairMesh,
+    /// The styling parameters.
+    pub style: HairStyle,
+    /// Strand and vertex counts at full detail.
+    pub params: StrandParams,
+    /// The head joint's inverse bind matrix (grown hair); `None`: placed by the entity.
+    pub inverse_bind: Option<glam::Mat4>,
+}
+
+/// Every hair source met so far: loading, ready or refused (with the one-line reason,
+/// logged once).
+#[derive(Resource, Default)]
+pub struct HairLibrary {
+    entries: HashMap<(HairSource, u32), Entry>,
+}
+
+enum Entry {
+    Loading(Task<Result<LoadedHair, String>>),
+    Ready(Arc<LoadedHair>),
+    Failed(String),
+}
+
+impl HairLibrary {
+    /// Sources still loading.
+    pub fn loading(&self) -> usize {
+        let busy = |e: &&Entry| matches!(e, Entry::Loading(_));
+        self.entries.values().filter(busy).count()
+    }
+
+    /// The refusals so far, one line each.
+    pub fn failures(&self) -> Vec<String> {
+        let text = |e: &Entry| match e {
+            Entry::Failed(why) => Some(why.clone()),
+            _ => None,
+        };
+        self.entries.values().filter_map(text).collect()
+    }
+
+    /// The hair of `hair`, starting its load the first time it is asked for.
+    fn get(&mut self, hair: &Hair) -> Option<Arc<LoadedHair>> {
+        let key = (hair.source.clone(), hair.strands_per_bundle);
+        let entry = self.entries.entry(key).or_insert_with(|| {
+            let (source, asked) = (hair.source.clone(), hair.strands_per_bundle);
+            let pool = AsyncComputeTaskPool::get();
+            Entry::Loading(pool.spawn(async move { load(&source, asked) }))
+        });
+        if let Entry::Loading(task) = entry
+            && task.is_finished()
+        {
+            *entry = match block_on(task) {
+                Ok(hair) => Entry::Ready(Arc::new(hair)),
+                Err(why) => {
+                    error!("hair: {why}");
+                    Entry::Failed(why)
+                }
+            };
+        }
+        match entry {
+            Entry::Ready(hair) => Some(hair.clone()),
+            _ => None,
+        }
+    }
+}
+
+/// Load (grow, bake) the hair of `source` with about `asked` strands per bundle.
+fn load(source: &HairSource, asked: u32) -> Result<LoadedHair, String> {
+    let params = |strands_per_bundle| StrandParams {
+        strands_per_bundle,
+        verts_log2: VERTS_LOG2,
+    };
+    match source {
+        HairSource::Mesh(path) => {
+            let (baked, style) =
+                hairmesh::render::scene::load_mesh(path, None, MemoryBudget::default())
+                    .map_err(|e| e.to_string())?;
+            Ok(LoadedHair {
+                baked,
+                style,
+                params: params(asked),
+                inverse_bind: None,
+            })
+        }
+        HairSource::Grown {
+            character,
+            joint,
+            family,
+            seed,
+        } => {
+            let own = OwnCharacter::load(character, joint, MemoryBudget::default())
+                .map_err(|e| e.to_string())?;
+            let grown = own.grow(*family, *seed).map_err(|e| e.to_string())?;
+            let baked = bake(&grown.mesh, &grown.style, BakeOptions::default(), |_, _| {})
+                .map_err(|e| e.to_string())?;
+            let skeleton = &own.character.skeleton;
+            Ok(LoadedHair {
+                params: params(grown.strands_per_bundle(asked)),
+                baked,
+                style: grown.style,
+                inverse_bind: Some(skeleton.joints[own.head_joint].inverse_bind),
+            })
+        }
+    }
+}
+
+/// Hair placed for this frame: what the render world extracts.
+#[derive(Component, Clone)]
+pub struct PlacedHair {
+    /// The loaded hair.
+    pub hair: Arc<LoadedHair>,
+    /// Hair space to world space.
+    pub model: glam::Mat4,
+}
+
+/// The head joint a grown hair follows (found once among the entity's descendants).
+#[derive(Component, Clone, Copy)]
+pub struct HairJoint(pub Entity);
+
+/// Start loads, and find each grown hair's head joint once its scene has spawned.
+pub fn load_hair(
+    mut commands: Commands,
+    mut library: ResMut<HairLibrary>,
+    hairs: Query<(Entity, &Hair, Option<&HairJoint>)>,
+    children: Query<&Children>,
+    names: Query<&Name>,
+) {
+    for (entity, hair, joint) in &hairs {
+        let _ = library.get(hair);
+        let HairSource::Grown { joint: name, .. } = &hair.source else {
+            continue;
+        };
+        if joint.is_some() {
+            continue;
+        }
+        let named = |e: &Entity| names.get(*e).is_ok_and(|n| n.as_str() == name);
+        if let Some(found) = children.iter_descendants(entity).find(named) {
+            commands.entity(entity).insert(HairJoint(found));
+        }
+    }
+}
+
+/// Place every loaded hair: by its entity's transform, or by its head joint's skinning
+/// matrix (joint to world, times the joint's inverse bind matrix, as Bevy skins the head).
+pub fn place_hair(
+    mut commands: Commands,
+    mut library: ResMut<HairLibrary>,
+    hairs: Query<(Entity, &Hair, &GlobalTransform, Option<&HairJoint>)>,
+    globals: Query<&GlobalTransform>,
+) {
+    for (entity, hair, global, joint) in &hairs {
+        let placed = library.get(hair).and_then(|loaded| {
+            let model = match (loaded.inverse_bind, joint) {
+                (None, _) => to_glam(global.to_matrix()),
+                (Some(inverse_bind), Some(joint)) => {
+                    let joint = globals.get(joint.0).ok()?;
+                    to_glam(joint.to_matrix()) * inverse_bind
+                }
+                (Some(_), None) => return None,
+            };
+            Some(PlacedHair {
+                hair: loaded,
+                model,
+            })
+        });
+        match placed {
+            Some(p) => commands.entity(entity).insert(p),
+            None => commands.entity(entity).remove::<PlacedHair>(),
+        };
+    }
+}
