@@ -9,6 +9,7 @@
 //! | [`tools`] | every tool's flags |
 //! | [`crowd`] | the crowd demo, its people, your own character |
 //! | [`embedding`] | the renderer inside an engine's frame |
+//! | [`bevy`] | the Bevy plugin (`tools/bevy_hair`) |
 //! | [`generation`] | GPU generation for a whole crowd, level of detail |
 //! | [`bake`] | how a hair mesh becomes five textures |
 //! | [`shading`] | shading, shadows, transparency, thick strands, multiple scattering |
@@ -32,6 +33,8 @@ pub mod tools {}
 pub mod crowd {}
 #[doc = include_str!("guide/embedding.md")]
 pub mod embedding {}
+#[doc = include_str!("guide/bevy.md")]
+pub mod bevy {}
 #[doc = include_str!("guide/generation.md")]
 pub mod generation {}
 #[doc = include_str!("guide/bake.md")]

@@ -6,14 +6,19 @@
 //!
 //! ```no_run
 //! use bevy::prelude::*;
-//! use hairmesh_bevy::{Hair, HairPlugin};
+//! use bevy::world_serialization::WorldAssetRoot;
+//! use hairmesh::characters::hairstyle::StyleFamily;
+//! use hairmesh_bevy::{Hair, HairPlugin, hair_camera};
 //!
 //! let hair = HairPlugin::new(Default::default()).expect("a Vulkan device for the hair");
 //! App::new()
 //!     .add_plugins(DefaultPlugins.set(hair.render_plugin()))
 //!     .add_plugins(hair)
-//!     .add_systems(Startup, |mut commands: Commands| {
-//!         commands.spawn((Hair::mesh("hairmeshes/sintel.obj"), Transform::default()));
+//!     .add_systems(Startup, |mut commands: Commands, assets: Res<AssetServer>| {
+//!         commands.spawn((hair_camera(), Transform::from_xyz(0.0, 1.6, 3.0)));
+//!         let person = "hairmeshes/people/character.glb";
+//!         let scene = assets.load(GltfAssetLabel::Scene(0).from_asset(person));
+//!         commands.spawn((WorldAssetRoot(scene), Hair::grown(person, "head", StyleFamily::Bob, 7)));
 //!     })
 //!     .run();
 //! ```
