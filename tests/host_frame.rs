@@ -288,6 +288,22 @@ fn host_frames_with_msaa_and_a_stencil_depth() {
     check(4, vk::Format::D32_SFLOAT_S8_UINT, false);
 }
 
+/// The renderer on `host` (its allocator lent) with head_long's hair, 4 strands a bundle, and
+/// a `W x H` host frame (B8G8R8A8 sRGB colour, D32 depth).
+fn small_scene(host: &Host) -> (Arc<Context>, Renderer, hairmesh::BakedHairMesh, Frame<'_>) {
+    let ctx = Arc::new(Context::from_host(host.lend(true)).unwrap());
+    let (baked, style) = sample("head_long.obj");
+    let mut r = Renderer::new(&ctx, &RendererDesc::default().size(W, H)).unwrap();
+    upload(&mut r, &baked, &style, 4, 3);
+    let frame = Frame::new(
+        host,
+        (W, H),
+        vk::Format::B8G8R8A8_SRGB,
+        vk::Format::D32_SFLOAT,
+    );
+    (ctx, r, baked, frame)
+}
+
 /// A frame without the host's depth after one with it on the same slot, the first frame's
 /// depth view destroyed while the second is recorded (as a host that stops drawing to a
 /// depth may; the Bevy plugin did): the second frame binds nothing that still names it. With
@@ -296,18 +312,9 @@ fn host_frames_with_msaa_and_a_stencil_depth() {
 #[test]
 fn a_frame_without_host_depth_binds_no_earlier_depth() {
     let host = Host::new();
-    let ctx = Arc::new(Context::from_host(host.lend(true)).unwrap());
-    let (baked, style) = sample("head_long.obj");
-    let mut r = Renderer::new(&ctx, &RendererDesc::default().size(W, H)).unwrap();
-    upload(&mut r, &baked, &style, 4, 3);
+    let (ctx, mut r, baked, mut frame) = small_scene(&host);
     let camera = framing(&baked);
     let look = View::new(camera);
-    let mut frame = Frame::new(
-        &host,
-        (W, H),
-        vk::Format::B8G8R8A8_SRGB,
-        vk::Format::D32_SFLOAT,
-    );
     let hc = host_camera(&camera, Convention::Standard);
     let open = vec![host_depth(&hc, None); (W * H) as usize];
     let first = frame.images(&ctx);
@@ -364,17 +371,8 @@ fn a_frame_without_host_depth_binds_no_earlier_depth() {
 fn bad_host_frames_are_refused() {
     use hairmesh::vk::{Image, ImageDesc};
     let host = Host::new();
-    let ctx = Arc::new(Context::from_host(host.lend(true)).unwrap());
-    let (baked, style) = sample("head_long.obj");
-    let mut r = Renderer::new(&ctx, &RendererDesc::default().size(W, H)).unwrap();
-    upload(&mut r, &baked, &style, 4, 3);
+    let (ctx, mut r, baked, mut frame) = small_scene(&host);
     let camera = framing(&baked);
-    let mut frame = Frame::new(
-        &host,
-        (W, H),
-        vk::Format::B8G8R8A8_SRGB,
-        vk::Format::D32_SFLOAT,
-    );
     let (color, depth) = frame.images(&ctx);
     let desc = |name, format, usage, (w, h)| ImageDesc::new_2d(name, format, w, h).usage(usage);
     use vk::ImageUsageFlags as U;
