@@ -65,7 +65,6 @@ git diff HEAD | (cd "$tree" && git apply --allow-empty)
 for g in "${groups[@]}"; do
     [ -n "${files[$g]:-}" ] || { echo "mutants.sh: unknown group '$g'" >&2; exit 2; }
     # Which mutants (also what --list counts for a sample) and what tests them.
-
     # The library only: the workspace's Bevy plugin is not built for mutants.
     select=(--package hairmesh)
     for f in ${files[$g]}; do select+=(--file "$f"); done
