@@ -154,6 +154,21 @@ pub fn parse_budget_flag(s: &str) -> std::result::Result<MemoryBudget, String> {
 mod tests {
     use super::*;
 
+    /// Survivors of the 2026-12-06 mutation sample: `part` returning 1, and `human_bytes`'s
+    /// GiB threshold shifted the wrong way (every size printed in GiB).
+    #[test]
+    fn parts_sum_by_name_and_sizes_print_in_their_unit() {
+        let e = Estimate::new()
+            .with("strands", 3, 8)
+            .with("textures", 2, 5)
+            .with("strands", 1, 6);
+        assert_eq!(e.part("strands"), 30);
+        assert_eq!(e.part("textures"), 10);
+        assert_eq!(e.part("absent"), 0);
+        assert_eq!(human_bytes(5 << 20), "5.0 MiB");
+        assert_eq!(human_bytes(3 << 30), "3.0 GiB");
+    }
+
     #[test]
     fn estimates_saturate_and_name_their_largest_part() {
         let e = Estimate::new()

@@ -654,6 +654,20 @@ pub fn exit_with_error(tool: &str, error: &dyn std::fmt::Display, code: i32) -> 
 mod tests {
     use super::*;
 
+    /// Every missing folder of a path is listed, outermost first, up to the first that exists
+    /// (a survivor of the 2026-12-06 mutation sample stopped after the innermost one, so a
+    /// failed run would have left the outer ones behind).
+    #[test]
+    fn missing_folders_lists_each_level_to_the_first_that_exists() {
+        let root = tempfile::tempdir().unwrap();
+        let deep = root.path().join("a").join("b").join("c");
+        let missing = missing_folders(&deep, "--out").unwrap();
+        let a = root.path().join("a");
+        assert_eq!(missing, vec![a.clone(), a.join("b"), deep.clone()]);
+        std::fs::create_dir_all(&deep).unwrap();
+        assert!(missing_folders(&deep, "--out").unwrap().is_empty());
+    }
+
     /// The size limit is inclusive: a file of exactly `max_bytes` is read, one byte more is
     /// refused naming the limit, and a folder is refused before anything is read.
     #[test]

@@ -60,10 +60,17 @@ fi
 rm -rf "$tree"
 git worktree prune
 git worktree add --detach "$tree" HEAD >/dev/null
-git diff HEAD | (cd "$tree" && git apply --allow-empty)
+git diff HEAD >"$root/target/mutants-uncommitted.diff"
+# Each group starts from the checkout as it is: a mutant that writes where it should not (an
+# output path turned into an input, say) must not leave a broken tree for the next group.
+fresh_tree() {
+    (cd "$tree" && git reset -q --hard HEAD && git clean -qfdx && \
+        git apply --allow-empty "$root/target/mutants-uncommitted.diff")
+}
 
 for g in "${groups[@]}"; do
     [ -n "${files[$g]:-}" ] || { echo "mutants.sh: unknown group '$g'" >&2; exit 2; }
+    fresh_tree
     # Which mutants (also what --list counts for a sample) and what tests them.
     # The library only: the workspace's Bevy plugin is not built for mutants.
     select=(--package hairmesh)

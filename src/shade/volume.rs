@@ -181,7 +181,10 @@ mod tests {
         let expected = (-extinction(100.0, width, opacity) * 0.5 / dir.x).exp();
         // Measured 0.7484 vs 0.7493 (0.11%, the march's steps); the exit as a remainder
         // instead of a quotient (a surviving mutant) gives 0.882.
-        assert!((slanted - expected).abs() < 0.01 * expected, "{slanted} vs {expected}");
+        assert!(
+            (slanted - expected).abs() < 0.01 * expected,
+            "{slanted} vs {expected}"
+        );
     }
 
     #[test]
