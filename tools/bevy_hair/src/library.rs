@@ -190,3 +190,51 @@ pub fn place_hair(
         };
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hairmesh::characters::hairstyle::StyleFamily;
+    use std::path::PathBuf;
+
+    fn people(name: &str) -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../hairmeshes/people")
+            .join(name)
+    }
+
+    /// Grown hair carries its head joint's inverse bind matrix (what places it on Bevy's
+    /// skinned head) and a strand count scaled from the one asked for.
+    #[test]
+    fn grown_hair_is_baked_with_its_head_joints_inverse_bind() {
+        let source = HairSource::Grown {
+            character: people("character.glb"),
+            joint: "head".into(),
+            family: StyleFamily::Bob,
+            seed: 7,
+        };
+        let hair = load(&source, 16).unwrap();
+        let own =
+            OwnCharacter::load(&people("character.glb"), "head", MemoryBudget::default()).unwrap();
+        let expected = own.character.skeleton.joints[own.head_joint].inverse_bind;
+        assert_eq!(hair.inverse_bind, Some(expected));
+        assert!(hair.params.strands_per_bundle >= 16);
+        assert!(hair.baked.info.bundle_count > 0);
+    }
+
+    /// Bad sources are refused in one line naming the file, never a panic.
+    #[test]
+    fn bad_sources_are_refused_in_one_line() {
+        let missing = HairSource::Mesh(people("absent.obj"));
+        let why = load(&missing, 16).err().unwrap();
+        assert!(why.contains("absent.obj") && !why.contains('\n'), "{why}");
+        let no_joint = HairSource::Grown {
+            character: people("character.glb"),
+            joint: "tail".into(),
+            family: StyleFamily::Bob,
+            seed: 7,
+        };
+        let why = load(&no_joint, 16).err().unwrap();
+        assert!(why.contains("tail") && !why.contains('\n'), "{why}");
+    }
+}
