@@ -253,3 +253,26 @@ fn roots_follow_a_curved_root_layer() {
         "roots {curved_sag} off the sphere, bilinear {flat_sag}"
     );
 }
+
+/// Every strand's root lies inside its bundle's bounds (`reference::lod::bundle_bounds`, the
+/// CPU twin of the task shader's culling box): a bundle culled by a wrong box would lose hair
+/// that is on screen. (The box with the texel offset subtracted instead of added survived the
+/// 2026-12-06 mutation sample.)
+#[test]
+fn strand_roots_lie_inside_their_bundle_bounds() {
+    let m = mesh("head_long.obj");
+    let style = HairStyle::default();
+    let baked = bake(&m, &style, BakeOptions::default(), |_, _| {}).unwrap();
+    let set = CpuGenerator::new(&baked, style).generate(8, 3);
+    let extent = Vec3::from_slice(&baked.info.pos_extent[..3]).length();
+    // Roots interpolate the decoded corners; 1e-4 of the mesh's size covers float rounding.
+    let slack = 1e-4 * extent;
+    for (s, b) in set.strand_bundle.iter().enumerate() {
+        let root = set.positions[s * set.verts_per_strand];
+        let (lo, hi) = hairmesh::reference::lod::bundle_bounds(&baked, *b as usize, slack);
+        assert!(
+            root.cmpge(lo).all() && root.cmple(hi).all(),
+            "strand {s}: root {root} outside bundle {b}'s bounds {lo}..{hi}"
+        );
+    }
+}
