@@ -79,6 +79,25 @@ fn rejects_damaged_files() {
         "{}",
         err(&absurd)
     );
+    // Consistent files (checksums right) with one bad bundle each: its cell outside the root
+    // slice across or down, a NaN size or density. (Each alone must do: two of the checks
+    // joined by `&&` instead of `||` survived the 2026-12-06 mutation sample.)
+    let good = baked("small_patch.obj");
+    let bad_bundle = |change: &dyn Fn(&mut hairmesh::BundleDesc)| {
+        let mut b = good.clone();
+        change(&mut b.bundles[0]);
+        b
+    };
+    let [w, h] = good.info.root_size;
+    for bad in [
+        bad_bundle(&|b| b.origin[0] = w),
+        bad_bundle(&|b| b.origin[1] = h),
+        bad_bundle(&|b| b.rest_size = f32::NAN),
+        bad_bundle(&|b| b.density = f32::NAN),
+    ] {
+        let e = err(&baked_file::to_bytes(&bad));
+        assert!(e.contains("bundle 0:"), "{e}");
+    }
     for e in [err(&flipped), err(&absurd)] {
         assert!(
             e.starts_with("x.hmb: ") && !e.contains('\n'),
