@@ -277,6 +277,21 @@ pub fn shadow_buffers(light: Option<(u32, ShadowMode)>) -> [TransientBuffer; 2] 
 mod tests {
     use super::*;
 
+    /// Under k-buffer transparency `Auto` sends every bundle to software, keeping its `k`;
+    /// everything else is left as asked (`under` returning the default, hardware, survived
+    /// the 2026-12-06 sample).
+    #[test]
+    fn auto_raster_goes_software_under_a_k_buffer() {
+        use crate::render::Transparency;
+        let oit = Transparency::KBuffer { budget: 8 };
+        let auto = StrandRaster::Auto { k: 3 };
+        assert_eq!(auto.under(oit), StrandRaster::Software { k: 3 });
+        assert_eq!(auto.under(Transparency::Opaque), auto);
+        let soft = StrandRaster::Software { k: 5 };
+        assert_eq!(soft.under(oit), soft);
+        assert_eq!(StrandRaster::Hardware.under(oit), StrandRaster::Hardware);
+    }
+
     /// Each raster reaches the shaders as its own mode number (`FrameBlock::soft.x`).
     #[test]
     fn each_raster_has_its_shader_mode() {
@@ -569,5 +584,7 @@ mod pack_tests {
         assert_eq!(f16_bits(65504.0), 0x7bff);
         assert_eq!(f16_bits(0.0), 0);
         assert_eq!(pack_fragment([1.0, 0.0, 0.25], 1.0), 0xff80_00ff);
+        // Green in its own byte (its shift reversed survived the 2026-12-06 sample).
+        assert_eq!(pack_fragment([0.0, 1.0, 0.0], 0.0), 0x0000_ff00);
     }
 }

@@ -692,5 +692,13 @@ mod tests {
         // Half white in linear light is sRGB 188.
         assert_eq!(out[0], 188);
         assert_eq!(out[3], 255);
+        // Two blocks side by side (4x2 -> 2x1): the left half white, the right black with one
+        // of its four pixels clear (alpha 0.75). Each output pixel reads its own block, and alpha is averaged (the
+        // column offset divided and the mean multiplied survived the 2026-12-06 sample).
+        let (white, black, clear) = ([255u8, 255, 255, 255], [0u8, 0, 0, 255], [0u8, 0, 0, 0]);
+        let row = |right: [u8; 4]| [white, black, black, right].concat();
+        let px = [row(clear), row(black)].concat();
+        let out = downsample(&px, (4, 2), 2);
+        assert_eq!(out, vec![188, 188, 188, 255, 0, 0, 0, 191]);
     }
 }

@@ -434,6 +434,30 @@ fn job(e: &VolumeEntry, r: &CharacterRecord, (lo, hi): (Vec3, Vec3)) -> DensityJ
 mod tests {
     use super::*;
 
+    /// The mean width is the taper's integral: checked against a midpoint sum of
+    /// `strand_width * mix(1, tip_width_ratio, s^p)` (returning a constant survived the
+    /// 2026-12-06 sample).
+    #[test]
+    fn mean_strand_width_integrates_the_taper() {
+        let mut style = crate::model::style::HairStyle::default();
+        style.strand_width = 0.002;
+        style.tip_width_ratio = 0.25;
+        style.taper_power = 2.0;
+        let n = 10_000;
+        let (w, tip, p) = (0.002f64, 0.25f64, 2.0f64);
+        let sum: f64 = (0..n)
+            .map(|i| {
+                let s = (i as f64 + 0.5) / n as f64;
+                w * (1.0 + (tip - 1.0) * s.powf(p))
+            })
+            .sum();
+        let numeric = sum / n as f64;
+        // 0.002 * (1 - 0.75 / 3) = 0.0015; the midpoint sum's error is below 1e-9 of it.
+        let relative = (mean_strand_width(&style) as f64 - numeric).abs() / numeric;
+        assert!(relative < 1e-5, "{relative}");
+        assert!((numeric - 0.0015).abs() < 1e-9);
+    }
+
     /// The switch is measured with the look its doc names (what `bench volume-tier` and
     /// `tests/volume_tier.rs` compare).
     #[test]
