@@ -439,10 +439,12 @@ mod tests {
     /// 2026-12-06 sample).
     #[test]
     fn mean_strand_width_integrates_the_taper() {
-        let mut style = crate::model::style::HairStyle::default();
-        style.strand_width = 0.002;
-        style.tip_width_ratio = 0.25;
-        style.taper_power = 2.0;
+        let style = crate::model::style::HairStyle {
+            strand_width: 0.002,
+            tip_width_ratio: 0.25,
+            taper_power: 2.0,
+            ..Default::default()
+        };
         let n = 10_000;
         let (w, tip, p) = (0.002f64, 0.25f64, 2.0f64);
         let sum: f64 = (0..n)
