@@ -271,11 +271,7 @@ fn check(msaa: u32, depth_format: vk::Format, share_allocator: bool) {
         // Measured 0 between conventions (same pixels); 1e-4 leaves float rounding room.
         assert!(mean_abs_diff(&pictures[0], p) < 1e-4, "conventions differ");
     }
-    drop(frame);
-    drop(r);
-    assert_no_validation_errors(&ctx);
-    drop(ctx);
-    host.still_works();
+    tear_down(&host, ctx, r, frame);
 }
 
 #[test]
@@ -286,6 +282,16 @@ fn host_frames_match_own_frames_and_hide_behind_host_depth() {
 #[test]
 fn host_frames_with_msaa_and_a_stencil_depth() {
     check(4, vk::Format::D32_SFLOAT_S8_UINT, false);
+}
+
+/// Drop the frame and the renderer, check that validation said nothing, and that the host
+/// still works after the renderer is gone.
+fn tear_down(host: &Host, ctx: Arc<Context>, r: Renderer, frame: Frame) {
+    drop(frame);
+    drop(r);
+    assert_no_validation_errors(&ctx);
+    drop(ctx);
+    host.still_works();
 }
 
 /// The renderer on `host` (its allocator lent) with head_long's hair, 4 strands a bundle, and
@@ -358,11 +364,7 @@ fn a_frame_without_host_depth_binds_no_earlier_depth() {
         mean_abs_diff(&slack, &with) < 1e-4,
         "the slack moves the wall behind it"
     );
-    drop(frame);
-    drop(r);
-    assert_no_validation_errors(&ctx);
-    drop(ctx);
-    host.still_works();
+    tear_down(&host, ctx, r, frame);
 }
 
 /// What a host frame refuses, before recording anything: each a one-line error naming the
