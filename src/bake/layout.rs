@@ -390,6 +390,21 @@ mod tests {
         assert_cells_match_faces(&mesh, &layout);
     }
 
+    /// A quad wound the other way round still joins its neighbours' chart: `across` reads its
+    /// far vertices in either direction (the reversed branch was never reached by a test: its
+    /// index mutant survived the 2026-12-06 sample).
+    #[test]
+    fn a_quad_wound_backwards_joins_the_chart() {
+        let mut mesh = grid_mesh(6, 5, false);
+        if let Face::Quad(q) = &mut mesh.faces[13] {
+            q.reverse();
+        }
+        let layout = layout_root_slice(&mesh, true);
+        assert_eq!(layout.charts, 1);
+        assert_eq!(layout.charted_faces, 30);
+        assert_cells_match_faces(&mesh, &layout);
+    }
+
     #[test]
     fn blocks_without_charts_and_triangles() {
         let mesh = grid_mesh(3, 4, true);
