@@ -47,60 +47,46 @@ pub(super) fn pick_physical(
             None => "no Vulkan 1.3 device found (run tools/setup.sh for lavapipe)".into(),
         }));
     };
-    // SAFETY: valid physical device.
-    let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-    let presents = |i: usize| {
-        surface.is_none_or(|s| {
+    let presents = surface.map(|s| {
+        move |i: usize| {
             // SAFETY: valid physical device, family index and surface.
             unsafe {
                 s.loader
                     .get_physical_device_surface_support(physical, i as u32, s.raw)
             }
             .unwrap_or(false)
-        })
-    };
-    let queue_family = families
-        .iter()
-        .enumerate()
-        .position(|(i, f)| {
-            f.queue_flags
-                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-                && f.timestamp_valid_bits > 0
-                && presents(i)
-        })
-        .ok_or_else(|| {
-            GpuError::Unsupported(format!(
-                "{name}: no graphics+compute queue with timestamps{}",
-                if surface.is_some() {
-                    " that can present to the window"
-                } else {
-                    ""
-                }
-            ))
-        })?;
-    Ok((physical, name, queue_family as u32))
+        }
+    });
+    let window = presents.as_ref().map(|p| p as &dyn Fn(usize) -> bool);
+    let queue_family = graphics_family(instance, physical, &name, window)?;
+    Ok((physical, name, queue_family))
 }
 
-/// The first queue family of `physical` with graphics, compute and timestamps.
-#[cfg(feature = "wgpu")]
+/// The first queue family of `physical` with graphics, compute and timestamps (and, given
+/// `presents`, that it accepts: the window's surface can be presented from it).
 pub(super) fn graphics_family(
     instance: &ash::Instance,
     physical: vk::PhysicalDevice,
     name: &str,
+    presents: Option<&dyn Fn(usize) -> bool>,
 ) -> GpuResult<u32> {
     // SAFETY: valid physical device.
     let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-    families
-        .iter()
-        .position(|f| {
-            f.queue_flags
-                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-                && f.timestamp_valid_bits > 0
-        })
-        .map(|i| i as u32)
-        .ok_or_else(|| {
-            GpuError::Unsupported(format!("{name}: no graphics+compute queue with timestamps"))
-        })
+    let family = families.iter().enumerate().position(|(i, f)| {
+        f.queue_flags
+            .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+            && f.timestamp_valid_bits > 0
+            && presents.is_none_or(|p| p(i))
+    });
+    family.map(|i| i as u32).ok_or_else(|| {
+        let window = match presents {
+            Some(_) => " that can present to the window",
+            None => "",
+        };
+        GpuError::Unsupported(format!(
+            "{name}: no graphics+compute queue with timestamps{window}"
+        ))
+    })
 }
 
 /// Optional features found on the device (the required ones are checked).

@@ -122,7 +122,7 @@ fn open(
     let physical = hal.raw_physical_device();
     let name = adapter.get_info().name;
     let found = device::query_features(&instance, physical, &name)?;
-    let family = device::graphics_family(&instance, physical, &name)?;
+    let family = device::graphics_family(&instance, physical, &name, None)?;
     let mut extensions = hal.required_device_extensions(features);
     if found.has_mesh() && !extensions.contains(&ash::ext::mesh_shader::NAME) {
         extensions.push(ash::ext::mesh_shader::NAME);

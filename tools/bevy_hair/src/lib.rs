@@ -200,7 +200,7 @@ impl Plugin for HairPlugin {
             .init_resource::<HairLibrary>()
             .add_systems(
                 PostUpdate,
-                (library::load_hair, library::place_hair)
+                (library::find_head_joints, library::place_hair)
                     .chain()
                     .after(bevy::transform::TransformSystems::Propagate),
             );

@@ -138,16 +138,15 @@ pub struct PlacedHair {
 #[derive(Component, Clone, Copy)]
 pub struct HairJoint(pub Entity);
 
-/// Start loads, and find each grown hair's head joint once its scene has spawned.
-pub fn load_hair(
+/// Find each grown hair's head joint once its scene has spawned (loads start in
+/// [`place_hair`], which asks the library for every hair each frame).
+pub fn find_head_joints(
     mut commands: Commands,
-    mut library: ResMut<HairLibrary>,
     hairs: Query<(Entity, &Hair, Option<&HairJoint>)>,
     children: Query<&Children>,
     names: Query<&Name>,
 ) {
     for (entity, hair, joint) in &hairs {
-        let _ = library.get(hair);
         let HairSource::Grown { joint: name, .. } = &hair.source else {
             continue;
         };
