@@ -5,7 +5,10 @@
 // weighted by the strands it stands for, trilinearly into the job's cells at points no more
 // than SPLAT_SPACING of a cell apart. Cells (VolumeCell) hold fixed-point strand length and
 // flow (VOLUME_FIXED per object unit; the flow's components as two's complement); the one
-// after the grid gathers the length that fell outside.
+// after the grid gathers the length that fell outside. A second dispatch
+// (DENSITY_PASS_OCCUPANCY, a workgroup per job) writes each job's occupancy mask after that
+// cell, a bit per brick (the twin of reference::volume::occupancy_of): volume_hair.frag skips
+// the bricks it leaves clear.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_buffer_reference_uvec2 : require
@@ -66,8 +69,42 @@ void splat_segment(vec3 a, vec3 b, float weight) {
     }
 }
 
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Words { uint words[]; };
+
+// reference::volume::occupancy_of, a brick per invocation: set where a cell from
+// k * BRICK_CELLS - 1 to (k + 1) * BRICK_CELLS (per axis) holds strand length. The words
+// follow the cells and the one after them, cleared with them.
+void write_occupancy() {
+    uvec3 dims = job.dims.xyz;
+    uvec3 bricks = (dims + uvec3(BRICK_CELLS - 1u)) / BRICK_CELLS;
+    uint cells_after = dims.x * dims.y * dims.z + 1u;
+    Words words = Words(job.cells);
+    uint total = bricks.x * bricks.y * bricks.z;
+    for (uint b = gl_LocalInvocationID.x; b < total; b += VOLUME_GROUP_SIZE) {
+        uvec3 k = uvec3(b % bricks.x, (b / bricks.x) % bricks.y, b / (bricks.x * bricks.y));
+        ivec3 lo = max(ivec3(k * BRICK_CELLS) - 1, ivec3(0));
+        ivec3 hi = min(ivec3((k + 1u) * BRICK_CELLS), ivec3(dims) - 1);
+        bool filled = false;
+        for (int z = lo.z; z <= hi.z && !filled; z++) {
+            for (int y = lo.y; y <= hi.y && !filled; y++) {
+                for (int x = lo.x; x <= hi.x && !filled; x++) {
+                    filled = cells.cells[(uint(z) * dims.y + uint(y)) * dims.x + uint(x)].len != 0u;
+                }
+            }
+        }
+        if (filled) {
+            atomicOr(words.words[cells_after * 4u + (b >> 5u)], 1u << (b & 31u));
+        }
+    }
+}
+
 void main() {
     job = DensityJobs(push.params.xy).jobs[gl_WorkGroupID.y];
+    if (push.params.w == DENSITY_PASS_OCCUPANCY) {
+        cells = Cells(job.cells);
+        write_occupancy();
+        return;
+    }
     uint local = gl_WorkGroupID.x;
     if (local >= job.bundles.y) {
         return;

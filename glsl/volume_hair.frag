@@ -48,9 +48,21 @@ void main() {
     float transmittance = 1.0;
     vec3 point = vec3(0.0);
     vec3 flow = vec3(0.0);
-    for (uint i = 0u; i < steps; i++) {
+    // Empty bricks are skipped (shade::volume::march_masked): their samples are exactly 0.
+    uvec3 dims = volume_dims(c);
+    bool skip = (characters[c].volume.w & VOLUME_SKIP_EMPTY) != 0u;
+    uint i = 0u;
+    while (i < steps) {
         float ds = min(step, t_exit - t0 - float(i) * step);
         float t = t0 + float(i) * step + 0.5 * ds;
+        uvec3 brick = volume_brick(dims, g0 + gd * t);
+        if (skip && !brick_occupied(c, dims, brick)) {
+            float leave = brick_exit(g0, gd, brick);
+            float next = clamp(ceil((leave - t0) / step - 0.5), 0.0, float(steps));
+            i = max(i + 1u, uint(next));
+            continue;
+        }
+        i++;
         vec4 s = volume_sample(c, g0 + gd * t);
         if (s.x <= 0.0) {
             continue;

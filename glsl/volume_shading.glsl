@@ -50,6 +50,32 @@ vec4 volume_sample(uint c, vec3 g) {
     return sum * characters[c].volume_shading.x;
 }
 
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer VolumeWords { uint words[]; };
+
+// Whether brick b of character c's occupancy mask is set (reference::volume::brick_set): the
+// density build writes the mask, a bit per brick of BRICK_CELLS^3 cells (x fastest), after the
+// grid's cells and the one after them.
+bool brick_occupied(uint c, uvec3 dims, uvec3 b) {
+    uvec3 n = (dims + uvec3(BRICK_CELLS - 1u)) / BRICK_CELLS;
+    uint bit = (b.z * n.y + b.y) * n.x + b.x;
+    uint first = (dims.x * dims.y * dims.z + 1u) * 4u;
+    uint word = VolumeWords(characters[c].volume.xy).words[first + (bit >> 5u)];
+    return (word & (1u << (bit & 31u))) != 0u;
+}
+
+// The brick holding grid point g, clamped to the grid's (reference::volume::brick_of).
+uvec3 volume_brick(uvec3 dims, vec3 g) {
+    vec3 last = vec3((dims + uvec3(BRICK_CELLS - 1u)) / BRICK_CELLS - uvec3(1u));
+    return uvec3(clamp(floor(g / float(BRICK_CELLS)), vec3(0.0), last));
+}
+
+// Where the ray g0 + t gd (grid coordinates) leaves brick b (reference::volume::brick_exit).
+float brick_exit(vec3 g0, vec3 gd, uvec3 b) {
+    vec3 face = (vec3(b) + step(vec3(0.0), gd)) * float(BRICK_CELLS);
+    vec3 t = mix((face - g0) / gd, vec3(1e30), equal(gd, vec3(0.0)));
+    return min(t.x, min(t.y, t.z));
+}
+
 // Ambient light reaching world point p of character c through its hair
 // (shade::volume::ambient_visibility): 1 without a volume or with occlusion off.
 float volume_ambient(uint c, vec3 p) {

@@ -117,6 +117,21 @@ fn the_volume_matches_the_strands_at_the_switch_distance() {
         // the strands at full detail.
         let strands = frame(&ctx, name, camera, (tier(0.0, 0.0, true), lod));
         let volume = frame(&ctx, name, camera, (tier(1e6, 1e6, true), lod));
+        // Skipping the volume's empty bricks changes no pixel (their samples are exactly 0).
+        let every_brick = VolumeTier {
+            skip_empty: false,
+            ..tier(1e6, 1e6, true)
+        };
+        let marched_whole = frame(&ctx, name, camera, (every_brick, lod));
+        let changed = volume
+            .chunks(4)
+            .zip(marched_whole.chunks(4))
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(
+            changed, 0,
+            "{short}: skipping empty bricks changed {changed} pixels"
+        );
         let full = frame(
             &ctx,
             name,

@@ -172,6 +172,98 @@ impl DensityVolume {
     pub fn mean_cell(&self) -> f32 {
         (self.cell.x + self.cell.y + self.cell.z) / 3.0
     }
+
+    /// Which bricks of [`BRICK_CELLS`]^3 cells a sample can find strands in
+    /// ([`occupancy_of`]): a march skips the others, whose samples are all exactly 0, so
+    /// skipping changes nothing. The GPU's twin is the density build's second dispatch
+    /// (`density_volume.comp`).
+    pub fn occupancy(&self) -> Vec<u32> {
+        occupancy_of(self.dims, |i| self.density[i] > 0.0)
+    }
+}
+
+/// Cells along each side of a brick of a volume's occupancy mask ([`occupancy_of`]).
+pub const BRICK_CELLS: u32 = 2;
+
+/// Bricks along x, y and z of a grid of `dims` cells (the last may be short).
+pub fn bricks(dims: UVec3) -> UVec3 {
+    (dims + UVec3::splat(BRICK_CELLS - 1)) / BRICK_CELLS
+}
+
+/// 32-bit words of the occupancy mask of a grid of `dims` cells: one bit per brick.
+pub fn occupancy_words(dims: UVec3) -> u32 {
+    let b = bricks(dims);
+    (b.x * b.y * b.z).div_ceil(32)
+}
+
+/// Bit of brick `b` in the occupancy mask of a grid of `dims` cells (x fastest).
+pub fn brick_bit(dims: UVec3, b: UVec3) -> u32 {
+    let n = bricks(dims);
+    (b.z * n.y + b.y) * n.x + b.x
+}
+
+/// The brick holding grid point `g` (cell `i` spans `[i, i + 1)`), clamped to the grid's.
+pub fn brick_of(dims: UVec3, g: Vec3) -> UVec3 {
+    let last = (bricks(dims) - UVec3::ONE).as_vec3();
+    (g / BRICK_CELLS as f32)
+        .floor()
+        .clamp(Vec3::ZERO, last)
+        .as_uvec3()
+}
+
+/// Whether brick `b` is marked in `mask`.
+pub fn brick_set(mask: &[u32], dims: UVec3, b: UVec3) -> bool {
+    let bit = brick_bit(dims, b);
+    mask[(bit / 32) as usize] & (1 << (bit % 32)) != 0
+}
+
+/// The occupancy mask of a grid of `dims` cells whose cell `i` (x fastest) holds strands
+/// where `filled(i)`: bit [`brick_bit`] of brick `k` (per axis) is set where a cell from
+/// `k B - 1` to `(k + 1) B` holds strands, `B` = [`BRICK_CELLS`]: a trilinear sample at grid
+/// point `g` reads the cells `floor(g - 0.5)` and one more, and `g` in brick `k` lies in
+/// `[k B, (k + 1) B)`. A sample on a brick's face reads cells both bricks mark, so rounding
+/// which brick it falls in cannot skip strands.
+pub fn occupancy_of(dims: UVec3, filled: impl Fn(usize) -> bool) -> Vec<u32> {
+    let n = bricks(dims);
+    let mut mask = vec![0u32; occupancy_words(dims) as usize];
+    for z in 0..dims.z {
+        for y in 0..dims.y {
+            for x in 0..dims.x {
+                if !filled(((z * dims.y + y) * dims.x + x) as usize) {
+                    continue;
+                }
+                // Whole numbers, so the GPU's twin gets the same bricks.
+                let c = UVec3::new(x, y, z);
+                let lo = c.saturating_sub(UVec3::ONE) / BRICK_CELLS;
+                let hi = ((c + 1) / BRICK_CELLS).min(n - UVec3::ONE);
+                for bz in lo.z..=hi.z {
+                    for by in lo.y..=hi.y {
+                        for bx in lo.x..=hi.x {
+                            let bit = brick_bit(dims, UVec3::new(bx, by, bz));
+                            mask[(bit / 32) as usize] |= 1 << (bit % 32);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    mask
+}
+
+/// Where the ray `g0 + t gd` (grid coordinates) leaves brick `b`: the least `t` at which it
+/// crosses one of the brick's faces ahead of it (infinite for a ray that stands still).
+pub fn brick_exit(g0: Vec3, gd: Vec3, b: UVec3) -> f32 {
+    let size = BRICK_CELLS as f32;
+    let mut t = f32::INFINITY;
+    for axis in 0..3 {
+        let d = gd[axis];
+        if d == 0.0 {
+            continue;
+        }
+        let face = (b[axis] as f32 + if d > 0.0 { 1.0 } else { 0.0 }) * size;
+        t = t.min((face - g0[axis]) / d);
+    }
+    t
 }
 
 /// The density volume of `generator`'s hair with `n` strands per average bundle (`N` of eq. 8:

@@ -332,6 +332,14 @@ impl Renderer {
         self.volumes.read(&self.ctx, id)
     }
 
+    /// Character `id`'s density volume's occupancy mask as the GPU wrote it (its bricks with
+    /// strands: [`crate::reference::volume::DensityVolume::occupancy`]), after the frames in
+    /// flight.
+    pub fn read_density_occupancy(&mut self, id: CharacterId) -> GpuResult<Vec<u32>> {
+        self.finish()?;
+        self.volumes.read_occupancy(&self.ctx, id)
+    }
+
     /// The pose character `id`'s GPU hair dynamics last wrote (`layers x vertices`,
     /// character frame), read back after the frames in flight.
     pub fn read_hair_pose(&mut self, id: CharacterId) -> GpuResult<Vec<glam::Vec3>> {

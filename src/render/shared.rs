@@ -36,6 +36,9 @@ pub const VOLUME_BUILT: u32 = 1;
 /// `CharacterRecord::volume.w` bit: the ambient term of this character's strands is
 /// occluded by its density volume (`shade::volume::ambient_visibility`).
 pub const VOLUME_OCCLUSION: u32 = 2;
+/// `CharacterRecord::volume.w` bit: the far hair's march skips the volume's empty bricks
+/// (`VolumeTier::skip_empty`).
+pub const VOLUME_SKIP_EMPTY: u32 = 4;
 
 pub use crate::shade::lut::{
     MARSCHNER_LUT_D, MARSCHNER_LUT_PHI, MARSCHNER_LUT_TRT_SCALE, SCATTER_LUT_THETA,
@@ -69,6 +72,9 @@ pub const VOLUME_FIXED: f32 = 16384.0;
 pub const VOLUME_DIMS_BITS: u32 = 10;
 /// Invocations of one `density_volume.comp` workgroup (one bundle; a strand each).
 pub const VOLUME_GROUP_SIZE: u32 = 32;
+/// The density build's second dispatch (push constant `w`): each job's occupancy mask
+/// (`reference::volume::occupancy_of`), one bit per brick, as words after its cells.
+pub const DENSITY_PASS_OCCUPANCY: u32 = 1;
 /// Most colliders one simulated character may have (the solver keeps them in shared memory).
 pub const MAX_SIM_COLLIDERS: u32 = 16;
 /// `SimCollider::shape.x`: an ellipsoid (`a`: centre, `b`: radii).
@@ -575,7 +581,7 @@ pub struct CharacterRecord {
     pub world_to_volume: [[f32; 4]; 4],
     /// Density volume: xy its cells' device address ([`VolumeCell`]s, x fastest), z its cell
     /// counts packed ([`VOLUME_DIMS_BITS`] per axis, x lowest), w [`VOLUME_BUILT`] |
-    /// [`VOLUME_OCCLUSION`].
+    /// [`VOLUME_OCCLUSION`] | [`VOLUME_SKIP_EMPTY`].
     pub volume: [u32; 4],
     /// Density volume shading: x strand width over a cell's volume and [`VOLUME_FIXED`]
     /// (a cell's fixed-point length times x is density times width, object units), y mean
@@ -939,7 +945,7 @@ pub struct SimState {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DensityJob {
     /// [`VolumeCell`]`[]`: the cells (x fastest), then one more whose length is what fell
-    /// outside.
+    /// outside, then the occupancy mask's words (`reference::volume::occupancy_words`).
     pub cells: [u32; 2],
     /// Padding.
     pub _pad: [u32; 2],
@@ -1134,7 +1140,10 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("CHARACTER_VOLUME_ONLY", CHARACTER_VOLUME_ONLY),
         uint("VOLUME_BUILT", VOLUME_BUILT),
         uint("VOLUME_OCCLUSION", VOLUME_OCCLUSION),
+        uint("VOLUME_SKIP_EMPTY", VOLUME_SKIP_EMPTY),
         uint("VOLUME_DIMS_BITS", VOLUME_DIMS_BITS),
+        uint("BRICK_CELLS", crate::reference::volume::BRICK_CELLS),
+        uint("DENSITY_PASS_OCCUPANCY", DENSITY_PASS_OCCUPANCY),
         uint("MARSCHNER_LUT_PHI", MARSCHNER_LUT_PHI),
         uint("MARSCHNER_LUT_D", MARSCHNER_LUT_D),
         uint("SCATTER_LUT_THETA", SCATTER_LUT_THETA),

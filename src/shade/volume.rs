@@ -19,7 +19,7 @@
 
 use glam::Vec3;
 
-use crate::reference::volume::DensityVolume;
+use crate::reference::volume::{DensityVolume, brick_exit, brick_of, brick_set};
 
 /// Radius of the ambient occlusion neighbourhood, in mean cell sizes.
 pub const AO_RADIUS_CELLS: f32 = 2.0;
@@ -59,15 +59,40 @@ pub fn march(
     from: Vec3,
     dir: Vec3,
     length: f32,
+    strands: (f32, f32),
+) -> MarchResult {
+    march_masked(volume, &volume.occupancy(), from, dir, length, strands)
+}
+
+/// [`march`] skipping the bricks `mask` marks empty ([`DensityVolume::occupancy`]; all ones:
+/// no skipping), as `volume_hair.frag` does: the same samples, so the same result for any
+/// mask that marks every brick with strands.
+pub fn march_masked(
+    volume: &DensityVolume,
+    mask: &[u32],
+    from: Vec3,
+    dir: Vec3,
+    length: f32,
     (width, opacity): (f32, f32),
 ) -> MarchResult {
     let step = MARCH_STEP_CELLS * volume.mean_cell();
     let steps = (length / step).ceil().max(0.0) as u32;
     let mut t = 1.0f32;
     let (mut point, mut flow, mut absorbed) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
-    for i in 0..steps {
+    let (g0, gd) = ((from - volume.origin) / volume.cell, dir / volume.cell);
+    let mut i = 0;
+    while i < steps {
         let ds = step.min(length - i as f32 * step);
-        let p = from + dir * (i as f32 * step + 0.5 * ds);
+        let at = i as f32 * step + 0.5 * ds;
+        let brick = brick_of(volume.dims, g0 + gd * at);
+        if !brick_set(mask, volume.dims, brick) {
+            // Every sample in an empty brick is 0: on to the first one past it.
+            let exit = brick_exit(g0, gd, brick);
+            i = (i + 1).max((exit / step - 0.5).ceil().max(0.0) as u32);
+            continue;
+        }
+        i += 1;
+        let p = from + dir * at;
         let sigma = extinction(volume.sample(p), width, opacity);
         if sigma <= 0.0 {
             continue;

@@ -3,12 +3,14 @@
 //! a workgroup per (bundle, volume), reading the frame slot's job table by device address.
 //! Reads: the frame's records, bundle table and the characters' textures (after this frame's
 //! texture rebuilds). Writes: each requested volume's cells, cleared first (the frame's
-//! density volumes, one resource of the graph: shaders reach them by device address).
+//! density volumes, one resource of the graph: shaders reach them by device address); then a
+//! second dispatch, a workgroup per volume, writes each one's occupancy mask after its cells.
 
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets};
 use crate::render::graph::FrameGraph;
+use crate::render::shared::DENSITY_PASS_OCCUPANCY;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 
@@ -64,6 +66,17 @@ impl DensityVolumePass {
             rec.dispatch(most_bundles, count, 1);
             Ok(())
         });
+        let occupancy = [address[0], address[1], count, DENSITY_PASS_OCCUPANCY];
+        g.pass("density occupancy")
+            .read(jobs, Access::ComputeRead)
+            .read_all(&[r.constants], Access::ComputeRead)
+            .write(r.volumes, Access::ComputeReadWrite)
+            .record(move |rec, _| {
+                rec.bind(&self.pipeline, &sets.both());
+                rec.push_constants(&self.pipeline, &occupancy);
+                rec.dispatch(1, count, 1);
+                Ok(())
+            });
         g.end_scope();
     }
 }
