@@ -187,6 +187,14 @@ enum Cmd {
     /// frames (bare strands soft and hw on both paths at 20K and 100K, the full look, the
     /// people crowd at 100 and 1000) alternating old and new, print new/old per row.
     Compare(compare::CompareArgs),
+    /// FLIP (nv-flip) of a test picture against a reference of the same size: mean and 99th
+    /// percentile, as the golden tests and `compare` measure.
+    Flip {
+        /// Reference PNG.
+        reference: PathBuf,
+        /// Test PNG.
+        test: PathBuf,
+    },
     /// Copies of one hair mesh in wind, simulated and re-textured every frame (30 Hz), for
     /// each character count and dynamics path: CPU and GPU ms of the dynamics, GPU ms of the
     /// texture rebuild and of the frame; optionally a strip of frames.
@@ -811,6 +819,7 @@ fn run(args: Args) -> Result<()> {
         })?,
         Cmd::Temporal(args) => temporal::bench_temporal(args)?,
         Cmd::Compare(args) => compare::bench_compare(args)?,
+        Cmd::Flip { reference, test } => compare::print_flip(&reference, &test)?,
         Cmd::Fuzz {
             iterations,
             seed,

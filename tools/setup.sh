@@ -55,7 +55,7 @@ $SUDO apt-get install -y -qq --no-install-recommends \
     -t "$codename-backports" mesa-vulkan-drivers >/dev/null
 $SUDO apt-get install -y -qq --no-install-recommends \
     libvulkan1 libvulkan-dev vulkan-validationlayers vulkan-tools \
-    libshaderc-dev glslang-dev spirv-tools pkg-config xvfb xauth >/dev/null
+    libshaderc-dev glslang-dev spirv-tools pkg-config g++ xvfb xauth >/dev/null
 
 # Lavapipe must advertise mesh shaders (Mesa >= 25 from backports).
 if command -v vulkaninfo >/dev/null; then

@@ -93,6 +93,8 @@ impl OwnCharacter {
         super::people::FarPlan {
             cell: super::people::FAR_CELL * self.head.scale,
             levels: super::people::FAR_LEVELS,
+            // Its scalp is part of the body: clustered, so it never bulges through the hair.
+            method: super::people::FarMethod::Cluster,
         }
     }
 

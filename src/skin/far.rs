@@ -1,4 +1,7 @@
-//! Far versions of skinned meshes: vertex clustering (Rossignac and Borrel 1993), as
+//! Far versions of skinned meshes, two ways. [`simplified_mesh`]: edge collapse under
+//! quadric error metrics (Garland and Heckbert 1997, meshoptimizer's simplifier) within an
+//! error, keeping original vertices; the people's bodies and clothes. [`far_mesh`]: vertex
+//! clustering (Rossignac and Borrel 1993), as
 //! `characters::far_mesh` does for static props, carrying skinning data. Vertices are snapped
 //! to `cell`-sized cubes at bind time; each cell keeps the vertex nearest its mean (its joints
 //! and weights, so the far mesh skins like the near one) with the mean colour and roughness of
@@ -70,6 +73,46 @@ pub fn far_mesh(mesh: &SkinnedMesh, cell: f32) -> SkinnedMesh {
     }
 }
 
+/// The far version of `mesh` simplified by edge collapse (quadric error metrics, Garland and
+/// Heckbert 1997, through meshoptimizer) until its surface would move more than `error` (mesh
+/// units): flat parts lose most of their triangles, outlines and limbs keep their place. Its
+/// vertices are the original's that remain (joints, weights and colours included), compacted.
+pub fn simplified_mesh(mesh: &SkinnedMesh, error: f32) -> SkinnedMesh {
+    let positions: Vec<[f32; 3]> = mesh
+        .vertices
+        .iter()
+        .map(|v| v.position.to_array())
+        .collect();
+    let bytes: &[u8] = bytemuck::cast_slice(&positions);
+    let kept = match meshopt::VertexDataAdapter::new(bytes, 12, 0) {
+        Ok(adapter) => meshopt::simplify(
+            &mesh.indices,
+            &adapter,
+            0,
+            error,
+            meshopt::SimplifyOptions::ErrorAbsolute,
+            None,
+        ),
+        Err(_) => mesh.indices.clone(),
+    };
+    let mut remap: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    let mut vertices = Vec::new();
+    let indices = kept
+        .iter()
+        .map(|&i| {
+            *remap.entry(i).or_insert_with(|| {
+                vertices.push(mesh.vertices[i as usize]);
+                vertices.len() as u32 - 1
+            })
+        })
+        .collect();
+    SkinnedMesh {
+        name: format!("{} (far)", mesh.name),
+        vertices,
+        indices,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,5 +171,82 @@ mod tests {
             .iter()
             .fold(Vec3::MIN, |m, v| m.max(v.position));
         assert!(max.x > 0.9 && max.y > 0.9, "{max}");
+    }
+
+    /// Edge collapse on a unit sphere of 64 x 32 quads at an error of 1 cm: at most a third of
+    /// the triangles are left (measured: 853 of 3968), every vertex is an original one with
+    /// its skinning data, and the surface stays near the error: the middle of every triangle
+    /// left lies at most 2 cm inside the sphere (measured: 1.7 cm; at 4 cm of error it is
+    /// far deeper).
+    #[test]
+    fn edge_collapse_keeps_the_surface_within_the_error() {
+        let (cols, rows) = (64u32, 32u32);
+        let mut vertices = Vec::new();
+        for r in 0..=rows {
+            for c in 0..=cols {
+                let (theta, phi) = (
+                    std::f32::consts::PI * r as f32 / rows as f32,
+                    std::f32::consts::TAU * c as f32 / cols as f32,
+                );
+                let p = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                );
+                vertices.push(SkinVertex {
+                    position: p,
+                    normal: p,
+                    color: Vec3::ONE,
+                    roughness: 0.5,
+                    joints: [(c % 5) as u16, (r % 3) as u16, 0, 0],
+                    weights: [0.75, 0.25, 0.0, 0.0],
+                });
+            }
+        }
+        let mut indices = Vec::new();
+        for r in 0..rows {
+            for c in 0..cols {
+                let a = r * (cols + 1) + c;
+                let (b, d, e) = (a + 1, a + cols + 1, a + cols + 2);
+                if r > 0 {
+                    indices.extend([a, b, e]);
+                }
+                if r + 1 < rows {
+                    indices.extend([a, e, d]);
+                }
+            }
+        }
+        let sphere = SkinnedMesh {
+            name: "sphere".into(),
+            vertices,
+            indices,
+        };
+        let far = simplified_mesh(&sphere, 0.01);
+        let (before, after) = (sphere.indices.len() / 3, far.indices.len() / 3);
+        eprintln!("{after} of {before} triangles left");
+        assert!(after > 0 && after * 3 <= before, "{after} of {before}");
+        for v in &far.vertices {
+            let same = |w: &&SkinVertex| (w.position, w.joints) == (v.position, v.joints);
+            let original = sphere
+                .vertices
+                .iter()
+                .find(same)
+                .expect("an original vertex");
+            assert_eq!(original, v);
+        }
+        let sag = far
+            .indices
+            .chunks_exact(3)
+            .map(|t| {
+                let c = t
+                    .iter()
+                    .map(|&i| far.vertices[i as usize].position)
+                    .sum::<Vec3>()
+                    / 3.0;
+                1.0 - c.length()
+            })
+            .fold(0.0f32, f32::max);
+        eprintln!("deepest triangle middle {sag} inside");
+        assert!(sag <= 0.02, "a triangle's middle {sag} inside the sphere");
     }
 }

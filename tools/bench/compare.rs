@@ -229,6 +229,11 @@ fn measure(crowd: &Path, row: &Row, frames: u16) -> Result<Option<Measured>> {
 
 /// FLIP mean of `new` against `old` (the same frame of both builds).
 fn flip_mean(old: &image::RgbImage, new: &image::RgbImage) -> Option<f64> {
+    flip_pool(old, new).map(|p| p.mean() as f64)
+}
+
+/// FLIP of `new` against `old`, pooled (`None` when their sizes differ).
+fn flip_pool(old: &image::RgbImage, new: &image::RgbImage) -> Option<nv_flip::FlipPool> {
     if old.dimensions() != new.dimensions() {
         return None;
     }
@@ -238,7 +243,33 @@ fn flip_mean(old: &image::RgbImage, new: &image::RgbImage) -> Option<f64> {
         nv_flip::FlipImageRgb8::with_data(w, h, new.as_raw()),
         nv_flip::DEFAULT_PIXELS_PER_DEGREE,
     );
-    Some(nv_flip::FlipPool::from_image(&err).mean() as f64)
+    Some(nv_flip::FlipPool::from_image(&err))
+}
+
+/// `bench flip`: print FLIP's mean and 99th percentile of `test` against `reference`.
+pub fn print_flip(reference: &std::path::Path, test: &std::path::Path) -> anyhow::Result<()> {
+    let load = |p: &std::path::Path| {
+        image::open(p)
+            .map(|i| i.to_rgb8())
+            .map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))
+    };
+    let (old, new) = (load(reference)?, load(test)?);
+    let pool = flip_pool(&old, &new).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: {}x{}, the reference is {}x{}",
+            test.display(),
+            new.width(),
+            new.height(),
+            old.width(),
+            old.height()
+        )
+    })?;
+    println!(
+        "FLIP mean {:.4}, 99th percentile {:.4}",
+        pool.mean(),
+        pool.get_weighted_percentile(0.99)
+    );
+    Ok(())
 }
 
 /// Whether row `name` is chosen by `pattern`: its whole name, or its first words

@@ -164,8 +164,9 @@ pub struct Args {
     #[arg(long, default_value = "gpu")]
     dynamics: hairmesh::animate::DynamicsPath,
     /// Simulate characters small on screen less often (every 2nd, 4th or 8th frame below 96,
-    /// 48 and 24 pixels of hair); off: every character every frame.
-    #[arg(long, default_value = "off", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
+    /// 48 and 24 pixels of hair, with the time they skipped in one step); off: every character
+    /// every frame (1000 people: 340 ms more a frame on lavapipe, FLIP 0.015 against on).
+    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
     dynamics_schedule: bool,
     /// Wind strength on the hair tips, m/s^2 (0..=100; gusty).
     #[arg(long, default_value_t = 0.0)]
