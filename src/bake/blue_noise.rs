@@ -126,10 +126,19 @@ impl Ord for HeapItem {
     }
 }
 
+/// The weight floor of sample elimination (Yuksel 2015, sec. 3.3's `r_min`): pairs closer than
+/// this weigh as much as pairs at it, so a few near-coincident candidates do not outweigh a
+/// crowded neighbourhood; `rmax` the target count's packing radius, `candidates` the count
+/// eliminated from.
+fn r_min(rmax: f32, target: usize, candidates: usize) -> f32 {
+    let ratio = target as f32 / candidates.max(1) as f32;
+    rmax * (1.0 - ratio.powf(GAMMA)) * BETA
+}
+
 /// Eliminate `points` down to `target`; returns (kept, eliminated in elimination order).
 fn eliminate(points: &[Vec2], target: usize, domain: Domain) -> (Vec<Vec2>, Vec<Vec2>) {
     let rmax = r_max(domain.area(), target);
-    let rmin = rmax * (1.0 - (target as f32 / points.len() as f32).powf(GAMMA)) * BETA;
+    let rmin = r_min(rmax, target, points.len());
     let weight = |d: f32| (1.0 - d.max(rmin) / (2.0 * rmax)).max(0.0).powf(ALPHA);
     let nb = neighbours(points, 2.0 * rmax, domain);
     let mut w: Vec<f32> = nb
@@ -231,6 +240,17 @@ pub fn prefix_min_distances(points: &[Vec2], domain: Domain) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Yuksel's weight floor at this module's 5x candidates: `(1 - (1/5)^1.5) 0.65 = 0.5919`
+    /// of `r_max`, inside `(0, r_max)`; as the candidates approach the target it falls to 0.
+    #[test]
+    fn weight_floor_follows_yuksel() {
+        let rmax = 2.0;
+        let floor = r_min(rmax, 100, 500);
+        assert!((floor / rmax - 0.591_863).abs() < 1e-5, "{}", floor / rmax);
+        assert!(r_min(rmax, 100, 100).abs() < 1e-6);
+        assert!(r_min(rmax, 100, 200) < floor && r_min(rmax, 100, 200) > 0.0);
+    }
 
     fn check_prefixes(domain: Domain) {
         let n = 1024;

@@ -352,3 +352,45 @@ pub fn bake(
 pub fn texels_per_face(baked: &BakedHairMesh) -> f32 {
     baked.info.slice_texels() as f32 / baked.bundles.len().max(1) as f32
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::hair_mesh::{Face, HairMesh};
+
+    /// The estimate's column control points are what the bake allocates for them: one vector
+    /// of `4 (L - 1) + 1` points per vertex column (measured equal to the byte for a quad of 5
+    /// layers: 4 x (24 + 17 x 12) = 912 bytes).
+    #[test]
+    fn column_control_points_estimate_is_the_allocation() {
+        let layers: Vec<Vec<Vec3>> = (0..5)
+            .map(|k| {
+                let y = k as f32 * 0.1;
+                vec![
+                    Vec3::new(0.0, y, 0.0),
+                    Vec3::new(1.0, y, 0.0),
+                    Vec3::new(1.0, y, 1.0),
+                    Vec3::new(0.0, y, 1.0),
+                ]
+            })
+            .collect();
+        let uv = vec![
+            glam::Vec2::new(0.0, 0.0),
+            glam::Vec2::new(1.0, 0.0),
+            glam::Vec2::new(1.0, 1.0),
+            glam::Vec2::new(0.0, 1.0),
+        ];
+        let mesh = HairMesh::new("quad", layers, None, uv, vec![Face::Quad([0, 1, 2, 3])]).unwrap();
+        let n = mesh.vertices_per_layer();
+        let allocated: u64 = (0..n)
+            .map(|i| {
+                let column: Vec<Vec3> = mesh.layers.iter().map(|l| l[i]).collect();
+                let ctrl = column_control_points(&column);
+                (size_of::<Vec<Vec3>>() + ctrl.capacity() * size_of::<Vec3>()) as u64
+            })
+            .sum();
+        let estimate = memory_estimate(n as u64, mesh.layer_count() as u64, 1);
+        assert_eq!(estimate.part("column control points"), allocated);
+        assert_eq!(allocated, 912);
+    }
+}
