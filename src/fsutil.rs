@@ -654,6 +654,20 @@ pub fn exit_with_error(tool: &str, error: &dyn std::fmt::Display, code: i32) -> 
 mod tests {
     use super::*;
 
+    /// An output given as a symbolic link is refused as one (not as some other kind of file),
+    /// and a path the system cannot even look up (a NUL in its name) is an error, not taken
+    /// for a file that does not exist yet (both survived the third mutation sample).
+    #[test]
+    fn outputs_that_are_links_or_unreadable_paths_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let (target, link) = (dir.path().join("real.hmb"), dir.path().join("link.hmb"));
+        std::fs::write(&target, b"x").unwrap();
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        let err = OutputPath::check(&link, &[]).unwrap_err().to_string();
+        assert!(err.contains("symbolic link"), "{err}");
+        assert!(OutputPath::check(Path::new("bad\0name.hmb"), &[]).is_err());
+    }
+
     /// Every missing folder of a path is listed, outermost first, up to the first that exists
     /// (a survivor of the 2026-12-06 mutation sample stopped after the innermost one, so a
     /// failed run would have left the outer ones behind).

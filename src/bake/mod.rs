@@ -356,7 +356,56 @@ pub fn texels_per_face(baked: &BakedHairMesh) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::hair_mesh::{Face, HairMesh};
+    use crate::model::hair_mesh::Face;
+
+    /// The uv texture decodes to the mesh's uvs: every texel (through the mesh's uv box) lies
+    /// within one 16-bit step of a vertex's uv, and every vertex's uv is in some texel. The uvs
+    /// sit in [0.25, 0.75], off the origin, so an encoding that loses the box's corner shows.
+    #[test]
+    fn uv_texture_decodes_to_the_mesh_uvs() {
+        let layers: Vec<Vec<Vec3>> = (0..3)
+            .map(|k| {
+                let y = k as f32 * 0.1;
+                vec![
+                    Vec3::new(0.0, y, 0.0),
+                    Vec3::new(1.0, y, 0.0),
+                    Vec3::new(1.0, y, 1.0),
+                    Vec3::new(0.0, y, 1.0),
+                ]
+            })
+            .collect();
+        let uv: Vec<glam::Vec2> = [(0.25, 0.25), (0.75, 0.3), (0.7, 0.75), (0.3, 0.7)]
+            .map(|(u, v)| glam::Vec2::new(u, v))
+            .to_vec();
+        let faces = vec![Face::Quad([0, 1, 2, 3])];
+        let mesh = HairMesh::new("quad", layers, None, uv.clone(), faces).unwrap();
+        let baked = bake(
+            &mesh,
+            &HairStyle::default(),
+            BakeOptions::default(),
+            |_, _| {},
+        )
+        .unwrap();
+        let [ox, oy, ex, ey] = baked.info.uv_origin_extent;
+        let decode = |t: [u16; 2]| {
+            glam::Vec2::new(
+                ox + ex * t[0] as f32 / 65535.0,
+                oy + ey * t[1] as f32 / 65535.0,
+            )
+        };
+        let step = 0.5 / 65535.0 + 1e-6;
+        let near = |a: glam::Vec2, b: glam::Vec2| (a - b).abs().max_element() <= step;
+        for (i, t) in baked.uv.iter().enumerate() {
+            let got = decode(*t);
+            assert!(uv.iter().any(|&u| near(u, got)), "texel {i}: {got}");
+        }
+        for u in &uv {
+            assert!(
+                baked.uv.iter().any(|t| near(*u, decode(*t))),
+                "{u} in no texel"
+            );
+        }
+    }
 
     /// The estimate's column control points are what the bake allocates for them: one vector
     /// of `4 (L - 1) + 1` points per vertex column (measured equal to the byte for a quad of 5

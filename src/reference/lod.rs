@@ -95,6 +95,46 @@ pub fn apply_geomorph(p: &mut [Vec3], t: &mut [Vec3], gamma: f32) {
 mod tests {
     use super::*;
 
+    /// Eq. 11: an odd vertex moves toward the midpoint of its even neighbours by `gamma` (a
+    /// bent three-vertex strand: halfway at 0.5, onto the chord at 1), even vertices stay, and
+    /// the odd tangent turns toward the even-only one.
+    #[test]
+    fn geomorph_moves_odd_vertices_toward_their_neighbours_midpoint() {
+        let bent = [
+            Vec3::ZERO,
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+        ];
+        for (gamma, want) in [
+            (0.5, Vec3::new(1.0, 0.5, 0.0)),
+            (1.0, Vec3::new(1.0, 0.0, 0.0)),
+        ] {
+            let (mut p, mut t) = (bent, [Vec3::X; 3]);
+            t[1] = Vec3::Y;
+            apply_geomorph(&mut p, &mut t, gamma);
+            assert!(p[1].distance(want) < 1e-6, "gamma {gamma}: {}", p[1]);
+            assert_eq!((p[0], p[2]), (bent[0], bent[2]));
+            assert!(t[1].x > 0.0 && t[1].is_normalized(), "{}", t[1]);
+        }
+    }
+
+    /// Eq. 8's per-bundle increment `delta_i` is uniform in [0, 1) and differs between
+    /// bundles: 4096 bundles give at least 4000 distinct values (24-bit values: a collision or
+    /// two is chance) with a mean within 0.02 of 0.5, and a seed changes them (the GPU's
+    /// `bundle_lod.glsl` hashes the same way).
+    #[test]
+    fn bundle_delta_is_uniform_and_per_bundle() {
+        let d: Vec<f32> = (0..4096).map(|b| bundle_delta(b, 7)).collect();
+        let mut sorted = d.clone();
+        sorted.sort_by(f32::total_cmp);
+        sorted.dedup();
+        assert!(sorted.len() >= 4000, "{} distinct increments", sorted.len());
+        let mean = d.iter().sum::<f32>() / d.len() as f32;
+        assert!((mean - 0.5).abs() < 0.02, "mean {mean}");
+        assert!(d.iter().all(|x| (0.0..1.0).contains(x)));
+        assert_ne!(bundle_delta(3, 7), bundle_delta(3, 8));
+    }
+
     #[test]
     fn detail_level_falls_with_distance_and_clamps() {
         let near = detail_level(0.02, 720.0, 0.5, 0.5, 0.05);

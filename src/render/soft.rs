@@ -587,4 +587,22 @@ mod pack_tests {
         // Green in its own byte (its shift reversed survived the 2026-12-06 sample).
         assert_eq!(pack_fragment([0.0, 1.0, 0.0], 0.0), 0x0000_ff00);
     }
+
+    /// A shaded segment carries its ends, depth step, colours and width in `SoftSegment`'s
+    /// packing (what `rasterize_segments` hands the GPU; the whole constructor replaced by a
+    /// default survived the third sample).
+    #[test]
+    fn shaded_segment_packs_its_ends_colours_and_width() {
+        let s = SoftSegment::shaded(
+            glam::Vec3::new(3.0, 4.0, 0.25),
+            glam::Vec3::new(5.0, 3.0, 0.75),
+            1.5,
+            [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+        );
+        assert_eq!((s.a, s.za), ([3.0, 4.0], 0.25));
+        assert_eq!(s.dz_id, f16_bits(0.5));
+        assert_eq!(s.b[0], f16_bits(2.0) | f16_bits(-1.0) << 16);
+        assert_eq!((s.b[1], s.b[2]), (0xff00_00ff, 0xffff_0000));
+        assert_eq!(s.b[3], f16_bits(1.5) | f16_bits(1.0) << 16);
+    }
 }

@@ -700,5 +700,10 @@ mod tests {
         let px = [row(clear), row(black)].concat();
         let out = downsample(&px, (4, 2), 2);
         assert_eq!(out, vec![188, 188, 188, 255, 0, 0, 0, 191]);
+        // Two blocks stacked (2x4 -> 1x2): each output row reads its own block's rows (the row
+        // offset divided survived the third sample).
+        let px = [white, white, white, white, black, black, black, black].concat();
+        let out = downsample(&px, (2, 4), 2);
+        assert_eq!(out, vec![255, 255, 255, 255, 0, 0, 0, 255]);
     }
 }

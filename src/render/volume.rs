@@ -463,6 +463,24 @@ fn job(e: &VolumeEntry, r: &CharacterRecord, (lo, hi): (Vec3, Vec3)) -> DensityJ
 mod tests {
     use super::*;
 
+    /// A frame's tier draw counts each character once, as alone or blended, and its instance
+    /// range reaches one past the last slot drawn (the volume hair pass's instance count).
+    #[test]
+    fn tier_draw_counts_and_spans_its_characters() {
+        let mut d = TierDraw::default();
+        d.add(4, true);
+        d.add(1, false);
+        d.add(9, true);
+        assert_eq!(
+            d,
+            TierDraw {
+                slots: 10,
+                alone: 2,
+                blended: 1
+            }
+        );
+    }
+
     /// The mean width is the taper's integral: checked against a midpoint sum of
     /// `strand_width * mix(1, tip_width_ratio, s^p)` (returning a constant survived the
     /// 2026-12-06 sample).

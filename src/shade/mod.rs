@@ -219,6 +219,22 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 pub(crate) mod tests {
     use super::*;
 
+    /// The sRGB inverse on both of its pieces: the linear toe below 0.04045 (`c / 12.92`), the
+    /// power curve above, and the two meeting at the knee (IEC 61966-2-1); glTF base colours of
+    /// dark hair and clothes fall on the toe.
+    #[test]
+    fn srgb_to_linear_has_the_standard_toe_and_curve() {
+        assert!((srgb_to_linear(0.02) - 0.02 / 12.92).abs() < 1e-7);
+        assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
+        assert_eq!(srgb_to_linear(0.0), 0.0);
+        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
+        let (below, above) = (srgb_to_linear(0.04045), srgb_to_linear(0.040_451));
+        assert!(
+            (above - below).abs() < 1e-6,
+            "{below} vs {above} at the knee"
+        );
+    }
+
     /// `integral over the sphere of S(omega_i, omega_o) cos(theta_o) d omega_o` for white hair
     /// (no absorption) and incidence `theta_i`, by midpoint quadrature in (theta_o, phi).
     pub(crate) fn furnace(theta_i: f32, p: &MarschnerParams) -> f32 {
