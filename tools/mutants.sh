@@ -2,7 +2,7 @@
 # Mutation testing of the CPU twins with cargo-mutants (issue 43): the mutants of each module
 # group are built and run against that group's tests, and the caught share is reported per
 # group. Not run by CI: a mutant costs 7-45 s on the 2-core VM (dev profile, which rebuilds only
-# the changed codegen unit, plus 3-5 s of tests), and the groups hold 3,041 mutants (~12 h).
+# the changed codegen unit, plus 3-5 s of tests), and the groups hold 3,196 mutants (~12 h).
 # The guide's testing chapter has the measured sample and every survivor.
 #
 #   bash tools/mutants.sh                  # every group, every mutant (hours on 2 cores)
