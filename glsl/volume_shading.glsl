@@ -57,7 +57,8 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Vo
 // grid's cells and the one after them.
 bool brick_occupied(uint c, uvec3 dims, uvec3 b) {
     uvec3 n = (dims + uvec3(BRICK_CELLS - 1u)) / BRICK_CELLS;
-    uint bit = (b.z * n.y + b.y) * n.x + b.x;
+    // Clamped, so a ray that went NaN never reads past the mask.
+    uint bit = min((b.z * n.y + b.y) * n.x + b.x, n.x * n.y * n.z - 1u);
     uint first = (dims.x * dims.y * dims.z + 1u) * 4u;
     uint word = VolumeWords(characters[c].volume.xy).words[first + (bit >> 5u)];
     return (word & (1u << (bit & 31u))) != 0u;
