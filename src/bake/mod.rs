@@ -358,12 +358,9 @@ mod tests {
     use super::*;
     use crate::model::hair_mesh::Face;
 
-    /// The uv texture decodes to the mesh's uvs: every texel (through the mesh's uv box) lies
-    /// within one 16-bit step of a vertex's uv, and every vertex's uv is in some texel. The uvs
-    /// sit in [0.25, 0.75], off the origin, so an encoding that loses the box's corner shows.
-    #[test]
-    fn uv_texture_decodes_to_the_mesh_uvs() {
-        let layers: Vec<Vec<Vec3>> = (0..3)
+    /// `count` layers of a unit square, 0.1 apart along y.
+    fn square_layers(count: usize) -> Vec<Vec<Vec3>> {
+        (0..count)
             .map(|k| {
                 let y = k as f32 * 0.1;
                 vec![
@@ -373,7 +370,15 @@ mod tests {
                     Vec3::new(0.0, y, 1.0),
                 ]
             })
-            .collect();
+            .collect()
+    }
+
+    /// The uv texture decodes to the mesh's uvs: every texel (through the mesh's uv box) lies
+    /// within one 16-bit step of a vertex's uv, and every vertex's uv is in some texel. The uvs
+    /// sit in [0.25, 0.75], off the origin, so an encoding that loses the box's corner shows.
+    #[test]
+    fn uv_texture_decodes_to_the_mesh_uvs() {
+        let layers = square_layers(3);
         let uv: Vec<glam::Vec2> = [(0.25, 0.25), (0.75, 0.3), (0.7, 0.75), (0.3, 0.7)]
             .map(|(u, v)| glam::Vec2::new(u, v))
             .to_vec();
@@ -412,17 +417,7 @@ mod tests {
     /// layers: 4 x (24 + 17 x 12) = 912 bytes).
     #[test]
     fn column_control_points_estimate_is_the_allocation() {
-        let layers: Vec<Vec<Vec3>> = (0..5)
-            .map(|k| {
-                let y = k as f32 * 0.1;
-                vec![
-                    Vec3::new(0.0, y, 0.0),
-                    Vec3::new(1.0, y, 0.0),
-                    Vec3::new(1.0, y, 1.0),
-                    Vec3::new(0.0, y, 1.0),
-                ]
-            })
-            .collect();
+        let layers = square_layers(5);
         let uv = vec![
             glam::Vec2::new(0.0, 0.0),
             glam::Vec2::new(1.0, 0.0),

@@ -395,17 +395,9 @@ impl DensityVolumes {
 
     /// `id`'s volume as last built (call after its frame completed).
     pub fn read(&self, ctx: &Arc<Context>, id: CharacterId) -> GpuResult<DensityVolume> {
-        let e = self
-            .entry(id)
-            .ok_or_else(|| GpuError::Unsupported("no density volume was requested".into()))?;
-        let Some((lo, hi)) = e.built.filter(|_| !e.pending) else {
-            return Err(GpuError::Unsupported(
-                "the density volume has not been built yet (render a frame first)".into(),
-            ));
-        };
-        let bytes = super::debug::read_device_buffer(ctx, &e.cells, e.cells.size)?;
+        let (sampling, (lo, hi), bytes) = self.read_built(ctx, id)?;
         let cells: Vec<VolumeCell> = bytemuck::pod_collect_to_vec(&bytes);
-        let mut volume = DensityVolume::empty(lo, hi, e.sampling.dims);
+        let mut volume = DensityVolume::empty(lo, hi, sampling.dims);
         let per_volume = 1.0 / (VOLUME_FIXED * volume.cell.x * volume.cell.y * volume.cell.z);
         let n = volume.density.len();
         for (i, c) in cells[..n].iter().enumerate() {
@@ -420,15 +412,30 @@ impl DensityVolumes {
     /// Character `id`'s occupancy mask as the GPU wrote it (the twin of
     /// [`DensityVolume::occupancy`]), after the frames in flight (the caller waits for them).
     pub fn read_occupancy(&self, ctx: &Arc<Context>, id: CharacterId) -> GpuResult<Vec<u32>> {
-        let volume = self.read(ctx, id)?;
+        let (sampling, _, bytes) = self.read_built(ctx, id)?;
+        let d = sampling.dims;
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        let first = (d.x * d.y * d.z) as usize * size_of::<VolumeCell>() / 4 + 4;
+        Ok(words[first..first + occupancy_words(d) as usize].to_vec())
+    }
+
+    /// `id`'s sampling, box and whole buffer (cells, the one after them, the occupancy mask)
+    /// as last built.
+    fn read_built(
+        &self,
+        ctx: &Arc<Context>,
+        id: CharacterId,
+    ) -> GpuResult<(VolumeSampling, (Vec3, Vec3), Vec<u8>)> {
         let e = self
             .entry(id)
             .ok_or_else(|| GpuError::Unsupported("no density volume was requested".into()))?;
+        let Some(built) = e.built.filter(|_| !e.pending) else {
+            return Err(GpuError::Unsupported(
+                "the density volume has not been built yet (render a frame first)".into(),
+            ));
+        };
         let bytes = super::debug::read_device_buffer(ctx, &e.cells, e.cells.size)?;
-        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        let first = (volume.density.len() + 1) * size_of::<VolumeCell>() / 4;
-        let n = occupancy_words(volume.dims) as usize;
-        Ok(words[first..first + n].to_vec())
+        Ok((e.sampling, built, bytes))
     }
 }
 

@@ -254,7 +254,7 @@ pub fn print_flip(reference: &std::path::Path, test: &std::path::Path) -> anyhow
             .map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))
     };
     let (old, new) = (load(reference)?, load(test)?);
-    let pool = flip_pool(&old, &new).ok_or_else(|| {
+    let mut pool = flip_pool(&old, &new).ok_or_else(|| {
         anyhow::anyhow!(
             "{}: {}x{}, the reference is {}x{}",
             test.display(),
@@ -267,7 +267,7 @@ pub fn print_flip(reference: &std::path::Path, test: &std::path::Path) -> anyhow
     println!(
         "FLIP mean {:.4}, 99th percentile {:.4}",
         pool.mean(),
-        pool.get_weighted_percentile(0.99)
+        pool.get_percentile(0.99, true)
     );
     Ok(())
 }
