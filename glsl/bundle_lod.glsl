@@ -57,10 +57,30 @@ bool box_visible(vec3 lo, vec3 hi) {
     return true;
 }
 
+// Eq. 7's measure h R / (d tan theta) before alpha and the clamp (orthographic: the view
+// height for d tan theta).
+float detail_level_unclamped(float h, float d) {
+    float denom = frame.lod.w > 0.0 ? max(d, 1e-6) * frame.lod.w : max(frame.lod_ortho.x, 1e-6);
+    return h * frame.camera_pos.w / denom;
+}
+
 // Eq. 7 (perspective, or orthographic when lod.w == 0).
 float detail_level(float h, float d, float alpha) {
     float denom = frame.lod.w > 0.0 ? max(d, 1e-6) * frame.lod.w : max(frame.lod_ortho.x, 1e-6);
     return clamp(h * frame.camera_pos.w * alpha / denom, 0.0, 1.0);
+}
+
+// Eq. 7's strand level times the crowd's area term (frame.lod_ortho.y: 0 off): below that
+// extent (h R / (d tan theta), about pixels) a bundle's strands fall with its area, and eq. 8's
+// thickness widens the rest. CPU twin: reference::lod::{bundle_extent, area_factor}.
+float strand_level(float h, float d) {
+    float level = detail_level(h, d, frame.lod.x);
+    float below = frame.lod_ortho.y;
+    if (below > 0.0) {
+        float extent = detail_level_unclamped(h, d);
+        level *= clamp(extent / below, 0.0, 1.0);
+    }
+    return level;
 }
 
 // Culling and LoD of crowd bundle g (its character bound with bind_character).
@@ -114,7 +134,7 @@ BundleLod bundle_lod(uint g) {
     // volume tier's band the level drops by the strands' share, the thickness does not: the
     // strands thin out one by one (each fading as set_strands says) while the volume comes in under
     // them, a blend with no screen-door pattern (CPU twin: LodView::strand_share).
-    float ls = detail_level(h, d, frame.lod.x);
+    float ls = strand_level(h, d);
     set_strands(r, ls * ch_strand_share * (float(count) + delta), count);
     r.thickness = min(1.0 / max(ls, 1e-6), float(count));
     // Vertex LoD: eq. 9, 10, 12.

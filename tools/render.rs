@@ -76,6 +76,10 @@ struct Args {
     /// Alpha of eq. 7 for strand LoD.
     #[arg(long, default_value_t = 0.1)]
     lod_alpha_strands: f32,
+    /// Strands of bundles spanning fewer than this many pixels fall with their area, thickened
+    /// to keep the coverage (0: off, the paper's eq. 7; `crowd` uses 8).
+    #[arg(long, default_value_t = 0.0)]
+    lod_area_below: f32,
     /// Alpha of eq. 7 for vertex LoD.
     #[arg(long, default_value_t = 0.1)]
     lod_alpha_verts: f32,
@@ -198,11 +202,15 @@ fn lod_settings(args: &Args) -> Result<LodSettings> {
     let lod = LodSettings {
         enabled: args.lod,
         alpha_strands: args.lod_alpha_strands,
+        area_below: args.lod_area_below,
         alpha_verts: args.lod_alpha_verts,
         lambda: args.lod_lambda,
     };
-    lod.validate()
-        .map_err(|e| anyhow::anyhow!("--lod-alpha-strands/--lod-alpha-verts/--lod-lambda: {e}"))?;
+    lod.validate().map_err(|e| {
+        anyhow::anyhow!(
+            "--lod-alpha-strands/--lod-area-below/--lod-alpha-verts/--lod-lambda: {e}"
+        )
+    })?;
     Ok(lod)
 }
 
@@ -420,6 +428,7 @@ fn check_unused(p: &Parsed<Args>, inputs: &Inputs, look: &Look) -> Result<(), St
     )?;
     for id in [
         "lod_alpha_strands",
+        "lod_area_below",
         "lod_alpha_verts",
         "lod_lambda",
         "lod_appearance",

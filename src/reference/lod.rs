@@ -10,6 +10,25 @@ pub fn detail_level(h: f32, resolution: f32, distance: f32, fov_y: f32, alpha: f
     (h * resolution * alpha / denom).clamp(0.0, 1.0)
 }
 
+/// Eq. 7's measure of a bundle of size `h` on screen, `h R / (d tan theta)`, before alpha and
+/// the clamp: about its size in pixels (GLSL: `bundle_lod.glsl` `strand_level`).
+pub fn bundle_extent(h: f32, resolution: f32, distance: f32, fov_y: f32) -> f32 {
+    h * resolution / (distance.max(1e-6) * fov_y.tan())
+}
+
+/// The crowd's area term on eq. 7's strand level: 1 for a bundle whose extent `x`
+/// ([`bundle_extent`]) is at least `area_below` (0: off, the paper's eq. 7), below it `x /
+/// area_below`. With it, a small bundle's strand count falls with its area on screen rather
+/// than its width, and eq. 8's thickness term (`1 / L`) widens the strands left so the bundle
+/// keeps its coverage: far characters cost per pixel of hair, not per strand they would show
+/// up close.
+pub fn area_factor(x: f32, area_below: f32) -> f32 {
+    match area_below > 0.0 {
+        true => (x / area_below).clamp(0.0, 1.0),
+        false => 1.0,
+    }
+}
+
 /// Eq. 7, orthographic (shadow maps): `d tan theta` replaced by the view height in world units.
 pub fn detail_level_ortho(h: f32, resolution: f32, view_height: f32, alpha: f32) -> f32 {
     (h * resolution * alpha / view_height.max(1e-6)).clamp(0.0, 1.0)
@@ -202,6 +221,7 @@ mod tests {
             resolution: 720.0,
             fov_y: 0.8,
             alpha_strands: 1.0,
+            area_below: 0.0,
             alpha_verts: 1.0,
             lambda: 0.5,
             strand_share: share,
@@ -266,6 +286,8 @@ pub struct LodView {
     pub fov_y: f32,
     /// Alpha for strand LoD.
     pub alpha_strands: f32,
+    /// The strand level's area term below this extent ([`area_factor`]; 0: off).
+    pub area_below: f32,
     /// Alpha for vertex LoD.
     pub alpha_verts: f32,
     /// Geomorph window lambda.
@@ -332,7 +354,9 @@ pub fn bundle_lod(
     let (lo, hi) = bundle_bounds(baked, b, margin);
     let d = view.eye.distance(view.eye.clamp(lo, hi));
     let h = baked.bundles[b].rest_size;
-    let ls = detail_level(h, view.resolution, d, view.fov_y, view.alpha_strands);
+    let x = bundle_extent(h, view.resolution, d, view.fov_y);
+    let ls = detail_level(h, view.resolution, d, view.fov_y, view.alpha_strands)
+        * area_factor(x, view.area_below);
     let delta = bundle_delta(b as u32, style.seed);
     let drawn = ls * view.strand_share.clamp(0.0, 1.0);
     let strands = strands_at_level(drawn, n, delta);

@@ -137,6 +137,9 @@ impl Camera {
 /// Strand alpha of [`LodSettings::crowd`].
 pub const CROWD_ALPHA_STRANDS: f32 = 0.05;
 
+/// The area term's extent of [`LodSettings::crowd`] (about pixels a bundle spans).
+pub const CROWD_AREA_BELOW: f32 = 8.0;
+
 /// Level-of-detail settings (paper 003 sec. 3.6): separate alphas for strands and vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LodSettings {
@@ -144,6 +147,11 @@ pub struct LodSettings {
     pub enabled: bool,
     /// Alpha of eq. 7 for strand LoD.
     pub alpha_strands: f32,
+    /// Below this extent (eq. 7's `h R / (d tan theta)`, about the pixels a bundle spans) the
+    /// strand level falls with the bundle's area, not its width
+    /// (`reference::lod::area_factor`); eq. 8's thickness keeps the coverage. 0: off, the
+    /// paper's eq. 7. The light's views apply it in texels.
+    pub area_below: f32,
     /// Alpha of eq. 7 for vertex LoD.
     pub alpha_verts: f32,
     /// Geomorph transition window lambda of eq. 10-12, in `(0, 1]`.
@@ -155,6 +163,7 @@ impl Default for LodSettings {
         LodSettings {
             enabled: true,
             alpha_strands: 0.1,
+            area_below: 0.0,
             alpha_verts: 0.1,
             lambda: 0.5,
         }
@@ -167,6 +176,12 @@ impl LodSettings {
         let alpha_ok = |a: f32| a > 0.0 && a.is_finite();
         if !alpha_ok(self.alpha_strands) || !alpha_ok(self.alpha_verts) {
             return Err("LoD alphas must be positive and finite".into());
+        }
+        if !(self.area_below >= 0.0 && self.area_below.is_finite()) {
+            return Err(format!(
+                "LoD area term below {} pixels: need a finite number >= 0",
+                self.area_below
+            ));
         }
         if !(self.lambda > 0.0 && self.lambda <= 1.0) {
             return Err(format!("LoD lambda {} is outside (0, 1]", self.lambda));
@@ -185,6 +200,7 @@ impl LodSettings {
     pub fn crowd() -> Self {
         LodSettings {
             alpha_strands: CROWD_ALPHA_STRANDS,
+            area_below: CROWD_AREA_BELOW,
             ..Default::default()
         }
     }
@@ -367,7 +383,7 @@ impl View {
                 self.lod.lambda,
                 camera.fov_y.tan(),
             ],
-            lod_ortho: [0.0; 4],
+            lod_ortho: [0.0, self.lod.area_below, 0.0, 0.0],
             counts: [bundles, characters, self.lod.enabled as u32, vertex_budget],
             shading: [
                 self.shading as u32,

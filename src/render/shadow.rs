@@ -212,7 +212,7 @@ impl LightView {
                 lod.lambda,
                 0.0,
             ],
-            lod_ortho: [self.size, 0.0, 0.0, 0.0],
+            lod_ortho: [self.size, lod.area_below, 0.0, 0.0],
             soft,
             soft_params: [0.0; 4],
             soft_grid,

@@ -490,7 +490,8 @@ pub struct FrameBlock {
     pub planes: [[f32; 4]; 6],
     /// x alpha strands, y alpha vertices, z lambda, w `tan(fov_y)` of eq. 7 (0: orthographic).
     pub lod: [f32; 4],
-    /// x view height of orthographic views; yzw unused.
+    /// x view height of orthographic views, y the strand level's area term below this extent
+    /// (`LodSettings::area_below`; 0 off); zw unused.
     pub lod_ortho: [f32; 4],
     /// x bundles of all characters, y character slots, z LoD on, w vertex pool budget
     /// (compute path, in `HairVertex` slots).

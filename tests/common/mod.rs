@@ -244,6 +244,7 @@ pub fn lod_view(cam: &Camera, size: u32) -> hairmesh::reference::lod::LodView {
         resolution: size as f32,
         fov_y: cam.fov_y,
         alpha_strands: lod.alpha_strands,
+        area_below: lod.area_below,
         alpha_verts: lod.alpha_verts,
         lambda: lod.lambda,
         strand_share: 1.0,

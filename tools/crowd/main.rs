@@ -152,6 +152,11 @@ pub struct Args {
     /// 0.008 against 0.1 on the people crowd, 1.4x faster).
     #[arg(long, default_value_t = hairmesh::render::CROWD_ALPHA_STRANDS)]
     lod_alpha_strands: f32,
+    /// Strands of bundles spanning fewer than this many pixels fall with their area, thickened
+    /// to keep the coverage (0: off, the paper's eq. 7): 1000 people draw half the strands,
+    /// FLIP 0.009 against off.
+    #[arg(long, default_value_t = hairmesh::render::CROWD_AREA_BELOW)]
+    lod_area_below: f32,
     /// Alpha of eq. 7 for vertex LoD.
     #[arg(long, default_value_t = 0.1)]
     lod_alpha_verts: f32,
@@ -459,6 +464,7 @@ impl Args {
         if self.lod {
             LodSettings {
                 alpha_strands: self.lod_alpha_strands,
+                area_below: self.lod_area_below,
                 alpha_verts: self.lod_alpha_verts,
                 ..LodSettings::crowd()
             }
@@ -546,7 +552,12 @@ fn check_unused(p: &hairmesh::cli::Parsed<Args>) -> Result<(), String> {
         a.shading == hairmesh::shade::ShadingModel::Marschner,
         "it is part of --shading marschner",
     )?;
-    for id in ["lod_appearance", "lod_alpha_strands", "lod_alpha_verts"] {
+    for id in [
+        "lod_appearance",
+        "lod_alpha_strands",
+        "lod_area_below",
+        "lod_alpha_verts",
+    ] {
         p.unused_unless(id, a.lod, "--lod is off")?;
     }
     p.unused_unless(
@@ -585,7 +596,7 @@ fn check_args(p: &hairmesh::cli::Parsed<Args>) -> Result<Checked> {
     }
     args.lod_settings()
         .validate()
-        .map_err(|e| anyhow::anyhow!("--lod-alpha-strands / --lod-alpha-verts: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("--lod-alpha-strands / --lod-area-below / --lod-alpha-verts: {e}"))?;
     let settings = args.frame_settings();
     if let Err(why) = settings.check_combination() {
         bail!("--draw / --msaa {} / --transparency: {why}", args.msaa);

@@ -93,6 +93,11 @@ impl Controls {
                 );
                 ui.add_enabled(
                     self.lod.enabled,
+                    egui::Slider::new(&mut self.lod.area_below, 0.0..=32.0)
+                        .text("strands by area below (px)"),
+                );
+                ui.add_enabled(
+                    self.lod.enabled,
                     egui::Slider::new(&mut self.lod.alpha_verts, 0.01..=1.0)
                         .logarithmic(true)
                         .text("alpha vertices"),
