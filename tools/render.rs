@@ -207,9 +207,7 @@ fn lod_settings(args: &Args) -> Result<LodSettings> {
         lambda: args.lod_lambda,
     };
     lod.validate().map_err(|e| {
-        anyhow::anyhow!(
-            "--lod-alpha-strands/--lod-area-below/--lod-alpha-verts/--lod-lambda: {e}"
-        )
+        anyhow::anyhow!("--lod-alpha-strands/--lod-area-below/--lod-alpha-verts/--lod-lambda: {e}")
     })?;
     Ok(lod)
 }

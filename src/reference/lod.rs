@@ -249,6 +249,64 @@ mod tests {
         }
     }
 
+    /// The crowd's area term: below `area_below` a bundle's level is eq. 7's times `x /
+    /// area_below`, so twice the distance leaves a quarter of the strands where eq. 7 alone
+    /// leaves half (the level ratio squared), while the strands left widen so that the
+    /// bundle's drawn width, `(strands - 1 + fade) * thickness`, stays `N + delta` (its full
+    /// coverage) in both; at or above `area_below` nothing changes.
+    #[test]
+    fn the_area_term_thins_small_bundles_and_keeps_their_coverage() {
+        let mesh = crate::model::obj_io::parse_hair_mesh_obj(
+            "hairmeshes/small_patch.obj",
+            include_bytes!("../../hairmeshes/small_patch.obj"),
+        )
+        .unwrap();
+        let style = crate::HairStyle::default();
+        let baked = crate::bake(&mesh, &style, Default::default(), |_, _| {}).unwrap();
+        let n = 64;
+        let delta = bundle_delta(0, style.seed);
+        let lod = |z: f32, area_below: f32| {
+            let view = LodView {
+                eye: Vec3::new(0.0, 0.0, z),
+                resolution: 720.0,
+                fov_y: 0.8,
+                alpha_strands: 0.05,
+                area_below,
+                alpha_verts: 1.0,
+                lambda: 0.5,
+                strand_share: 1.0,
+            };
+            bundle_lod(&baked, &style, 0, n, 4, &view)
+        };
+        let level = |l: &BundleLod| 1.0 / l.thickness;
+        let width = |l: &BundleLod| (l.strands as f32 - 1.0 + l.fade) * l.thickness;
+        let (near_off, far_off) = (lod(6.0, 0.0), lod(12.0, 0.0));
+        // Eq. 7's extent here is 4.7 and 2.3: both under the crowd's 8.
+        let (near_on, far_on) = (lod(6.0, 8.0), lod(12.0, 8.0));
+        for l in [&near_off, &far_off, &near_on, &far_on] {
+            assert!(l.thickness < n as f32 && l.strands >= 1, "{l:?}");
+            let w = width(l);
+            assert!(
+                (w - (n as f32 + delta)).abs() < 1e-2 * n as f32,
+                "{l:?}: {w}"
+            );
+        }
+        let off = level(&near_off) / level(&far_off);
+        let on = level(&near_on) / level(&far_on);
+        assert!(off > 1.5 && off < 2.5, "eq. 7 alone: {off}");
+        assert!(
+            (on / (off * off) - 1.0).abs() < 1e-3,
+            "area term {on}, eq. 7 {off}"
+        );
+        // 3 strands against 8 at the far distance.
+        assert!(
+            far_on.strands * 2 < far_off.strands,
+            "{far_on:?} {far_off:?}"
+        );
+        // A bundle at or above the extent keeps eq. 7's decision.
+        assert_eq!(lod(12.0, 1e-3), far_off);
+    }
+
     #[test]
     fn vertex_level_is_power_of_two_plus_one() {
         assert_eq!(vertex_level(1.0, 32), 5);

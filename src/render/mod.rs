@@ -27,7 +27,9 @@ pub mod transparency;
 pub mod volume;
 pub mod workspace;
 
-pub use camera::{CROWD_ALPHA_STRANDS, CROWD_AREA_BELOW, Camera, DEFAULT_VIEW_DIR, LodSettings, View};
+pub use camera::{
+    CROWD_ALPHA_STRANDS, CROWD_AREA_BELOW, Camera, DEFAULT_VIEW_DIR, LodSettings, View,
+};
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use host::{HostCamera, HostFrame, HostImage};
 pub use renderer::{

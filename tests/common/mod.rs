@@ -238,7 +238,15 @@ pub fn upload(
 
 /// The LoD inputs the shaders see for `cam` at `size` pixels with default LoD settings.
 pub fn lod_view(cam: &Camera, size: u32) -> hairmesh::reference::lod::LodView {
-    let lod = LodSettings::default();
+    lod_view_with(cam, size, &LodSettings::default())
+}
+
+/// The LoD inputs the shaders see for `cam` at `size` pixels with `lod`.
+pub fn lod_view_with(
+    cam: &Camera,
+    size: u32,
+    lod: &LodSettings,
+) -> hairmesh::reference::lod::LodView {
     hairmesh::reference::lod::LodView {
         eye: cam.eye,
         resolution: size as f32,

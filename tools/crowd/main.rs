@@ -594,9 +594,9 @@ fn check_args(p: &hairmesh::cli::Parsed<Args>) -> Result<Checked> {
             args.wind_dir
         );
     }
-    args.lod_settings()
-        .validate()
-        .map_err(|e| anyhow::anyhow!("--lod-alpha-strands / --lod-area-below / --lod-alpha-verts: {e}"))?;
+    args.lod_settings().validate().map_err(|e| {
+        anyhow::anyhow!("--lod-alpha-strands / --lod-area-below / --lod-alpha-verts: {e}")
+    })?;
     let settings = args.frame_settings();
     if let Err(why) = settings.check_combination() {
         bail!("--draw / --msaa {} / --transparency: {why}", args.msaa);
