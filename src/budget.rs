@@ -190,6 +190,29 @@ mod tests {
         assert!(!err.contains('\n'));
     }
 
+    /// The budget's edges: an estimate whose total with slack is exactly the budget fits (4
+    /// MiB of parts + 64 MiB program + 1 MiB slack = 69 MiB), one byte more does not; exactly
+    /// 1 GiB prints in GiB; `and` keeps the other estimate's parts; an empty estimate's
+    /// largest part is "nothing".
+    #[test]
+    fn a_budget_is_inclusive_and_estimates_combine() {
+        let b = MemoryBudget::from_mib(69, "--memory-budget-mib").unwrap();
+        let exact = Estimate::new().with("x", 4 << 20, 1);
+        assert_eq!(exact.clone().with_slack().total(), 69 << 20);
+        assert!(b.check("f", "w", &exact, "s").is_ok());
+        let over = Estimate::new().with("x", (4 << 20) + 4, 1);
+        assert!(b.check("f", "w", &over, "s").is_err());
+        assert_eq!(human_bytes(1 << 30), "1.0 GiB");
+        assert_eq!(human_bytes((1 << 30) - (1 << 20)), "1023.0 MiB");
+        let both = Estimate::new()
+            .with("a", 2, 3)
+            .and(Estimate::new().with("b", 5, 1).with("a", 1, 1));
+        assert_eq!((both.part("a"), both.part("b"), both.total()), (7, 5, 12));
+        assert_eq!(both.largest(), ("a", 6));
+        assert_eq!(Estimate::new().largest(), ("nothing", 0));
+        assert_eq!(b.bytes(), 69 << 20);
+    }
+
     #[test]
     fn a_budget_admits_what_fits_and_the_flag_is_bounded() {
         assert_eq!(parse_budget_flag("1").unwrap().bytes(), 1 << 20);

@@ -668,6 +668,48 @@ mod tests {
         assert!(OutputPath::check(Path::new("bad\0name.hmb"), &[]).is_err());
     }
 
+    /// Outputs are refused by what they are, each naming why: a folder, a FIFO, a path below
+    /// a file, a path with no file name. Two spellings of one place are one output; a device
+    /// may be named twice (both written in place); an output in folders that do not exist yet
+    /// makes them when written, and the first folder made is the outermost.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn outputs_are_refused_by_kind_and_compared_by_place() {
+        let dir = tempfile::tempdir().unwrap();
+        let why = |p: &Path| OutputPath::check(p, &[]).unwrap_err().to_string();
+        assert!(
+            why(dir.path()).contains("is a folder"),
+            "{}",
+            why(dir.path())
+        );
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.unwrap().success());
+        assert!(why(&fifo).contains("FIFO"), "{}", why(&fifo));
+        let file = dir.path().join("plain.txt");
+        std::fs::write(&file, b"x").unwrap();
+        let below = file.join("out.png");
+        assert!(why(&below).contains("is not a folder"), "{}", why(&below));
+        let bare = dir.path().join("new").join("..");
+        assert!(why(&bare).contains("not a file path"), "{}", why(&bare));
+        let mut files = RunFiles::new();
+        files.output(&dir.path().join("a.png"), "--out").unwrap();
+        let again = dir.path().join(".").join("a.png");
+        let err = files.output(&again, "--also").unwrap_err().to_string();
+        assert!(err.contains("also this run's output"), "{err}");
+        files.output(Path::new("/dev/null"), "--x").unwrap();
+        files.output(Path::new("/dev/null"), "--y").unwrap();
+        let deep = dir.path().join("m").join("n").join("o.txt");
+        let out = OutputPath::check(&deep, &[]).unwrap();
+        assert_eq!(
+            out.missing,
+            vec![dir.path().join("m"), dir.path().join("m/n")]
+        );
+        out.write(b"o").unwrap();
+        assert_eq!(std::fs::read(&deep).unwrap(), b"o");
+        assert_eq!(out.path(), deep.as_path());
+    }
+
     /// Every missing folder of a path is listed, outermost first, up to the first that exists
     /// (a survivor of the 2026-12-06 mutation sample stopped after the innermost one, so a
     /// failed run would have left the outer ones behind).

@@ -252,6 +252,45 @@ mod tests {
         assert!(r_min(rmax, 100, 200) < floor && r_min(rmax, 100, 200) > 0.0);
     }
 
+    /// The grid search finds exactly the pairs a brute-force search finds (with their
+    /// distances), on both domains, across the torus's seam, and below three cells a side
+    /// (where it is the brute force); samples of the triangle lie in it.
+    #[test]
+    fn neighbours_are_every_pair_within_the_radius() {
+        for domain in [Domain::Torus, Domain::Triangle] {
+            let mut rng = Pcg32::new(11);
+            let points: Vec<Vec2> = (0..400).map(|_| domain.random(&mut rng)).collect();
+            if domain == Domain::Triangle {
+                assert!(
+                    points
+                        .iter()
+                        .all(|p| p.min_element() >= 0.0 && p.x + p.y <= 1.0)
+                );
+            }
+            for radius in [0.06, 0.4] {
+                let found = neighbours(&points, radius, domain);
+                let mut pairs = 0;
+                for (i, list) in found.iter().enumerate() {
+                    let mut got = list.clone();
+                    got.sort_by_key(|p| p.0);
+                    let want: Vec<(u32, f32)> = (0..points.len())
+                        .filter(|&j| j != i)
+                        .map(|j| (j as u32, domain.distance(points[i], points[j])))
+                        .filter(|p| p.1 < radius)
+                        .collect();
+                    assert_eq!(got, want, "{domain:?} r {radius} point {i}");
+                    pairs += got.len();
+                }
+                assert!(pairs > points.len(), "{domain:?} r {radius}: {pairs} pairs");
+            }
+        }
+        // Across the seam: 0.02 apart on the torus, 0.98 in the triangle's plane.
+        let seam = [Vec2::new(0.01, 0.5), Vec2::new(0.99, 0.5)];
+        assert_eq!(neighbours(&seam, 0.05, Domain::Torus)[0].len(), 1);
+        assert!((Domain::Torus.distance(seam[0], seam[1]) - 0.02).abs() < 1e-6);
+        assert!((Domain::Triangle.distance(seam[0], seam[1]) - 0.98).abs() < 1e-6);
+    }
+
     fn check_prefixes(domain: Domain) {
         let n = 1024;
         let blue = progressive_samples(n, domain, 7);

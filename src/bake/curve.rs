@@ -223,6 +223,30 @@ mod tests {
         );
     }
 
+    /// Section 3.5's tangents are exact on a uniformly sampled circular arc: central
+    /// differences inside (the chord of two neighbours is parallel to the middle tangent), and
+    /// eq. 5 and 6's mirror about the end chords at both ends (the chord's symmetry); a lone
+    /// segment gives both ends its direction, a lone point +Y.
+    #[test]
+    fn tangents_are_exact_on_a_circular_arc() {
+        let theta = |k: usize| 0.3 * k as f32 + 0.2;
+        let p: Vec<Vec3> = (0..6)
+            .map(|k| Vec3::new(theta(k).cos(), theta(k).sin(), 0.5))
+            .collect();
+        let mut t = vec![Vec3::ZERO; 6];
+        strand_tangents(&p, &mut t);
+        for (k, t) in t.iter().enumerate() {
+            let want = Vec3::new(-theta(k).sin(), theta(k).cos(), 0.0);
+            assert!(t.dot(want) > 1.0 - 1e-5, "{k}: {t} vs {want}");
+        }
+        let mut two = [Vec3::ZERO; 2];
+        strand_tangents(&[Vec3::ZERO, Vec3::new(0.0, 0.0, -2.0)], &mut two);
+        assert_eq!(two, [Vec3::NEG_Z; 2]);
+        let mut one = [Vec3::ZERO];
+        strand_tangents(&[Vec3::ONE], &mut one);
+        assert_eq!(one, [Vec3::Y]);
+    }
+
     #[test]
     fn column_passes_through_layers() {
         let p = vec![

@@ -683,6 +683,43 @@ mod tests {
         assert!(c0 > 0.01, "{c0}");
     }
 
+    /// Luminance is Rec. 709's weighting of the linear channels, through the sRGB toe below
+    /// 0.04045 and the power curve above it.
+    #[test]
+    fn luminance_weighs_linear_channels() {
+        let lum = |rgb: [u8; 3]| luminance(&[rgb[0], rgb[1], rgb[2], 255]);
+        assert!((lum([255, 0, 0]) - 0.2126).abs() < 1e-6);
+        assert!((lum([0, 255, 0]) - 0.7152).abs() < 1e-6);
+        assert!((lum([0, 0, 255]) - 0.0722).abs() < 1e-6);
+        assert!((lum([10, 10, 10]) - 10.0 / 255.0 / 12.92).abs() < 1e-6);
+        assert!((lum([128, 128, 128]) - 0.215861).abs() < 1e-5);
+    }
+
+    /// The flicker measure is the mean change over the masked pixels whose previous position
+    /// has its four neighbours in the image (without motion: all but the last column and row),
+    /// and 0 over no pixels; a point above or below the image samples nothing.
+    #[test]
+    fn reprojected_change_is_the_mean_over_measured_pixels() {
+        let size = (5u32, 4u32);
+        let grey = |g: u8| [g, g, g, 255].repeat(20);
+        let (before, now) = (grey(100), grey(150));
+        let mut mask = vec![false; 20];
+        // Pixel 4 ends the first row, 19 is the last: not measured.
+        for i in [0, 1, 4, 6, 19] {
+            mask[i] = true;
+        }
+        let still = [PixelMotion::default(); 20];
+        let (c, n) = reprojected_change(&before, &now, &still, &mask, size);
+        let want = luminance(&[150, 150, 150, 255]) - luminance(&[100, 100, 100, 255]);
+        assert_eq!(n, 3);
+        assert!((c - want as f64).abs() < 1e-6, "{c} vs {want}");
+        let none = reprojected_change(&before, &now, &still, &[false; 20], size);
+        assert_eq!(none, (0.0, 0));
+        assert!(sample_luminance(&now, size, Vec2::new(2.5, 0.2)).is_none());
+        assert!(sample_luminance(&now, size, Vec2::new(2.5, 3.7)).is_none());
+        assert!(sample_luminance(&now, size, Vec2::new(2.5, 3.4)).is_some());
+    }
+
     #[test]
     fn downsample_averages_in_linear_light() {
         let px = [

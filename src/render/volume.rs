@@ -549,6 +549,31 @@ mod tests {
         assert!((hair_pixels(&r, &block) - 720.0).abs() < 1e-3);
     }
 
+    /// `camera_spanning` is the inverse of `hair_pixels` for a character at the origin: its
+    /// camera looks at the hair box's centre along the default view direction, from where the
+    /// box's sphere spans the pixels asked for, at the 40-degree field of view.
+    #[test]
+    fn camera_spanning_is_the_inverse_of_hair_pixels() {
+        let mut r: CharacterRecord = bytemuck::Zeroable::zeroed();
+        r.model = Mat4::IDENTITY.to_cols_array_2d();
+        r.mesh.pos_origin = [1.0, 2.0, -3.0, 0.0];
+        r.mesh.pos_extent = [4.0, 2.0, 1.0, 0.0];
+        r.model_scale = 1.0;
+        let centre = Vec3::new(3.0, 3.0, -2.5);
+        for (pixels, height) in [(20.0, 720), (64.0, 720), (300.0, 1080)] {
+            let cam = camera_spanning(&r.mesh, pixels, height);
+            assert!((cam.fov_y - 40f32.to_radians()).abs() < 1e-6);
+            assert!(cam.target.distance(centre) < 1e-5, "{}", cam.target);
+            let dir = (cam.eye - centre).normalize();
+            assert!(dir.dot(super::super::DEFAULT_VIEW_DIR.normalize()) > 0.99999);
+            let mut block: FrameBlock = bytemuck::Zeroable::zeroed();
+            block.camera_pos = cam.eye.extend(height as f32).to_array();
+            block.light_dir[3] = 1.0 / (cam.fov_y * 0.5).tan();
+            let spans = hair_pixels(&r, &block);
+            assert!((spans / pixels - 1.0).abs() < 1e-4, "{pixels}: {spans}");
+        }
+    }
+
     #[test]
     fn the_tier_weight_falls_across_the_band() {
         let tier = VolumeTier::on();
