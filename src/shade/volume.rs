@@ -24,7 +24,7 @@ use crate::reference::volume::{DensityVolume, brick_exit, brick_of, brick_set};
 /// Radius of the ambient occlusion neighbourhood, in mean cell sizes.
 pub const AO_RADIUS_CELLS: f32 = 2.0;
 /// Step of the view and light marches, in mean cell sizes.
-pub const MARCH_STEP_CELLS: f32 = 1.0;
+pub const MARCH_STEP_CELLS: f32 = 2.0;
 /// A march stops once less than this transmittance is left.
 pub const MARCH_MIN_TRANSMITTANCE: f32 = 0.01;
 
