@@ -6,7 +6,7 @@
 //! carries the state across. With the screen-size schedule on, characters small on screen
 //! simulate less often: by the height in pixels of their hair (the projected size eq. 7 of
 //! paper 003 uses), every frame above 96 px, every 2nd above 48, every 4th above 24, else
-//! every 8th frame, with the time they skipped (up to
+//! every 8th frame (phases staggered by crowd slot, [`due_on`]), with the time they skipped (up to
 //! [`MAX_FRAME_STEP`](crate::dynamics::MAX_FRAME_STEP)) in one step.
 
 use std::time::Instant;
@@ -243,7 +243,7 @@ impl CrowdAnimation {
             let centre = model.transform_point3(c.bounds.0);
             let scale = model.x_axis.truncate().length();
             let pixels = 2.0 * c.bounds.1 * scale * focal / camera.eye.distance(centre).max(1e-3);
-            if !self.schedule || self.frame.is_multiple_of(update_interval(pixels)) {
+            if !self.schedule || due_on(self.frame, c.id.slot(), update_interval(pixels)) {
                 due.push((c, model));
             }
         }
@@ -318,6 +318,13 @@ fn simulate_on_cpu(
     Ok(())
 }
 
+/// Whether a character in crowd slot `slot` on an update `interval` is due on `frame`: the
+/// slot staggers the phase, so each frame updates about `1 / interval` of the characters on
+/// that interval instead of all of them on one frame in `interval` (a frame-time spike).
+pub fn due_on(frame: u64, slot: u32, interval: u64) -> bool {
+    (frame + slot as u64).is_multiple_of(interval.max(1))
+}
+
 /// Frames between hair updates for a character whose hair is `pixels` tall on screen.
 pub fn update_interval(pixels: f32) -> u64 {
     let mut interval = 1;
@@ -339,5 +346,30 @@ mod tests {
         assert_eq!(update_interval(60.0), 2);
         assert_eq!(update_interval(30.0), 4);
         assert_eq!(update_interval(5.0), 8);
+    }
+
+    /// Every slot is due once in each `interval` frames, and each frame takes an even share
+    /// of the slots on that interval (64 slots on 8: 8 a frame), not all of them at once.
+    #[test]
+    fn updates_are_staggered_by_slot() {
+        for interval in [1u64, 2, 4, 8] {
+            for frame in 0..16u64 {
+                let due = (0..64u32).filter(|&s| due_on(frame, s, interval)).count();
+                assert_eq!(
+                    due as u64,
+                    64 / interval,
+                    "interval {interval} frame {frame}"
+                );
+            }
+            for slot in 0..64u32 {
+                let times = (0..16u64).filter(|&f| due_on(f, slot, interval)).count();
+                assert_eq!(
+                    times as u64,
+                    16 / interval,
+                    "interval {interval} slot {slot}"
+                );
+            }
+        }
+        assert!(due_on(5, 0, 0));
     }
 }
