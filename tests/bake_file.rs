@@ -92,6 +92,10 @@ fn rejects_damaged_files() {
     for bad in [
         bad_bundle(&|b| b.origin[0] = w),
         bad_bundle(&|b| b.origin[1] = h),
+        // A cell is 2x2 texels: one at the last column or row has none beyond it (the
+        // fourth mutation sample's survivor took `x * 1` for `x + 1`).
+        bad_bundle(&|b| b.origin[0] = w - 1),
+        bad_bundle(&|b| b.origin[1] = h - 1),
         bad_bundle(&|b| b.rest_size = f32::NAN),
         bad_bundle(&|b| b.density = f32::NAN),
     ] {

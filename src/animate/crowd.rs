@@ -353,21 +353,14 @@ mod tests {
     #[test]
     fn updates_are_staggered_by_slot() {
         for interval in [1u64, 2, 4, 8] {
+            let due = |frame: u64, slot: u32| due_on(frame, slot, interval) as u64;
             for frame in 0..16u64 {
-                let due = (0..64u32).filter(|&s| due_on(frame, s, interval)).count();
-                assert_eq!(
-                    due as u64,
-                    64 / interval,
-                    "interval {interval} frame {frame}"
-                );
+                let slots: u64 = (0..64).map(|s| due(frame, s)).sum();
+                assert_eq!(slots, 64 / interval, "interval {interval} frame {frame}");
             }
             for slot in 0..64u32 {
-                let times = (0..16u64).filter(|&f| due_on(f, slot, interval)).count();
-                assert_eq!(
-                    times as u64,
-                    16 / interval,
-                    "interval {interval} slot {slot}"
-                );
+                let frames: u64 = (0..16).map(|f| due(f, slot)).sum();
+                assert_eq!(frames, 16 / interval, "interval {interval} slot {slot}");
             }
         }
         assert!(due_on(5, 0, 0));

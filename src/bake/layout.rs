@@ -405,6 +405,26 @@ mod tests {
         assert_cells_match_faces(&mesh, &layout);
     }
 
+    /// Quads listed from any of their corners, wound either way, still make one chart: `across`
+    /// finds the shared edge's vertices at every index (a survivor of the fourth mutation
+    /// sample read `k - 2` for `k + 2`, which only the first two corners tell apart).
+    #[test]
+    fn quads_listed_from_any_corner_join_the_chart() {
+        let mut mesh = grid_mesh(6, 5, false);
+        for (f, face) in mesh.faces.iter_mut().enumerate() {
+            if let Face::Quad(q) = face {
+                q.rotate_left(f % 4);
+                if f % 3 == 0 {
+                    q.reverse();
+                }
+            }
+        }
+        let layout = layout_root_slice(&mesh, true);
+        assert_eq!(layout.charts, 1);
+        assert_eq!(layout.charted_faces, 30);
+        assert_cells_match_faces(&mesh, &layout);
+    }
+
     #[test]
     fn blocks_without_charts_and_triangles() {
         let mesh = grid_mesh(3, 4, true);

@@ -519,3 +519,60 @@ impl CpuGenerator {
         set
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::lod::{LodView, bundle_lod};
+
+    /// `generate_lod` draws each bundle as `bundle_lod` decides: its strand count, `2^e + 1`
+    /// vertices a strand, widths times eq. 8's thickness, and the newest strand's times its
+    /// fade as well (a survivor of the fourth mutation sample faded no strand).
+    #[test]
+    fn lod_strands_follow_the_bundle_decisions() {
+        let mesh = crate::model::obj_io::parse_hair_mesh_obj(
+            "hairmeshes/small_patch.obj",
+            include_bytes!("../../hairmeshes/small_patch.obj"),
+        )
+        .unwrap();
+        let style = crate::HairStyle::default();
+        let baked = crate::bake(&mesh, &style, Default::default(), |_, _| {}).unwrap();
+        let generator = CpuGenerator::new(&baked, style);
+        let view = LodView {
+            eye: Vec3::new(0.0, 0.0, 6.0),
+            resolution: 720.0,
+            fov_y: 0.8,
+            alpha_strands: 0.05,
+            area_below: 0.0,
+            alpha_verts: 0.1,
+            lambda: 0.5,
+            strand_share: 1.0,
+        };
+        let (n, e_max) = (16, 4);
+        let (set, counts) = generator.generate_lod(n, e_max, &baked, &view);
+        let (mut at, mut s, mut faded) = (0, 0, 0);
+        for (bundle, b) in baked.bundles.iter().enumerate() {
+            let count = strands_in_bundle(b, &style, n);
+            let l = bundle_lod(&baked, &style, bundle, count, e_max, &view);
+            for k in 0..l.strands {
+                let verts = (1usize << l.e) + 1;
+                assert_eq!((set.strand_bundle[s], counts[s]), (bundle as u32, verts));
+                let (mut p, mut t, mut w) = (
+                    vec![Vec3::ZERO; verts],
+                    vec![Vec3::ZERO; verts],
+                    vec![0.0; verts],
+                );
+                generator.strand(bundle as u32, k, 1 << l.e, &mut p, &mut t, &mut w);
+                let fade = if k + 1 == l.strands { l.fade } else { 1.0 };
+                faded += (fade < 1.0) as usize;
+                for (i, w) in w.iter().enumerate() {
+                    let want = w * l.thickness * fade;
+                    assert!((set.widths[at + i] - want).abs() <= 1e-6 * want.max(1e-6));
+                }
+                (at, s) = (at + verts, s + 1);
+            }
+        }
+        assert_eq!(s, set.strand_count());
+        assert!(faded > 0, "the view must fade some bundle's newest strand");
+    }
+}

@@ -203,12 +203,8 @@ mod tests {
         assert_eq!(newest_strand_fade(1e-4, n, delta), 1.0);
     }
 
-    /// In the volume tier's band the strands thin out in proportion to their share, one by
-    /// one and without widening (the volume comes in under them): a bundle's drawn width,
-    /// `(strands - 1 + fade) * thickness`, is its full width times the share (within one
-    /// strand), continuous in the share, with the thickness of the full level.
-    #[test]
-    fn the_band_thins_strands_by_their_share_without_widening_them() {
+    /// `hairmeshes/small_patch.obj` baked with the default style.
+    fn small_patch() -> (crate::BakedHairMesh, crate::HairStyle) {
         let mesh = crate::model::obj_io::parse_hair_mesh_obj(
             "hairmeshes/small_patch.obj",
             include_bytes!("../../hairmeshes/small_patch.obj"),
@@ -216,6 +212,16 @@ mod tests {
         .unwrap();
         let style = crate::HairStyle::default();
         let baked = crate::bake(&mesh, &style, Default::default(), |_, _| {}).unwrap();
+        (baked, style)
+    }
+
+    /// In the volume tier's band the strands thin out in proportion to their share, one by
+    /// one and without widening (the volume comes in under them): a bundle's drawn width,
+    /// `(strands - 1 + fade) * thickness`, is its full width times the share (within one
+    /// strand), continuous in the share, with the thickness of the full level.
+    #[test]
+    fn the_band_thins_strands_by_their_share_without_widening_them() {
+        let (baked, style) = small_patch();
         let view = |share: f32| LodView {
             eye: Vec3::new(0.0, 0.0, 3.0),
             resolution: 720.0,
@@ -256,13 +262,7 @@ mod tests {
     /// coverage) in both; at or above `area_below` nothing changes.
     #[test]
     fn the_area_term_thins_small_bundles_and_keeps_their_coverage() {
-        let mesh = crate::model::obj_io::parse_hair_mesh_obj(
-            "hairmeshes/small_patch.obj",
-            include_bytes!("../../hairmeshes/small_patch.obj"),
-        )
-        .unwrap();
-        let style = crate::HairStyle::default();
-        let baked = crate::bake(&mesh, &style, Default::default(), |_, _| {}).unwrap();
+        let (baked, style) = small_patch();
         let n = 64;
         let delta = bundle_delta(0, style.seed);
         let lod = |z: f32, area_below: f32| {
@@ -291,6 +291,14 @@ mod tests {
                 "{l:?}: {w}"
             );
         }
+        // The factor is eq. 7's own extent (its level over alpha) over 8 (a survivor of the
+        // fourth mutation sample scaled the extent by tan^2: the ratio below still held).
+        let extent = level(&near_off) / 0.05;
+        let factor = level(&near_on) / level(&near_off);
+        assert!(
+            (factor - extent / 8.0).abs() < 1e-4,
+            "{factor} vs {extent} / 8"
+        );
         let off = level(&near_off) / level(&far_off);
         let on = level(&near_on) / level(&far_on);
         assert!(off > 1.5 && off < 2.5, "eq. 7 alone: {off}");

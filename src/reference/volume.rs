@@ -307,3 +307,30 @@ pub fn density_volume(
     }
     volume
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ray leaves a brick (2 cells a side) through the face ahead of it on the axis it
+    /// reaches first: +x from (0.5, 0.5, 0.5) in brick 0 at t = 1.5, -x from (5.5, 1, 1) in
+    /// brick 2 at t = 1.5 (the face x = 4), diagonally at the nearer face, never for a ray
+    /// that stands still (a survivor of the fourth mutation sample always took the face
+    /// behind: the march still matched, stepping brick by brick, without skipping).
+    #[test]
+    fn a_ray_leaves_a_brick_through_the_face_ahead() {
+        let half = Vec3::splat(0.5);
+        assert_eq!(brick_exit(half, Vec3::X, UVec3::ZERO), 1.5);
+        assert_eq!(
+            brick_exit(Vec3::new(5.5, 1.0, 1.0), -Vec3::X, UVec3::new(2, 0, 0)),
+            1.5
+        );
+        let diagonal = brick_exit(half, Vec3::new(1.0, 2.0, 0.0), UVec3::ZERO);
+        assert_eq!(diagonal, 0.75);
+        assert_eq!(brick_exit(half, Vec3::ZERO, UVec3::ZERO), f32::INFINITY);
+        assert_eq!(
+            brick_of(UVec3::splat(24), Vec3::new(5.5, 1.0, 23.9)),
+            UVec3::new(2, 0, 11)
+        );
+    }
+}

@@ -720,6 +720,21 @@ mod tests {
         assert!(sample_luminance(&now, size, Vec2::new(2.5, 3.4)).is_some());
     }
 
+    /// Only a character's hair counts as hair: not a prop's or a solid's pixel, nor an empty
+    /// one (a survivor of the fourth mutation sample joined the two tests with `||`, which
+    /// took every prop for hair).
+    #[test]
+    fn hair_pixels_are_characters_not_props_or_solids() {
+        let with = |id: u32| PixelMotion {
+            id,
+            ..Default::default()
+        };
+        assert!(with(5).is_hair());
+        assert!(!with(VISIBILITY_PROP | 3).is_hair());
+        assert!(!with(VISIBILITY_SOLID | 1).is_hair());
+        assert!(!with(VISIBILITY_EMPTY).is_hair());
+    }
+
     #[test]
     fn downsample_averages_in_linear_light() {
         let px = [

@@ -582,6 +582,18 @@ mod tests {
         assert_eq!(tier.weight(near + 1.0), 0.0);
         assert!((tier.weight(0.5 * (far + near)) - 0.5).abs() < 1e-6);
         assert_eq!(VolumeTier::OFF.weight(0.0), 0.0);
+        // Either half of the tier needs volumes; neither, none (the fourth mutation sample's
+        // survivor was `enabled` always true).
+        assert!(!VolumeTier::OFF.enabled() && tier.enabled());
+        let occlusion_only = VolumeTier {
+            occlusion: true,
+            ..VolumeTier::OFF
+        };
+        let far_only = VolumeTier {
+            occlusion: false,
+            ..tier
+        };
+        assert!(occlusion_only.enabled() && far_only.enabled());
         let bad = VolumeTier {
             far: Some((50.0, 10.0)),
             ..tier

@@ -219,6 +219,18 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 pub(crate) mod tests {
     use super::*;
 
+    /// The hemisphere light: the sky's tint straight up, the ground's straight down, their mean
+    /// sideways, and clamped beyond (a survivor of the fourth mutation sample swapped sky and
+    /// ground).
+    #[test]
+    fn hemisphere_ambient_is_sky_above_and_ground_below() {
+        let (sky, ground) = (Vec3::from(SKY_TINT), Vec3::from(GROUND_TINT));
+        assert!((hemisphere_ambient(1.0) - AMBIENT * sky).length() < 1e-6);
+        assert!((hemisphere_ambient(-1.0) - AMBIENT * ground).length() < 1e-6);
+        assert!((hemisphere_ambient(0.0) - AMBIENT * 0.5 * (sky + ground)).length() < 1e-6);
+        assert_eq!(hemisphere_ambient(3.0), hemisphere_ambient(1.0));
+    }
+
     /// The sRGB inverse on both of its pieces: the linear toe below 0.04045 (`c / 12.92`), the
     /// power curve above, and the two meeting at the knee (IEC 61966-2-1); glTF base colours of
     /// dark hair and clothes fall on the toe.

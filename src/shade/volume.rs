@@ -186,6 +186,24 @@ mod tests {
         assert_eq!(miss.transmittance, 1.0);
     }
 
+    /// A march that ends inside the hair, after a part of a step, absorbs exactly that part:
+    /// 0.33 of uniform hair (two steps of 0.125 and one of 0.08) transmits `exp(-sigma 0.33)`
+    /// (a survivor of the fourth mutation sample took the last step whole: `exp(-sigma
+    /// 0.375)`, 9% less).
+    #[test]
+    fn a_march_ending_inside_the_hair_takes_its_last_part_step() {
+        let v = slab(400.0);
+        let (width, opacity) = (0.01, 0.5);
+        let from = Vec3::new(0.5, 0.5, 0.32);
+        let r = march(&v, from, Vec3::Z, 0.33, (width, opacity));
+        let expected = (-extinction(400.0, width, opacity) * 0.33).exp();
+        assert!(
+            (r.transmittance / expected - 1.0).abs() < 1e-4,
+            "{} vs {expected}",
+            r.transmittance
+        );
+    }
+
     #[test]
     fn light_through_a_slab_falls_with_the_hair_it_crosses() {
         let v = slab(100.0);
