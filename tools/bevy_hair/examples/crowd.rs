@@ -388,12 +388,12 @@ fn check(
 }
 
 /// Shares of the picture with hair shown over Bevy's colour and hidden by its depth, measured
-/// at 640x360 on lavapipe with 4 people and 12 frames of walking (1,545 and 545 pixels, the
+/// at 640x360 on lavapipe with 4 people and 12 frames of walking (1,539 and 547 pixels, the
 /// same in every run: time steps are fixed); a run passes within [`SHARE_TOLERANCE`] of each.
 /// Without the depth slack the scalps hide hair: 1,264 shown (-18%), 834 hidden (+53%).
-const SHOWN_SHARE: f64 = 1545.0 / (640.0 * 360.0);
+const SHOWN_SHARE: f64 = 1539.0 / (640.0 * 360.0);
 /// See [`SHOWN_SHARE`].
-const HIDDEN_SHARE: f64 = 545.0 / (640.0 * 360.0);
+const HIDDEN_SHARE: f64 = 547.0 / (640.0 * 360.0);
 /// Relative tolerance of the shares: pictures differ by a few pixels across drivers and CPUs;
 /// losing the depth slack moves the shown share by 18%.
 const SHARE_TOLERANCE: f64 = 0.12;
