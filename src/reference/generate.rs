@@ -530,13 +530,7 @@ mod tests {
     /// fade as well (a survivor of the fourth mutation sample faded no strand).
     #[test]
     fn lod_strands_follow_the_bundle_decisions() {
-        let mesh = crate::model::obj_io::parse_hair_mesh_obj(
-            "hairmeshes/small_patch.obj",
-            include_bytes!("../../hairmeshes/small_patch.obj"),
-        )
-        .unwrap();
-        let style = crate::HairStyle::default();
-        let baked = crate::bake(&mesh, &style, Default::default(), |_, _| {}).unwrap();
+        let (baked, style) = crate::reference::lod::tests::small_patch();
         let generator = CpuGenerator::new(&baked, style);
         let view = LodView {
             eye: Vec3::new(0.0, 0.0, 6.0),

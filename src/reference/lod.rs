@@ -111,7 +111,7 @@ pub fn apply_geomorph(p: &mut [Vec3], t: &mut [Vec3], gamma: f32) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// Eq. 11: an odd vertex moves toward the midpoint of its even neighbours by `gamma` (a
@@ -204,7 +204,7 @@ mod tests {
     }
 
     /// `hairmeshes/small_patch.obj` baked with the default style.
-    fn small_patch() -> (crate::BakedHairMesh, crate::HairStyle) {
+    pub(crate) fn small_patch() -> (crate::BakedHairMesh, crate::HairStyle) {
         let mesh = crate::model::obj_io::parse_hair_mesh_obj(
             "hairmeshes/small_patch.obj",
             include_bytes!("../../hairmeshes/small_patch.obj"),
