@@ -57,17 +57,19 @@ bool box_visible(vec3 lo, vec3 hi) {
     return true;
 }
 
-// Eq. 7's measure h R / (d tan theta) before alpha and the clamp (orthographic: the view
-// height for d tan theta).
+// Eq. 7's d tan theta at distance d (orthographic, lod.w == 0: the view height).
+float eq7_denominator(float d) {
+    return frame.lod.w > 0.0 ? max(d, 1e-6) * frame.lod.w : max(frame.lod_ortho.x, 1e-6);
+}
+
+// Eq. 7's measure h R / (d tan theta) before alpha and the clamp.
 float detail_level_unclamped(float h, float d) {
-    float denom = frame.lod.w > 0.0 ? max(d, 1e-6) * frame.lod.w : max(frame.lod_ortho.x, 1e-6);
-    return h * frame.camera_pos.w / denom;
+    return h * frame.camera_pos.w / eq7_denominator(d);
 }
 
 // Eq. 7 (perspective, or orthographic when lod.w == 0).
 float detail_level(float h, float d, float alpha) {
-    float denom = frame.lod.w > 0.0 ? max(d, 1e-6) * frame.lod.w : max(frame.lod_ortho.x, 1e-6);
-    return clamp(h * frame.camera_pos.w * alpha / denom, 0.0, 1.0);
+    return clamp(h * frame.camera_pos.w * alpha / eq7_denominator(d), 0.0, 1.0);
 }
 
 // Eq. 7's strand level times the crowd's area term (frame.lod_ortho.y: 0 off): below that

@@ -92,8 +92,8 @@ fn covered_brightness(img: &[u8]) -> f64 {
 }
 
 /// At the middle of the default band (52 pixels), FLIP means over the character's square
-/// (lavapipe, 128x128 frames, 24^3 cells, steps of two cells): head_long 0.133, sintel 0.095 between the volume
-/// alone and the strands alone. Inside the hair the two agree (mean colour within 1% for
+/// (lavapipe, 128x128 frames, 24^3 cells, steps of two cells): head_long 0.133, sintel 0.095
+/// between the volume alone and the strands alone. Inside the hair the two agree (mean colour within 1% for
 /// head_long, 10% for sintel); most of the error is the volume's edge, which the trilinear
 /// cells blur about a cell (2 pixels here) beyond the strands. For scale, the strands with
 /// LoD against the strands at full detail (both the renderer's own strands) already differ by

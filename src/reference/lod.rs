@@ -6,14 +6,18 @@ use glam::Vec3;
 /// Eq. 7, perspective: `L = min(1, h R alpha / (d tan theta))` for bundle size `h`, vertical
 /// resolution `R` in pixels, distance `d`, vertical field of view `theta` (radians).
 pub fn detail_level(h: f32, resolution: f32, distance: f32, fov_y: f32, alpha: f32) -> f32 {
-    let denom = distance.max(1e-6) * fov_y.tan();
-    (h * resolution * alpha / denom).clamp(0.0, 1.0)
+    (h * resolution * alpha / eq7_denominator(distance, fov_y)).clamp(0.0, 1.0)
+}
+
+/// Eq. 7's `d tan theta` (GLSL: `bundle_lod.glsl` `eq7_denominator`).
+fn eq7_denominator(distance: f32, fov_y: f32) -> f32 {
+    distance.max(1e-6) * fov_y.tan()
 }
 
 /// Eq. 7's measure of a bundle of size `h` on screen, `h R / (d tan theta)`, before alpha and
 /// the clamp: about its size in pixels (GLSL: `bundle_lod.glsl` `strand_level`).
 pub fn bundle_extent(h: f32, resolution: f32, distance: f32, fov_y: f32) -> f32 {
-    h * resolution / (distance.max(1e-6) * fov_y.tan())
+    h * resolution / eq7_denominator(distance, fov_y)
 }
 
 /// The crowd's area term on eq. 7's strand level: 1 for a bundle whose extent `x`

@@ -178,6 +178,12 @@ pub fn switch_look(camera: super::Camera, tier: VolumeTier) -> (super::View, sup
     (view, opts)
 }
 
+/// Byte offset of the occupancy mask in a volume's buffer of `dims` cells: after the cells and
+/// the one that gathers what fell outside (`volume_shading.glsl` `brick_occupied`).
+fn mask_offset(dims: UVec3) -> u64 {
+    (dims.x as u64 * dims.y as u64 * dims.z as u64 + 1) * size_of::<VolumeCell>() as u64
+}
+
 /// Refuse a sampling the GPU build cannot hold.
 fn check_sampling(sampling: &VolumeSampling) -> GpuResult<()> {
     let d = sampling.dims;
@@ -236,9 +242,7 @@ impl DensityVolumes {
     ) -> GpuResult<Option<Buffer>> {
         check_sampling(&sampling)?;
         let d = sampling.dims;
-        // The cells, the one that gathers what fell outside, then the occupancy mask.
-        let bytes = (d.x as u64 * d.y as u64 * d.z as u64 + 1) * size_of::<VolumeCell>() as u64
-            + occupancy_words(d) as u64 * 4;
+        let bytes = mask_offset(d) + occupancy_words(d) as u64 * 4;
         let slot = id.slot() as usize;
         if let Some(Some(e)) = self.entries.get_mut(slot)
             && e.id == id
@@ -415,7 +419,7 @@ impl DensityVolumes {
         let (sampling, _, bytes) = self.read_built(ctx, id)?;
         let d = sampling.dims;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        let first = (d.x * d.y * d.z) as usize * size_of::<VolumeCell>() / 4 + 4;
+        let first = (mask_offset(d) / 4) as usize;
         Ok(words[first..first + occupancy_words(d) as usize].to_vec())
     }
 

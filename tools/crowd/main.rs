@@ -154,7 +154,7 @@ pub struct Args {
     lod_alpha_strands: f32,
     /// Strands of bundles spanning fewer than this many pixels fall with their area, thickened
     /// to keep the coverage (0: off, the paper's eq. 7): 1000 people draw half the strands,
-    /// FLIP 0.009 against off.
+    /// FLIP 0.011 against off.
     #[arg(long, default_value_t = hairmesh::render::CROWD_AREA_BELOW)]
     lod_area_below: f32,
     /// Alpha of eq. 7 for vertex LoD.
