@@ -4,12 +4,12 @@
 #ifndef SOFT_RASTER_GLSL
 #define SOFT_RASTER_GLSL
 #include "fragment_pack.glsl"
+#include "soft_depth.glsl"
 
 layout(set = SET_FRAME, binding = BINDING_SOFT_SEGMENTS, std430) readonly buffer SoftSegments { SoftSegment soft_segments[]; };
 // Per tile: x segments touching it, y first entry, z scatter cursor, w entries kept.
 layout(set = SET_FRAME, binding = BINDING_SOFT_TILES, std430) buffer SoftTiles { uvec4 soft_tiles[]; };
 layout(set = SET_FRAME, binding = BINDING_SOFT_ENTRIES, std430) buffer SoftEntries { uint soft_entries[]; };
-layout(set = SET_FRAME, binding = BINDING_SOFT_DEPTH, std430) readonly buffer SoftDepth { float soft_depth[]; };
 
 struct Segment {
     vec2 a;          // end a, pixels

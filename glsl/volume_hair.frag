@@ -12,6 +12,7 @@
 #include "bindings.glsl"
 #include "strand_radiance.glsl"
 #include "temporal.glsl"
+#include "soft_depth.glsl"
 
 layout(location = 0) in vec3 in_world;
 layout(location = 1) flat in uint in_character;
@@ -38,6 +39,18 @@ void main() {
     // the eye outside the box or inside it.
     if (t_exit <= max(t_enter, 0.0)) {
         discard;
+    }
+    // With the software rasterizer the opaque depth (bodies, hardware strands) is at hand
+    // (soft_depth.glsl): the march ends at the surface the pixel shows, so hair behind a head
+    // is not counted in front of it, and a pixel whose box lies behind that surface is left
+    // at once (the depth test would reject whatever it found). The band's depth stays the
+    // box's exit (below).
+    float t_box_exit = t_exit;
+    if (frame.soft.x != RASTER_HARDWARE) {
+        t_exit = min(t_exit, ray_length_to_depth(eye, dir, opaque_depth_at(uvec2(gl_FragCoord.xy))));
+        if (t_exit <= max(t_enter, 0.0)) {
+            discard;
+        }
     }
     float scale = characters[c].model_scale;
     float step = MARCH_STEP_CELLS * characters[c].volume_shading.y * scale;
@@ -99,7 +112,7 @@ void main() {
     // In the band the volume lies under the strands that remain: its depth is where the ray
     // leaves the box, so strands drawn before (hardware) hide it and strands composited after
     // (the software rasterizer's) are not hidden by it.
-    vec3 depth_point = weight < 1.0 ? eye + dir * t_exit : point;
+    vec3 depth_point = weight < 1.0 ? eye + dir * t_box_exit : point;
     vec4 clip = frame.view_proj * vec4(depth_point, 1.0);
     float depth = clamp(clip.z / clip.w, 0.0, 1.0);
     gl_FragDepth = depth;

@@ -87,6 +87,16 @@ float volume_ambient(uint c, vec3 p) {
     return exp(-STRAND_SHADOW_OPACITY * volume_sample(c, volume_grid(c, p)).x * radius);
 }
 
+// How far along the ray eye + t dir (unit dir, world units) the frame's view puts `depth`
+// (0..1): where the march meets the opaque surface a pixel shows. Infinite at the cleared
+// depth. CPU twin: shade::volume::ray_length_to_depth.
+float ray_length_to_depth(vec3 eye, vec3 dir, float depth) {
+    vec4 a = frame.view_proj * vec4(eye, 1.0);
+    vec4 b = frame.view_proj * vec4(dir, 0.0);
+    float t = (depth * a.w - a.z) / (b.z - depth * b.w);
+    return depth < 1.0 && !isinf(t) && !isnan(t) && t >= 0.0 ? t : 1e30;
+}
+
 // The volume tier's share of character c (0: strands only).
 float volume_weight(uint c) {
     return volume_built(c) ? characters[c].volume_shading.z : 0.0;

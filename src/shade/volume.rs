@@ -146,6 +146,23 @@ pub fn light_transmittance(
     (-extinction(depth * step, width, opacity)).exp()
 }
 
+/// How far along the ray `eye + t dir` (unit `dir`, world units) the view `view_proj` puts
+/// `depth` (0..1, clip z over w): where a march of `volume_hair.frag` meets the opaque surface
+/// the pixel shows, so the hair behind a head or a body is not counted in front of it.
+/// `ray_length_to_depth` in `volume_shading.glsl`. Infinite at the cleared depth (1) and
+/// where the ray never reaches `depth`.
+pub fn ray_length_to_depth(view_proj: glam::Mat4, eye: Vec3, dir: Vec3, depth: f32) -> f32 {
+    // Clip space along the ray is a + t b, and depth(t) = (a.z + t b.z) / (a.w + t b.w).
+    let a = view_proj * eye.extend(1.0);
+    let b = view_proj * dir.extend(0.0);
+    let t = (depth * a.w - a.z) / (b.z - depth * b.w);
+    if depth < 1.0 && t.is_finite() && t >= 0.0 {
+        t
+    } else {
+        f32::INFINITY
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -241,5 +258,32 @@ mod tests {
         assert!(inside < surface && surface < outside, "{inside} {surface}");
         let expected = (-extinction(400.0, width, opacity) * 2.0 / 16.0).exp();
         assert!((inside - expected).abs() < 1e-5, "{inside} vs {expected}");
+    }
+
+    /// The ray length to a depth is the distance of the point that projects to it: points at
+    /// known distances along slanted rays through a perspective view come back within 1e-3
+    /// relative (measured 4.6e-6 at 0.7, 6.3e-6 at 3.9 and 7.2e-5 at 57 world units, where a
+    /// float depth near 1 has few steps left); the cleared depth is infinitely far.
+    #[test]
+    fn ray_length_to_depth_inverts_the_projection() {
+        let eye = Vec3::new(0.3, 1.6, 4.0);
+        // The renderer's own camera (Vulkan depth 0..1, y down).
+        let camera = crate::render::camera::Camera::look_at(eye, Vec3::new(0.0, 1.0, 0.0), 45.0);
+        let view_proj = camera.view_proj(16.0 / 9.0);
+        for (dir, t) in [
+            (Vec3::new(-0.1, -0.2, -1.0), 0.7),
+            (Vec3::new(0.3, 0.1, -1.0), 3.9),
+            (Vec3::new(0.0, -0.05, -1.0), 57.0),
+        ] {
+            let dir = dir.normalize();
+            let c = view_proj * (eye + dir * t).extend(1.0);
+            let back = ray_length_to_depth(view_proj, eye, dir, c.z / c.w);
+            assert!((back - t).abs() < 1e-3 * t, "{t} -> {back}");
+        }
+        let forward = (Vec3::new(0.0, 1.0, 0.0) - eye).normalize();
+        assert_eq!(
+            ray_length_to_depth(view_proj, eye, forward, 1.0),
+            f32::INFINITY
+        );
     }
 }

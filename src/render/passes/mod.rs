@@ -881,8 +881,9 @@ impl FramePasses {
             query,
         );
         if volumes {
+            let flags = (opaque_strands, inp.raster.uses_software());
             self.volume_hair
-                .add(g, r, inp.sets, inp.volume_slots, opaque_strands);
+                .add(g, r, inp.sets, inp.volume_slots, flags);
         }
         if transparent {
             let draw = TransparentDraw {

@@ -127,17 +127,9 @@ impl SoftRasterPass {
     ) {
         let (tx, ty) = tile_grid(size.0, size.1);
         let rw = Access::ComputeReadWrite;
-        let soft_depth = r.soft_depth;
         g.begin_scope("soft bin");
         if copy_depth {
-            let depth = r.images.depth;
-            g.pass("soft depth copy")
-                .read(r.depth, Access::TransferRead)
-                .discard(r.soft_depth, Access::TransferWrite)
-                .record(move |rec, res| {
-                    rec.copy_image_to_buffer_at(depth, res.buffer(soft_depth)?, 0);
-                    Ok(())
-                });
+            add_depth_copy(g, r, "soft depth copy");
         }
         self.add_binning(g, r, sets, size);
         g.end_scope();
@@ -216,4 +208,19 @@ impl SoftRasterPass {
             });
         bin(g, "soft bin scatter", &self.scatter, true);
     }
+}
+
+/// Add a pass named `name` copying the camera's depth target into the soft depth buffer
+/// (`glsl/soft_depth.glsl`: a float per pixel, row by row), which exists when the camera's
+/// strands go through the software rasterizer. Single-sampled targets only: MSAA frames draw
+/// no software strands.
+pub fn add_depth_copy<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>, name: &'static str) {
+    let (depth, soft_depth) = (r.images.depth, r.soft_depth);
+    g.pass(name)
+        .read(r.depth, Access::TransferRead)
+        .discard(r.soft_depth, Access::TransferWrite)
+        .record(move |rec, res| {
+            rec.copy_image_to_buffer_at(depth, res.buffer(soft_depth)?, 0);
+            Ok(())
+        });
 }

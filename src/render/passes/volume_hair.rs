@@ -2,7 +2,8 @@
 //! `glsl/volume_hair.frag`): each character with a share of volume this frame draws its
 //! density volume's box, whose fragments march the view ray through the volume and write the
 //! shaded hair premultiplied over the target at the hair's mean depth. Drawn after the opaque
-//! pass (whose MSAA resolve it then makes). Reads: frame block, character records, the
+//! pass (whose MSAA resolve it then makes); with the software rasterizer, the march ends at the
+//! opaque depth, copied into its buffer first. Reads: frame block, character records, the
 //! light's maps, the density volumes (by device address). Writes: colour and depth (and the
 //! visibility words in frames with motion vectors).
 
@@ -46,18 +47,24 @@ impl VolumeHairDraw {
 
     /// Add the pass drawing the volumes of the first `slots` character slots (characters
     /// without a share of volume get no triangles) over the colour and depth, ending with the
-    /// colour's MSAA resolve when `resolve`.
+    /// colour's MSAA resolve when `resolve`. With `soft` (the camera's strands go through the
+    /// software rasterizer, so the frame has its depth buffer) the opaque depth is copied
+    /// there first, and each ray's march ends at the surface its pixel shows.
     pub fn add<'a>(
         &'a self,
         g: &mut FrameGraph<'a>,
         r: &FrameRes<'a>,
         sets: PassSets<'a>,
         slots: u32,
-        resolve: bool,
+        (resolve, soft): (bool, bool),
     ) {
         g.begin_scope("volume hair");
+        if soft {
+            super::soft_raster::add_depth_copy(g, r, "volume depth copy");
+        }
         let mut p = g
             .pass("volume hair")
+            .read_some(Some(r.soft_depth).filter(|_| soft), Access::FragmentRead)
             .write(r.color, Access::ColorAttachment)
             .write(r.depth, Access::DepthAttachment)
             .read(r.constants, Access::VertexRead)
