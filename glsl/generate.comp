@@ -33,9 +33,11 @@ void main() {
     uint count = min(per, lod.x - first);
 #ifdef SOFT_RASTER
     if (lod_is_soft(lod.y)) {
-        float cap = model_scale * bundles[bundle].rest_size;
-        fade_newest_strand(lod, first);
-        emit_soft_segments(count, segments, width_scale, uintBitsToFloat(lod.w), cap, style_color(), bundles[bundle].character, t);
+        if (t < per) {
+            float cap = model_scale * bundles[bundle].rest_size;
+            set_soft_strand(t, width_scale * lod_strand_fade(lod, first + t), uintBitsToFloat(lod.w), cap);
+        }
+        emit_soft_segments(count, segments, style_color(), bundles[bundle].character, t);
         return;
     }
 #endif

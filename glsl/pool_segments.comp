@@ -37,6 +37,9 @@ void main() {
         sw[idx] = v.pos_width.w;
     }
     barrier();
-    float cap = model_scale * bundles[bundle].rest_size;
-    emit_soft_segments(count, segments, 1.0, uintBitsToFloat(lod.w), cap, style_color(), bundles[bundle].character, t);
+    if (t < per) {
+        // The stored widths (sw) carry the width scale and the newest strand's share.
+        set_soft_strand(t, 1.0, uintBitsToFloat(lod.w), model_scale * bundles[bundle].rest_size);
+    }
+    emit_soft_segments(count, segments, style_color(), bundles[bundle].character, t);
 }

@@ -30,27 +30,24 @@ shared float sw[MAX_ENTRIES];
 shared vec2 sv_residual[MAX_ENTRIES];
 #endif
 
-// Width of shared vertex idx at parameter s: the stored one, or the builder's strand width.
-// The newest strand's width share (lod_strand_fade) and its index among the strands handed to
-// emit_soft_segments (set by the generators before the call; the pool's stored widths
-// already carry it).
-float soft_fade = 1.0;
-uint soft_fade_strand = 0xFFFFFFFFu;
+// Per strand handed to emit_soft_segments (strand j of the shared arrays): x its width scale
+// (the model's scale times eq. 8's thickness, and for a bundle's newest strand its width share,
+// lod_strand_fade), y eq. 8's thickness, z the cap on its drawn width (its bundle's size). The
+// mesh path's software pass packs strands of several bundles into one workgroup, so these
+// are per strand; set by the thread of strand j before the call.
+shared vec3 s_soft_strand[S];
 
-// Before emit_soft_segments: the strands handed over start at strand `first` of a bundle
-// with LoD decision `lod`; its newest strand (if among them) fades in.
-void fade_newest_strand(uvec4 lod, uint first) {
-    soft_fade = lod_strand_fade(lod, lod.x - 1u);
-    soft_fade_strand = lod.x - 1u - first;
+void set_soft_strand(uint j, float width_scale, float thickness, float cap) {
+    s_soft_strand[j] = vec3(width_scale, thickness, cap);
 }
 
-// Width of entry idx (strand `strand` of those handed over) at parameter s.
-float soft_vertex_width(uint idx, uint strand, float s, float width_scale) {
+// Width of entry idx (strand `strand` of those handed over) at parameter s: the stored one,
+// or the builder's strand width.
+float soft_vertex_width(uint idx, uint strand, float s) {
 #ifdef SOFT_POOL
     return sw[idx];
 #else
-    float fade = strand == soft_fade_strand ? soft_fade : 1.0;
-    return width_scale * fade * strand_width_at(s);
+    return s_soft_strand[strand].x * strand_width_at(s);
 #endif
 }
 
@@ -83,21 +80,24 @@ bool soft_segment_kept(uint idx) {
 }
 
 // Shade, project and append the segments of `count` strands of `segments` segments in
-// sp / st (all S threads call it: it contains barriers).
-void emit_soft_segments(uint count, uint segments, float width_scale, float thickness, float cap, vec3 color, uint character, uint t) {
+// sp / st, each with its set_soft_strand (all S threads call it: it contains barriers).
+void emit_soft_segments(uint count, uint segments, vec3 color, uint character, uint t) {
     uint stride = segments + 1u;
     uint entries = count * stride;
     if (t == 0u) {
         s_soft_count = 0u;
     }
+    barrier();
     for (uint idx = t; idx < entries; idx += S) {
         uint k = idx % stride;
         float s = float(k) / float(segments);
         vec3 p = sp[idx];
         vec4 c = frame.view_proj * vec4(p, 1.0);
         float pixel = pixel_size(p);
-        float width = soft_vertex_width(idx, idx / stride, s, width_scale);
-        float drawn = soft_drawn_width(width, pixel, thickness, cap);
+        vec3 strand = s_soft_strand[idx / stride];
+        float thickness = strand.y;
+        float width = soft_vertex_width(idx, idx / stride, s);
+        float drawn = soft_drawn_width(width, pixel, thickness, strand.z);
         bool in_range = c.w > 1e-6 && c.z >= 0.0 && c.z <= c.w;
         vec3 ndc = c.xyz / max(c.w, 1e-6);
         vec2 screen = (ndc.xy * 0.5 + 0.5) * frame.viewport.xy;
@@ -138,6 +138,7 @@ void emit_soft_segments(uint count, uint segments, float width_scale, float thic
                 soft_segments[out_index].a = a.xy;
                 soft_segments[out_index].za = a.z;
                 soft_segments[out_index].dz_id = dz | ((character & VISIBILITY_INDEX) << 16);
+                float thickness = s_soft_strand[idx / stride].y;
                 soft_segments[out_index].b = uvec4(packHalf2x16(b.xy - a.xy), sv_color[idx], sv_color[idx + 1u],
                                                    packHalf2x16(vec2(0.5 * (a.w + b.w), thickness)));
 #ifdef VISIBILITY

@@ -28,6 +28,18 @@ shared vec3 sd[MAX_ENTRIES];
 // (root_bulge: twelve texel fetches), made once per strand instead of once per vertex.
 shared StrandInfo s_info[S];
 shared vec3 s_root_offset[S];
+// Per strand (lane) of the workgroup: its bundle and index there, and eq. 12's geomorph
+// factor. The software passes of the mesh path pack strands of several bundles (one
+// character, one vertex level) into a workgroup (strands.task); the others fill every lane
+// from one bundle (build_strands).
+shared uvec2 s_lane[S];
+shared float s_lane_gamma[S];
+
+// Before build_lane_strands, by the thread of lane j: strand `strand` of crowd bundle `bundle`.
+void set_strand_lane(uint j, uint bundle, uint strand, float gamma) {
+    s_lane[j] = uvec2(bundle, strand);
+    s_lane_gamma[j] = gamma;
+}
 
 // Strands one workgroup builds for strands of `segments` segments.
 uint strands_per_group(uint segments) {
@@ -97,10 +109,11 @@ vec2 entry_residual(uint idx, uint character) {
     return vec2(0.0);
 }
 
-// Build strands first .. first + strands_per_group(segments) - 1 of crowd bundle `bundle` (extra strands
-// past the bundle's count are computed and ignored by the caller). Must be called by all S
-// threads (contains barriers). World-space results in sp / st (and sd with deform_motion()).
-void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) {
+// Build the strands of the workgroup's lanes (set_strand_lane by threads 0 .. per - 1, of the
+// bound character), all of `segments` segments (lanes past the caller's count are computed
+// and ignored). Must be called by all S threads (contains barriers). World-space results in
+// sp / st (and sd with deform_motion()).
+void build_lane_strands(uint segments, uint t) {
     uint per = strands_per_group(segments);
     uint stride = segments + 1u;
 #ifdef VISIBILITY
@@ -109,7 +122,7 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
     bool moving = false;
 #endif
     if (t < per) {
-        StrandInfo si = strand_info(bundle, first + t);
+        StrandInfo si = strand_info(s_lane[t].x, s_lane[t].y);
         s_info[t] = si;
         s_root_offset[t] = root_bulge(root_cell(si.origin), si.local);
     }
@@ -147,6 +160,7 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
         if (idx < entries) {
             uint base = (idx / stride) * stride;
             uint k = idx - base;
+            float gamma = s_lane_gamma[idx / stride];
             vec3 tk = tangent_at(base, k, segments);
             vec3 pk = sp[idx];
             bool morph_odd = gamma > 0.0 && segments >= 2u && (k & 1u) == 1u && k < segments;
@@ -180,6 +194,16 @@ void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) 
         }
     }
     barrier();
+}
+
+// Build strands first .. first + strands_per_group(segments) - 1 of crowd bundle `bundle` (extra strands
+// past the bundle's count are computed and ignored by the caller): build_lane_strands with
+// every lane from one bundle.
+void build_strands(uint bundle, uint first, uint segments, float gamma, uint t) {
+    if (t < strands_per_group(segments)) {
+        set_strand_lane(t, bundle, first + t, gamma);
+    }
+    build_lane_strands(segments, t);
 }
 
 #endif

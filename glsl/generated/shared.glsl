@@ -15,6 +15,7 @@
 #define SLICES_PER_SEGMENT 4u
 #define BUNDLE_TRIANGLE 1u
 #define TASK_PAYLOAD_BUNDLES 32
+#define PAYLOAD_LANE_BITS 5u
 #define CULL_GROUP_SIZE 64
 #define SCAN_THREADS 256
 #define SCAN_BLOCK 1024u
@@ -325,7 +326,7 @@ struct SkinJob {
 struct TaskPayload {
     uvec4 lods[32];
     uint bundle[32];
-    uint first_group[33];
+    uint place[33];
     uint count;
     uint _pad[2];
 };

@@ -12,6 +12,7 @@ pub mod frame;
 pub mod graph;
 pub mod host;
 pub mod passes;
+pub mod payload;
 pub mod prop_table;
 pub mod renderer;
 pub mod scene;

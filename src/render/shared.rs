@@ -18,6 +18,10 @@ pub const MAX_VERTS_LOG2: u32 = 6;
 pub const MAX_SEGMENTS: u32 = 1 << MAX_VERTS_LOG2;
 /// Bundles one task-shader workgroup can cull and compact (payload capacity).
 pub const TASK_PAYLOAD_BUNDLES: u32 = 32;
+/// Low bits of a payload place ([`TaskPayload::place`]) that hold the lane: a strand
+/// workgroup's strands are lanes `0..STRAND_GROUP_SIZE`.
+pub const PAYLOAD_LANE_BITS: u32 = 5;
+const _: () = assert!(STRAND_GROUP_SIZE <= 1 << PAYLOAD_LANE_BITS);
 /// Invocations of a cull workgroup (one bundle each).
 pub const CULL_GROUP_SIZE: u32 = 64;
 /// Threads of a scan workgroup.
@@ -842,7 +846,9 @@ pub struct SkinJob {
 gpu_struct!(SkinJob as "SkinJob" { rest_first: "uint", vertex_count: "uint", matrix_first: "uint", out_first: "uint" });
 
 /// Task shader -> mesh shader payload: up to [`TASK_PAYLOAD_BUNDLES`] visible bundles of one
-/// task workgroup, compacted, with the first mesh workgroup of each.
+/// task workgroup, compacted, with where each one's strands start among the mesh workgroups.
+/// Bundles of one character and one vertex level may share a workgroup (the software
+/// passes', `glsl/strands.task`): a run of them fills workgroups lane by lane.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct TaskPayload {
@@ -850,8 +856,9 @@ pub struct TaskPayload {
     pub lods: [[u32; 4]; TASK_PAYLOAD_BUNDLES as usize],
     /// Global bundle index of each visible bundle.
     pub bundle: [u32; TASK_PAYLOAD_BUNDLES as usize],
-    /// First mesh workgroup of each visible bundle; element `count` is the total.
-    pub first_group: [u32; TASK_PAYLOAD_BUNDLES as usize + 1],
+    /// Where each visible bundle's first strand is built: mesh workgroup `<<`
+    /// [`PAYLOAD_LANE_BITS`] `|` lane; element `count` is the workgroups in all (lane 0).
+    pub place: [u32; TASK_PAYLOAD_BUNDLES as usize + 1],
     /// Visible bundles.
     pub count: u32,
     /// Padding to a 16-byte multiple (std430 struct size).
@@ -860,7 +867,7 @@ pub struct TaskPayload {
 
 gpu_struct!(TaskPayload as "TaskPayload" {
     lods: "uvec4"[TASK_PAYLOAD_BUNDLES], bundle: "uint"[TASK_PAYLOAD_BUNDLES],
-    first_group: "uint"[TASK_PAYLOAD_BUNDLES + 1], count: "uint", _pad: "uint"[2],
+    place: "uint"[TASK_PAYLOAD_BUNDLES + 1], count: "uint", _pad: "uint"[2],
 });
 
 /// std430 `(size, alignment)` of a GLSL scalar, vector or matrix type.
@@ -1119,6 +1126,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("SLICES_PER_SEGMENT", SLICES_PER_SEGMENT),
         uint("BUNDLE_TRIANGLE", crate::bake::BUNDLE_TRIANGLE),
         layout("TASK_PAYLOAD_BUNDLES", TASK_PAYLOAD_BUNDLES),
+        uint("PAYLOAD_LANE_BITS", PAYLOAD_LANE_BITS),
         layout("CULL_GROUP_SIZE", CULL_GROUP_SIZE),
         layout("SCAN_THREADS", SCAN_THREADS),
         uint("SCAN_BLOCK", SCAN_BLOCK),
