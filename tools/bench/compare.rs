@@ -149,6 +149,7 @@ fn build_control(rev: &str) -> Result<(String, PathBuf)> {
         std::fs::remove_file(&archive)?;
         std::fs::rename(&staging, &src)?;
     }
+    own_workspace(&src.join("Cargo.toml"))?;
     eprintln!("building crowd of {short} in {}", root.display());
     run_checked(
         Command::new("cargo")
@@ -160,6 +161,24 @@ fn build_control(rev: &str) -> Result<(String, PathBuf)> {
     std::fs::create_dir_all(bin.parent().unwrap())?;
     std::fs::copy(root.join("target/release/crowd"), &bin)?;
     Ok((sha, bin))
+}
+
+/// Make the control's manifest its own workspace root: the sources lie under this
+/// repository's `target/`, so cargo would otherwise take this repository's workspace for
+/// theirs and refuse a commit from before the workspace existed (one package, no
+/// `[workspace]` table).
+fn own_workspace(manifest: &Path) -> Result<()> {
+    let text = std::fs::read_to_string(manifest)
+        .with_context(|| format!("{}: cannot read the control's manifest", manifest.display()))?;
+    if text.lines().any(|l| l.trim() == "[workspace]") {
+        return Ok(());
+    }
+    std::fs::write(manifest, format!("{text}\n[workspace]\n")).with_context(|| {
+        format!(
+            "{}: cannot write the control's manifest",
+            manifest.display()
+        )
+    })
 }
 
 /// Build this tree's `crowd` (up to date in the usual case).
@@ -376,4 +395,28 @@ fn print_table(sha: &str, rows: &[Row], samples: &Samples, args: &CompareArgs) -
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A manifest without a `[workspace]` table gets one, once; one with it is left alone.
+    #[test]
+    fn a_control_manifest_becomes_its_own_workspace() {
+        let dir = std::env::temp_dir().join(format!("hairmesh-own-ws-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let manifest = dir.join("Cargo.toml");
+        let package = "[package]\nname = \"old\"\n";
+        std::fs::write(&manifest, package).unwrap();
+        own_workspace(&manifest).unwrap();
+        own_workspace(&manifest).unwrap();
+        let text = std::fs::read_to_string(&manifest).unwrap();
+        assert_eq!(text, format!("{package}\n[workspace]\n"));
+        let workspace = "[workspace]\nmembers = [\"a\"]\n";
+        std::fs::write(&manifest, workspace).unwrap();
+        own_workspace(&manifest).unwrap();
+        assert_eq!(std::fs::read_to_string(&manifest).unwrap(), workspace);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
