@@ -724,6 +724,29 @@ mod tests {
         assert!(missing_folders(&deep, "--out").unwrap().is_empty());
     }
 
+    /// A relative path's levels stop at its first component: the empty path above it is not
+    /// a folder to make (a guard that let it through listed "" first).
+    #[test]
+    fn missing_folders_of_a_relative_path_stop_at_its_first_component() {
+        let top = PathBuf::from(format!("hairmesh-no-such-folder-{}", std::process::id()));
+        let deep = top.join("sub");
+        let missing = missing_folders(&deep, "--out").unwrap();
+        assert_eq!(missing, vec![top.clone(), deep.clone()]);
+    }
+
+    /// A file that holds more than its metadata said (here a `/proc` file, which reports 0
+    /// bytes) is still refused past the limit: the read takes one byte more than the limit to
+    /// see it, where reading exactly the limit would have accepted it cut short.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_file_longer_than_its_metadata_is_refused_past_the_limit() {
+        let status = Path::new("/proc/self/status");
+        assert_eq!(std::fs::metadata(status).unwrap().len(), 0);
+        let err = read_input(status, 64).unwrap_err().to_string();
+        assert!(err.contains("64-byte limit"), "{err}");
+        assert!(read_input(status, 1 << 20).unwrap().len() > 64);
+    }
+
     /// The size limit is inclusive: a file of exactly `max_bytes` is read, one byte more is
     /// refused naming the limit, and a folder is refused before anything is read.
     #[test]

@@ -415,6 +415,32 @@ mod tests {
     /// The estimate's column control points are what the bake allocates for them: one vector
     /// of `4 (L - 1) + 1` points per vertex column (measured equal to the byte for a quad of 5
     /// layers: 4 x (24 + 17 x 12) = 912 bytes).
+    /// The deepest mesh the format takes (MAX_LAYERS layers: 2,045 slices of the 2,048 a
+    /// texture may have) bakes, and progress rises step by step to its total. A depth bound
+    /// counted from `layers + 1` refuses it (2,053 slices); progress counted from `n + k - 1`
+    /// ends two steps short and repeats a step.
+    #[test]
+    fn the_deepest_mesh_bakes_and_progress_reaches_its_total() {
+        let layers = square_layers(crate::model::hair_mesh::MAX_LAYERS);
+        let uv = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+            .map(|(u, v)| glam::Vec2::new(u, v))
+            .to_vec();
+        let mesh = HairMesh::new("deep", layers, None, uv, vec![Face::Quad([0, 1, 2, 3])]).unwrap();
+        let mut steps = Vec::new();
+        let baked = bake(
+            &mesh,
+            &HairStyle::default(),
+            BakeOptions::default(),
+            |done, total| steps.push((done, total)),
+        )
+        .unwrap();
+        assert_eq!(baked.info.position_depth(), 2045);
+        let total = 4 + crate::model::hair_mesh::MAX_LAYERS;
+        assert_eq!(steps.last(), Some(&(total, total)));
+        assert!(steps.iter().all(|&(_, t)| t == total));
+        assert!(steps.windows(2).all(|w| w[1].0 > w[0].0), "{steps:?}");
+    }
+
     #[test]
     fn column_control_points_estimate_is_the_allocation() {
         let layers = square_layers(5);
