@@ -13,10 +13,7 @@ layout(set = SET_FRAME, binding = BINDING_OIT_NODES, std430) buffer OitNodes { u
 layout(set = SET_FRAME, binding = BINDING_OIT_TAIL, std430) buffer OitTail { uvec4 oit_tail[]; };
 
 #define OIT_EMPTY 0xFFFFFFFFFFFFFFFFul
-// Fixed-point scale of the tail sums: integer adds make the tail independent of the order
-// fragments arrive in. One fragment adds at most 5.6 OIT_FIXED per lane (optical depth is
-// capped by the 8-bit alpha), so a lane holds about 740 000 evicted fragments per pixel.
-#define OIT_FIXED 1024.0
+// OIT_FIXED (shared.glsl): the fixed-point scale of the tail sums.
 
 // The fragment's pixel (fragment shaders; the software rasterizer, a compute shader, defines
 // OIT_COMPUTE and indexes pixels itself).

@@ -7,7 +7,9 @@
 // pixel's K nearest fragments in shared memory (64-bit atomicMin of depth bits << 32 | packed
 // colour, as oit.frag) or merged into its fixed-point tail, so the result does not depend on
 // the order. At the end every pixel merges its list with the frame's k-buffer (oit.glsl),
-// nearest first.
+// nearest first. A fragment behind fragments of the pixel whose transmittance together is
+// below SOFT_HIDDEN_TRANSMITTANCE is hidden (insert): it is dropped before its coverage is
+// computed, as behind the opaque depth (CPU twin: render::soft::PixelFragments).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
@@ -21,12 +23,19 @@ layout(local_size_x = SOFT_TILE, local_size_y = SOFT_TILE) in;
 #include "volume_shading.glsl"
 
 #define TILE_PIXELS (SOFT_TILE * SOFT_TILE)
+// Optical depth past which what lies behind is hidden.
+const float HIDDEN_TAU = -log(SOFT_HIDDEN_TRANSMITTANCE);
 
 shared uint64_t s_nodes[TILE_PIXELS * SOFT_MAX_K];
 // Per pixel: the tail's fixed-point sums, (r, g) and (b, optical depth) in the low and high
 // halves of two 64-bit lanes.
 shared uint64_t s_tail[TILE_PIXELS * 2u];
-shared float s_depth[TILE_PIXELS];
+// Per pixel: the depth (float bits; depths are not negative, so their bits order as the
+// floats do) from which fragments are hidden: the opaque depth, then nearer where the
+// pixel's own fragments hide what lies behind them (insert).
+shared uint s_depth[TILE_PIXELS];
+// Per pixel row of the tile: its farthest opaque depth (tile_far).
+shared float s_row_far[SOFT_TILE];
 // optical_depth of each 8-bit fragment alpha (a log per evicted fragment otherwise).
 shared float s_optical_depth[256];
 #ifdef VISIBILITY
@@ -35,25 +44,42 @@ shared float s_optical_depth[256];
 shared uint64_t s_visible[TILE_PIXELS];
 #endif
 
-// Add fragment `v` to pixel lp's K nearest (k of them), or its tail.
+// Add fragment `v` to pixel lp's K nearest (k of them), or its tail. The walk down the list
+// adds up the optical depth of the nodes it passes or leaves behind it; once that is past
+// HIDDEN_TAU, everything behind the farthest of them is hidden: the pixel's hiding depth
+// comes nearer (shade_pixel drops what lies behind it) and the fragment still carried, which
+// lies behind them, is dropped. Every node counted is a fragment already deposited, so what
+// is dropped lies behind fragments of transmittance below SOFT_HIDDEN_TRANSMITTANCE whatever
+// the order of arrival.
 void insert(uint lp, uint k, uint64_t v) {
     uint first = lp * SOFT_MAX_K;
     // Nodes only ever get nearer and stay sorted once every insert has passed: a fragment
     // not nearer than the K-th node now is not among the K nearest at the end either, so it
     // goes straight to the tail (most fragments, where hair is dense) without the walk.
     if (v < s_nodes[first + k - 1u]) {
+        float tau = 0.0;
+        uint far = 0u;
         for (uint i = 0u; i < k; i++) {
             // A plain read first: a node already nearer than v stays so, and the atomic (a
             // compare-and-swap loop on some GPUs, slow where hundreds of fragments meet in
             // one pixel) is spent only where v displaces something.
-            if (v >= s_nodes[first + i]) {
-                continue;
+            uint64_t node = s_nodes[first + i];
+            if (v < node) {
+                uint64_t old = atomicMin(s_nodes[first + i], v);
+                node = min(old, v);
+                v = max(old, v);
             }
-            uint64_t old = atomicMin(s_nodes[first + i], v);
-            if (old == OIT_EMPTY) {
+            tau += s_optical_depth[uint(node) >> 24];
+            far = max(far, uint(node >> 32));
+            if (tau > HIDDEN_TAU) {
+                atomicMin(s_depth[lp], far);
+                if (uint(v >> 32) >= far) {
+                    return;
+                }
+            }
+            if (v == OIT_EMPTY) {
                 return;
             }
-            v = max(old, v);
         }
     }
     // Two 32-bit sums in each 64-bit lane: a low half carries into the high half only past
@@ -87,7 +113,7 @@ void shade_pixel(SegmentRaster s, ivec2 pixel, ivec2 origin, uint k) {
     float u = clamp(dot(pmin + 0.5 - s.f.a, s.f.d) / s.f.len, 0.0, 1.0);
     float depth = mix(s.z.x, s.z.y, u);
     uint lp = uint(pixel.y - origin.y) * SOFT_TILE + uint(pixel.x - origin.x);
-    if (!(depth < s_depth[lp])) {
+    if (!(depth < uintBitsToFloat(s_depth[lp]))) {
         return;
     }
     float cov = pixel_coverage(s.f, s.h, pmin);
@@ -117,8 +143,15 @@ ivec4 footprint_box(Segment s, ivec2 origin, ivec2 extent) {
     return ivec4(lo, hi);
 }
 
+// The farthest opaque depth of the tile: a segment nearer nowhere than it is hidden in all of
+// the tile (a pixel's depth lies between its segment's end depths).
+float tile_far;
+
 // Rasterize segment `s` alone, walking its footprint inside the tile row by row.
 void raster_segment(Segment s, vec2 residual, ivec2 origin, ivec2 extent, uint k) {
+    if (min(s.za, s.zb) > tile_far) {
+        return;
+    }
     float h = s.half_width;
     SegmentRaster r = SegmentRaster(segment_frame(s.a, s.b), h, vec2(s.za, s.zb), unpack_fragment(s.color_a),
                                     unpack_fragment(s.color_b), s.thickness, s.id, residual);
@@ -171,11 +204,25 @@ void main() {
 #ifdef VISIBILITY
     s_visible[lp] = OIT_EMPTY;
 #endif
-    s_depth[lp] = inside ? soft_depth[p] : 0.0;
+    s_depth[lp] = floatBitsToUint(inside ? soft_depth[p] : 0.0);
+    if (lp < SOFT_TILE) {
+        // The farthest opaque depth of tile row lp, read from the buffer (so no barrier is
+        // needed before it); rows below the image stay 0.
+        uint row = uint(origin.y) + lp;
+        float far = 0.0;
+        for (uint x = 0u; x < uint(extent.x) && lp < uint(extent.y); x++) {
+            far = max(far, soft_depth[row * uint(size.x) + uint(origin.x) + x]);
+        }
+        s_row_far[lp] = far;
+    }
     for (uint a = lp; a < 256u; a += TILE_PIXELS) {
         s_optical_depth[a] = optical_depth(float(a) / 255.0);
     }
     barrier();
+    tile_far = 0.0;
+    for (uint y = 0u; y < SOFT_TILE; y++) {
+        tile_far = max(tile_far, s_row_far[y]);
+    }
     for (uint e = lp; e < info.w; e += TILE_PIXELS) {
         uint si = soft_entries[info.y + e];
         raster_segment(load_segment(si), segment_residual(si), origin, extent, k);

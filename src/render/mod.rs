@@ -22,6 +22,7 @@ pub mod shared;
 pub mod skinned_props;
 pub mod slots;
 pub mod soft;
+pub mod soft_pixel;
 pub mod targets;
 pub mod temporal;
 pub mod transparency;

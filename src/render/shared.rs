@@ -54,6 +54,15 @@ pub const SOFT_TILE: u32 = 16;
 /// Software rasterizer: most fragments per pixel it keeps sorted in a tile's shared memory
 /// (`256 x 8 x 8` bytes; the rest merge into the tail).
 pub const SOFT_MAX_K: u32 = 8;
+/// K-buffer tail: fixed-point scale of its sums (`oit.glsl`): integer adds make the tail
+/// independent of the order fragments arrive in. One fragment adds at most 5.6 `OIT_FIXED` per
+/// lane (optical depth is capped by the 8-bit alpha), so a 32-bit lane holds about 740 000
+/// evicted fragments per pixel.
+pub const OIT_FIXED: f32 = 1024.0;
+/// Software rasterizer: a fragment behind fragments of its pixel whose transmittance together
+/// is below this is hidden and dropped (`render::soft::PixelFragments`, `soft_raster.comp`):
+/// under half an 8-bit step of light comes through.
+pub const SOFT_HIDDEN_TRANSMITTANCE: f32 = 1.0 / 512.0;
 /// Threads of the software rasterizer's binning workgroups (one segment each).
 pub const SOFT_BIN_GROUP: u32 = 256;
 /// `bundle_lods[].y` bit: the bundle is drawn by the software rasterizer (the low byte is the
@@ -1198,6 +1207,8 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
 fn float_constants() -> Vec<(&'static str, f32)> {
     vec![
         ("STRAND_OPACITY", STRAND_OPACITY),
+        ("SOFT_HIDDEN_TRANSMITTANCE", SOFT_HIDDEN_TRANSMITTANCE),
+        ("OIT_FIXED", OIT_FIXED),
         ("SHAPE_TIP_LOSS", crate::dynamics::SHAPE_TIP_LOSS),
         ("BOUND_SLACK", crate::dynamics::BOUND_SLACK),
         ("BOUND_PAD", crate::dynamics::BOUND_PAD),

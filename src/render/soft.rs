@@ -537,12 +537,19 @@ fn f16_bits(x: f32) -> u32 {
 }
 
 /// `pack_fragment` of `fragment_pack.glsl`: sqrt-encoded RGB and linear alpha, 8 bits each.
-fn pack_fragment(rgb: [f32; 3], alpha: f32) -> u32 {
+pub(crate) fn pack_fragment(rgb: [f32; 3], alpha: f32) -> u32 {
     let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u32;
     q(rgb[0].max(0.0).sqrt())
         | q(rgb[1].max(0.0).sqrt()) << 8
         | q(rgb[2].max(0.0).sqrt()) << 16
         | q(alpha) << 24
+}
+
+/// `unpack_fragment` of `fragment_pack.glsl`: linear colour and alpha.
+pub(crate) fn unpack_fragment(p: u32) -> ([f32; 3], f32) {
+    let byte = |i: u32| ((p >> (8 * i)) & 0xff) as f32 / 255.0;
+    let sq = |x: f32| x * x;
+    ([sq(byte(0)), sq(byte(1)), sq(byte(2))], byte(3))
 }
 
 impl SoftSegment {
