@@ -5,11 +5,12 @@
 // opaque depth gets the area of its square under the segment's rectangle (soft_raster.glsl),
 // the depth and colour at the centre line point nearest its centre, and is inserted into the
 // pixel's K nearest fragments in shared memory (64-bit atomicMin of depth bits << 32 | packed
-// colour, as oit.frag) or merged into its fixed-point tail, so the result does not depend on
-// the order. At the end every pixel merges its list with the frame's k-buffer (oit.glsl),
-// nearest first. A fragment behind fragments of the pixel whose transmittance together is
-// below SOFT_HIDDEN_TRANSMITTANCE is hidden (insert): it is dropped before its coverage is
-// computed, as behind the opaque depth (CPU twin: render::soft::PixelFragments).
+// colour, as oit.frag) or merged into its fixed-point tail. At the end every pixel merges its
+// list with the frame's k-buffer (oit.glsl), nearest first. A fragment behind fragments of the
+// pixel whose transmittance together is below SOFT_HIDDEN_TRANSMITTANCE is hidden (insert):
+// it is dropped before its coverage is computed, as behind the opaque depth. The result does
+// not depend on the order of arrival but for what hiding takes out of the tail (CPU twin:
+// render::soft_pixel::PixelFragments).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
@@ -45,9 +46,9 @@ shared uint64_t s_visible[TILE_PIXELS];
 // Add fragment `v` to pixel lp's K nearest (k of them), or its tail. The walk down the list
 // multiplies the light the nodes it passes or leaves behind it let through (a product of
 // 1 - alpha: no table lookup, which cost 3 % of the crowd's raster); once that is below
-// SOFT_HIDDEN_TRANSMITTANCE, everything behind the farthest of them is hidden: the pixel's hiding depth
-// comes nearer (shade_pixel drops what lies behind it) and the fragment still carried, which
-// lies behind them, is dropped. Every node counted is a fragment already deposited, so what
+// SOFT_HIDDEN_TRANSMITTANCE, everything behind the farthest of them is hidden: the pixel's
+// hiding depth comes nearer (shade_pixel drops what lies behind it) and the fragment still
+// carried, which lies behind them, is dropped. Every node counted is a fragment already deposited, so what
 // is dropped lies behind fragments of transmittance below SOFT_HIDDEN_TRANSMITTANCE whatever
 // the order of arrival.
 void insert(uint lp, uint k, uint64_t v) {

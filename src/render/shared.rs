@@ -60,7 +60,7 @@ pub const SOFT_MAX_K: u32 = 8;
 /// evicted fragments per pixel.
 pub const OIT_FIXED: f32 = 1024.0;
 /// Software rasterizer: a fragment behind fragments of its pixel whose transmittance together
-/// is below this is hidden and dropped (`render::soft::PixelFragments`, `soft_raster.comp`):
+/// is below this is hidden and dropped (`render::soft_pixel::PixelFragments`, `soft_raster.comp`):
 /// under half an 8-bit step of light comes through.
 pub const SOFT_HIDDEN_TRANSMITTANCE: f32 = 1.0 / 512.0;
 /// Threads of the software rasterizer's binning workgroups (one segment each).

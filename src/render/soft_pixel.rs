@@ -41,6 +41,15 @@ pub struct PixelFragments {
     hidden_below: f32,
 }
 
+/// Composite a layer of linear colour `rgb` and alpha `fa` behind premultiplied `c`, `a`
+/// (front to back, as `oit_resolve.frag`).
+fn under(c: &mut [f32; 3], a: &mut f32, rgb: [f32; 3], fa: f32) {
+    for (ci, x) in c.iter_mut().zip(rgb) {
+        *ci += (1.0 - *a) * fa * x;
+    }
+    *a += (1.0 - *a) * fa;
+}
+
 /// Optical depth of an 8-bit alpha (`optical_depth` of `oit.glsl`, the raster's table).
 fn optical_depth(alpha8: u32) -> f32 {
     -(1.0 - alpha8 as f32 / 255.0).max(1.0 / 256.0).ln()
@@ -129,18 +138,12 @@ impl PixelFragments {
         let (mut c, mut a) = ([0.0f32; 3], 0.0f32);
         for &node in self.nodes.iter().take_while(|&&n| n != EMPTY) {
             let (rgb, fa) = unpack_fragment(node as u32);
-            for (ci, x) in c.iter_mut().zip(rgb) {
-                *ci += (1.0 - a) * fa * x;
-            }
-            a += (1.0 - a) * fa;
+            under(&mut c, &mut a, rgb, fa);
         }
         if self.tail[3] > 0 {
-            let tau = self.tail[3] as f32 / OIT_FIXED;
-            let ta = 1.0 - (-tau).exp();
-            for (ci, sum) in c.iter_mut().zip(self.tail) {
-                *ci += (1.0 - a) * ta * sum as f32 / self.tail[3] as f32;
-            }
-            a += (1.0 - a) * ta;
+            let w = self.tail[3] as f32;
+            let mean = [0, 1, 2].map(|i| self.tail[i] as f32 / w);
+            under(&mut c, &mut a, mean, 1.0 - (-w / OIT_FIXED).exp());
         }
         (c, a)
     }
@@ -157,10 +160,7 @@ pub fn composite_sorted(fragments: &[(f32, [f32; 3], f32)]) -> ([f32; 3], f32) {
     sorted.sort_by(|x, y| x.0.total_cmp(&y.0));
     let (mut c, mut a) = ([0.0f32; 3], 0.0f32);
     for (_, (rgb, fa)) in sorted {
-        for (ci, x) in c.iter_mut().zip(rgb) {
-            *ci += (1.0 - a) * fa * x;
-        }
-        a += (1.0 - a) * fa;
+        under(&mut c, &mut a, rgb, fa);
     }
     (c, a)
 }
