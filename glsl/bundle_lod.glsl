@@ -85,6 +85,39 @@ float strand_level(float h, float d) {
     return level;
 }
 
+// Strands of a bundle at full detail, N_i of eq. 8: the character's count per average
+// bundle, weighted by the bundle's root area where the style asks (its character bound).
+// CPU twin: reference::generate::strands_in_bundle.
+uint bundle_strand_count(GpuBundle desc) {
+    uint n = ch_strands;
+    uint count = style.density_by_area != 0u ? uint(round(float(n) * desc.density)) : n;
+    return clamp(count, 1u, MAX_STRANDS_PER_BUNDLE);
+}
+
+// The share of its strands every bundle of a kind keeps when the view's LoD asks for
+// `demand` items (units of LOD_DEMAND_UNIT, summed by cull.comp) of a buffer of `budget`:
+// 1 when they fit, else (budget - slack) / demand. CPU twin: reference::lod::lod_pressure.
+float lod_pressure(uint demand, uint slack, uint budget) {
+    float d = float(demand) * float(LOD_DEMAND_UNIT);
+    if (d <= float(budget)) {
+        return 1.0;
+    }
+    return clamp((float(budget) - float(slack) * float(LOD_DEMAND_UNIT)) / d, 0.0, 1.0);
+}
+
+// A decision (encode_lod) under pressure p < 1: eq. 8's level times p (the strands it wanted,
+// strands - 1 + fade, p times as many, at least one, never more), eq. 8's thickness
+// min(1/L, N) with the lower level, so the bundle keeps its coverage. `count`: N.
+// CPU twin: reference::lod::pressed_lod.
+uvec4 press_lod(uvec4 lod, float p, uint count) {
+    float wanted = float(lod.x - 1u) + float(lod.y >> 16u) / 65535.0;
+    BundleLod r = BundleLod(0u, 0u, 0.0, 1.0, false, 1.0);
+    set_strands(r, max(p * wanted, 1e-3), lod.x);
+    float thickness = min(uintBitsToFloat(lod.w) / max(p, 1e-6), float(count));
+    uint fade = uint(round(clamp(r.fade, 0.0, 1.0) * 65535.0)) << 16;
+    return uvec4(r.strands, (lod.y & 0xFFFFu) | fade, lod.z, floatBitsToUint(thickness));
+}
+
 // Culling and LoD of crowd bundle g (its character bound with bind_character).
 BundleLod bundle_lod(uint g) {
     // Hidden characters, and hair drawn as its density volume alone (the volume tier's far
@@ -109,9 +142,7 @@ BundleLod bundle_lod(uint g) {
     float margin = scale * (style.curl_radius + style.wave_amplitude + style.frizz_amplitude + style.strand_width);
     lo -= margin;
     hi += margin;
-    uint n = ch_strands;
-    uint count = style.density_by_area != 0u ? uint(round(float(n) * desc.density)) : n;
-    count = clamp(count, 1u, MAX_STRANDS_PER_BUNDLE);
+    uint count = bundle_strand_count(desc);
     uint emax = ch_emax;
     BundleLod r = BundleLod(count, emax, 0.0, 1.0, false, 1.0);
     // Curved roots leave the hull by at most the root cell's bulge bound; the LoD distance

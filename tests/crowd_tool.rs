@@ -23,6 +23,7 @@ fn headless(extra: &[&str], frames: usize, min_strands: u64) -> (tempfile::TempD
         String::from_utf8_lossy(&o.stderr)
     );
     assert!(!String::from_utf8_lossy(&o.stderr).contains("validation error"));
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("dropped"));
     let csv = std::fs::read_to_string(out.join("stats.csv")).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let column = |name: &str| header.iter().position(|c| *c == name).unwrap();
@@ -34,6 +35,19 @@ fn headless(extra: &[&str], frames: usize, min_strands: u64) -> (tempfile::TempD
         scopes_cover_the_frame(f, |name| cols[column(name)]);
         let strands: u64 = cols[column("strands_drawn")].parse().unwrap();
         assert!(strands > min_strands, "frame {f}: {strands} strands");
+        // Every frame says what its buffers could not hold, and these hold everything.
+        for name in [
+            "dropped_strands",
+            "dropped_segments",
+            "dropped_tile_entries",
+        ] {
+            assert_eq!(cols[column(name)], "0", "frame {f}: {name}");
+        }
+        let pressure: f32 = cols[column("lod_pressure")].parse().unwrap();
+        assert!(
+            pressure > 0.0 && pressure <= 1.0,
+            "frame {f}: LoD pressure {pressure}"
+        );
         let img = image::open(out.join(format!("frame_{f:05}.png")))
             .unwrap()
             .to_rgb8();

@@ -490,17 +490,12 @@ fn print_report(
             s.segments_written,
             s.tile_entries_written
         )?;
-        if s.segments_written < s.segments_demanded
-            || s.tile_entries_written < s.tile_entries_demanded
-        {
-            outln!(
-                "  software raster overflow: kept {} of {} segments and {} of {} tile entries; the rest were dropped",
-                s.segments_written,
-                s.segments_demanded,
-                s.tile_entries_written,
-                s.tile_entries_demanded
-            )?;
-        }
+    }
+    // Nothing a buffer could not hold goes unsaid (camera and light).
+    let dropped = out.dropped();
+    outln!("  LoD pressure {:.3}; {dropped}", out.lod_pressure())?;
+    if dropped.any() {
+        eprintln!("render: warning: {dropped} (buffers full)");
     }
     for (pass, ms) in &out.pass_ms {
         outln!("  gpu {pass:<10} {ms:9.3} ms")?;

@@ -67,6 +67,46 @@ pub fn thickness_scale(l: f32, n: u32) -> f32 {
     (1.0 / l.max(1e-6)).min(n.max(1) as f32)
 }
 
+/// The share of every bundle's strands a view keeps when its bundles' LoD asks for `demand`
+/// items (segments or vertex slots, in units of [`LOD_DEMAND_UNIT`]) of a buffer that holds
+/// `budget` items: 1 when it fits, else `(budget - slack) / demand` (at least 0), where `slack`
+/// is what eq. 8's ceiling can add, one strand per bundle, so the kept strands fit even after
+/// rounding up (GLSL: `lod_pressure` in `bundle_lod.glsl`).
+///
+/// [`LOD_DEMAND_UNIT`]: crate::render::shared::LOD_DEMAND_UNIT
+pub fn lod_pressure(demand: u32, slack: u32, budget: u32) -> f32 {
+    let unit = crate::render::shared::LOD_DEMAND_UNIT as f32;
+    let (demand, slack, budget) = (demand as f32 * unit, slack as f32 * unit, budget as f32);
+    match demand <= budget {
+        true => 1.0,
+        false => ((budget - slack) / demand).clamp(0.0, 1.0),
+    }
+}
+
+/// A bundle's decision under pressure `p` in `(0, 1)` (GLSL: `press_lod`): eq. 8's level
+/// times `p`, so the strands it wanted (`strands - 1 + fade`) become `p` times as many, at
+/// least one, never more than before; eq. 8's thickness `min(1 / L, N)` with the lower level,
+/// so the strands left widen and the bundle keeps its coverage. `count`: the bundle's
+/// strands at full detail (`N`).
+pub fn pressed_lod(lod: BundleLod, p: f32, count: u32) -> BundleLod {
+    if lod.strands == 0 || p >= 1.0 {
+        return lod;
+    }
+    let wanted = (lod.strands - 1) as f32 + lod.fade;
+    let drawn = (p * wanted).max(1e-3);
+    let strands = (drawn.ceil() as u32).clamp(1, lod.strands);
+    let fade = match strands > 1 && drawn < strands as f32 {
+        true => drawn - (strands - 1) as f32,
+        false => 1.0,
+    };
+    BundleLod {
+        strands,
+        fade: (fade.clamp(0.0, 1.0) * 65535.0).round() / 65535.0,
+        thickness: (lod.thickness / p.max(1e-6)).min(count.max(1) as f32),
+        ..lod
+    }
+}
+
 /// Eq. 9: vertex level `e` (strands get `2^e + 1` vertices) for `ns` segments at full detail.
 /// Clamped to `log2(ns)`, the full-detail level.
 pub fn vertex_level(l: f32, ns: u32) -> u32 {
@@ -317,6 +357,101 @@ pub(crate) mod tests {
         );
         // A bundle at or above the extent keeps eq. 7's decision.
         assert_eq!(lod(12.0, 1e-3), far_off);
+    }
+
+    /// LoD pressure: a view whose bundles ask for more segments than the budget keeps the
+    /// same share of every bundle's strands, and what is kept fits the budget even after
+    /// eq. 8's ceiling (random bundles of 1..4096 strands at levels 0..6, budgets of 5% to
+    /// 120% of the demand); a view that fits is left alone.
+    #[test]
+    fn pressure_fits_the_budget_and_thins_every_bundle_alike() {
+        use crate::render::shared::LOD_DEMAND_UNIT as UNIT;
+        let mut rng = crate::rng::Pcg32::new(11);
+        for round in 0..40 {
+            let bundles: Vec<BundleLod> = (0..200 + round * 30)
+                .map(|_| {
+                    let strands = 1 + (rng.next_f32() * 4095.0) as u32;
+                    BundleLod {
+                        strands,
+                        e: (rng.next_f32() * 6.99) as u32,
+                        gamma: 0.0,
+                        thickness: 1.0 + rng.next_f32(),
+                        fade: match strands {
+                            1 => 1.0,
+                            _ => rng.next_f32().max(1e-3),
+                        },
+                    }
+                })
+                .collect();
+            // The GPU's sums: per bundle strands x 2^e and 2^e, rounded up per 64 bundles.
+            let units = |v: &[u32]| -> u32 {
+                v.chunks(64)
+                    .map(|c| c.iter().sum::<u32>().div_ceil(UNIT))
+                    .sum()
+            };
+            let need: Vec<u32> = bundles.iter().map(|b| b.strands << b.e).collect();
+            let slack: Vec<u32> = bundles.iter().map(|b| 1 << b.e).collect();
+            let (demand, slack) = (units(&need), units(&slack));
+            let total: u32 = need.iter().sum();
+            let budget = (total as f32 * (0.05 + 1.15 * rng.next_f32())) as u32;
+            let p = lod_pressure(demand, slack, budget);
+            if total <= budget && demand * UNIT <= budget {
+                assert_eq!(p, 1.0, "a view that fits keeps its LoD");
+                continue;
+            }
+            assert!(p < 1.0);
+            let kept: u32 = bundles
+                .iter()
+                .map(|b| pressed_lod(*b, p, 4096).strands << b.e)
+                .sum();
+            let floor: u32 = slack * UNIT; // one strand a bundle is the least a view draws
+            assert!(
+                kept <= budget.max(floor),
+                "round {round}: {kept} > {budget} (p {p})"
+            );
+            // Every bundle keeps about the same share of the strands it wanted (within the
+            // one strand of eq. 8's ceiling).
+            for b in &bundles {
+                let after = pressed_lod(*b, p, 4096);
+                let wanted = (b.strands - 1) as f32 + b.fade;
+                let share = (after.strands - 1) as f32 + after.fade;
+                assert!(
+                    (share - p * wanted).abs() <= 1e-3 + 1e-4 * wanted || after.strands == 1,
+                    "{b:?} -> {after:?} at {p}"
+                );
+            }
+        }
+        assert_eq!(lod_pressure(10, 1, 640), 1.0);
+        assert_eq!(lod_pressure(20, 2, 640), (640.0 - 128.0) / 1280.0);
+    }
+
+    /// A pressed bundle keeps its coverage: the width it draws, `(strands - 1 + fade) *
+    /// thickness`, is what it drew before (eq. 8's thickness grows as the strands fall), until
+    /// one strand is left or the thickness reaches N.
+    #[test]
+    fn pressure_keeps_a_bundles_coverage() {
+        let width = |l: &BundleLod| ((l.strands - 1) as f32 + l.fade) * l.thickness;
+        let before = BundleLod {
+            strands: 300,
+            e: 4,
+            gamma: 0.25,
+            thickness: 2.5,
+            fade: 0.4,
+        };
+        for p in [0.9, 0.5, 0.1, 0.02] {
+            let after = pressed_lod(before, p, 3000);
+            assert!(after.strands < before.strands, "{after:?}");
+            assert_eq!((after.e, after.gamma), (before.e, before.gamma));
+            let (w0, w1) = (width(&before), width(&after));
+            assert!(
+                (w1 - w0).abs() < 1e-3 * w0 + after.thickness / 65535.0,
+                "{p}: {w0} -> {w1}"
+            );
+        }
+        // The thickness stops at N; one strand at least.
+        let last = pressed_lod(before, 1e-4, 3000);
+        assert_eq!((last.strands, last.thickness), (1, 3000.0));
+        assert_eq!(pressed_lod(before, 1.0, 3000), before);
     }
 
     #[test]

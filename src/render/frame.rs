@@ -207,6 +207,13 @@ impl Renderer {
             volume_characters: (work_draw.alone, work_draw.blended),
             probe_roots: opts.probe_roots.then_some(self.crowd.bundle_count()),
             unscoped_commands,
+            budgets: super::slots::ViewBudgets {
+                segments: self.soft_budget.segments,
+                pool: match path {
+                    RenderPath::Compute => block.counts[3],
+                    _ => 0,
+                },
+            },
         };
         self.hand_over(i, pending, target)?;
         self.remember_frame(&records, &motion, temporal);

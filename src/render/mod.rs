@@ -41,7 +41,7 @@ pub use renderer::{
 pub use settings::{LightRaster, parse_switch};
 pub use shadow::ShadowMode;
 pub use shared::FrameStats;
-pub use slots::{FRAMES_IN_FLIGHT, FrameReport};
+pub use slots::{Dropped, FRAMES_IN_FLIGHT, FrameReport, ViewBudgets};
 pub use soft::StrandRaster;
 pub use temporal::Temporal;
 pub use transparency::Transparency;

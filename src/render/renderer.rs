@@ -589,6 +589,8 @@ impl Renderer {
                 width: p.width,
                 height: p.height,
                 stats: args.stats,
+                light_stats: args.light_stats,
+                budgets: p.budgets,
                 pass_ms: times.scopes,
                 frame_ms: times.frame_ms,
                 unscoped_commands: p.unscoped_commands,

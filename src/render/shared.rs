@@ -68,6 +68,10 @@ pub const SOFT_BIN_GROUP: u32 = 256;
 /// `bundle_lods[].y` bit: the bundle is drawn by the software rasterizer (the low byte is the
 /// vertex level e).
 pub const LOD_SOFT: u32 = 256;
+
+/// Unit of the bundle LoD pass's demand counters ([`FrameStats::soft_demand`] and the
+/// others): segments or vertex slots, so a crowd's sum stays inside 32 bits.
+pub const LOD_DEMAND_UNIT: u32 = 64;
 /// Invocations of one `hair_mesh_update.comp` workgroup.
 pub const DEFORM_GROUP_SIZE: u32 = 64;
 /// Invocations of one `hair_dynamics.comp` workgroup (one workgroup simulates one character)
@@ -692,6 +696,19 @@ pub struct FrameStats {
     pub tile_entries_demanded: u32,
     /// Software rasterizer: (tile, segment) pairs stored (<= the entry budget).
     pub tile_entries_written: u32,
+    /// The bundle LoD pass (`cull.comp`): segments the software bundles' LoD asks for at
+    /// most (strands times segments), in units of [`LOD_DEMAND_UNIT`], rounded up per
+    /// workgroup.
+    pub soft_demand: u32,
+    /// The same pass: one strand's segments per visible software bundle (what eq. 8's
+    /// ceiling can add), in units of [`LOD_DEMAND_UNIT`].
+    pub soft_slack: u32,
+    /// The same pass: vertex slots the hardware bundles' LoD asks for (the compute path's
+    /// pool), in units of [`LOD_DEMAND_UNIT`].
+    pub pool_demand: u32,
+    /// The same pass: one strand's vertex slots per visible hardware bundle, in units of
+    /// [`LOD_DEMAND_UNIT`].
+    pub pool_slack: u32,
 }
 
 gpu_struct!(FrameStats as "FrameStats" {
@@ -699,6 +716,7 @@ gpu_struct!(FrameStats as "FrameStats" {
     triangles_demanded: "uint", triangles_drawn: "uint", vertex_slots_demanded: "uint",
     vertex_slots_written: "uint", groups: "uint", segments_demanded: "uint",
     segments_written: "uint", tile_entries_demanded: "uint", tile_entries_written: "uint",
+    soft_demand: "uint", soft_slack: "uint", pool_demand: "uint", pool_slack: "uint",
 });
 
 /// Indirect arguments of the compute path and the frame statistics of both paths.
@@ -712,12 +730,15 @@ pub struct GenerateArgs {
     /// `VkDispatchIndirectCommand` of the software rasterizer's binning passes (one thread
     /// per stored segment; w unused).
     pub soft_dispatch: [u32; 4],
-    /// Statistics.
+    /// Statistics of the view being drawn (the camera's at the end of a frame).
     pub stats: FrameStats,
+    /// The light's view's statistics, kept here before the camera's start from zero.
+    pub light_stats: FrameStats,
 }
 
 gpu_struct!(GenerateArgs as "GenerateArgs" {
     dispatch: "uvec4", draw: "uvec4", soft_dispatch: "uvec4", stats: "FrameStats",
+    light_stats: "FrameStats",
 });
 
 impl GenerateArgs {
@@ -727,6 +748,10 @@ impl GenerateArgs {
     pub const DRAW_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, draw) as u64;
     /// Byte offset of the software rasterizer's binning dispatch.
     pub const SOFT_DISPATCH_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, soft_dispatch) as u64;
+    /// Byte offset of `stats`.
+    pub const STATS_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, stats) as u64;
+    /// Byte offset of `light_stats`.
+    pub const LIGHT_STATS_OFFSET: u64 = std::mem::offset_of!(GenerateArgs, light_stats) as u64;
     /// Byte offset of `stats.segments_demanded`.
     pub const SEGMENTS_DEMANDED_OFFSET: u64 = (std::mem::offset_of!(GenerateArgs, stats)
         + std::mem::offset_of!(FrameStats, segments_demanded))
@@ -1173,6 +1198,7 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
         uint("SOFT_MAX_K", SOFT_MAX_K),
         layout("SOFT_BIN_GROUP", SOFT_BIN_GROUP),
         uint("LOD_SOFT", LOD_SOFT),
+        uint("LOD_DEMAND_UNIT", LOD_DEMAND_UNIT),
         uint("LOD_LEVEL_MASK", LOD_LEVEL_MASK),
         uint("MAX_OIT_BUDGET", MAX_OIT_BUDGET),
         uint(

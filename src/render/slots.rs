@@ -37,8 +37,13 @@ pub struct FrameReport {
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// What the GPU generated.
+    /// What the GPU generated for the camera.
     pub stats: FrameStats,
+    /// What the GPU generated for the light's view (zero without shadows, and on the static
+    /// and LHS paths).
+    pub light_stats: FrameStats,
+    /// The buffers the views' LoD had to fit (the LoD pressure's budgets).
+    pub budgets: ViewBudgets,
     /// GPU milliseconds per timing scope (a pass, or passes grouped under one name; scopes
     /// of one name summed), in the order they first ran.
     pub pass_ms: Vec<(&'static str, f64)>,
@@ -100,6 +105,95 @@ impl FrameReport {
         }
         parts.join(sep)
     }
+
+    /// Work the frame's buffers had no room for, camera and light together (all zero:
+    /// nothing was lost).
+    pub fn dropped(&self) -> Dropped {
+        Dropped::of(&self.stats).plus(Dropped::of(&self.light_stats))
+    }
+
+    /// The share of their strands the camera's bundles kept so the frame fit its buffers
+    /// (1: the LoD as asked; below 1 every bundle of the kind that ran short was thinned by
+    /// it, widened to keep its coverage): the smaller of the software and the vertex-pool
+    /// shares, and of the camera's and the light's.
+    pub fn lod_pressure(&self) -> f32 {
+        [&self.stats, &self.light_stats]
+            .iter()
+            .map(|s| self.budgets.pressure(s))
+            .fold(1.0, f32::min)
+    }
+}
+
+/// The buffers a frame's views fit their LoD into (`lod_pressure.comp`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ViewBudgets {
+    /// Software rasterizer segments per view (0: no software rasterizer).
+    pub segments: u32,
+    /// Compute path: vertex-pool slots per view (0: the frame drew no pool).
+    pub pool: u32,
+}
+
+impl ViewBudgets {
+    /// The share of its strands a view with statistics `s` kept (the smaller of the software
+    /// and the pool share; `reference::lod::lod_pressure`).
+    pub fn pressure(&self, s: &FrameStats) -> f32 {
+        use crate::reference::lod::lod_pressure;
+        let soft = lod_pressure(s.soft_demand, s.soft_slack, self.segments);
+        let pool = match self.pool {
+            0 => 1.0,
+            slots => lod_pressure(s.pool_demand, s.pool_slack, slots),
+        };
+        soft.min(pool)
+    }
+}
+
+/// Work a frame's fixed-size buffers had no room for: counted on the GPU, never silent.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Dropped {
+    /// Strands the LoD asked for that the compute path's vertex pool could not hold.
+    pub strands: u32,
+    /// Software rasterizer segments past the segment budget.
+    pub segments: u32,
+    /// Software rasterizer (tile, segment) entries past the entry budget: the fragments those
+    /// segments would have made in those tiles.
+    pub tile_entries: u32,
+}
+
+impl Dropped {
+    /// What one view's statistics say was dropped.
+    pub fn of(s: &FrameStats) -> Self {
+        Dropped {
+            strands: s.strands_demanded.saturating_sub(s.strands_drawn),
+            segments: s.segments_demanded.saturating_sub(s.segments_written),
+            tile_entries: s
+                .tile_entries_demanded
+                .saturating_sub(s.tile_entries_written),
+        }
+    }
+
+    /// Both views' drops.
+    pub fn plus(self, o: Dropped) -> Self {
+        Dropped {
+            strands: self.strands.saturating_add(o.strands),
+            segments: self.segments.saturating_add(o.segments),
+            tile_entries: self.tile_entries.saturating_add(o.tile_entries),
+        }
+    }
+
+    /// Whether anything was dropped.
+    pub fn any(&self) -> bool {
+        *self != Dropped::default()
+    }
+}
+
+impl std::fmt::Display for Dropped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} strands, {} segments, {} tile entries (fragments) dropped",
+            self.strands, self.segments, self.tile_entries
+        )
+    }
 }
 
 pub(crate) struct Pending {
@@ -118,6 +212,8 @@ pub(crate) struct Pending {
     pub probe_roots: Option<u32>,
     /// Commands recorded outside every timing scope.
     pub unscoped_commands: u32,
+    /// The buffers the views' LoD had to fit.
+    pub budgets: ViewBudgets,
 }
 
 /// One frame in flight.

@@ -335,10 +335,7 @@ impl PaperRun {
             let off = self.time(r, &view(camera, false), p)?;
             self.rows += &csv_row(scenario, name, &format!("{p:?} lod on"), &on, None);
             self.rows += &csv_row(scenario, name, &format!("{p:?} lod off"), &off, None);
-            let dropped = |f: &FrameReport| {
-                let s = &f.stats;
-                s.strands_drawn < s.strands_demanded || s.segments_written < s.segments_demanded
-            };
+            let dropped = |f: &FrameReport| f.dropped().any();
             // Software frames draw segments, hardware ones triangles (auto: both).
             let prims = |f: &FrameReport| f.stats.triangles_drawn + f.stats.segments_written;
             outln!(

@@ -671,7 +671,7 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     let mut animation = scene.animation(&mut renderer, &args)?;
     let csv_path = args.out.join("stats.csv");
     let mut csv = String::from(
-        "frame,gpu_ms,unscoped_ms,unscoped_commands,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,passes\n",
+        "frame,gpu_ms,unscoped_ms,unscoped_commands,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,lod_pressure,dropped_strands,dropped_segments,dropped_tile_entries,passes\n",
     );
     outln!(
         "device: {} ({}); {} characters ({}), generated and baked in {generate_s:.2} s, textures {:.1} MiB",
@@ -754,8 +754,12 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
             );
         }
         let s = report.stats;
+        let (dropped, pressure) = (report.dropped(), report.lod_pressure());
+        if dropped.any() {
+            eprintln!("crowd: warning: frame {f}: {dropped} (buffers full)");
+        }
         csv.push_str(&format!(
-            "{f},{:.3},{:.3},{},{:.3},{wall_ms:.1},{:.3},{},{root_gap:.6},{},{},{},{},{},{}\n",
+            "{f},{:.3},{:.3},{},{:.3},{wall_ms:.1},{:.3},{},{root_gap:.6},{},{},{},{},{},{pressure:.4},{},{},{},{}\n",
             report.gpu_ms(),
             report.unscoped_ms().unwrap_or(f64::NAN),
             report.unscoped_commands,
@@ -767,10 +771,13 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
             s.triangles_drawn,
             s.vertex_slots_written,
             s.vertex_slots_demanded,
+            dropped.strands,
+            dropped.segments,
+            dropped.tile_entries,
             report.scope_summary(" ")
         ));
         outln!(
-            "frame {f}: {:?} path, {} strands, {} triangles, volumes {} alone + {} blended, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
+            "frame {f}: {:?} path, {} strands, {} triangles, LoD pressure {pressure:.3}, {dropped}, volumes {} alone + {} blended, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
             report.path,
             s.strands_drawn,
             s.triangles_drawn,

@@ -632,7 +632,13 @@ impl Running {
         self.frame += 1;
         // The previous frame has (nearly always) completed: its report costs no stall.
         if let Some(t) = self.last_ticket.replace(ticket) {
-            self.last_report = Some(self.renderer.wait(t)?);
+            let report = self.renderer.wait(t)?;
+            let dropped = report.dropped();
+            // Nothing dropped goes unsaid: on stderr too, at most once a second of frames.
+            if dropped.any() && self.frame % 60 == 1 {
+                eprintln!("crowd: warning: frame {}: {dropped} (buffers full)", t.0);
+            }
+            self.last_report = Some(report);
             let done: Vec<_> = self
                 .panel
                 .pending_free
@@ -790,6 +796,14 @@ impl Running {
         text.push_str(&format!(
             "\nhair dynamics on the {}: {:.1} ms CPU, {} characters, {} vertices",
             a.path, a.simulate_ms, a.simulated, a.vertices
+        ));
+        // What the buffers could not hold, every frame: the LoD pressure that kept the frame
+        // inside them, and anything dropped all the same.
+        let dropped = r.dropped();
+        text.push_str(&format!(
+            "\nLoD pressure {:.3}; {}{dropped}",
+            r.lod_pressure(),
+            if dropped.any() { "WARNING: " } else { "" }
         ));
         if r.path == RenderPath::Compute {
             text.push_str(&format!(

@@ -1,4 +1,4 @@
-//! Compute path generation for the whole crowd: cull (one invocation per bundle), a
+//! Compute path generation for the whole crowd, after the bundle LoD pass: a
 //! multi-level exclusive scan over all bundles, finalize (totals, vertex-pool budget, indirect
 //! arguments), generate (strand workgroups into the vertex pool).
 //! What each step reads and writes is declared where it is added to the frame graph.
@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use super::{FrameRes, PassSets, TemporalRes, device_shader_options, dispatch_2d};
 use crate::render::graph::FrameGraph;
-use crate::render::shared::{CULL_GROUP_SIZE, GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
+use crate::render::shared::{GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 
@@ -25,20 +25,17 @@ pub enum GenerateView {
 }
 
 impl GenerateView {
-    /// Profiler scope names of the cull, scan and generate timings.
-    pub fn scopes(self) -> [&'static str; 3] {
+    /// Profiler scope names of the scan and generate timings.
+    pub fn scopes(self) -> [&'static str; 2] {
         match self {
-            GenerateView::Camera => ["cull", "scan", "generate"],
-            GenerateView::Light | GenerateView::LightSoftware => {
-                ["shadow cull", "shadow scan", "shadow generate"]
-            }
+            GenerateView::Camera => ["scan", "generate"],
+            GenerateView::Light | GenerateView::LightSoftware => ["shadow scan", "shadow generate"],
         }
     }
 }
 
 /// The compute pipelines of the generation pass.
 pub struct ComputeGenerate {
-    cull: Pipeline,
     scan: Pipeline,
     scan_add: Pipeline,
     finalize: Pipeline,
@@ -55,7 +52,6 @@ impl ComputeGenerate {
         let p =
             |name: &str, file: &str| Pipeline::compute(ctx, name, layout, &compile(file, &opts)?);
         Ok(ComputeGenerate {
-            cull: p("cull", "cull.comp")?,
             scan: p("scan", "scan.comp")?,
             scan_add: p("scan add", "scan_add.comp")?,
             finalize: p("finalize", "finalize.comp")?,
@@ -70,9 +66,9 @@ impl ComputeGenerate {
     }
 
     /// Add generation of every visible strand of the `bundles` bundles, seen from the view
-    /// of `sets`' frame block, into the vertex pool: cull, the scan levels, finalize and the
-    /// strand workgroups, each a pass. `args` must have been cleared before (statistics
-    /// accumulate).
+    /// of `sets`' frame block, into the vertex pool: the scan levels, finalize and the
+    /// strand workgroups, each a pass, after the view's bundle LoD pass
+    /// (`bundle_lod::BundleLodPass`) decided each bundle's strands.
     pub fn add<'a>(
         &'a self,
         g: &mut FrameGraph<'a>,
@@ -85,21 +81,9 @@ impl ComputeGenerate {
         let rw = Access::ComputeReadWrite;
         let inputs = [r.constants, r.textures];
         g.begin_scope(scopes[0]);
-        g.pass("cull")
-            .read_all(&inputs, Access::ComputeRead)
-            .write(r.lods, rw)
-            .write(r.args, rw)
-            .record(move |rec, _| {
-                rec.bind(&self.cull, &sets.both());
-                let (x, y) = dispatch_2d(bundles.div_ceil(CULL_GROUP_SIZE));
-                rec.dispatch(x, y, 1);
-                Ok(())
-            });
-        g.end_scope();
-        g.begin_scope(scopes[1]);
         self.add_scan(g, r, sets, bundles);
         g.end_scope();
-        g.begin_scope(scopes[2]);
+        g.begin_scope(scopes[1]);
         let generate = match view {
             GenerateView::Camera | GenerateView::LightSoftware => &self.generate_camera,
             GenerateView::Light => &self.generate_light,

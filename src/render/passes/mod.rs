@@ -1,6 +1,7 @@
 //! One file per pass. Each pass owns its pipelines and adds itself to the frame graph with
 //! `add`, declaring what it reads and writes; the graph derives the synchronisation.
 
+pub mod bundle_lod;
 pub mod compute_generate;
 pub mod density_volume;
 pub mod hair_dynamics;
@@ -595,6 +596,8 @@ pub struct FrameInputs<'a> {
 /// strands; the mesh path generates inside it); with transparency, the transparent strand
 /// passes; the software rasterizer; the resolve.
 pub struct FramePasses {
+    /// Culling, LoD and LoD pressure per view (both paths).
+    lod: bundle_lod::BundleLodPass,
     generate: ComputeGenerate,
     shadow: ShadowPass,
     props: PropPass,
@@ -660,6 +663,27 @@ pub(crate) fn add_clear_args<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
         });
 }
 
+/// After the light's view: keep its statistics in `GenerateArgs::light_stats`, then clear the
+/// rest for the camera's.
+fn add_clear_args_for_camera<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
+    let args = r.args_buffer;
+    let bytes = size_of::<super::shared::FrameStats>() as u64;
+    g.pass("keep light statistics")
+        .read(r.args, Access::TransferRead)
+        .write(r.args, Access::TransferWrite)
+        .record(move |rec, _| {
+            let (from, to) = (GenerateArgs::STATS_OFFSET, GenerateArgs::LIGHT_STATS_OFFSET);
+            rec.copy_buffer(args, from, args, to, bytes);
+            Ok(())
+        });
+    g.pass("clear args")
+        .write(r.args, Access::TransferWrite)
+        .record(move |rec, _| {
+            rec.fill_buffer(args, 0, GenerateArgs::LIGHT_STATS_OFFSET, 0);
+            Ok(())
+        });
+}
+
 fn no_soft() -> crate::vk::GpuError {
     crate::vk::GpuError::Unsupported("no software rasterizer on this device".into())
 }
@@ -679,6 +703,7 @@ impl FramePasses {
         };
         let camera = DrawTarget::Camera(targets);
         Ok(FramePasses {
+            lod: bundle_lod::BundleLodPass::new(ctx, layout)?,
             generate: ComputeGenerate::new(ctx, layout)?,
             shadow: ShadowPass::new(ctx, layout, task_bundles)?,
             props: PropPass::new(ctx, layout, camera)?,
@@ -846,10 +871,13 @@ impl FramePasses {
         }
         if let Some(mode) = inp.shadow {
             self.add_light(g, r, &inp, mode)?;
-            // The camera's statistics start from zero again.
+            // The camera's statistics start from zero again; the light's are kept.
             if !keep_args {
-                add_clear_args(g, r);
+                add_clear_args_for_camera(g, r);
             }
+        }
+        if inp.bundles > 0 && !keep_args {
+            self.lod.add(g, r, (inp.sets, "cull"), inp.bundles, compute);
         }
         if compute {
             let view = GenerateView::Camera;
@@ -922,6 +950,11 @@ impl FramePasses {
         mode: ShadowMode,
     ) -> GpuResult<()> {
         let soft_light = inp.light_raster == LightRaster::Software;
+        if inp.bundles > 0 && matches!(inp.path, RenderPath::Mesh | RenderPath::Compute) {
+            let pool = inp.path == RenderPath::Compute;
+            self.lod
+                .add(g, r, (inp.light_sets, "shadow cull"), inp.bundles, pool);
+        }
         if inp.bundles > 0 && inp.path == RenderPath::Compute {
             let view = match soft_light {
                 true => GenerateView::LightSoftware,

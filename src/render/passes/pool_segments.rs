@@ -65,9 +65,13 @@ impl PoolSegments {
 mod tests {
     use crate::render::shared::{FrameStats, GenerateArgs};
 
+    /// The clear covers the four software counters and nothing after them (the LoD demand
+    /// that follows is the compute frame's).
     #[test]
-    fn soft_counters_are_the_last_four_statistics() {
-        let end = std::mem::offset_of!(GenerateArgs, stats) + size_of::<FrameStats>();
+    fn soft_counters_are_four_statistics_in_a_row() {
+        let end = std::mem::offset_of!(GenerateArgs, stats)
+            + std::mem::offset_of!(FrameStats, tile_entries_written)
+            + 4;
         assert_eq!(
             GenerateArgs::SEGMENTS_DEMANDED_OFFSET + super::SOFT_COUNTER_BYTES,
             end as u64

@@ -90,7 +90,7 @@ impl SoftRasterPass {
         g.begin_scope(scope);
         let p = g
             .pass("soft segments (mesh)")
-            .read_all(&[r.constants, r.textures], Access::TaskRead)
+            .read_all(&[r.constants, r.textures, r.lods], Access::TaskRead)
             .read(r.textures, Access::MeshRead)
             .write(r.args, Access::TaskReadWrite)
             .write(r.args, Access::MeshReadWrite)

@@ -126,8 +126,8 @@ impl StrandDraw {
         }
     }
 
-    /// Mesh path: cull, pick LoD, generate and draw the strands of `bundles` bundles (inside
-    /// rendering; the statistics in `GenerateArgs` must be cleared before).
+    /// Mesh path: generate and draw the strands of `bundles` bundles as the view's bundle LoD
+    /// pass decided (inside rendering).
     pub fn record_mesh(
         &self,
         rec: &mut CommandRecorder,
@@ -158,7 +158,8 @@ pub enum StrandUse {
 /// Declare what drawing the strands as `path` does reads and writes (beside the pass's
 /// targets): the pulled paths read the vertex pool, LoDs and offsets and the draw arguments
 /// (and in the camera's view the vertices' deformation residuals); the mesh path's task
-/// shaders read the textures and add to the statistics.
+/// shaders read the bundle LoDs (`bundle_lod.rs`) and add to the statistics, its mesh shaders
+/// the textures.
 pub fn strand_uses<'g, 'a>(
     p: PassBuilder<'g, 'a>,
     r: &FrameRes,
@@ -175,7 +176,7 @@ pub fn strand_uses<'g, 'a>(
             .read_some(residuals, Access::VertexRead)
             .read(r.args, Access::IndirectRead)
     } else {
-        p.read_all(&[r.constants, r.textures], Access::TaskRead)
+        p.read_all(&[r.constants, r.textures, r.lods], Access::TaskRead)
             .read(r.textures, Access::MeshRead)
             .write(r.args, Access::TaskReadWrite)
     };

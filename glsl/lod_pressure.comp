@@ -1,0 +1,34 @@
+#version 460
+// Both paths, every view, after cull.comp: when the bundles' LoD asks for more software
+// segments than the segment budget (frame.soft.z), or on the compute path (push.params.x != 0)
+// more vertex slots than the pool holds (frame.counts.w), every bundle of that kind keeps the
+// same share of its strands (a coarser LoD, eq. 8's thickness widened to keep its coverage:
+// press_lod), so the frame fits and no character loses its hair to the order in which its
+// strands were appended. CPU twin: reference::lod::{lod_pressure, pressed_lod}.
+#extension GL_GOOGLE_include_directive : require
+#include "bindings.glsl"
+layout(local_size_x = CULL_GROUP_SIZE) in;
+#include "common.glsl"
+#include "strand_eval.glsl"
+#include "bundle_lod.glsl"
+
+void main() {
+    uint g = gl_WorkGroupID.y * (DISPATCH_ROW * uint(CULL_GROUP_SIZE)) + gl_GlobalInvocationID.x;
+    if (g >= frame.counts.x) {
+        return;
+    }
+    uvec4 lod = bundle_lods[g];
+    if (lod.x == 0u) {
+        return;
+    }
+    float p = 1.0;
+    if (lod_is_soft(lod.y)) {
+        p = lod_pressure(args.stats.soft_demand, args.stats.soft_slack, frame.soft.z);
+    } else if (push.params.x != 0u) {
+        p = lod_pressure(args.stats.pool_demand, args.stats.pool_slack, frame.counts.w);
+    }
+    if (p < 1.0) {
+        bind_character(bundles[g].character);
+        bundle_lods[g] = press_lod(lod, p, bundle_strand_count(bundles[g]));
+    }
+}
