@@ -50,6 +50,7 @@
 #define SOFT_MAX_K 8u
 #define SOFT_BIN_GROUP 256
 #define LOD_SOFT 256u
+#define LOD_DEMAND_UNIT 64u
 #define LOD_LEVEL_MASK 255u
 #define MAX_OIT_BUDGET 16u
 #define STRAND_RAND_THINNING 3u
@@ -269,6 +270,10 @@ struct FrameStats {
     uint segments_written;
     uint tile_entries_demanded;
     uint tile_entries_written;
+    uint soft_demand;
+    uint soft_slack;
+    uint pool_demand;
+    uint pool_slack;
 };
 
 struct GenerateArgs {
@@ -276,6 +281,7 @@ struct GenerateArgs {
     uvec4 draw;
     uvec4 soft_dispatch;
     FrameStats stats;
+    FrameStats light_stats;
 };
 
 struct HairVertex {
