@@ -32,7 +32,7 @@ bool soft_raster(float d, float width, float thickness, float cap) {
                                           : frame.lod_ortho.x / frame.camera_pos.w;
     float drawn = width * thickness;
     if (frame.shading.y != 0u && thickness > 1.0) {
-        drawn = max(drawn, min(sqrt(thickness) * pixel, cap));
+        drawn = max(drawn, min(sqrt(thickness) * min(pixel, width), cap));
     }
     return drawn <= frame.soft_params.x * pixel;
 }
@@ -74,13 +74,21 @@ float detail_level(float h, float d, float alpha) {
 
 // Eq. 7's strand level times the crowd's area term (frame.lod_ortho.y: 0 off): below that
 // extent (h R / (d tan theta), about pixels) a bundle's strands fall with its area, and eq. 8's
-// thickness widens the rest. CPU twin: reference::lod::{bundle_extent, area_factor}.
-float strand_level(float h, float d) {
+// thickness widens the rest; then the pixel cap (frame.lod_ortho.z strands per square pixel of
+// the extent, 0 off) for a bundle of `count` strands: at crowd distance a bundle draws as many
+// strands as the pixels it covers need, whatever its count at full detail (seed 000's thick
+// strands in place of a cluster). CPU twin: reference::lod::{bundle_extent, area_factor,
+// pixel_cap_level}.
+float strand_level(float h, float d, uint count) {
     float level = detail_level(h, d, frame.lod.x);
+    float extent = detail_level_unclamped(h, d);
     float below = frame.lod_ortho.y;
     if (below > 0.0) {
-        float extent = detail_level_unclamped(h, d);
         level *= clamp(extent / below, 0.0, 1.0);
+    }
+    float per_pixel = frame.lod_ortho.z;
+    if (per_pixel > 0.0) {
+        level = min(level, per_pixel * extent * extent / float(count));
     }
     return level;
 }
@@ -105,21 +113,27 @@ float lod_pressure(uint demand, uint slack, uint budget) {
     return clamp((float(budget) - float(slack) * float(LOD_DEMAND_UNIT)) / d, 0.0, 1.0);
 }
 
-// A decision (encode_lod) under pressure p < 1: eq. 8's level times p (the strands it wanted,
-// strands - 1 + fade, p times as many, at least one, never more), eq. 8's thickness
-// min(1/L, N) with the lower level, so the bundle keeps its coverage. `count`: N.
-// CPU twin: reference::lod::pressed_lod.
-uvec4 press_lod(uvec4 lod, float p, uint count) {
-    float wanted = float(lod.x - 1u) + float(lod.y >> 16u) / 65535.0;
-    BundleLod r = BundleLod(0u, 0u, 0.0, 1.0, false, 1.0);
-    set_strands(r, max(p * wanted, 1e-3), lod.x);
-    float thickness = min(uintBitsToFloat(lod.w) / max(p, 1e-6), float(count));
-    uint fade = uint(round(clamp(r.fade, 0.0, 1.0) * 65535.0)) << 16;
-    return uvec4(r.strands, (lod.y & 0xFFFFu) | fade, lod.z, floatBitsToUint(thickness));
+// Eq. 8's width factor min(1/L, N) for `strands` strands at level `level` of a bundle of
+// `count`, held to the bundle's cross-section: each of k strands at most `size_over_width /
+// sqrt(k)` strand widths (h / sqrt(k) across), so k thick strands cover the bundle once and no
+// more (a cluster's footprint, seed 000). The cap only binds where the strands left would
+// cover the bundle more than sqrt(k) times over, opaque either way. CPU twin:
+// reference::lod::thickness_at.
+float eq8_thickness(float level, uint count, uint strands, float size_over_width) {
+    float t = min(1.0 / max(level, 1e-6), float(count));
+    return max(min(t, size_over_width / sqrt(float(max(strands, 1u)))), 1.0);
 }
 
-// Culling and LoD of crowd bundle g (its character bound with bind_character).
-BundleLod bundle_lod(uint g) {
+// A bundle's size over its strands' width (both in object units): the cross-section cap's
+// measure (its character bound).
+float bundle_size_over_width(GpuBundle desc) {
+    return desc.rest_size / max(style.strand_width, 1e-12);
+}
+
+// Culling and LoD of crowd bundle g (its character bound with bind_character), with eq. 7's
+// strand level times `pressure` (1, or lod_pressure's share where the view's buffers would
+// run full: the strands fall, eq. 8's thickness keeps the coverage).
+BundleLod bundle_lod(uint g, float pressure) {
     // Hidden characters, and hair drawn as its density volume alone (the volume tier's far
     // characters), have no strands in any view: skip the texture reads.
     if (!ch_visible || ch_volume_only) {
@@ -156,10 +170,14 @@ BundleLod bundle_lod(uint g) {
     float d = length(eye - clamp(eye, lo, hi));
     float h = scale * desc.rest_size;
     float delta = hash_f32(hash_u32(desc.local_index ^ 0x2545f491u) ^ style.seed);
+    float size_over_width = bundle_size_over_width(desc);
     if (frame.counts.z == 0u) {
         r.soft = soft_raster(d, scale * style.strand_width, 1.0, h);
-        if (ch_strand_share < 1.0) {
-            set_strands(r, ch_strand_share * (float(count) + delta), count);
+        if (ch_strand_share < 1.0 || pressure < 1.0) {
+            set_strands(r, ch_strand_share * pressure * (float(count) + delta), count);
+        }
+        if (pressure < 1.0) {
+            r.thickness = eq8_thickness(pressure, count, r.strands, size_over_width);
         }
         return r;
     }
@@ -167,9 +185,9 @@ BundleLod bundle_lod(uint g) {
     // volume tier's band the level drops by the strands' share, the thickness does not: the
     // strands thin out one by one (each fading as set_strands says) while the volume comes in under
     // them, a blend with no screen-door pattern (CPU twin: LodView::strand_share).
-    float ls = strand_level(h, d);
+    float ls = strand_level(h, d, count) * pressure;
     set_strands(r, ls * ch_strand_share * (float(count) + delta), count);
-    r.thickness = min(1.0 / max(ls, 1e-6), float(count));
+    r.thickness = eq8_thickness(ls, count, r.strands, size_over_width);
     // Vertex LoD: eq. 9, 10, 12.
     float lv = detail_level(h, d, frame.lod.y);
     float x = log2(max(lv * float(1u << emax), 1e-30));

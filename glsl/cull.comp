@@ -23,7 +23,7 @@ void main() {
     barrier();
     if (g < frame.counts.x) {
         bind_character(bundles[g].character);
-        BundleLod r = bundle_lod(g);
+        BundleLod r = bundle_lod(g, 1.0);
         bundle_lods[g] = encode_lod(r);
         if (r.strands > 0u) {
             atomicAdd(args.stats.bundles_visible, 1u);

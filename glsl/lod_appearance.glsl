@@ -4,10 +4,14 @@
 // src/shade/lod_appearance.rs. Switched by frame.shading.y (off: single-strand behaviour).
 //
 // - Footprint: seed 000 models a cluster as a cylinder holding n strands of radius r at packing
-//   density rho, so its diameter is 2 r sqrt(n / rho). Strands are drawn at least one pixel
-//   wide, so a cluster of k strands is drawn at least sqrt(k) pixels wide (rho = 1), never
-//   wider than its bundle. (One pixel lets the background through: measured +18-24% luminance
-//   for opaque hair at mid/far distance; k pixels, strands side by side, over-covers: -22-24%.)
+//   density rho, so its diameter is 2 r sqrt(n / rho). A strand is drawn at most one pixel
+//   wide where it is wider (hardware strips are drawn at least that wide), else its own width,
+//   so a cluster of k strands is drawn at least sqrt(k) times that (rho = 1), never wider than
+//   its bundle. (For strands a pixel wide, one pixel lets the background through: measured
+//   +18-24% luminance for opaque hair at mid/far distance; k pixels, strands side by side,
+//   over-covers: -22-24%. Real hair, a tenth of a millimetre, is far under a pixel: its k
+//   strands' eq. 8 width, k times its own, is more than sqrt(k) times it, and the term leaves
+//   it alone.)
 // - Opacity: the k strands lie across the strip independently, each covering c / k of it
 //   (c = the strip's coverage, so about sqrt(k) strands along a ray, seed 000's n), and light
 //   through a point passes (1 - a1 c / k)^k rather than (1 - a1 c): exact at k = 1, the
@@ -18,13 +22,14 @@
 #ifndef LOD_APPEARANCE_GLSL
 #define LOD_APPEARANCE_GLSL
 
-// Least drawn width of a strip of `thickness` strands: one pixel, or with the term sqrt(k)
-// pixels, at most `cap` (its bundle's size), never less than one pixel.
-float cluster_min_width(float pixel, float thickness, float cap) {
+// Least drawn width of a strip of `thickness` strands each `single` wide: one pixel, or with
+// the term sqrt(k) times the smaller of a pixel and `single`, at most `cap` (its bundle's
+// size), never less than one pixel.
+float cluster_min_width(float pixel, float thickness, float cap, float single) {
     if (frame.shading.y == 0u) {
         return pixel;
     }
-    return max(pixel, min(sqrt(max(thickness, 1.0)) * pixel, cap));
+    return max(pixel, min(sqrt(max(thickness, 1.0)) * min(pixel, single), cap));
 }
 
 // Strands of a strip's cluster that a ray crosses: sqrt(k) at packing density 1 (seed 000's

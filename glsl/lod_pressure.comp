@@ -2,9 +2,9 @@
 // Both paths, every view, after cull.comp: when the bundles' LoD asks for more software
 // segments than the segment budget (frame.soft.z), or on the compute path (push.params.x != 0)
 // more vertex slots than the pool holds (frame.counts.w), every bundle of that kind keeps the
-// same share of its strands (a coarser LoD, eq. 8's thickness widened to keep its coverage:
-// press_lod), so the frame fits and no character loses its hair to the order in which its
-// strands were appended. CPU twin: reference::lod::{lod_pressure, pressed_lod}.
+// same share of its strands (eq. 7's strand level times the share, eq. 8's thickness widened
+// to keep its coverage: bundle_lod's pressure), so the frame fits and no character loses its hair to the order in which its
+// strands were appended. CPU twin: reference::lod::{lod_pressure, strand_lod}.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 layout(local_size_x = CULL_GROUP_SIZE) in;
@@ -28,7 +28,11 @@ void main() {
         p = lod_pressure(args.stats.pool_demand, args.stats.pool_slack, frame.counts.w);
     }
     if (p < 1.0) {
+        // The decision again with the lower level; the bundle stays with the rasterizer
+        // whose budget the pressure answers.
         bind_character(bundles[g].character);
-        bundle_lods[g] = press_lod(lod, p, bundle_strand_count(bundles[g]));
+        BundleLod r = bundle_lod(g, p);
+        r.soft = lod_is_soft(lod.y);
+        bundle_lods[g] = encode_lod(r);
     }
 }

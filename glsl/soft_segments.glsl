@@ -56,13 +56,13 @@ float soft_vertex_width(uint idx, uint strand, float s) {
 
 // Width the software rasterizer draws a strand of `width` with: its own width, or with the
 // thick-strand term the footprint of the `thickness` strands it stands for (lod_appearance.glsl,
-// sqrt(k) pixels capped by the bundle). Unlike hardware strips it is not widened to a pixel:
-// coverage is computed exactly.
+// sqrt(k) times the smaller of a pixel and one strand's width, capped by the bundle). Unlike
+// hardware strips it is not widened to a pixel: coverage is computed exactly.
 float soft_drawn_width(float width, float pixel, float thickness, float cap) {
     if (frame.shading.y == 0u || thickness <= 1.0) {
         return width;
     }
-    return max(width, min(sqrt(thickness) * pixel, cap));
+    return max(width, min(sqrt(thickness) * min(pixel, width / thickness), cap));
 }
 
 bool soft_segment_kept(uint idx) {

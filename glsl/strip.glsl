@@ -19,7 +19,8 @@ float pixel_size(vec3 pos) {
 // the thick-strand term, at least the pixels of the `thickness` strands it stands for, capped
 // by the bundle's size `cap` (lod_appearance.glsl).
 float drawn_width(vec3 pos, float width, float thickness, float cap) {
-    return max(width, cluster_min_width(pixel_size(pos), thickness, cap));
+    float single = width / max(thickness, 1.0);
+    return max(width, cluster_min_width(pixel_size(pos), thickness, cap, single));
 }
 
 vec3 strip_offset(vec3 pos, vec3 tangent, float drawn, float side) {

@@ -168,29 +168,49 @@ fn triangle_counts_follow_cpu_lod_functions() {
 #[test]
 fn gpu_lod_strands_match_cpu_oracle() {
     let ctx = context();
-    let eq7 = lod_strands_match_cpu_oracle(&ctx, LodSettings::default());
+    let eq7 = lod_strands_match_cpu_oracle(&ctx, LodSettings::default(), 8);
     // The crowd's area term (eq. 7's extent under 8 px: strands fall with the bundle's area,
     // widths grow), through the same oracle: 168 strands against 245 measured.
     let crowd = LodSettings {
         area_below: hairmesh::render::CROWD_AREA_BELOW,
         ..LodSettings::default()
     };
-    let area = lod_strands_match_cpu_oracle(&ctx, crowd);
+    let area = lod_strands_match_cpu_oracle(&ctx, crowd, 8);
     assert!(
         area * 5 < eq7 * 4,
         "area term {area} strands, eq. 7 alone {eq7}"
     );
+    // The crowd's pixel cap (0.5 strands per square pixel of a bundle's extent, the
+    // cross-section cap on the thick strands left) at 64 strands a bundle, against the area
+    // term alone, strand for strand and width for width.
+    let dense = lod_strands_match_cpu_oracle(&ctx, crowd, 64);
+    let capped = lod_strands_match_cpu_oracle(
+        &ctx,
+        LodSettings {
+            strands_per_pixel: hairmesh::render::CROWD_STRANDS_PER_PIXEL,
+            ..crowd
+        },
+        64,
+    );
+    println!("eq. 7 {eq7}, area term {area}; at 64: {dense}, pixel cap {capped} strands");
+    // Measured 168 against 246 (one strand a visible bundle).
+    assert!(
+        capped * 5 < dense * 4,
+        "pixel cap {capped} strands, area term {dense}"
+    );
 }
 
-/// Render head_long at 3x its framing distance with `lod` on the compute path and compare the
-/// strands, widths and positions with the CPU oracle; the strands drawn.
+/// Render head_long at 3x its framing distance with `lod` and `n` strands a bundle on the
+/// compute path and compare the strands, widths and positions with the CPU oracle; the strands
+/// drawn.
 fn lod_strands_match_cpu_oracle(
     ctx: &std::sync::Arc<hairmesh::vk::Context>,
     lod: LodSettings,
+    n: u32,
 ) -> usize {
     let name = "head_long.obj";
     let (baked, style) = sample(name);
-    let (n, e) = (8, 5);
+    let e = 5;
     let cam = dolly(name, 3.0);
     let mut r = renderer(ctx, SIZE);
     upload(&mut r, &baked, &style, n, e);

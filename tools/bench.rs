@@ -98,7 +98,7 @@ enum Cmd {
         #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=8192))]
         height: u32,
         /// Strands per bundle.
-        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=16384))]
         strands_per_bundle: u32,
         /// Timed runs per configuration (after one warm-up).
         #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..=1000))]
@@ -212,7 +212,7 @@ enum Cmd {
         #[arg(long, default_value = "240x240")]
         size: String,
         /// Strands per bundle.
-        #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=16384))]
         strands_per_bundle: u32,
         /// Character counts, one run each (copies of the mesh on a grid, all simulated every
         /// frame on all cores).
@@ -250,7 +250,7 @@ enum Cmd {
         #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=8192))]
         height: u32,
         /// Strands per bundle.
-        #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=16384))]
         strands_per_bundle: u32,
         /// Vertex level e (2^e + 1 vertices at full detail).
         #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=6))]

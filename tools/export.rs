@@ -27,7 +27,7 @@ struct Args {
     #[arg(long)]
     style: Option<PathBuf>,
     /// Strands per average bundle.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=16384))]
     strands_per_bundle: u32,
     /// Strands get 2^e + 1 points (e in 1..=6, as the GPU generates).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=6))]

@@ -54,8 +54,8 @@ struct Args {
     /// Host memory the run may use, MiB: meshes and images past it are refused before loading.
     #[arg(long, value_name = "MIB", default_value = "4096", value_parser = budget::parse_budget_flag)]
     memory_budget_mib: MemoryBudget,
-    /// Strands per average bundle (1..=4096).
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    /// Strands per average bundle (1..=16384).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=16384))]
     strands_per_bundle: u32,
     /// Vertices per strand are 2^e + 1 (e in 0..=6).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=6))]
@@ -80,6 +80,10 @@ struct Args {
     /// to keep the coverage (0: off, the paper's eq. 7; `crowd` uses 8).
     #[arg(long, default_value_t = 0.0)]
     lod_area_below: f32,
+    /// At most this many strands per square pixel of a bundle's extent, thickened to keep the
+    /// coverage (0: off; `crowd` uses 0.5).
+    #[arg(long, default_value_t = 0.0)]
+    lod_strands_per_pixel: f32,
     /// Alpha of eq. 7 for vertex LoD.
     #[arg(long, default_value_t = 0.1)]
     lod_alpha_verts: f32,
@@ -203,11 +207,14 @@ fn lod_settings(args: &Args) -> Result<LodSettings> {
         enabled: args.lod,
         alpha_strands: args.lod_alpha_strands,
         area_below: args.lod_area_below,
+        strands_per_pixel: args.lod_strands_per_pixel,
         alpha_verts: args.lod_alpha_verts,
         lambda: args.lod_lambda,
     };
     lod.validate().map_err(|e| {
-        anyhow::anyhow!("--lod-alpha-strands/--lod-area-below/--lod-alpha-verts/--lod-lambda: {e}")
+        anyhow::anyhow!(
+            "--lod-alpha-strands/--lod-area-below/--lod-strands-per-pixel/--lod-alpha-verts/--lod-lambda: {e}"
+        )
     })?;
     Ok(lod)
 }
@@ -427,6 +434,7 @@ fn check_unused(p: &Parsed<Args>, inputs: &Inputs, look: &Look) -> Result<(), St
     for id in [
         "lod_alpha_strands",
         "lod_area_below",
+        "lod_strands_per_pixel",
         "lod_alpha_verts",
         "lod_lambda",
         "lod_appearance",

@@ -122,6 +122,10 @@ pub struct Hairstyle {
 /// families' 5x5 grid on an average scalp (22-25 cm² per bundle).
 pub const REFERENCE_BUNDLE_AREA: f32 = 24e-4;
 
+/// Strands per cm² of scalp on a real head (about 150-200 hairs per cm², 90-150K on a whole
+/// head): the crowd's, the window's and the Bevy plugin's density.
+pub const SCALP_STRANDS_PER_CM2: f32 = 150.0;
+
 impl Hairstyle {
     /// Strands per bundle for a crowd that asks for `asked` per reference bundle
     /// ([`REFERENCE_BUNDLE_AREA`]): a coarser hair mesh gets proportionally more, so that no
@@ -133,6 +137,46 @@ impl Hairstyle {
         let mean = areas.iter().sum::<f32>() / areas.len().max(1) as f32;
         let scale = (mean / REFERENCE_BUNDLE_AREA).max(1.0);
         ((asked as f32 * scale).round() as u32).clamp(1, MAX_STRANDS_PER_BUNDLE as u32)
+    }
+
+    /// Scalp this hair covers, cm²: its bundles' root faces, for a mesh of `metres_per_unit`
+    /// (1 for the crowd's people and glTF characters; the inverse of
+    /// [`AnyHead::scale`](super::any_head::AnyHead::scale) for a head in its own units).
+    pub fn scalp_cm2(&self, metres_per_unit: f32) -> f32 {
+        let areas = self.mesh.bundle_areas();
+        areas.iter().sum::<f32>() * metres_per_unit * metres_per_unit * 1e4
+    }
+
+    /// Strands per average bundle (`N` of eq. 8; each bundle grows `N` times its root area
+    /// over the mean, `style.density_by_area`) for `per_cm2` strands per cm² of scalp, on a
+    /// mesh of `metres_per_unit`. Refused where a bundle would need more strands than
+    /// [`MAX_STRANDS_PER_BUNDLE`], naming the density that fits.
+    pub fn strands_per_bundle_at(&self, per_cm2: f32, metres_per_unit: f32) -> Result<u32> {
+        let refuse = |what: String| crate::error::HairError::invalid(&self.mesh.name, what);
+        if !(per_cm2 > 0.0 && per_cm2.is_finite()) {
+            return Err(refuse(format!(
+                "{per_cm2} strands per cm²: need a positive number"
+            )));
+        }
+        let areas = self.mesh.bundle_areas();
+        let cm2 = |a: f32| a * metres_per_unit * metres_per_unit * 1e4;
+        let mean = areas.iter().sum::<f32>() / areas.len().max(1) as f32;
+        let largest = areas.iter().copied().fold(0.0f32, f32::max);
+        let weight = match self.style.density_by_area {
+            0 => 1.0,
+            _ => largest / mean.max(f32::MIN_POSITIVE),
+        };
+        let n = (per_cm2 * cm2(mean)).round().max(1.0);
+        let most = MAX_STRANDS_PER_BUNDLE as f32;
+        if (n * weight).round() > most {
+            return Err(refuse(format!(
+                "{per_cm2} strands per cm²: its {:.0} cm² bundle would need {:.0} strands, more than {most} (at most {:.0} per cm²)",
+                cm2(largest),
+                n * weight,
+                most / weight / cm2(mean).max(f32::MIN_POSITIVE)
+            )));
+        }
+        Ok(n as u32)
     }
 }
 
@@ -367,7 +411,7 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
 fn style_for(family: StyleFamily, seed: u32, rng: &mut Pcg32) -> HairStyle {
     let mut s = HairStyle {
         seed,
-        strand_width: range(rng, 0.0008, 0.0012),
+        strand_width: range(rng, 0.00008, 0.00012),
         tip_width_ratio: range(rng, 0.3, 0.5),
         length_variation: range(rng, 0.05, 0.15),
         root_ramp: 0.03,

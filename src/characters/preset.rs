@@ -94,6 +94,27 @@ pub const FAR_CELL_PIXELS: f32 = 2.0;
 /// Most vertex level fur uses: 2^3 = 8 segments are plenty for strands a few centimetres long.
 pub const FUR_MAX_VERTS_LOG2: u32 = 3;
 
+/// Strands per bundle of fur (balls, teapots) when the crowd asks for a scalp density.
+pub const FUR_STRANDS_PER_BUNDLE: u32 = 96;
+
+/// How densely a crowd's heads grow their strands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StrandDensity {
+    /// Strands per cm² of scalp (a real head: about 150,
+    /// [`SCALP_STRANDS_PER_CM2`](super::hairstyle::SCALP_STRANDS_PER_CM2)); fur grows
+    /// [`FUR_STRANDS_PER_BUNDLE`].
+    PerCm2(f32),
+    /// Strands per bundle of 24 cm² of scalp (people with coarser hair meshes get
+    /// proportionally more per bundle), and per bundle of fur.
+    PerReferenceBundle(u32),
+}
+
+impl Default for StrandDensity {
+    fn default() -> Self {
+        StrandDensity::PerCm2(super::hairstyle::SCALP_STRANDS_PER_CM2)
+    }
+}
+
 impl CrowdCharacter {
     /// The strand settings this character uses when the crowd asks for `crowd`: people get at
     /// least the reference density ([`Hairstyle::strands_per_bundle`](super::hairstyle::Hairstyle::strands_per_bundle)),
@@ -109,6 +130,31 @@ impl CrowdCharacter {
                 ..crowd
             },
         }
+    }
+
+    /// The strand settings of this character at `density` with full vertex level
+    /// `verts_log2` (fur caps it at [`FUR_MAX_VERTS_LOG2`]); people's hair meshes are in
+    /// metres. Refused where a bundle would need more strands than a bundle holds.
+    pub fn strand_params_at(
+        &self,
+        density: StrandDensity,
+        verts_log2: u32,
+    ) -> Result<StrandParams> {
+        let strands_per_bundle = match (density, self.body) {
+            (StrandDensity::PerCm2(d), Body::Person(_) | Body::Own) => {
+                self.hair.strands_per_bundle_at(d, 1.0)?
+            }
+            (StrandDensity::PerCm2(_), Body::Ball | Body::Teapot) => FUR_STRANDS_PER_BUNDLE,
+            (StrandDensity::PerReferenceBundle(n), _) => n,
+        };
+        let asked = StrandParams {
+            strands_per_bundle,
+            verts_log2,
+        };
+        Ok(match (density, self.body) {
+            (StrandDensity::PerCm2(_), Body::Person(_) | Body::Own) => asked,
+            _ => self.strand_params(asked),
+        })
     }
 
     /// Colliders for this character's hair dynamics in its hair's frame: a person's body and

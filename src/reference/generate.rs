@@ -9,7 +9,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::bake::blue_noise::{MAX_STRANDS_PER_BUNDLE, quad_samples, triangle_samples};
+use crate::bake::blue_noise::{MAX_STRANDS_PER_BUNDLE, quad_samples_for, triangle_samples_for};
 use crate::bake::{BakedHairMesh, BundleDesc, MeshInfo};
 use crate::model::style::HairStyle;
 use crate::reference::root_surface::{RootCell, bulge_fade, local_coord};
@@ -264,11 +264,11 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 pub fn root_sample(b: &BundleDesc, index: u32, strand: u32) -> Vec2 {
     let s = strand as usize % MAX_STRANDS_PER_BUNDLE;
     if b.is_triangle() {
-        triangle_samples()[s]
+        triangle_samples_for(s + 1)[s]
     } else {
         let h = hash_u32(index ^ 0x51ed_270b);
         let shift = Vec2::new(hash_f32(h), hash_f32(h.wrapping_add(1)));
-        (quad_samples()[s] + shift).fract()
+        (quad_samples_for(s + 1)[s] + shift).fract()
     }
 }
 
@@ -283,14 +283,14 @@ pub fn strands_in_bundle(b: &BundleDesc, style: &HairStyle, n: u32) -> u32 {
 }
 
 /// Strands per (average) bundle that give about `target` strands over `baked`'s bundles
-/// (1..=4096), and the strands that makes.
+/// (1..=[`MAX_STRANDS_PER_BUNDLE`]), and the strands that makes.
 pub fn strands_per_bundle_for(
     baked: &crate::bake::BakedHairMesh,
     style: &HairStyle,
     target: u64,
 ) -> (u32, u64) {
     let per = (target as f32 / baked.bundles.len().max(1) as f32).ceil() as u32;
-    let per = per.clamp(1, 4096);
+    let per = per.clamp(1, MAX_STRANDS_PER_BUNDLE as u32);
     let total = baked
         .bundles
         .iter()
@@ -538,9 +538,11 @@ mod tests {
             fov_y: 0.8,
             alpha_strands: 0.05,
             area_below: 0.0,
+            strands_per_pixel: 0.0,
             alpha_verts: 0.1,
             lambda: 0.5,
             strand_share: 1.0,
+            pressure: 1.0,
         };
         let (n, e_max) = (16, 4);
         let (set, counts) = generator.generate_lod(n, e_max, &baked, &view);

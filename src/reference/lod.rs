@@ -33,6 +33,19 @@ pub fn area_factor(x: f32, area_below: f32) -> f32 {
     }
 }
 
+/// The pixel cap on a bundle's strand level: at most `per_pixel` strands per square pixel of
+/// its extent `x` ([`bundle_extent`]) for a bundle of `n` strands, `per_pixel x^2 / n` (0: no
+/// cap, infinity). A bundle's strands then follow the pixels it covers, not its count at full
+/// detail: twice the density draws no more strands at crowd distance, and eq. 8's thickness
+/// `min(1 / L, N)` widens the strands drawn into the coverage of those it stands for (seed 000:
+/// one thick strand for a cluster of fine ones once the fine ones are sub-pixel).
+pub fn pixel_cap_level(x: f32, per_pixel: f32, n: u32) -> f32 {
+    match per_pixel > 0.0 {
+        true => per_pixel * x * x / n.max(1) as f32,
+        false => f32::INFINITY,
+    }
+}
+
 /// Eq. 7, orthographic (shadow maps): `d tan theta` replaced by the view height in world units.
 pub fn detail_level_ortho(h: f32, resolution: f32, view_height: f32, alpha: f32) -> f32 {
     (h * resolution * alpha / view_height.max(1e-6)).clamp(0.0, 1.0)
@@ -83,28 +96,37 @@ pub fn lod_pressure(demand: u32, slack: u32, budget: u32) -> f32 {
     }
 }
 
-/// A bundle's decision under pressure `p` in `(0, 1)` (GLSL: `press_lod`): eq. 8's level
-/// times `p`, so the strands it wanted (`strands - 1 + fade`) become `p` times as many, at
-/// least one, never more than before; eq. 8's thickness `min(1 / L, N)` with the lower level,
-/// so the strands left widen and the bundle keeps its coverage. `count`: the bundle's
-/// strands at full detail (`N`).
-pub fn pressed_lod(lod: BundleLod, p: f32, count: u32) -> BundleLod {
-    if lod.strands == 0 || p >= 1.0 {
-        return lod;
-    }
-    let wanted = (lod.strands - 1) as f32 + lod.fade;
-    let drawn = (p * wanted).max(1e-3);
-    let strands = (drawn.ceil() as u32).clamp(1, lod.strands);
-    let fade = match strands > 1 && drawn < strands as f32 {
-        true => drawn - (strands - 1) as f32,
-        false => 1.0,
-    };
-    BundleLod {
+/// Eq. 8's width factor `min(1 / L, N)` for `strands` strands at level `l` of a bundle of `n`,
+/// held to the bundle's cross-section: each of `k` strands at most `size_over_width / sqrt(k)`
+/// strand widths (`h / sqrt(k)` across, `h` the bundle's size), so `k` thick strands cover the
+/// bundle once and no more, as a cluster's footprint does (seed 000). The cap binds only where
+/// the strands left would cover the bundle more than `sqrt(k)` times over, opaque either way;
+/// at crowd distance, with the pixel cap, it holds thick strands near `1 / sqrt(per_pixel)`
+/// pixels wide (GLSL: `eq8_thickness`).
+pub fn thickness_at(l: f32, n: u32, strands: u32, size_over_width: f32) -> f32 {
+    let t = thickness_scale(l, n);
+    t.min(size_over_width / (strands.max(1) as f32).sqrt())
+        .max(1.0)
+}
+
+/// A bundle's strands at strand level `l` (eq. 7 with its terms), the volume band's `share`
+/// and the LoD `pressure` ([`lod_pressure`]): eq. 8's count with increment `delta`, the newest
+/// strand's fade, and [`thickness_at`] with the pressed level (the share thins strands without
+/// widening them). Returns (strands, fade, thickness).
+pub fn strand_lod(
+    (l, share, pressure): (f32, f32, f32),
+    n: u32,
+    delta: f32,
+    size_over_width: f32,
+) -> (u32, f32, f32) {
+    let level = l * pressure;
+    let drawn = level * share.clamp(0.0, 1.0);
+    let strands = strands_at_level(drawn, n, delta);
+    (
         strands,
-        fade: (fade.clamp(0.0, 1.0) * 65535.0).round() / 65535.0,
-        thickness: (lod.thickness / p.max(1e-6)).min(count.max(1) as f32),
-        ..lod
-    }
+        newest_strand_fade(drawn, n, delta),
+        thickness_at(level, n, strands, size_over_width),
+    )
 }
 
 /// Eq. 9: vertex level `e` (strands get `2^e + 1` vertices) for `ns` segments at full detail.
@@ -272,9 +294,11 @@ pub(crate) mod tests {
             fov_y: 0.8,
             alpha_strands: 1.0,
             area_below: 0.0,
+            strands_per_pixel: 0.0,
             alpha_verts: 1.0,
             lambda: 0.5,
             strand_share: share,
+            pressure: 1.0,
         };
         let width = |l: &BundleLod| (l.strands as f32 - 1.0 + l.fade) * l.thickness;
         let full = bundle_lod(&baked, &style, 0, 64, 4, &view(1.0));
@@ -303,10 +327,16 @@ pub(crate) mod tests {
     /// area_below`, so twice the distance leaves a quarter of the strands where eq. 7 alone
     /// leaves half (the level ratio squared), while the strands left widen so that the
     /// bundle's drawn width, `(strands - 1 + fade) * thickness`, stays `N + delta` (its full
-    /// coverage) in both; at or above `area_below` nothing changes.
+    /// coverage) in both; at or above `area_below` nothing changes. (Strands 0.1 mm wide:
+    /// the sample's 2 mm would cover its bundles several times over, where the cross-section
+    /// cap, [`thickness_at`], holds the strands to the bundle.)
     #[test]
     fn the_area_term_thins_small_bundles_and_keeps_their_coverage() {
         let (baked, style) = small_patch();
+        let style = crate::HairStyle {
+            strand_width: 1e-4,
+            ..style
+        };
         let n = 64;
         let delta = bundle_delta(0, style.seed);
         let lod = |z: f32, area_below: f32| {
@@ -316,9 +346,11 @@ pub(crate) mod tests {
                 fov_y: 0.8,
                 alpha_strands: 0.05,
                 area_below,
+                strands_per_pixel: 0.0,
                 alpha_verts: 1.0,
                 lambda: 0.5,
                 strand_share: 1.0,
+                pressure: 1.0,
             };
             bundle_lod(&baked, &style, 0, n, 4, &view)
         };
@@ -367,57 +399,52 @@ pub(crate) mod tests {
     fn pressure_fits_the_budget_and_thins_every_bundle_alike() {
         use crate::render::shared::LOD_DEMAND_UNIT as UNIT;
         let mut rng = crate::rng::Pcg32::new(11);
+        let wide = 1e9; // no cross-section cap
         for round in 0..40 {
-            let bundles: Vec<BundleLod> = (0..200 + round * 30)
+            // (level, N, delta, e)
+            let bundles: Vec<(f32, u32, f32, u32)> = (0..200 + round * 30)
                 .map(|_| {
-                    let strands = 1 + (rng.next_f32() * 4095.0) as u32;
-                    BundleLod {
-                        strands,
-                        e: (rng.next_f32() * 6.99) as u32,
-                        gamma: 0.0,
-                        thickness: 1.0 + rng.next_f32(),
-                        fade: match strands {
-                            1 => 1.0,
-                            _ => rng.next_f32().max(1e-3),
-                        },
-                    }
+                    let n = 1 + (rng.next_f32() * 4095.0) as u32;
+                    let l = rng.next_f32().powi(2).max(1e-4);
+                    (l, n, rng.next_f32(), (rng.next_f32() * 6.99) as u32)
                 })
                 .collect();
+            let at = |&(l, n, delta, _): &(f32, u32, f32, u32), p: f32| {
+                strand_lod((l, 1.0, p), n, delta, wide)
+            };
             // The GPU's sums: per bundle strands x 2^e and 2^e, rounded up per 64 bundles.
             let units = |v: &[u32]| -> u32 {
                 v.chunks(64)
                     .map(|c| c.iter().sum::<u32>().div_ceil(UNIT))
                     .sum()
             };
-            let need: Vec<u32> = bundles.iter().map(|b| b.strands << b.e).collect();
-            let slack: Vec<u32> = bundles.iter().map(|b| 1 << b.e).collect();
+            let need: Vec<u32> = bundles.iter().map(|b| at(b, 1.0).0 << b.3).collect();
+            let slack: Vec<u32> = bundles.iter().map(|b| 1 << b.3).collect();
             let (demand, slack) = (units(&need), units(&slack));
             let total: u32 = need.iter().sum();
             let budget = (total as f32 * (0.05 + 1.15 * rng.next_f32())) as u32;
             let p = lod_pressure(demand, slack, budget);
-            if total <= budget && demand * UNIT <= budget {
+            if demand * UNIT <= budget {
                 assert_eq!(p, 1.0, "a view that fits keeps its LoD");
                 continue;
             }
             assert!(p < 1.0);
-            let kept: u32 = bundles
-                .iter()
-                .map(|b| pressed_lod(*b, p, 4096).strands << b.e)
-                .sum();
+            let kept: u32 = bundles.iter().map(|b| at(b, p).0 << b.3).sum();
             let floor: u32 = slack * UNIT; // one strand a bundle is the least a view draws
             assert!(
                 kept <= budget.max(floor),
                 "round {round}: {kept} > {budget} (p {p})"
             );
-            // Every bundle keeps about the same share of the strands it wanted (within the
-            // one strand of eq. 8's ceiling).
+            // Every bundle keeps the same share of the strands it wanted (eq. 8 before its
+            // ceiling: strands - 1 + fade), down to its last strand.
             for b in &bundles {
-                let after = pressed_lod(*b, p, 4096);
-                let wanted = (b.strands - 1) as f32 + b.fade;
-                let share = (after.strands - 1) as f32 + after.fade;
+                let (strands, fade, _) = at(b, p);
+                let wanted = b.0 * (b.1 as f32 + b.2);
+                let share = (strands - 1) as f32 + fade;
+                let want = (p * wanted).min(b.1 as f32);
                 assert!(
-                    (share - p * wanted).abs() <= 1e-3 + 1e-4 * wanted || after.strands == 1,
-                    "{b:?} -> {after:?} at {p}"
+                    (share - want).abs() <= 1e-3 * (1.0 + wanted) || strands == 1,
+                    "{b:?}: {share} of {wanted} at {p}"
                 );
             }
         }
@@ -430,28 +457,36 @@ pub(crate) mod tests {
     /// one strand is left or the thickness reaches N.
     #[test]
     fn pressure_keeps_a_bundles_coverage() {
-        let width = |l: &BundleLod| ((l.strands - 1) as f32 + l.fade) * l.thickness;
-        let before = BundleLod {
-            strands: 300,
-            e: 4,
-            gamma: 0.25,
-            thickness: 2.5,
-            fade: 0.4,
-        };
+        let width = |(s, fade, t): (u32, f32, f32)| ((s - 1) as f32 + fade) * t;
+        let (n, delta, wide) = (3000, 0.37, 1e9);
+        let before = strand_lod((0.1, 1.0, 1.0), n, delta, wide);
         for p in [0.9, 0.5, 0.1, 0.02] {
-            let after = pressed_lod(before, p, 3000);
-            assert!(after.strands < before.strands, "{after:?}");
-            assert_eq!((after.e, after.gamma), (before.e, before.gamma));
-            let (w0, w1) = (width(&before), width(&after));
-            assert!(
-                (w1 - w0).abs() < 1e-3 * w0 + after.thickness / 65535.0,
-                "{p}: {w0} -> {w1}"
-            );
+            let after = strand_lod((0.1, 1.0, p), n, delta, wide);
+            assert!(after.0 < before.0, "{after:?}");
+            let (w0, w1) = (width(before), width(after));
+            assert!((w1 - w0).abs() < 2e-3 * w0, "{p}: {w0} -> {w1}");
         }
         // The thickness stops at N; one strand at least.
-        let last = pressed_lod(before, 1e-4, 3000);
-        assert_eq!((last.strands, last.thickness), (1, 3000.0));
-        assert_eq!(pressed_lod(before, 1.0, 3000), before);
+        let last = strand_lod((0.1, 1.0, 1e-6), n, delta, wide);
+        assert_eq!((last.0, last.2), (1, 3000.0));
+    }
+
+    /// The cross-section cap: k thick strands are each at most `h / sqrt(k)` wide, so they
+    /// cover the bundle about once where eq. 8's thickness would pile them up (a 5 cm bundle
+    /// of 3,600 strands 0.1 mm wide, 36 thick strands: 1/L would make each 1 cm wide, 7 times
+    /// the bundle's width together; the cap holds them at 8.3 mm, 6 bundle widths... of their
+    /// own row); it never narrows a strand below its own width, and leaves thin hair alone.
+    #[test]
+    fn the_cross_section_cap_holds_thick_strands_to_their_bundle() {
+        let size_over_width = 0.05 / 1e-4;
+        let t = thickness_at(36.0 / 3600.0, 3600, 36, size_over_width);
+        assert!((t * 1e-4 - 0.05 / 6.0).abs() < 1e-6, "{t}");
+        assert_eq!(thickness_at(36.0 / 3600.0, 3600, 36, 1e9), 100.0);
+        assert_eq!(thickness_at(1.0, 3600, 3600, size_over_width), 1.0);
+        assert_eq!(thickness_at(0.01, 3600, 36, 1.0), 1.0);
+        // The old density's strands (96 a bundle, 1 mm wide): untouched down to 2 strands.
+        assert_eq!(thickness_at(0.5, 96, 48, 50.0), 2.0);
+        assert_eq!(thickness_at(2.0 / 96.0, 96, 2, 50.0), 35.355339);
     }
 
     #[test]
@@ -493,10 +528,15 @@ pub struct LodView {
     pub alpha_strands: f32,
     /// The strand level's area term below this extent ([`area_factor`]; 0: off).
     pub area_below: f32,
+    /// The pixel cap: strands per square pixel of a bundle's extent ([`pixel_cap_level`]; 0:
+    /// off).
+    pub strands_per_pixel: f32,
     /// Alpha for vertex LoD.
     pub alpha_verts: f32,
     /// Geomorph window lambda.
     pub lambda: f32,
+    /// The LoD pressure on this view's bundles ([`lod_pressure`]; 1: none).
+    pub pressure: f32,
     /// Share of the character's strands drawn: 1, or 1 minus the volume tier's weight in its
     /// switch band, where strands thin out one by one (eq. 8's level times the share; widths
     /// keep eq. 8's thickness) while the density volume comes in.
@@ -560,11 +600,13 @@ pub fn bundle_lod(
     let d = view.eye.distance(view.eye.clamp(lo, hi));
     let h = baked.bundles[b].rest_size;
     let x = bundle_extent(h, view.resolution, d, view.fov_y);
-    let ls = detail_level(h, view.resolution, d, view.fov_y, view.alpha_strands)
-        * area_factor(x, view.area_below);
+    let ls = (detail_level(h, view.resolution, d, view.fov_y, view.alpha_strands)
+        * area_factor(x, view.area_below))
+    .min(pixel_cap_level(x, view.strands_per_pixel, n));
     let delta = bundle_delta(b as u32, style.seed);
-    let drawn = ls * view.strand_share.clamp(0.0, 1.0);
-    let strands = strands_at_level(drawn, n, delta);
+    let size_over_width = h / style.strand_width.max(1e-12);
+    let levels = (ls, view.strand_share, view.pressure);
+    let (strands, fade, thickness) = strand_lod(levels, n, delta, size_over_width);
     let lv = detail_level(h, view.resolution, d, view.fov_y, view.alpha_verts);
     let ns = 1u32 << e_max;
     let e = vertex_level(lv, ns);
@@ -573,7 +615,7 @@ pub fn bundle_lod(
         strands,
         e,
         gamma,
-        thickness: thickness_scale(ls, n),
-        fade: newest_strand_fade(drawn, n, delta),
+        thickness,
+        fade,
     }
 }

@@ -140,6 +140,9 @@ pub const CROWD_ALPHA_STRANDS: f32 = 0.05;
 /// The area term's extent of [`LodSettings::crowd`] (about pixels a bundle spans).
 pub const CROWD_AREA_BELOW: f32 = 8.0;
 
+/// The pixel cap of [`LodSettings::crowd`]: strands per square pixel of a bundle's extent.
+pub const CROWD_STRANDS_PER_PIXEL: f32 = 0.5;
+
 /// Level-of-detail settings (paper 003 sec. 3.6): separate alphas for strands and vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LodSettings {
@@ -152,6 +155,11 @@ pub struct LodSettings {
     /// (`reference::lod::area_factor`); eq. 8's thickness keeps the coverage. 0: off, the
     /// paper's eq. 7. The light's views apply it in texels.
     pub area_below: f32,
+    /// At most this many strands per square pixel of a bundle's extent (eq. 7's `h R / (d tan
+    /// theta)`, squared; in texels for the light's views): at crowd distance the strands a
+    /// bundle draws follow the pixels it covers, not its count at full detail, and eq. 8's
+    /// thickness widens them to keep its coverage (`reference::lod::pixel_cap_level`). 0: off.
+    pub strands_per_pixel: f32,
     /// Alpha of eq. 7 for vertex LoD.
     pub alpha_verts: f32,
     /// Geomorph transition window lambda of eq. 10-12, in `(0, 1]`.
@@ -164,6 +172,7 @@ impl Default for LodSettings {
             enabled: true,
             alpha_strands: 0.1,
             area_below: 0.0,
+            strands_per_pixel: 0.0,
             alpha_verts: 0.1,
             lambda: 0.5,
         }
@@ -181,6 +190,12 @@ impl LodSettings {
             return Err(format!(
                 "LoD area term below {} pixels: need a finite number >= 0",
                 self.area_below
+            ));
+        }
+        if !(self.strands_per_pixel >= 0.0 && self.strands_per_pixel.is_finite()) {
+            return Err(format!(
+                "LoD strands per pixel {}: need a finite number >= 0",
+                self.strands_per_pixel
             ));
         }
         if !(self.lambda > 0.0 && self.lambda <= 1.0) {
@@ -202,6 +217,7 @@ impl LodSettings {
         LodSettings {
             alpha_strands: CROWD_ALPHA_STRANDS,
             area_below: CROWD_AREA_BELOW,
+            strands_per_pixel: CROWD_STRANDS_PER_PIXEL,
             ..Default::default()
         }
     }
@@ -384,7 +400,7 @@ impl View {
                 self.lod.lambda,
                 camera.fov_y.tan(),
             ],
-            lod_ortho: [0.0, self.lod.area_below, 0.0, 0.0],
+            lod_ortho: [0.0, self.lod.area_below, self.lod.strands_per_pixel, 0.0],
             counts: [bundles, characters, self.lod.enabled as u32, vertex_budget],
             shading: [
                 self.shading as u32,

@@ -34,7 +34,9 @@ pub const TEXTURE_FORMATS: [vk::Format; 5] = [
 /// What to generate for a character.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StrandParams {
-    /// Strands per (average) bundle, `1..=4096`.
+    /// Strands per (average) bundle, `1..=MAX_STRANDS_PER_BUNDLE` (32,768); a bundle of
+    /// larger root area than the mean grows more (`HairStyle::density_by_area`), and no bundle
+    /// may grow more than that either.
     pub strands_per_bundle: u32,
     /// Vertices per strand are `2^verts_log2 + 1`, `verts_log2 <= 6`.
     pub verts_log2: u32,
@@ -56,8 +58,8 @@ impl StrandParams {
     }
 }
 
-/// Draw vertices of a character's strands at full detail (6 per segment).
-fn max_draw_vertices(
+/// Strand triangles of a character at full detail (2 per segment).
+fn max_triangles(
     bundles: &[crate::bake::BundleDesc],
     style: &HairStyle,
     params: StrandParams,
@@ -69,7 +71,35 @@ fn max_draw_vertices(
                 as u64
         })
         .sum();
-    strands * (1u64 << params.verts_log2) * 6
+    strands * (1u64 << params.verts_log2) * 2
+}
+
+/// Strands of a character's fullest bundle at full detail, before any limit.
+fn most_in_a_bundle(bundles: &[crate::bake::BundleDesc], style: &HairStyle, n: u32) -> f32 {
+    bundles
+        .iter()
+        .map(|b| match style.density_by_area {
+            0 => n as f32,
+            _ => (n as f32 * b.density).round(),
+        })
+        .fold(0.0, f32::max)
+}
+
+/// Refuse strand settings under which a bundle of `bundles` would grow more strands than a
+/// bundle holds (they would be cut to it).
+fn check_fullest_bundle(
+    bundles: &[crate::bake::BundleDesc],
+    style: &HairStyle,
+    params: StrandParams,
+) -> GpuResult<()> {
+    let most = most_in_a_bundle(bundles, style, params.strands_per_bundle);
+    if most > MAX_STRANDS_PER_BUNDLE as f32 {
+        return Err(GpuError::Unsupported(format!(
+            "{} strands per bundle: the character's largest bundle would grow {most} strands, more than a bundle holds ({MAX_STRANDS_PER_BUNDLE})",
+            params.strands_per_bundle
+        )));
+    }
+    Ok(())
 }
 
 /// A character transform must be finite.
@@ -147,7 +177,7 @@ impl CharacterTextures {
 
 struct Character {
     generation: u32,
-    max_draw_vertices: u64,
+    max_triangles: u64,
     /// Largest root offset of a bundle at rest ([`RootCell::bulge_bound`]), object units.
     root_bulge: f32,
     info: MeshInfo,
@@ -257,6 +287,7 @@ impl Crowd {
         model: Mat4,
     ) -> GpuResult<CharacterId> {
         params.validate()?;
+        check_fullest_bundle(&baked.bundles, style, params)?;
         self.version += 1;
         self.structure_version += 1;
         check_model(&model)?;
@@ -285,7 +316,7 @@ impl Crowd {
         let generation = self.generations[slot as usize];
         self.slots[slot as usize] = Some(Character {
             generation,
-            max_draw_vertices: max_draw_vertices(&baked.bundles, style, params),
+            max_triangles: max_triangles(&baked.bundles, style, params),
             root_bulge: baked
                 .bundles
                 .iter()
@@ -575,19 +606,29 @@ impl Crowd {
         self.structure_version += 1;
         params.validate()?;
         let c = self.get_mut(id)?;
+        check_fullest_bundle(&c.bundles, &c.style, params)?;
         c.params = params;
-        c.max_draw_vertices = max_draw_vertices(&c.bundles, &c.style, params);
+        c.max_triangles = max_triangles(&c.bundles, &c.style, params);
         Ok(())
     }
 
-    /// Draw vertices (6 per strand segment) of every character at full detail: the largest
-    /// value the frame's 32-bit prefix sums can reach.
-    pub fn max_draw_vertices(&self) -> u64 {
+    /// Strands the fullest bundle of any character grows at full detail (the root samples the
+    /// GPU needs).
+    pub fn most_in_a_bundle(&self) -> u32 {
         self.slots
             .iter()
             .flatten()
-            .map(|c| c.max_draw_vertices)
-            .sum()
+            .map(|c| most_in_a_bundle(&c.bundles, &c.style, c.params.strands_per_bundle) as u32)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Strand triangles (2 per segment) of every character at full detail: the largest value
+    /// a frame's 32-bit counters can reach (the compute path's vertex and draw-vertex sums are
+    /// held to its pool by the LoD pressure, `lod_pressure.comp`; the triangle statistics are
+    /// not).
+    pub fn max_triangles(&self) -> u64 {
+        self.slots.iter().flatten().map(|c| c.max_triangles).sum()
     }
 
     /// World-space bounds of every visible character's hair: the box of its latest pose for

@@ -404,12 +404,12 @@ impl Renderer {
                 "the LHS path needs strands stored by capture_lhs for the current characters, and a compute-path frame since the last mesh-path one".into(),
             ));
         }
-        // Prefix sums and statistics are 32-bit: refuse a crowd that could wrap them (LoD
-        // usually needs far less, but a frame without LoD must not produce garbage).
-        let worst = self.crowd.max_draw_vertices();
+        // Statistics are 32-bit: refuse a crowd that could wrap them (LoD usually needs far
+        // less, but a frame without LoD must not report garbage).
+        let worst = self.crowd.max_triangles();
         if worst > u32::MAX as u64 {
             return Err(GpuError::Unsupported(format!(
-                "the crowd needs up to {worst} strand draw vertices at full detail, more than 32-bit frame counters hold; lower strands per bundle or vertex level"
+                "the crowd has {worst} strand triangles at full detail, more than 32-bit frame counters hold; lower strands per bundle or vertex level"
             )));
         }
         let settings = super::settings::FrameSettings {
@@ -761,6 +761,14 @@ impl Renderer {
                 .push(Retired::Resource(Box::new(old)));
         }
         if let Some(old) = self.work.grow(self.crowd.bundle_count())? {
+            self.frames[i]
+                .retired
+                .push(Retired::Resource(Box::new(old)));
+        }
+        if let Some(old) = self
+            .work
+            .ensure_root_samples(self.crowd.most_in_a_bundle())?
+        {
             self.frames[i]
                 .retired
                 .push(Retired::Resource(Box::new(old)));

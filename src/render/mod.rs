@@ -30,7 +30,8 @@ pub mod volume;
 pub mod workspace;
 
 pub use camera::{
-    CROWD_ALPHA_STRANDS, CROWD_AREA_BELOW, Camera, DEFAULT_VIEW_DIR, LodSettings, View,
+    CROWD_ALPHA_STRANDS, CROWD_AREA_BELOW, CROWD_STRANDS_PER_PIXEL, Camera, DEFAULT_VIEW_DIR,
+    LodSettings, View,
 };
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use host::{HostCamera, HostFrame, HostImage};

@@ -212,7 +212,14 @@ impl LightView {
                 lod.lambda,
                 0.0,
             ],
-            lod_ortho: [self.size, lod.area_below, 0.0, 0.0],
+            // The pixel cap counts texels of the map at LIGHT_LOD_SCALE of its resolution,
+            // as eq. 7's alphas do: a quarter of the camera's strands per texel².
+            lod_ortho: [
+                self.size,
+                lod.area_below,
+                lod.strands_per_pixel * LIGHT_LOD_SCALE * LIGHT_LOD_SCALE,
+                0.0,
+            ],
             soft,
             soft_params: [0.0; 4],
             soft_grid,

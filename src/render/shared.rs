@@ -508,7 +508,8 @@ pub struct FrameBlock {
     /// x alpha strands, y alpha vertices, z lambda, w `tan(fov_y)` of eq. 7 (0: orthographic).
     pub lod: [f32; 4],
     /// x view height of orthographic views, y the strand level's area term below this extent
-    /// (`LodSettings::area_below`; 0 off); zw unused.
+    /// (`LodSettings::area_below`; 0 off), z strands per square pixel of a bundle's extent
+    /// (`LodSettings::strands_per_pixel`; 0 off); w unused.
     pub lod_ortho: [f32; 4],
     /// x bundles of all characters, y character slots, z LoD on, w vertex pool budget
     /// (compute path, in `HairVertex` slots).

@@ -14,7 +14,7 @@ use glam::Vec2;
 use super::shared::{
     FrameBinding, GenerateArgs, SCAN_BLOCK, SHADING_LUT_HEIGHT, SHADING_LUT_WIDTH,
 };
-use crate::bake::blue_noise::{quad_samples, triangle_samples};
+use crate::bake::blue_noise::{MAX_STRANDS_PER_BUNDLE, quad_samples_for, triangle_samples_for};
 use crate::vk::{Buffer, BufferDesc, Context, DescriptorSet, GpuResult, Image, ImageDesc, Sampler};
 
 fn storage(ctx: &Arc<Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
@@ -98,6 +98,8 @@ pub struct WorkBuffers<'a> {
 pub struct Workspace {
     ctx: Arc<Context>,
     root_samples: Buffer,
+    /// Samples of each set in `root_samples` (a tier of `bake::blue_noise`).
+    root_sample_count: usize,
     lods: Buffer,
     offsets: Buffer,
     scan: Buffer,
@@ -112,25 +114,32 @@ pub struct Workspace {
     lut_sampler: Sampler,
 }
 
+/// The root samples of bundles of up to `strands` strands, as the shaders read them
+/// (`strand_eval.glsl`): the quad set from 0, the triangle set from `MAX_STRANDS_PER_BUNDLE`,
+/// each as large as the sample tier holding `strands` (the rest zero, never read).
+fn root_samples(ctx: &Arc<Context>, strands: usize) -> GpuResult<Buffer> {
+    let mut samples = vec![Vec2::ZERO; 2 * MAX_STRANDS_PER_BUNDLE];
+    let (quad, triangle) = (quad_samples_for(strands), triangle_samples_for(strands));
+    samples[..quad.len()].copy_from_slice(quad);
+    samples[MAX_STRANDS_PER_BUNDLE..][..triangle.len()].copy_from_slice(triangle);
+    Buffer::with_data(
+        ctx,
+        "root samples",
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        bytemuck::cast_slice(&samples),
+    )
+}
+
 /// Buffers replaced by a resize, to retire with the current frame.
 pub type ReplacedBuffers = [Buffer; 3];
 
 impl Workspace {
     /// Minimal buffers (nothing to draw yet).
     pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
-        let samples: Vec<Vec2> = quad_samples()
-            .iter()
-            .chain(triangle_samples())
-            .copied()
-            .collect();
         Ok(Workspace {
             ctx: ctx.clone(),
-            root_samples: Buffer::with_data(
-                ctx,
-                "root samples",
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                bytemuck::cast_slice(&samples),
-            )?,
+            root_samples: root_samples(ctx, 1)?,
+            root_sample_count: quad_samples_for(1).len(),
             lods: storage(ctx, "bundle lods", 16)?,
             offsets: storage(ctx, "bundle offsets", 16)?,
             scan: storage(ctx, "scan scratch", 16)?,
@@ -179,6 +188,17 @@ impl Workspace {
             std::mem::replace(&mut self.offsets, offsets),
             std::mem::replace(&mut self.scan, scan),
         ]))
+    }
+
+    /// Hold the root samples of bundles of up to `strands` strands; returns the replaced buffer,
+    /// which frames in flight may still use.
+    pub fn ensure_root_samples(&mut self, strands: u32) -> GpuResult<Option<Buffer>> {
+        if strands as usize <= self.root_sample_count {
+            return Ok(None);
+        }
+        let buffer = root_samples(&self.ctx, strands as usize)?;
+        self.root_sample_count = quad_samples_for(strands as usize).len();
+        Ok(Some(std::mem::replace(&mut self.root_samples, buffer)))
     }
 
     /// Allocate the vertex pool of `bytes` if it is not there yet.

@@ -1,15 +1,16 @@
 //! Thick-strand appearance under strand LoD: the CPU twin of `glsl/lod_appearance.glsl`
-//! (seed 000 sec. 4). A strip standing for `k` strands is drawn at least `sqrt(k)` pixels wide
-//! (seed 000's cluster diameter `2 r sqrt(n / rho)` with `rho = 1`, capped by the bundle), and
-//! its opacity is that of `k` strands lying independently across it.
+//! (seed 000 sec. 4). A strip standing for `k` strands is drawn at least `sqrt(k)` times one
+//! strand's drawn width, the smaller of a pixel and its own (seed 000's cluster diameter
+//! `2 r sqrt(n / rho)` with `rho = 1`, capped by the bundle), and its opacity is that of `k`
+//! strands lying independently across it.
 
-/// Least drawn width of a strip of `thickness` strands, for pixel size `pixel` and bundle size
-/// `cap` (same units); `term` off gives the single-strand one pixel.
-pub fn cluster_min_width(pixel: f32, thickness: f32, cap: f32, term: bool) -> f32 {
+/// Least drawn width of a strip of `thickness` strands each `single` wide, for pixel size
+/// `pixel` and bundle size `cap` (same units); `term` off gives the single-strand one pixel.
+pub fn cluster_min_width(pixel: f32, thickness: f32, cap: f32, single: f32, term: bool) -> f32 {
     if !term {
         return pixel;
     }
-    pixel.max((thickness.max(1.0).sqrt() * pixel).min(cap))
+    pixel.max((thickness.max(1.0).sqrt() * pixel.min(single)).min(cap))
 }
 
 /// Opacity of a strip of `thickness` strands whose single-strand opacity over the pixel is
@@ -29,7 +30,7 @@ mod tests {
     fn one_strand_is_unchanged_and_clusters_saturate() {
         assert_eq!(cluster_opacity(0.7, 1.0, true), 0.7);
         assert_eq!(cluster_opacity(0.7, 8.0, false), 0.7);
-        assert_eq!(cluster_min_width(0.01, 1.0, 1.0, true), 0.01);
+        assert_eq!(cluster_min_width(0.01, 1.0, 1.0, 0.02, true), 0.01);
         // Poisson limit exp(-a) from above, monotone in k.
         let mut last = 0.7;
         for k in [2.0, 4.0, 16.0, 256.0, 4096.0] {
@@ -38,9 +39,12 @@ mod tests {
             last = a;
         }
         assert!((last - (1.0 - (-0.7f32).exp())).abs() < 1e-3);
-        // sqrt(k) pixels, capped by the bundle, never under a pixel.
-        assert!((cluster_min_width(0.01, 16.0, 1.0, true) - 0.04).abs() < 1e-6);
-        assert_eq!(cluster_min_width(0.01, 16.0, 0.02, true), 0.02);
-        assert_eq!(cluster_min_width(0.01, 16.0, 0.001, true), 0.01);
+        // sqrt(k) pixels for strands a pixel wide or more, capped by the bundle, never under a
+        // pixel; sqrt(k) strand widths for thinner ones.
+        assert!((cluster_min_width(0.01, 16.0, 1.0, 0.02, true) - 0.04).abs() < 1e-6);
+        assert_eq!(cluster_min_width(0.01, 16.0, 0.02, 0.02, true), 0.02);
+        assert_eq!(cluster_min_width(0.01, 16.0, 0.001, 0.02, true), 0.01);
+        assert!((cluster_min_width(0.01, 64.0, 1.0, 0.002, true) - 0.016).abs() < 1e-6);
+        assert_eq!(cluster_min_width(0.01, 4.0, 1.0, 0.002, true), 0.01);
     }
 }

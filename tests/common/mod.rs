@@ -253,8 +253,10 @@ pub fn lod_view_with(
         fov_y: cam.fov_y,
         alpha_strands: lod.alpha_strands,
         area_below: lod.area_below,
+        strands_per_pixel: lod.strands_per_pixel,
         alpha_verts: lod.alpha_verts,
         lambda: lod.lambda,
         strand_share: 1.0,
+        pressure: 1.0,
     }
 }

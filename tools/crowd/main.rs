@@ -20,7 +20,7 @@ use glam::Vec3;
 use hairmesh::animate::{CharacterMotion, CrowdAnimation, Wind};
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::characters::own::OwnCharacter;
-use hairmesh::characters::preset::{self, Preset, SPACING};
+use hairmesh::characters::preset::{self, Preset, SPACING, StrandDensity};
 use hairmesh::fsutil::{RunFiles, StagedFolder};
 use hairmesh::render::{
     Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
@@ -91,10 +91,14 @@ pub struct Args {
     /// Seed of the hairstyles and placement.
     #[arg(long, default_value_t = 1)]
     seed: u32,
-    /// Strands per bundle of 24 cm² of scalp (people with coarser hair meshes get
-    /// proportionally more per bundle, so every head has at least that density).
-    #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    strands_per_bundle: u32,
+    /// Strands per cm² of scalp: a real head carries about 150 (90-150K strands on a full
+    /// head; the level of detail draws what the pixels need). Fur grows 96 per bundle.
+    #[arg(long, default_value_t = hairmesh::characters::hairstyle::SCALP_STRANDS_PER_CM2)]
+    strands_per_cm2: f32,
+    /// Instead of --strands-per-cm2: strands per bundle of 24 cm² of scalp (people with
+    /// coarser hair meshes get proportionally more per bundle), and per bundle of fur.
+    #[arg(long, conflicts_with = "strands_per_cm2", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    strands_per_bundle: Option<u32>,
     /// Vertices per strand are 2^e + 1 (e in 0..=6).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=6))]
     verts_log2: u32,
@@ -157,6 +161,11 @@ pub struct Args {
     /// FLIP 0.011 against off.
     #[arg(long, default_value_t = hairmesh::render::CROWD_AREA_BELOW)]
     lod_area_below: f32,
+    /// At most this many strands per square pixel of a bundle's extent (0: off): at crowd
+    /// distance a bundle draws the strands the pixels it covers need, whatever the density,
+    /// thickened to keep its coverage.
+    #[arg(long, default_value_t = hairmesh::render::CROWD_STRANDS_PER_PIXEL)]
+    lod_strands_per_pixel: f32,
     /// Alpha of eq. 7 for vertex LoD.
     #[arg(long, default_value_t = 0.1)]
     lod_alpha_verts: f32,
@@ -285,10 +294,7 @@ impl Scene {
                 .msaa(args.msaa)
                 .max_characters(args.count),
         )?;
-        let params = StrandParams {
-            strands_per_bundle: args.strands_per_bundle,
-            verts_log2: args.verts_log2,
-        };
+        let density = args.density();
         let meshes = preset::prop_meshes()?;
         renderer.set_prop_meshes(&meshes)?;
         renderer.set_prop_instances(&preset::world_props())?;
@@ -304,7 +310,10 @@ impl Scene {
             }
         }
         for (c, b) in self.characters.iter().zip(&self.baked) {
-            let id = renderer.add_character(b, &c.hair.style, c.strand_params(params), c.model)?;
+            let params = c
+                .strand_params_at(density, args.verts_log2)
+                .map_err(|e| anyhow::anyhow!("--strands-per-cm2 {}: {e}", args.strands_per_cm2))?;
+            let id = renderer.add_character(b, &c.hair.style, params, c.model)?;
             // Heads and bodies move with their characters: drawn at the same model as the hair.
             preset::dress(&mut renderer, id, c)?;
         }
@@ -408,12 +417,33 @@ impl Scene {
         self.characters.len()
     }
 
-    /// The strand settings of character `i` when the crowd asks for `crowd` (fur caps the
-    /// vertex level).
-    pub fn strand_params(&self, i: usize, crowd: StrandParams) -> StrandParams {
-        self.characters
-            .get(i)
-            .map_or(crowd, |c| c.strand_params(crowd))
+    /// The strand settings of character `i` at `density` and full vertex level `verts_log2`
+    /// (fur caps the vertex level).
+    pub fn strand_params(
+        &self,
+        i: usize,
+        density: StrandDensity,
+        verts_log2: u32,
+    ) -> Result<StrandParams> {
+        let c = self.characters.get(i).context("no such character")?;
+        Ok(c.strand_params_at(density, verts_log2)?)
+    }
+
+    /// Strands every character grows at full detail at `density` (the frame line's "of").
+    pub fn full_strands(&self, density: StrandDensity, verts_log2: u32) -> Result<u64> {
+        let mut total = 0u64;
+        for (i, b) in self.baked.iter().enumerate() {
+            let n = self
+                .strand_params(i, density, verts_log2)?
+                .strands_per_bundle;
+            let style = &self.characters[i].hair.style;
+            total += b
+                .bundles
+                .iter()
+                .map(|d| hairmesh::reference::generate::strands_in_bundle(d, style, n) as u64)
+                .sum::<u64>();
+        }
+        Ok(total)
     }
 }
 
@@ -459,12 +489,22 @@ fn check_memory(args: &Args) -> Result<()> {
 }
 
 impl Args {
+    /// The crowd's strand density: `--strands-per-bundle` where given, else
+    /// `--strands-per-cm2`.
+    pub fn density(&self) -> StrandDensity {
+        match self.strands_per_bundle {
+            Some(n) => StrandDensity::PerReferenceBundle(n),
+            None => StrandDensity::PerCm2(self.strands_per_cm2),
+        }
+    }
+
     /// Level of detail as the flags ask (checked by `check_args`).
     fn lod_settings(&self) -> LodSettings {
         if self.lod {
             LodSettings {
                 alpha_strands: self.lod_alpha_strands,
                 area_below: self.lod_area_below,
+                strands_per_pixel: self.lod_strands_per_pixel,
                 alpha_verts: self.lod_alpha_verts,
                 ..LodSettings::crowd()
             }
@@ -556,6 +596,7 @@ fn check_unused(p: &hairmesh::cli::Parsed<Args>) -> Result<(), String> {
         "lod_appearance",
         "lod_alpha_strands",
         "lod_area_below",
+        "lod_strands_per_pixel",
         "lod_alpha_verts",
     ] {
         p.unused_unless(id, a.lod, "--lod is off")?;
@@ -594,8 +635,16 @@ fn check_args(p: &hairmesh::cli::Parsed<Args>) -> Result<Checked> {
             args.wind_dir
         );
     }
+    if !(args.strands_per_cm2 > 0.0 && args.strands_per_cm2 <= 2000.0) {
+        bail!(
+            "--strands-per-cm2 {}: must be above 0 and at most 2000",
+            args.strands_per_cm2
+        );
+    }
     args.lod_settings().validate().map_err(|e| {
-        anyhow::anyhow!("--lod-alpha-strands / --lod-area-below / --lod-alpha-verts: {e}")
+        anyhow::anyhow!(
+            "--lod-alpha-strands / --lod-area-below / --lod-strands-per-pixel / --lod-alpha-verts: {e}"
+        )
     })?;
     let settings = args.frame_settings();
     if let Err(why) = settings.check_combination() {
@@ -685,6 +734,7 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
         renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64
     )?;
     let lod = args.lod_settings();
+    let full = scene.full_strands(args.density(), args.verts_log2)?;
     for f in 0..args.frames {
         let camera = match args.view.as_str() {
             "orbit" => hairmesh::characters::preset::orbit_camera(
@@ -777,7 +827,7 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
             report.scope_summary(" ")
         ));
         outln!(
-            "frame {f}: {:?} path, {} strands, {} triangles, LoD pressure {pressure:.3}, {dropped}, volumes {} alone + {} blended, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
+            "frame {f}: {:?} path, {} of {full} strands, {} triangles, LoD pressure {pressure:.3}, {dropped}, volumes {} alone + {} blended, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
             report.path,
             s.strands_drawn,
             s.triangles_drawn,

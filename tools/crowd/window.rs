@@ -14,14 +14,14 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use glam::Vec3;
-use hairmesh::characters::preset;
+use hairmesh::characters::preset::{self, StrandDensity};
 use hairmesh::outln;
 use hairmesh::render::Temporal;
 use hairmesh::render::soft::{DEFAULT_SOFT_K, StrandRaster};
 use hairmesh::render::transparency::{DEFAULT_OIT_BUDGET, DEFAULT_PEEL_LAYERS, MAX_OIT_BUDGET};
 use hairmesh::render::{
     Camera, FrameOptions, FrameReport, FrameTicket, LightRaster, LodSettings, PresentTarget,
-    RenderPath, Renderer, ShadowMode, StrandParams, Transparency, View,
+    RenderPath, Renderer, ShadowMode, Transparency, View,
 };
 use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{
@@ -54,7 +54,7 @@ struct Controls {
     dynamics: hairmesh::animate::DynamicsPath,
     schedule: bool,
     wind: hairmesh::animate::Wind,
-    params: StrandParams,
+    strands: Strands,
     lod: LodSettings,
     path: RenderPath,
     paused: bool,
@@ -76,13 +76,20 @@ impl Controls {
             .default_width(260.0)
             .show(ctx, |ui| {
                 ui.add(egui::Slider::new(&mut self.visible, 1..=total.max(1)).text("characters"));
+                match &mut self.strands.density {
+                    StrandDensity::PerCm2(d) => ui.add(
+                        egui::Slider::new(d, 1.0..=600.0)
+                            .logarithmic(true)
+                            .text("strands per cm²"),
+                    ),
+                    StrandDensity::PerReferenceBundle(n) => ui.add(
+                        egui::Slider::new(n, 1..=16384)
+                            .logarithmic(true)
+                            .text("strands per bundle"),
+                    ),
+                };
                 ui.add(
-                    egui::Slider::new(&mut self.params.strands_per_bundle, 1..=1024)
-                        .logarithmic(true)
-                        .text("strands per bundle"),
-                );
-                ui.add(
-                    egui::Slider::new(&mut self.params.verts_log2, 0..=6).text("vertex level e"),
+                    egui::Slider::new(&mut self.strands.verts_log2, 0..=6).text("vertex level e"),
                 );
                 ui.checkbox(&mut self.lod.enabled, "level of detail");
                 ui.add_enabled(
@@ -307,6 +314,26 @@ struct Panel {
 
 /// Everything that exists while the window does. Field order is drop order: Vulkan objects
 /// first, the window last (the surface must not outlive it).
+/// How densely the crowd grows its strands, and their full vertex level.
+#[derive(Clone, Copy, PartialEq)]
+struct Strands {
+    density: StrandDensity,
+    verts_log2: u32,
+}
+
+impl Strands {
+    /// The density scaled by `factor` (the `[` and `]` keys).
+    fn scaled(self, factor: f32) -> Self {
+        let density = match self.density {
+            StrandDensity::PerCm2(d) => StrandDensity::PerCm2((d * factor).clamp(1.0, 2000.0)),
+            StrandDensity::PerReferenceBundle(n) => StrandDensity::PerReferenceBundle(
+                ((n as f32 * factor).round() as u32).clamp(1, 16384),
+            ),
+        };
+        Strands { density, ..self }
+    }
+}
+
 struct Running {
     panel: Panel,
     swapchain: Option<Swapchain>,
@@ -318,9 +345,9 @@ struct Running {
     recreate: bool,
     present_mode: PresentMode,
     camera: OrbitCamera,
-    params: StrandParams,
-    /// Highest vertex level of each character (fur caps it), in the order they were added.
-    verts_caps: Vec<u32>,
+    strands: Strands,
+    /// The crowd (each character's strand settings follow from `strands` and its hair).
+    scene: Arc<Scene>,
     path: RenderPath,
     shading: ShadingModel,
     shadows: ShadowMode,
@@ -355,7 +382,7 @@ struct Running {
 
 struct App {
     args: Args,
-    scene: Scene,
+    scene: Arc<Scene>,
     running: Option<Running>,
     error: Option<anyhow::Error>,
     presented: u64,
@@ -372,7 +399,7 @@ pub fn run(args: Args, scene: Scene) -> Result<()> {
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         args,
-        scene,
+        scene: Arc::new(scene),
         running: None,
         error: None,
         presented: 0,
@@ -478,19 +505,11 @@ impl App {
                 distance: (side * 0.9 * 0.8).max(1.8),
                 fly: false,
             },
-            params: StrandParams {
-                strands_per_bundle: self.args.strands_per_bundle,
+            strands: Strands {
+                density: self.args.density(),
                 verts_log2: self.args.verts_log2,
             },
-            verts_caps: (0..self.scene.character_count())
-                .map(|i| {
-                    let most = StrandParams {
-                        strands_per_bundle: 1,
-                        verts_log2: 6,
-                    };
-                    self.scene.strand_params(i, most).verts_log2
-                })
-                .collect(),
+            scene: Arc::clone(&self.scene),
             path,
             shading: self.args.shading,
             shadows: self.args.shadows,
@@ -677,7 +696,7 @@ impl Running {
             dynamics: self.animation.path,
             schedule: self.animation.schedule,
             wind: self.animation.wind,
-            params: self.params,
+            strands: self.strands,
             lod: self.panel.lod,
             path: self.path,
             paused: self.paused,
@@ -744,8 +763,8 @@ impl Running {
             }
             self.panel.visible = c.visible;
         }
-        if c.params != self.params {
-            self.set_params(c.params)?;
+        if c.strands != self.strands {
+            self.set_strands(c.strands)?;
         }
         if c.present_mode != self.present_mode {
             self.present_mode = c.present_mode;
@@ -852,7 +871,7 @@ impl Running {
             String::new()
         };
         self.window.set_title(&format!(
-            "hairmesh crowd - {scene_len} characters, {:.1} fps, GPU {} ms, CPU {:.2} ms, {} strands, {} tris, tex {:.1} MiB{pool}, {:?}, LoD {}, {:?}, N {} e {}",
+            "hairmesh crowd - {scene_len} characters, {:.1} fps, GPU {} ms, CPU {:.2} ms, {} strands, {} tris, tex {:.1} MiB{pool}, {:?}, LoD {}, {:?}, {} e {}",
             self.fps,
             passes.join(" / "),
             r.record_ms,
@@ -862,25 +881,34 @@ impl Running {
             self.path,
             if self.panel.lod.enabled { "on" } else { "off" },
             self.swapchain.as_ref().map_or(self.present_mode, |s| s.present_mode),
-            self.params.strands_per_bundle,
-            self.params.verts_log2,
+            match self.strands.density {
+                StrandDensity::PerCm2(d) => format!("{d:.0} strands per cm²"),
+                StrandDensity::PerReferenceBundle(n) => format!("N {n}"),
+            },
+            self.strands.verts_log2,
         ));
     }
 
-    fn set_params(&mut self, params: StrandParams) -> Result<()> {
-        if params.validate().is_err() {
-            return Ok(());
-        }
-        self.params = params;
+    /// Grow every character at `strands` (each its own strands per bundle, fur its own vertex
+    /// cap); a density a character cannot hold, or settings the renderer refuses, leave the
+    /// crowd as it was.
+    fn set_strands(&mut self, strands: Strands) -> Result<()> {
         // Characters were added in order into slots 0.. and never removed: ids() is in that
         // order.
         let ids: Vec<_> = self.renderer.crowd().ids();
-        for (id, cap) in ids.into_iter().zip(&self.verts_caps) {
-            let own = StrandParams {
-                verts_log2: params.verts_log2.min(*cap),
-                ..params
-            };
-            self.renderer.set_params(id, own)?;
+        let mut params = Vec::with_capacity(ids.len());
+        for i in 0..ids.len() {
+            match self
+                .scene
+                .strand_params(i, strands.density, strands.verts_log2)
+            {
+                Ok(p) if p.validate().is_ok() => params.push(p),
+                _ => return Ok(()),
+            }
+        }
+        self.strands = strands;
+        for (id, p) in ids.into_iter().zip(params) {
+            self.renderer.set_params(id, p)?;
         }
         Ok(())
     }
@@ -943,21 +971,15 @@ impl Running {
                 };
                 self.recreate = true;
             }
-            KeyCode::BracketLeft => self.set_params(StrandParams {
-                strands_per_bundle: (self.params.strands_per_bundle / 2).max(1),
-                ..self.params
+            KeyCode::BracketLeft => self.set_strands(self.strands.scaled(0.5))?,
+            KeyCode::BracketRight => self.set_strands(self.strands.scaled(2.0))?,
+            KeyCode::Minus => self.set_strands(Strands {
+                verts_log2: self.strands.verts_log2.saturating_sub(1),
+                ..self.strands
             })?,
-            KeyCode::BracketRight => self.set_params(StrandParams {
-                strands_per_bundle: self.params.strands_per_bundle * 2,
-                ..self.params
-            })?,
-            KeyCode::Minus => self.set_params(StrandParams {
-                verts_log2: self.params.verts_log2.saturating_sub(1),
-                ..self.params
-            })?,
-            KeyCode::Equal => self.set_params(StrandParams {
-                verts_log2: self.params.verts_log2 + 1,
-                ..self.params
+            KeyCode::Equal => self.set_strands(Strands {
+                verts_log2: (self.strands.verts_log2 + 1).min(6),
+                ..self.strands
             })?,
             _ => {}
         }
