@@ -104,13 +104,15 @@ uint bundle_strand_count(GpuBundle desc) {
 
 // The share of its strands every bundle of a kind keeps when the view's LoD asks for
 // `demand` items (units of LOD_DEMAND_UNIT, summed by cull.comp) of a buffer of `budget`:
-// 1 when they fit, else (budget - slack) / demand. CPU twin: reference::lod::lod_pressure.
+// 1 when they fit, else (budget - slack) / demand, at least LOD_LEAST_PRESSURE (every visible
+// bundle keeps a strand). CPU twin: reference::lod::lod_pressure.
 float lod_pressure(uint demand, uint slack, uint budget) {
     float d = float(demand) * float(LOD_DEMAND_UNIT);
     if (d <= float(budget)) {
         return 1.0;
     }
-    return clamp((float(budget) - float(slack) * float(LOD_DEMAND_UNIT)) / d, 0.0, 1.0);
+    float p = (float(budget) - float(slack) * float(LOD_DEMAND_UNIT)) / d;
+    return clamp(p, LOD_LEAST_PRESSURE, 1.0);
 }
 
 // Eq. 8's width factor min(1/L, N) for `strands` strands at level `level` of a bundle of

@@ -154,7 +154,7 @@ fn vertex_pool_overflow_keeps_whole_strands_and_is_reported() {
     println!("overflow: {s:?}");
     // LoD pressure thinned every bundle to one strand (one strand of each of the 3,277
     // visible bundles is more than the pool holds): the rest is dropped and reported.
-    assert_eq!(out.lod_pressure(), 0.0);
+    assert!(out.lod_pressure() <= hairmesh::render::shared::LOD_LEAST_PRESSURE);
     assert_eq!(out.dropped().strands, s.strands_demanded - s.strands_drawn);
     assert_eq!(s.strands_demanded, s.bundles_visible);
     assert!(s.vertex_slots_demanded > r.vertex_budget());

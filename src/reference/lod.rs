@@ -82,9 +82,12 @@ pub fn thickness_scale(l: f32, n: u32) -> f32 {
 
 /// The share of every bundle's strands a view keeps when its bundles' LoD asks for `demand`
 /// items (segments or vertex slots, in units of [`LOD_DEMAND_UNIT`]) of a buffer that holds
-/// `budget` items: 1 when it fits, else `(budget - slack) / demand` (at least 0), where `slack`
-/// is what eq. 8's ceiling can add, one strand per bundle, so the kept strands fit even after
-/// rounding up (GLSL: `lod_pressure` in `bundle_lod.glsl`).
+/// `budget` items: 1 when it fits, else `(budget - slack) / demand`, where `slack` is what eq.
+/// 8's ceiling can add, one strand per bundle, so the kept strands fit even after rounding up;
+/// at least [`LOD_LEAST_PRESSURE`], so every visible bundle keeps a strand (GLSL:
+/// `lod_pressure` in `bundle_lod.glsl`).
+///
+/// [`LOD_LEAST_PRESSURE`]: crate::render::shared::LOD_LEAST_PRESSURE
 ///
 /// [`LOD_DEMAND_UNIT`]: crate::render::shared::LOD_DEMAND_UNIT
 pub fn lod_pressure(demand: u32, slack: u32, budget: u32) -> f32 {
@@ -92,7 +95,7 @@ pub fn lod_pressure(demand: u32, slack: u32, budget: u32) -> f32 {
     let (demand, slack, budget) = (demand as f32 * unit, slack as f32 * unit, budget as f32);
     match demand <= budget {
         true => 1.0,
-        false => ((budget - slack) / demand).clamp(0.0, 1.0),
+        false => ((budget - slack) / demand).clamp(crate::render::shared::LOD_LEAST_PRESSURE, 1.0),
     }
 }
 

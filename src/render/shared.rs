@@ -72,6 +72,9 @@ pub const LOD_SOFT: u32 = 256;
 /// Unit of the bundle LoD pass's demand counters ([`FrameStats::soft_demand`] and the
 /// others): segments or vertex slots, so a crowd's sum stays inside 32 bits.
 pub const LOD_DEMAND_UNIT: u32 = 64;
+/// The least LoD pressure: a view that cannot fit even one strand a bundle keeps one strand a
+/// bundle (and reports what its buffers drop).
+pub const LOD_LEAST_PRESSURE: f32 = 1e-6;
 /// Invocations of one `hair_mesh_update.comp` workgroup.
 pub const DEFORM_GROUP_SIZE: u32 = 64;
 /// Invocations of one `hair_dynamics.comp` workgroup (one workgroup simulates one character)
@@ -1236,6 +1239,7 @@ fn float_constants() -> Vec<(&'static str, f32)> {
         ("STRAND_OPACITY", STRAND_OPACITY),
         ("SOFT_HIDDEN_TRANSMITTANCE", SOFT_HIDDEN_TRANSMITTANCE),
         ("OIT_FIXED", OIT_FIXED),
+        ("LOD_LEAST_PRESSURE", LOD_LEAST_PRESSURE),
         ("SHAPE_TIP_LOSS", crate::dynamics::SHAPE_TIP_LOSS),
         ("BOUND_SLACK", crate::dynamics::BOUND_SLACK),
         ("BOUND_PAD", crate::dynamics::BOUND_PAD),
