@@ -16,11 +16,14 @@ float pixel_size(vec3 pos) {
 }
 
 // Width the strip is drawn with: the strand's (LoD-thickened) width, at least one pixel; with
-// the thick-strand term, at least the pixels of the `thickness` strands it stands for, capped
-// by the bundle's size `cap` (lod_appearance.glsl).
+// the thick-strand term, at least the pixels of the `thickness` one-pixel strips it stands for
+// (sqrt(k) pixels), capped by the bundle's size `cap` (lod_appearance.glsl).
 float drawn_width(vec3 pos, float width, float thickness, float cap) {
-    float single = width / max(thickness, 1.0);
-    return max(width, cluster_min_width(pixel_size(pos), thickness, cap, single));
+    // A strip's single strand is drawn at least a pixel wide at full detail, so its cluster's
+    // footprint counts pixels.
+    float pixel = pixel_size(pos);
+    float single = max(width / max(thickness, 1.0), pixel);
+    return max(width, cluster_min_width(pixel, thickness, cap, single));
 }
 
 vec3 strip_offset(vec3 pos, vec3 tangent, float drawn, float side) {

@@ -195,7 +195,7 @@ fn absurd_arguments_are_refused_before_allocating() {
         (vec!["animate", "--counts", "1,5000"], "--counts"),
         (vec!["animate", "--dynamics", "gpu,fpga"], "--dynamics"),
         (
-            vec!["crowd", "--strands-per-bundle", "5000"],
+            vec!["crowd", "--strands-per-bundle", "50000"],
             "--strands-per-bundle",
         ),
     ] {

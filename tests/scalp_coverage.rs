@@ -9,6 +9,7 @@ use glam::{Mat4, Vec3};
 use hairmesh::characters::hairstyle::{StyleFamily, generate};
 use hairmesh::characters::human::smooth_prop_mesh;
 use hairmesh::characters::person::{PersonShape, head_mesh};
+use hairmesh::characters::scalp::scalp_triangles;
 use hairmesh::render::shared::PropInstance;
 use hairmesh::render::{Camera, StrandParams};
 use hairmesh::{BakeOptions, bake};
@@ -22,35 +23,6 @@ use hairmesh::{BakeOptions, bake};
 /// the chords between root corners, and bundle interiors lifted outside the head where
 /// neighbouring columns spread or part (`hairstyle::lift_bundle_interiors`).
 const MIN_COVERAGE: f64 = 0.98;
-
-/// The root faces of `mesh`, each cut into `k x k` and laid 1.5 mm above the head.
-fn scalp_mesh(mesh: &hairmesh::HairMesh, person: &PersonShape, k: usize) -> Vec<[Vec3; 3]> {
-    let head = person.head().unwrap();
-    let roots = &mesh.layers[0];
-    let mut tris = Vec::new();
-    for f in &mesh.faces {
-        let v: Vec<Vec3> = f.vertices().iter().map(|&i| roots[i as usize]).collect();
-        let (a, b, c, d) = match v.as_slice() {
-            [a, b, c] => (*a, *b, *c, *c),
-            [a, b, c, d] => (*a, *b, *c, *d),
-            _ => unreachable!(),
-        };
-        let at = |s: f32, t: f32| {
-            let p = a.lerp(b, s).lerp(d.lerp(c, s), t);
-            head.project(p, 0.0015)
-        };
-        for i in 0..k {
-            for j in 0..k {
-                let (s0, s1) = (i as f32 / k as f32, (i + 1) as f32 / k as f32);
-                let (t0, t1) = (j as f32 / k as f32, (j + 1) as f32 / k as f32);
-                let (p00, p10, p11, p01) = (at(s0, t0), at(s1, t0), at(s1, t1), at(s0, t1));
-                tris.push([p00, p10, p11]);
-                tris.push([p00, p11, p01]);
-            }
-        }
-    }
-    tris
-}
 
 fn blue_pixels(rgba: &[u8]) -> usize {
     rgba.chunks(4)
@@ -78,7 +50,7 @@ fn hair_covers_the_scalp_seen_from_above() {
         let id = r
             .add_character(&baked, &hair.style, params, Mat4::IDENTITY)
             .unwrap();
-        let scalp = smooth_prop_mesh(&scalp_mesh(&hair.mesh, &person, 8));
+        let scalp = smooth_prop_mesh(&scalp_triangles(&hair.mesh, &person.head().unwrap(), 8));
         r.set_prop_meshes(&[head_mesh().unwrap(), scalp]).unwrap();
         let prop = |mesh: usize, model: Mat4, color: [f32; 4]| {
             (

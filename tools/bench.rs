@@ -41,6 +41,8 @@ mod defaults;
 mod paper;
 #[path = "bench/raster.rs"]
 mod raster;
+#[path = "bench/scalp.rs"]
+mod scalp;
 #[path = "bench/temporal.rs"]
 mod temporal;
 #[path = "bench/volume_tier.rs"]
@@ -187,6 +189,10 @@ enum Cmd {
     /// frames (bare strands soft and hw on both paths at 20K and 100K, the full look, the
     /// people crowd at 100 and 1000) alternating old and new, print new/old per row.
     Compare(compare::CompareArgs),
+    /// Scalp show-through of every family's portrait at each density: the share of the
+    /// scalp's pixels whose light through the hair is above one half (a real head: only at
+    /// partings and the hairline).
+    Scalp(scalp::ScalpArgs),
     /// FLIP (nv-flip) of a test picture against a reference of the same size: mean and 99th
     /// percentile, as the golden tests and `compare` measure.
     Flip {
@@ -825,6 +831,7 @@ fn run(args: Args) -> Result<()> {
         })?,
         Cmd::Temporal(args) => temporal::bench_temporal(args)?,
         Cmd::Compare(args) => compare::bench_compare(args)?,
+        Cmd::Scalp(args) => scalp::bench_scalp(args)?,
         Cmd::Flip { reference, test } => compare::print_flip(&reference, &test)?,
         Cmd::Fuzz {
             iterations,

@@ -385,6 +385,18 @@ pub fn dress(
     Ok(())
 }
 
+/// A portrait of the head of a person whose hair is placed by `model`: from the front, side or
+/// back (`view`), at eye height, 0.8 m away (`crowd --view front|side|back`).
+pub fn portrait_camera(model: Mat4, view: &str) -> crate::render::Camera {
+    let eye_local = match view {
+        "side" => Vec3::new(0.8, 1.6, 0.0),
+        "back" => Vec3::new(0.0, 1.62, -0.8),
+        _ => Vec3::new(0.0, 1.6, 0.8),
+    };
+    let at = model.transform_point3(Vec3::new(0.0, 1.52, 0.0));
+    crate::render::Camera::look_at(model.transform_point3(eye_local), at, 35.0)
+}
+
 /// Prop meshes of crowds, indexed by [`prop_mesh`].
 pub fn prop_meshes() -> Result<Vec<Vec<PropVertex>>> {
     let ball = ball_head();

@@ -206,18 +206,6 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
     hairmesh::render::scene::parse_size(s).map_err(anyhow::Error::msg)
 }
 
-/// A portrait of the head of a character placed by `model`: from the front, side or back,
-/// at eye height, 0.8 m away.
-pub fn portrait_camera(model: glam::Mat4, view: &str) -> Camera {
-    let eye_local = match view {
-        "side" => Vec3::new(0.8, 1.6, 0.0),
-        "back" => Vec3::new(0.0, 1.62, -0.8),
-        _ => Vec3::new(0.0, 1.6, 0.8),
-    };
-    let at = model.transform_point3(Vec3::new(0.0, 1.52, 0.0));
-    Camera::look_at(model.transform_point3(eye_local), at, 35.0)
-}
-
 /// The crowd: generated characters and their bakes.
 pub struct Scene {
     characters: Vec<preset::CrowdCharacter>,
@@ -759,7 +747,7 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
                     Some(w) => w.frame(animation.time() + dt)?.hair,
                     None => characters[0].model,
                 };
-                portrait_camera(model, view)
+                preset::portrait_camera(model, view)
             }
         };
         // Headless frames are 1/30 s apart in animation time.
