@@ -211,3 +211,53 @@ fn roots_stay_on_the_drawn_scalp_in_an_animated_crowd() {
     assert!(worst < 0.01, "roots {worst} head radii from the scalp");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// A real head's strand count (issue 64): at the crowd's 150 strands per cm² every family grows
+/// 150 strands on each cm² of the scalp it covers (within the rounding of its strands per
+/// bundle), and every family that covers a whole adult head (600 cm² of scalp or more) grows
+/// 90-150K strands, as a real head does; the mohawk by its strip's own area. The people's
+/// heads differ: over 39 people a family covers 521-888 cm² (78-133K strands; the smallest
+/// heads under 90K). The table (family, scalp cm², strands) is printed for the crowd chapter.
+#[test]
+fn every_family_grows_a_real_heads_count() {
+    use hairmesh::characters::hairstyle::SCALP_STRANDS_PER_CM2;
+    use hairmesh::characters::preset::{Preset, StrandDensity, build_families};
+    use hairmesh::reference::generate::strands_in_bundle;
+    println!("| family | scalp cm² | strands per bundle | strands |");
+    for family in StyleFamily::PEOPLE {
+        for seed in [1, 2, 3] {
+            let c = build_families(Preset::People, 1, seed, &[family])
+                .unwrap()
+                .remove(0);
+            let density = StrandDensity::PerCm2(SCALP_STRANDS_PER_CM2);
+            let n = c.strand_params_at(density, 4).unwrap().strands_per_bundle;
+            let b = bake(
+                &c.hair.mesh,
+                &c.hair.style,
+                BakeOptions::default(),
+                |_, _| {},
+            )
+            .unwrap();
+            let strands: u64 = b
+                .bundles
+                .iter()
+                .map(|d| strands_in_bundle(d, &c.hair.style, n) as u64)
+                .sum();
+            let cm2 = c.hair.scalp_cm2(1.0);
+            if seed == 1 {
+                println!("| {} | {cm2:.0} | {n} | {strands} |", family.name());
+            }
+            let per_cm2 = strands as f32 / cm2;
+            assert!(
+                (per_cm2 - SCALP_STRANDS_PER_CM2).abs() < 0.03 * SCALP_STRANDS_PER_CM2,
+                "{family:?} #{seed}: {per_cm2:.1} strands per cm² over {cm2:.0} cm²"
+            );
+            if family != StyleFamily::Mohawk && cm2 >= 600.0 {
+                assert!(
+                    (90_000..=150_000).contains(&strands),
+                    "{family:?} #{seed}: {strands} strands on {cm2:.0} cm²"
+                );
+            }
+        }
+    }
+}
