@@ -331,11 +331,16 @@ fn grow_on_head(args: &Args, head: &Path, out: &Path) -> Result<()> {
             args.seed
         );
         let bytes = hair_mesh_obj_bytes(&hair.mesh, &comment)?;
+        // A real head's density on this head's scalp, in its own units.
+        let metres = 1.0 / any.scale;
+        let per_cm2 = hairmesh::characters::hairstyle::SCALP_STRANDS_PER_CM2;
+        let n = hair.strands_per_bundle_at(per_cm2, metres)?;
         let line = format!(
-            "{}: {} bundles, {} layers",
+            "{}: {} bundles, {} layers, {:.0} cm² of scalp: {n} strands per bundle for {per_cm2} per cm² (render --strands-per-bundle {n})",
             path.display(),
             hair.mesh.faces.len(),
-            hair.mesh.layer_count()
+            hair.mesh.layer_count(),
+            hair.scalp_cm2(metres)
         );
         files.push((obj_out, bytes, line));
         let style = path.with_extension("toml");
