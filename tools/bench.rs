@@ -37,6 +37,8 @@ mod animate;
 mod compare;
 #[path = "bench/defaults.rs"]
 mod defaults;
+#[path = "bench/lod.rs"]
+mod lod;
 #[path = "bench/paper.rs"]
 mod paper;
 #[path = "bench/raster.rs"]
@@ -88,30 +90,9 @@ enum Cmd {
         #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u16).range(1..=1000))]
         runs: u16,
     },
-    /// GPU LoD comparison at near / mid / far distances, both paths.
-    Lod {
-        /// Hair mesh (.obj or .hmb).
-        #[arg(long, default_value = "hairmeshes/head_long.obj")]
-        mesh: PathBuf,
-        /// Image width.
-        #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
-        width: u32,
-        /// Image height.
-        #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=8192))]
-        height: u32,
-        /// Strands per bundle.
-        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=16384))]
-        strands_per_bundle: u32,
-        /// Timed runs per configuration (after one warm-up).
-        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..=1000))]
-        runs: u16,
-        /// Choose the GPU by name substring.
-        #[arg(long)]
-        device: Option<String>,
-        /// Write a near / mid / far picture (LoD on) here.
-        #[arg(long)]
-        picture: Option<PathBuf>,
-    },
+    /// GPU LoD against full detail at near / mid / far distances, both paths: strands,
+    /// triangles, GPU ms and FLIP of LoD on against off.
+    Lod(lod::LodArgs),
     /// Fuzz every reader (OBJ + bake, style TOML, scene TOML, .hmb) with seeded mutations.
     Fuzz {
         /// Inputs per reader.
@@ -290,97 +271,10 @@ enum Cmd {
     },
 }
 
-fn bench_lod(
-    mesh: PathBuf,
-    width: u32,
-    height: u32,
-    n: u32,
-    runs: usize,
-    device: Option<String>,
-    picture: Option<PathBuf>,
-) -> Result<()> {
-    let picture = picture
-        .map(|p| OutputPath::check(&p, &[mesh.as_path()]))
-        .transpose()?;
-    let (baked, style) = load_mesh(&mesh, None, Default::default())?;
-    let ctx = Arc::new(Context::new(&ContextDesc::default().device(device))?);
-    let mut renderer = Renderer::new(&ctx, &RendererDesc::default().size(width, height))?;
-    renderer.add_character(
-        &baked,
-        &style,
-        StrandParams {
-            strands_per_bundle: n,
-            verts_log2: 5,
-        },
-        Mat4::IDENTITY,
-    )?;
-    let at = dolly(&baked);
-    let views = [("near", at(0.6)), ("mid", at(2.5)), ("far", at(8.0))];
-    outln!(
-        "device: {} ({}), {}x{}, {} strands/bundle, 33 vertices at full detail",
-        ctx.info.name,
-        ctx.info.driver,
-        width,
-        height,
-        n
-    )?;
-    outln!("| view | path | LoD | strands | triangles | GPU ms (median of {runs}) |")?;
-    outln!("|---|---|---|---|---|---|")?;
-    let mut paths = vec![RenderPath::Compute];
-    if renderer.has_mesh_path() {
-        paths.insert(0, RenderPath::Mesh);
-    }
-    let mut pics = Vec::new();
-    for (label, cam) in &views {
-        for &path in &paths {
-            for lod_on in [true, false] {
-                let view = bench_view(*cam, lod_on);
-                let opts = FrameOptions {
-                    path: Some(path),
-                    read_image: true,
-                    ..Default::default()
-                };
-                let first = renderer.render_one(&view, &opts)?;
-                let mut times = Vec::new();
-                for _ in 0..runs {
-                    times.push(
-                        renderer
-                            .render_one(
-                                &view,
-                                &FrameOptions {
-                                    read_image: false,
-                                    ..opts
-                                },
-                            )?
-                            .gpu_ms(),
-                    );
-                }
-                outln!(
-                    "| {label} | {path:?} | {} | {} | {} | {:.2} |",
-                    if lod_on { "on" } else { "off" },
-                    first.stats.strands_drawn,
-                    first.stats.triangles_drawn,
-                    median(times)
-                )?;
-                if lod_on && path == paths[0] {
-                    pics.push(first);
-                }
-            }
-        }
-    }
-    if let Some(p) = picture {
-        let images = pics.iter().map(|out| out.rgba.clone().context("no image"));
-        let strip = side_by_side(&[images.collect::<Result<_>>()?], (width, height))?;
-        let (w, h) = strip.dimensions();
-        write_png(&p, strip.into_raw(), w, h)?;
-    }
-    Ok(())
-}
-
 /// Cameras on the line from the mesh's framing view (40 degrees, `DEFAULT_VIEW_DIR`) to its
 /// target, `k` times the framing distance away: the near / mid / far views of `bench lod` and
 /// `bench raster`.
-fn dolly(baked: &hairmesh::BakedHairMesh) -> impl Fn(f32) -> Camera {
+pub(crate) fn dolly(baked: &hairmesh::BakedHairMesh) -> impl Fn(f32) -> Camera {
     let o = Vec3::from_slice(&baked.info.pos_origin[..3]);
     let e = Vec3::from_slice(&baked.info.pos_extent[..3]);
     let frame = Camera::framing(o, o + e, hairmesh::render::DEFAULT_VIEW_DIR, 40.0);
@@ -665,7 +559,7 @@ fn median_passes<'a>(first: &'a FrameReport, reports: &[FrameReport]) -> Vec<(&'
 }
 
 /// RGBA images of `size` laid out side by side, one row of the picture per row given.
-fn side_by_side(rows: &[Vec<Vec<u8>>], (w, h): (u32, u32)) -> Result<image::RgbaImage> {
+pub(crate) fn side_by_side(rows: &[Vec<Vec<u8>>], (w, h): (u32, u32)) -> Result<image::RgbaImage> {
     let cols = rows.iter().map(Vec::len).max().unwrap_or(0) as u32;
     let mut out = image::RgbaImage::new(w * cols, h * rows.len() as u32);
     for (r, row) in rows.iter().enumerate() {
@@ -679,7 +573,7 @@ fn side_by_side(rows: &[Vec<Vec<u8>>], (w, h): (u32, u32)) -> Result<image::Rgba
 }
 
 /// Write RGBA pixels as a PNG by the output policy.
-fn write_png(out: &OutputPath, rgba: Vec<u8>, width: u32, height: u32) -> Result<()> {
+pub(crate) fn write_png(out: &OutputPath, rgba: Vec<u8>, width: u32, height: u32) -> Result<()> {
     let png = hairmesh::fsutil::encode_png(&out.path().display().to_string(), width, height, rgba)?;
     out.write(&png)?;
     outln!("wrote {}", out.path().display())?;
@@ -733,7 +627,7 @@ fn bench_fuzz(
 
 /// The median of `v` (the mean of the middle two for an even count: two runs read their
 /// mean, not the slower one); NaN for none.
-fn median(mut v: Vec<f64>) -> f64 {
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     match v.len() {
         0 => f64::NAN,
@@ -869,25 +763,7 @@ fn run(args: Args) -> Result<()> {
             (draw, compare_defaults, volume_tier),
             band_strip,
         )?,
-        Cmd::Lod {
-            mesh,
-            width,
-            height,
-            strands_per_bundle,
-            runs,
-            device,
-            picture,
-        } => {
-            bench_lod(
-                mesh,
-                width,
-                height,
-                strands_per_bundle,
-                runs as usize,
-                device,
-                picture,
-            )?;
-        }
+        Cmd::Lod(args) => lod::bench_lod(args)?,
         Cmd::CpuGenerate {
             mesh,
             strands,

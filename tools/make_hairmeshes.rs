@@ -331,8 +331,9 @@ fn grow_on_head(args: &Args, head: &Path, out: &Path) -> Result<()> {
             args.seed
         );
         let bytes = hair_mesh_obj_bytes(&hair.mesh, &comment)?;
-        // A real head's density on this head's scalp, in its own units.
-        let metres = 1.0 / any.scale;
+        // A real head's density on this head's scalp: a glTF head is in metres; an OBJ head's
+        // units are its own, taken to be the size of Sintel's (an adult head).
+        let metres = head_metres_per_unit(head, &any);
         let per_cm2 = hairmesh::characters::hairstyle::SCALP_STRANDS_PER_CM2;
         let n = hair.strands_per_bundle_at(per_cm2, metres)?;
         let line = format!(
@@ -354,6 +355,19 @@ fn grow_on_head(args: &Args, head: &Path, out: &Path) -> Result<()> {
     let outputs: Vec<_> = files.iter().map(|(p, b, _)| (p, b.as_slice())).collect();
     hairmesh::fsutil::write_together(&outputs)?;
     Ok(())
+}
+
+/// Metres per unit of the head in `path`: glTF's are metres; an OBJ's units are taken from its
+/// size against Sintel's adult head (`AnyHead::scale` user units per canonical metre).
+fn head_metres_per_unit(path: &Path, any: &AnyHead) -> f32 {
+    let gltf = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+    match gltf {
+        true => 1.0,
+        false => 1.0 / any.scale,
+    }
 }
 
 /// The head in `path`: an OBJ whole, a glTF character's `joint` and below.

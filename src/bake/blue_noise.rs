@@ -221,8 +221,8 @@ pub fn extend_progressive(prefix: Vec<Vec2>, n: usize, domain: Domain, seed: u64
     current
 }
 
-/// Size of the shared root sample sets (the most strands one bundle can hold): 150 strands per
-/// cm² (a real scalp's density) over a bundle of up to 218 cm².
+/// Size of the shared root sample sets (the most strands one bundle can hold): 175 strands per
+/// cm² (a real scalp's density) over a bundle of up to 187 cm².
 pub const MAX_STRANDS_PER_BUNDLE: usize = 32768;
 
 /// The sizes the shared sets are computed to, each when first needed and by extending the one

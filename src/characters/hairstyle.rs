@@ -122,9 +122,11 @@ pub struct Hairstyle {
 /// families' 5x5 grid on an average scalp (22-25 cm² per bundle).
 pub const REFERENCE_BUNDLE_AREA: f32 = 24e-4;
 
-/// Strands per cm² of scalp on a real head (about 150-200 hairs per cm², 90-150K on a whole
-/// head): the crowd's, the window's and the Bevy plugin's density.
-pub const SCALP_STRANDS_PER_CM2: f32 = 150.0;
+/// Strands per cm² of scalp on a real head (150-200 hairs per cm², 90-150K on a whole head):
+/// the crowd's, the window's and the Bevy plugin's density. 175, the middle, gives the crowd's
+/// people (521-888 cm² of scalp) 91-156K strands and `character.glb` (524 cm²) 92K; 150 left
+/// its head and the smallest people's under 80K.
+pub const SCALP_STRANDS_PER_CM2: f32 = 175.0;
 
 impl Hairstyle {
     /// Strands per bundle for a crowd that asks for `asked` per reference bundle

@@ -100,7 +100,7 @@ pub const FUR_STRANDS_PER_BUNDLE: u32 = 96;
 /// How densely a crowd's heads grow their strands.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum StrandDensity {
-    /// Strands per cm² of scalp (a real head: about 150,
+    /// Strands per cm² of scalp (a real head: 150-200,
     /// [`SCALP_STRANDS_PER_CM2`](super::hairstyle::SCALP_STRANDS_PER_CM2)); fur grows
     /// [`FUR_STRANDS_PER_BUNDLE`].
     PerCm2(f32),

@@ -1,5 +1,5 @@
 //! The scalp a hairstyle grows from, as a surface to draw, and how much of it shows through
-//! the hair. A real scalp carries about 150 hairs per cm² and shows only at partings; the
+//! the hair. A real scalp carries 150-200 hairs per cm² and shows only at partings; the
 //! measure here says how far a picture is from that.
 //!
 //! The scalp is the hair mesh's root faces, each cut into `k x k` quads and laid just above

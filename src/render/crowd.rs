@@ -624,9 +624,9 @@ impl Crowd {
     }
 
     /// Strand triangles (2 per segment) of every character at full detail: the largest value
-    /// a frame's 32-bit counters can reach (the compute path's vertex and draw-vertex sums are
-    /// held to its pool by the LoD pressure, `lod_pressure.comp`; the triangle statistics are
-    /// not).
+    /// a frame's 32-bit statistics can reach without LoD (the compute path's vertex and
+    /// draw-vertex sums are held to its pool by the LoD pressure, `lod_pressure.comp`; the
+    /// triangle statistics are not).
     pub fn max_triangles(&self) -> u64 {
         self.slots.iter().flatten().map(|c| c.max_triangles).sum()
     }

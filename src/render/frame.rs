@@ -404,10 +404,11 @@ impl Renderer {
                 "the LHS path needs strands stored by capture_lhs for the current characters, and a compute-path frame since the last mesh-path one".into(),
             ));
         }
-        // Statistics are 32-bit: refuse a crowd that could wrap them (LoD usually needs far
-        // less, but a frame without LoD must not report garbage).
+        // Statistics are 32-bit: refuse a frame without LoD whose crowd could wrap them (with
+        // LoD a real head's strands follow its pixels; the buffers' sums are held to their
+        // budgets by the LoD pressure either way).
         let worst = self.crowd.max_triangles();
-        if worst > u32::MAX as u64 {
+        if !view.lod.enabled && worst > u32::MAX as u64 {
             return Err(GpuError::Unsupported(format!(
                 "the crowd has {worst} strand triangles at full detail, more than 32-bit frame counters hold; lower strands per bundle or vertex level"
             )));

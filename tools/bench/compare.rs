@@ -252,7 +252,7 @@ fn flip_mean(old: &image::RgbImage, new: &image::RgbImage) -> Option<f64> {
 }
 
 /// FLIP of `new` against `old`, pooled (`None` when their sizes differ).
-fn flip_pool(old: &image::RgbImage, new: &image::RgbImage) -> Option<nv_flip::FlipPool> {
+pub(crate) fn flip_pool(old: &image::RgbImage, new: &image::RgbImage) -> Option<nv_flip::FlipPool> {
     if old.dimensions() != new.dimensions() {
         return None;
     }

@@ -26,9 +26,9 @@ pub struct ScalpArgs {
     /// Families (default: every people family).
     #[arg(long, value_delimiter = ',')]
     families: Vec<StyleFamily>,
-    /// Densities, one row each: strands per cm² of scalp (`150`, the crowd's) or strands per
+    /// Densities, one row each: strands per cm² of scalp (`175`, the crowd's) or strands per
     /// reference bundle (`96/bundle`, the crowd's rule before 2026-12-07).
-    #[arg(long, value_delimiter = ',', default_value = "150,96/bundle", value_parser = parse_density)]
+    #[arg(long, value_delimiter = ',', default_value = "175,96/bundle", value_parser = parse_density)]
     densities: Vec<StrandDensity>,
     /// Portrait views: front, side, back.
     #[arg(long, value_delimiter = ',', default_value = "front,back", value_parser = ["front", "side", "back"])]
@@ -48,9 +48,9 @@ pub struct ScalpArgs {
     pictures: Option<PathBuf>,
 }
 
-/// `150` (per cm²) or `96/bundle`.
+/// `175` (per cm²) or `96/bundle`.
 fn parse_density(s: &str) -> Result<StrandDensity, String> {
-    let bad = || format!("{s}: expected strands per cm² (150) or per bundle (96/bundle)");
+    let bad = || format!("{s}: expected strands per cm² (175) or per bundle (96/bundle)");
     match s.strip_suffix("/bundle") {
         Some(n) => match n.parse::<u32>() {
             Ok(n) if (1..=16384).contains(&n) => Ok(StrandDensity::PerReferenceBundle(n)),

@@ -91,7 +91,7 @@ pub struct Args {
     /// Seed of the hairstyles and placement.
     #[arg(long, default_value_t = 1)]
     seed: u32,
-    /// Strands per cm² of scalp: a real head carries about 150 (90-150K strands on a full
+    /// Strands per cm² of scalp: a real head carries 150-200 (90-150K strands on a full
     /// head; the level of detail draws what the pixels need). Fur grows 96 per bundle.
     #[arg(long, default_value_t = hairmesh::characters::hairstyle::SCALP_STRANDS_PER_CM2)]
     strands_per_cm2: f32,
@@ -240,6 +240,11 @@ impl Scene {
             Some(own) => preset::build_own(own, count, args.seed, &families)?,
             None => preset::build_families(args.preset, count, args.seed, &families)?,
         };
+        // Every head must hold the density asked for before anything is baked.
+        for c in &characters {
+            c.strand_params_at(args.density(), args.verts_log2)
+                .map_err(|e| density_error(args, e))?;
+        }
         let mut baked = Vec::with_capacity(characters.len());
         for c in &characters {
             baked.push(hairmesh::bake(
@@ -300,7 +305,7 @@ impl Scene {
         for (c, b) in self.characters.iter().zip(&self.baked) {
             let params = c
                 .strand_params_at(density, args.verts_log2)
-                .map_err(|e| anyhow::anyhow!("--strands-per-cm2 {}: {e}", args.strands_per_cm2))?;
+                .map_err(|e| density_error(args, e))?;
             let id = renderer.add_character(b, &c.hair.style, params, c.model)?;
             // Heads and bodies move with their characters: drawn at the same model as the hair.
             preset::dress(&mut renderer, id, c)?;
@@ -432,6 +437,14 @@ impl Scene {
                 .sum::<u64>();
         }
         Ok(total)
+    }
+}
+
+/// A density a character cannot hold, named by the flag that asked for it.
+fn density_error(args: &Args, e: hairmesh::HairError) -> anyhow::Error {
+    match args.strands_per_bundle {
+        Some(n) => anyhow::anyhow!("--strands-per-bundle {n}: {e}"),
+        None => anyhow::anyhow!("--strands-per-cm2 {}: {e}", args.strands_per_cm2),
     }
 }
 

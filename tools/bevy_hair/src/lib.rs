@@ -39,6 +39,7 @@ use bevy::render::renderer::{
 };
 use bevy::render::settings::RenderCreation;
 use hairmesh::characters::hairstyle::StyleFamily;
+pub use hairmesh::characters::preset::StrandDensity;
 use hairmesh::vk::wgpu_host::wgpu;
 use hairmesh::vk::{WgpuDesc, WgpuDevice};
 
@@ -51,8 +52,10 @@ pub use render_world::{FrameRecord, HairFrames};
 pub struct Hair {
     /// Where the hair comes from.
     pub source: HairSource,
-    /// Strands per average bundle at full detail (the renderer thins them with distance).
-    pub strands_per_bundle: u32,
+    /// How densely it grows at full detail (the renderer thins it with distance): grown hair
+    /// a real head's 175 strands per cm² by default, a hair mesh 64 strands per bundle (its
+    /// units are its own).
+    pub density: StrandDensity,
 }
 
 /// Where a [`Hair`] comes from.
@@ -81,8 +84,13 @@ impl Hair {
     pub fn mesh(path: impl Into<PathBuf>) -> Self {
         Hair {
             source: HairSource::Mesh(path.into()),
-            strands_per_bundle: 64,
+            density: StrandDensity::PerReferenceBundle(64),
         }
+    }
+
+    /// The same hair at `density`.
+    pub fn with_density(self, density: StrandDensity) -> Self {
+        Hair { density, ..self }
     }
 
     /// A hairstyle of `family` grown on the head (joint `joint`) of the glTF `character`.
@@ -99,7 +107,7 @@ impl Hair {
                 family,
                 seed,
             },
-            strands_per_bundle: 32,
+            density: StrandDensity::default(),
         }
     }
 }

@@ -10,6 +10,7 @@ use hairmesh::HairStyle;
 use hairmesh::bake::{BakeOptions, BakedHairMesh, bake};
 use hairmesh::budget::MemoryBudget;
 use hairmesh::characters::own::OwnCharacter;
+use hairmesh::characters::preset::StrandDensity;
 use hairmesh::render::StrandParams;
 
 use crate::{Hair, HairSource, to_glam};
@@ -34,7 +35,7 @@ pub struct LoadedHair {
 /// logged once).
 #[derive(Resource, Default)]
 pub struct HairLibrary {
-    entries: HashMap<(HairSource, u32), Entry>,
+    entries: HashMap<(HairSource, (bool, u32)), Entry>,
 }
 
 enum Entry {
@@ -61,9 +62,9 @@ impl HairLibrary {
 
     /// The hair of `hair`, starting its load the first time it is asked for.
     fn get(&mut self, hair: &Hair) -> Option<Arc<LoadedHair>> {
-        let key = (hair.source.clone(), hair.strands_per_bundle);
+        let key = (hair.source.clone(), density_key(hair.density));
         let entry = self.entries.entry(key).or_insert_with(|| {
-            let (source, asked) = (hair.source.clone(), hair.strands_per_bundle);
+            let (source, asked) = (hair.source.clone(), hair.density);
             let pool = AsyncComputeTaskPool::get();
             Entry::Loading(pool.spawn(async move { load(&source, asked) }))
         });
@@ -85,21 +86,35 @@ impl HairLibrary {
     }
 }
 
-/// Load (grow, bake) the hair of `source` with about `asked` strands per bundle.
-fn load(source: &HairSource, asked: u32) -> Result<LoadedHair, String> {
+/// A [`StrandDensity`] as a key of the library (its kind and number's bits).
+fn density_key(d: StrandDensity) -> (bool, u32) {
+    match d {
+        StrandDensity::PerCm2(v) => (true, v.to_bits()),
+        StrandDensity::PerReferenceBundle(n) => (false, n),
+    }
+}
+
+/// Load (grow, bake) the hair of `source` at density `asked`.
+fn load(source: &HairSource, asked: StrandDensity) -> Result<LoadedHair, String> {
     let params = |strands_per_bundle| StrandParams {
         strands_per_bundle,
         verts_log2: VERTS_LOG2,
     };
     match source {
         HairSource::Mesh(path) => {
+            let StrandDensity::PerReferenceBundle(n) = asked else {
+                return Err(format!(
+                    "{}: a hair mesh's units are its own: give its density in strands per bundle",
+                    path.display()
+                ));
+            };
             let (baked, style) =
                 hairmesh::render::scene::load_mesh(path, None, MemoryBudget::default())
                     .map_err(|e| e.to_string())?;
             Ok(LoadedHair {
                 baked,
                 style,
-                params: params(asked),
+                params: params(n),
                 inverse_bind: None,
             })
         }
@@ -115,8 +130,15 @@ fn load(source: &HairSource, asked: u32) -> Result<LoadedHair, String> {
             let baked = bake(&grown.mesh, &grown.style, BakeOptions::default(), |_, _| {})
                 .map_err(|e| e.to_string())?;
             let skeleton = &own.character.skeleton;
+            // glTF characters are in metres.
+            let n = match asked {
+                StrandDensity::PerCm2(d) => grown
+                    .strands_per_bundle_at(d, 1.0)
+                    .map_err(|e| format!("{}: {e}", character.display()))?,
+                StrandDensity::PerReferenceBundle(n) => grown.strands_per_bundle(n),
+            };
             Ok(LoadedHair {
-                params: params(grown.strands_per_bundle(asked)),
+                params: params(n),
                 baked,
                 style: grown.style,
                 inverse_bind: Some(skeleton.joints[own.head_joint].inverse_bind),
@@ -212,7 +234,7 @@ mod tests {
             family: StyleFamily::Bob,
             seed: 7,
         };
-        let hair = load(&source, 16).unwrap();
+        let hair = load(&source, StrandDensity::PerReferenceBundle(16)).unwrap();
         let own =
             OwnCharacter::load(&people("character.glb"), "head", MemoryBudget::default()).unwrap();
         let expected = own.character.skeleton.joints[own.head_joint].inverse_bind;
@@ -225,7 +247,9 @@ mod tests {
     #[test]
     fn bad_sources_are_refused_in_one_line() {
         let missing = HairSource::Mesh(people("absent.obj"));
-        let why = load(&missing, 16).err().unwrap();
+        let why = load(&missing, StrandDensity::PerReferenceBundle(16))
+            .err()
+            .unwrap();
         assert!(why.contains("absent.obj") && !why.contains('\n'), "{why}");
         let no_joint = HairSource::Grown {
             character: people("character.glb"),
@@ -233,7 +257,40 @@ mod tests {
             family: StyleFamily::Bob,
             seed: 7,
         };
-        let why = load(&no_joint, 16).err().unwrap();
+        let why = load(&no_joint, StrandDensity::default()).err().unwrap();
         assert!(why.contains("tail") && !why.contains('\n'), "{why}");
+        // A hair mesh has no units to count cm² in.
+        let mesh = HairSource::Mesh(people("../head_long.obj"));
+        let why = load(&mesh, StrandDensity::default()).err().unwrap();
+        assert!(
+            why.contains("head_long.obj") && why.contains("strands per bundle"),
+            "{why}"
+        );
+    }
+
+    /// Grown hair at the default density: a real head's 175 strands per cm² of the
+    /// character's scalp (524 cm² on `character.glb`: about 92K strands at full detail).
+    #[test]
+    fn grown_hair_is_a_real_heads_count() {
+        let source = HairSource::Grown {
+            character: people("character.glb"),
+            joint: "head".into(),
+            family: StyleFamily::Bob,
+            seed: 7,
+        };
+        let hair = load(&source, StrandDensity::default()).unwrap();
+        let strands: u32 = hair
+            .baked
+            .bundles
+            .iter()
+            .map(|b| {
+                hairmesh::reference::generate::strands_in_bundle(
+                    b,
+                    &hair.style,
+                    hair.params.strands_per_bundle,
+                )
+            })
+            .sum();
+        assert!((90_000..=150_000).contains(&strands), "{strands} strands");
     }
 }

@@ -279,6 +279,9 @@ fn record(
         glam::Vec3::ZERO,
         40.0,
     ));
+    // The crowd's level of detail: grown hair is a real head's count, which the pixel cap
+    // thins at distance.
+    look.lod = hairmesh::render::LodSettings::crowd();
     if let Some(dir) = extracted.toward_light {
         look.light_dir = dir;
     }
