@@ -90,11 +90,21 @@ fn animated_frames_differ() {
     let flags = [
         "--frames", "8", "--count", "16", "--orbit", "off", "--wind", "20",
     ];
+    // Pixels that differ by more than one level of 255 (measured 9,558-10,412 between animated
+    // frames at 320x180).
+    let changed = |a: &[u8], b: &[u8]| {
+        a.chunks(4)
+            .zip(b.chunks(4))
+            .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 1))
+            .count()
+    };
     let (_dir, moving) = headless(&flags, 8, 1000);
     for f in 1..8 {
+        let n = changed(&moving[f], &moving[f - 1]);
+        println!("animated frames {} and {f}: {n} pixels differ", f - 1);
         assert!(
-            moving[f] != moving[f - 1],
-            "frames {} and {f} are equal",
+            n > 300,
+            "frames {} and {f} differ in only {n} pixels",
             f - 1
         );
     }
@@ -112,10 +122,18 @@ fn animated_frames_differ() {
         3,
         1000,
     );
-    assert!(
-        off[1] == off[0] && off[2] == off[1],
-        "frames without animation differ"
-    );
+    // Without animation the frames agree, but for the order in which dense pixels' fragments
+    // reach the software rasterizer's hiding (`soft_raster.comp`): at a real head's density,
+    // measured 1 pixel of 57,600 by one level of 255 (at the 96 strands a bundle of before
+    // 2026-12-07, none).
+    for f in 1..3 {
+        let n = changed(&off[f], &off[f - 1]);
+        assert!(
+            n <= 30,
+            "frames {} and {f} without animation differ in {n} pixels",
+            f - 1
+        );
+    }
 }
 
 /// `--character`: copies of the example glTF character (its own head), walking in wind, their
