@@ -425,12 +425,18 @@ fn style_for(family: StyleFamily, seed: u32, rng: &mut Pcg32) -> HairStyle {
         ..HairStyle::default()
     };
     match family {
+        // Short hair does not clump: a bundle's tips drawn together leave its borders bare, a
+        // grid of seams over the scalp at a real head's density.
         StyleFamily::Buzz => {
             s.length_variation = range(rng, 0.2, 0.4);
             s.root_ramp = 0.0;
             s.frizz_amplitude = 0.0002;
+            s.clump_strength = 0.0;
         }
-        StyleFamily::ShortCrop => s.length_variation = range(rng, 0.2, 0.35),
+        StyleFamily::ShortCrop => {
+            s.length_variation = range(rng, 0.2, 0.35);
+            s.clump_strength = 0.0;
+        }
         StyleFamily::LongWavy => {
             s.wave_amplitude = range(rng, 0.008, 0.016);
             s.wave_frequency = range(rng, 5.0, 8.0);
