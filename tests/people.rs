@@ -222,7 +222,7 @@ fn roots_stay_on_the_drawn_scalp_in_an_animated_crowd() {
 fn every_family_grows_a_real_heads_count() {
     use hairmesh::characters::hairstyle::SCALP_STRANDS_PER_CM2;
     use hairmesh::characters::preset::{Preset, StrandDensity, build_families};
-    use hairmesh::reference::generate::strands_in_bundle;
+    use hairmesh::reference::generate::strands_at_full_detail;
     println!("| family | scalp cm² | strands per bundle | strands |");
     for family in StyleFamily::PEOPLE {
         for seed in [1, 2, 3] {
@@ -238,11 +238,7 @@ fn every_family_grows_a_real_heads_count() {
                 |_, _| {},
             )
             .unwrap();
-            let strands: u64 = b
-                .bundles
-                .iter()
-                .map(|d| strands_in_bundle(d, &c.hair.style, n) as u64)
-                .sum();
+            let strands = strands_at_full_detail(&b, &c.hair.style, n);
             let cm2 = c.hair.scalp_cm2(1.0);
             if seed == 1 {
                 println!("| {} | {cm2:.0} | {n} | {strands} |", family.name());

@@ -107,23 +107,44 @@ fn hair_covers_the_scalp_seen_from_above() {
 #[test]
 fn a_real_heads_hair_hides_its_scalp_and_the_old_density_did_not() {
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_bench"))
-        .args(["scalp", "--families", "bob", "--views", "front", "--size", "320"])
+        .args([
+            "scalp",
+            "--families",
+            "bob",
+            "--views",
+            "front",
+            "--size",
+            "320",
+        ])
         .args(["--densities", "175,96/bundle"])
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{stdout}{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let share = |density: &str| -> f32 {
         let row = stdout
             .lines()
             .find(|l| l.starts_with("| bob |") && l.contains(&format!("| {density} |")))
             .unwrap_or_else(|| panic!("no {density} row in {stdout}"));
         let cols: Vec<&str> = row.split('|').map(str::trim).collect();
-        assert!(cols[7].parse::<u32>().unwrap() > 1000, "scalp pixels: {row}");
+        assert!(
+            cols[7].parse::<u32>().unwrap() > 1000,
+            "scalp pixels: {row}"
+        );
         cols[8].parse().unwrap()
     };
     let (real, old) = (share("175/cm²"), share("96/bundle"));
     println!("show-through: {real} at 175 per cm², {old} at 96 a bundle");
-    assert!(real < 0.25, "{real} of the scalp shows through a real head's hair");
-    assert!(old > 0.8, "{old}: the measure should read high at the old density");
+    assert!(
+        real < 0.25,
+        "{real} of the scalp shows through a real head's hair"
+    );
+    assert!(
+        old > 0.8,
+        "{old}: the measure should read high at the old density"
+    );
 }

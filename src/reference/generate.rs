@@ -282,6 +282,19 @@ pub fn strands_in_bundle(b: &BundleDesc, style: &HairStyle, n: u32) -> u32 {
     count.clamp(1, MAX_STRANDS_PER_BUNDLE as u32)
 }
 
+/// Strands `baked`'s bundles grow at full detail with `n` per (average) bundle.
+pub fn strands_at_full_detail(
+    baked: &crate::bake::BakedHairMesh,
+    style: &HairStyle,
+    n: u32,
+) -> u64 {
+    baked
+        .bundles
+        .iter()
+        .map(|b| strands_in_bundle(b, style, n) as u64)
+        .sum()
+}
+
 /// Strands per (average) bundle that give about `target` strands over `baked`'s bundles
 /// (1..=[`MAX_STRANDS_PER_BUNDLE`]), and the strands that makes.
 pub fn strands_per_bundle_for(
@@ -291,12 +304,7 @@ pub fn strands_per_bundle_for(
 ) -> (u32, u64) {
     let per = (target as f32 / baked.bundles.len().max(1) as f32).ceil() as u32;
     let per = per.clamp(1, MAX_STRANDS_PER_BUNDLE as u32);
-    let total = baked
-        .bundles
-        .iter()
-        .map(|b| strands_in_bundle(b, style, per) as u64)
-        .sum();
-    (per, total)
+    (per, strands_at_full_detail(baked, style, per))
 }
 
 /// Styled offset of a vertex in the `u v w` frame (object units), section 3.4.

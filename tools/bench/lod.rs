@@ -83,7 +83,9 @@ pub fn bench_lod(args: LodArgs) -> Result<()> {
         .map(|p| OutputPath::check(p, &[args.mesh.as_path()]))
         .transpose()?;
     let (baked, style) = load_mesh(&args.mesh, None, Default::default())?;
-    let ctx = Arc::new(Context::new(&ContextDesc::default().device(args.device.clone()))?);
+    let ctx = Arc::new(Context::new(
+        &ContextDesc::default().device(args.device.clone()),
+    )?);
     let (width, height) = (args.width, args.height);
     let mut renderer = Renderer::new(&ctx, &RendererDesc::default().size(width, height))?;
     let params = StrandParams {
@@ -241,7 +243,8 @@ fn hair_flip(off: &image::RgbImage, on: &image::RgbImage) -> Result<HairFlip> {
     }
     anyhow::ensure!(covered.1 > 0, "no hair in view");
     let (cw, ch) = (hi.0 - lo.0 + 1, hi.1 - lo.1 + 1);
-    let crop = |img: &image::RgbImage| image::imageops::crop_imm(img, lo.0, lo.1, cw, ch).to_image();
+    let crop =
+        |img: &image::RgbImage| image::imageops::crop_imm(img, lo.0, lo.1, cw, ch).to_image();
     let mut pool = super::compare::flip_pool(&crop(off), &crop(on)).context("frame sizes")?;
     Ok(HairFlip {
         pixels: (cw * ch) as usize,

@@ -79,6 +79,7 @@ struct Portrait {
     renderer: Renderer,
     id: hairmesh::render::CharacterId,
     character: preset::CrowdCharacter,
+    baked: hairmesh::BakedHairMesh,
     scalp_mesh: usize,
     hair_model: Mat4,
 }
@@ -111,6 +112,7 @@ impl Portrait {
             renderer: r,
             id,
             character: c,
+            baked,
             scalp_mesh,
             hair_model,
         })
@@ -196,7 +198,11 @@ pub fn bench_scalp(args: ScalpArgs) -> Result<()> {
             for &density in &args.densities {
                 let params = p.character.strand_params_at(density, 4)?;
                 p.renderer.set_params(p.id, params)?;
-                let full: u64 = full_strands(&p.character, params.strands_per_bundle)?;
+                let full = hairmesh::reference::generate::strands_at_full_detail(
+                    &p.baked,
+                    &p.character.hair.style,
+                    params.strands_per_bundle,
+                );
                 let ((red, drawn), (blue, _)) =
                     (p.frame(&view, 0, true)?, p.frame(&view, 1, true)?);
                 let hair = [red, blue];
@@ -225,14 +231,4 @@ pub fn bench_scalp(args: ScalpArgs) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Strands a character grows at full detail with `n` strands per average bundle.
-fn full_strands(c: &preset::CrowdCharacter, n: u32) -> Result<u64> {
-    let baked = hairmesh::bake(&c.hair.mesh, &c.hair.style, Default::default(), |_, _| {})?;
-    Ok(baked
-        .bundles
-        .iter()
-        .map(|b| hairmesh::reference::generate::strands_in_bundle(b, &c.hair.style, n) as u64)
-        .sum())
 }

@@ -430,11 +430,7 @@ impl Scene {
                 .strand_params(i, density, verts_log2)?
                 .strands_per_bundle;
             let style = &self.characters[i].hair.style;
-            total += b
-                .bundles
-                .iter()
-                .map(|d| hairmesh::reference::generate::strands_in_bundle(d, style, n) as u64)
-                .sum::<u64>();
+            total += hairmesh::reference::generate::strands_at_full_detail(b, style, n);
         }
         Ok(total)
     }

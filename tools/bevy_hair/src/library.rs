@@ -279,18 +279,11 @@ mod tests {
             seed: 7,
         };
         let hair = load(&source, StrandDensity::default()).unwrap();
-        let strands: u32 = hair
-            .baked
-            .bundles
-            .iter()
-            .map(|b| {
-                hairmesh::reference::generate::strands_in_bundle(
-                    b,
-                    &hair.style,
-                    hair.params.strands_per_bundle,
-                )
-            })
-            .sum();
+        let strands = hairmesh::reference::generate::strands_at_full_detail(
+            &hair.baked,
+            &hair.style,
+            hair.params.strands_per_bundle,
+        );
         assert!((90_000..=150_000).contains(&strands), "{strands} strands");
     }
 }
