@@ -15,6 +15,10 @@ use crate::model::gltf::{Character, parse_character};
 use crate::rng::Pcg32;
 use crate::shade::PROP_ROUGHNESS;
 
+/// Pixels a far mesh's cell spans where the switch to it happens: the far version is drawn
+/// once a cell is under two pixels.
+pub const FAR_CELL_PIXELS: f32 = 2.0;
+
 /// The two figures, in [`Figure`] order.
 static FIGURES: OnceLock<std::result::Result<[Arc<Character>; 2], String>> = OnceLock::new();
 
@@ -68,7 +72,7 @@ pub const HEAD_MESH: usize = 2 * PARTS.len();
 pub const FAR_MESHES: usize = HEAD_MESH + 2;
 /// Far levels of every skinned mesh: level `j` (1 the first) is made at the mesh's far cell
 /// times `2^(j-1)` ([`FarMethod`]), so each level is drawn where its cell spans about
-/// [`super::preset::FAR_CELL_PIXELS`] and a crowd's far people cost what they cover.
+/// [`FAR_CELL_PIXELS`] and a crowd's far people cost what they cover.
 pub const FAR_LEVELS: usize = 4;
 /// Cell of the first far level of every skinned mesh (bodies, clothes, heads and eyes),
 /// metres.
@@ -105,7 +109,7 @@ fn far_plan(k: usize) -> FarPlan {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FarPlan {
     /// Cell of the first far level, in the mesh's units: it switches where a cell spans
-    /// [`super::preset::FAR_CELL_PIXELS`].
+    /// [`FAR_CELL_PIXELS`].
     pub cell: f32,
     /// Far levels drawn.
     pub levels: usize,
@@ -128,7 +132,7 @@ pub enum FarMethod {
 }
 
 /// Edge collapse's error for a far level, in cells of the level (a cell spans
-/// [`super::preset::FAR_CELL_PIXELS`] where the level is switched to: half a pixel).
+/// [`FAR_CELL_PIXELS`] where the level is switched to: half a pixel).
 pub const SIMPLIFY_ERROR_CELLS: f32 = 0.25;
 
 impl FarMethod {
@@ -198,7 +202,7 @@ pub fn with_far_levels(
 
 /// When each level of [`with_far_levels`]'s `meshes` (`n` near ones, made as `plan` says)
 /// switches to the next: once the next level's cell spans under
-/// [`super::preset::FAR_CELL_PIXELS`].
+/// [`FAR_CELL_PIXELS`].
 pub fn far_level_lods(
     meshes: &[crate::skin::SkinnedMesh],
     n: usize,
@@ -220,7 +224,7 @@ pub fn far_level_lods(
 }
 
 /// Far versions of [`skinned_meshes`]: a mesh switches to its next far level where that
-/// level's cell spans under [`super::preset::FAR_CELL_PIXELS`] (as the static props do).
+/// level's cell spans under [`FAR_CELL_PIXELS`] (as the static props do).
 pub fn skinned_lods(
     meshes: &[crate::skin::SkinnedMesh],
 ) -> Vec<crate::render::prop_table::PropLod> {
@@ -233,7 +237,7 @@ pub fn mesh_bounds(mesh: &crate::skin::SkinnedMesh) -> (Vec3, Vec3) {
 }
 
 /// When skinned mesh `mesh` (index `k`, far version at `far`, clustered at `cell`) switches
-/// to its far version: once a cell spans under [`super::preset::FAR_CELL_PIXELS`].
+/// to its far version: once a cell spans under [`FAR_CELL_PIXELS`].
 pub fn far_lod(
     mesh: &crate::skin::SkinnedMesh,
     (k, far): (usize, usize),
@@ -243,7 +247,7 @@ pub fn far_lod(
     crate::render::prop_table::PropLod {
         mesh: k,
         far_mesh: far,
-        below_pixels: super::preset::FAR_CELL_PIXELS * (hi - lo).length() / cell,
+        below_pixels: FAR_CELL_PIXELS * (hi - lo).length() / cell,
     }
 }
 

@@ -87,9 +87,7 @@ pub mod prop_mesh {
     pub const TEAPOT: usize = 2;
 }
 
-/// Pixels a far mesh's cell spans where the switch to it happens: the far version is drawn
-/// once a cell is under two pixels.
-pub const FAR_CELL_PIXELS: f32 = 2.0;
+pub use super::people::FAR_CELL_PIXELS;
 
 /// Most vertex level fur uses: 2^3 = 8 segments are plenty for strands a few centimetres long.
 pub const FUR_MAX_VERTS_LOG2: u32 = 3;

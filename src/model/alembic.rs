@@ -1,6 +1,7 @@
 //! Alembic (`.abc`, Ogawa) curves in: every curve object of the archive, at its first sample,
-//! placed by the transform hierarchy above it, as one [`StrandModel`] with widths where the
-//! file has them. Blender, Houdini, Maya and Unreal write grooms this way.
+//! placed by the transform hierarchy above it, with widths where the
+//! file has them (`StrandModel::from_alembic` joins them into one strand model). Blender,
+//! Houdini, Maya and Unreal write grooms this way.
 //!
 //! The archive, its objects, properties and the curves schema are read with Traverse Research's
 //! `ogawa-rs`. What this file adds is what `ogawa-rs` 0.4 lacks or does unsafely:
@@ -25,7 +26,6 @@ use ogawa_rs::{
     PodArray, PropertyReader,
 };
 
-use super::strands::StrandModel;
 use crate::error::{HairError, Result};
 
 /// First bytes of an HDF5 file (Alembic's storage before Ogawa).
@@ -137,27 +137,6 @@ fn check_ogawa(bytes: &[u8]) -> std::result::Result<(), String> {
         }
     }
     Ok(())
-}
-
-/// All curves of all curve objects of `bytes` as one strand model (widths kept when every
-/// object has them).
-pub fn strand_model(name: &str, bytes: &[u8]) -> Result<StrandModel> {
-    let objects = read_curves(name, bytes)?;
-    let all_widths = objects.iter().all(|o| o.widths.is_some());
-    let mut strands = Vec::new();
-    let mut widths = Vec::new();
-    for o in objects {
-        strands.extend(o.strands);
-        if let Some(w) = o.widths {
-            widths.extend(w);
-        }
-    }
-    StrandModel::checked(
-        name,
-        strands,
-        all_widths.then_some(widths),
-        bytes.len() as u64,
-    )
 }
 
 /// An in-memory archive for `ogawa-rs` (never a memory map: a file shrinking under one would

@@ -48,12 +48,33 @@ impl StrandModel {
             Some(e) if e.eq_ignore_ascii_case("hair") => {
                 Self::from_hair(&name, &HairFile::parse(&name, &bytes)?, bytes.len() as u64)
             }
-            Some(e) if e.eq_ignore_ascii_case("abc") => super::alembic::strand_model(&name, &bytes),
+            Some(e) if e.eq_ignore_ascii_case("abc") => Self::from_alembic(&name, &bytes),
             _ => Err(HairError::invalid(
                 name,
                 "unknown strand file type (expected .tfx, .hair or .abc)",
             )),
         }
+    }
+
+    /// All curves of all curve objects of `bytes` as one strand model (widths kept when every
+    /// object has them).
+    pub fn from_alembic(name: &str, bytes: &[u8]) -> Result<Self> {
+        let objects = super::alembic::read_curves(name, bytes)?;
+        let all_widths = objects.iter().all(|o| o.widths.is_some());
+        let mut strands = Vec::new();
+        let mut widths = Vec::new();
+        for o in objects {
+            strands.extend(o.strands);
+            if let Some(w) = o.widths {
+                widths.extend(w);
+            }
+        }
+        StrandModel::checked(
+            name,
+            strands,
+            all_widths.then_some(widths),
+            bytes.len() as u64,
+        )
     }
 
     /// Parse a TressFX 4.0 file; checks every count against the file size and every position

@@ -7,6 +7,7 @@
 //! (section 3.4), roots on a curved root surface ([`crate::reference::root_surface`]) and
 //! tangents by eq. 5-6 (section 3.5). `glsl/strand_eval.glsl` is the GPU twin.
 
+use super::texel::{snorm, unorm};
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::bake::blue_noise::{MAX_STRANDS_PER_BUNDLE, quad_samples_for, triangle_samples_for};
@@ -107,16 +108,6 @@ pub struct HairTextures {
     w: SampledTexture,
     u_dir: SampledTexture,
     v_dir: SampledTexture,
-}
-
-/// A UNORM16 texel value as the GPU decodes it.
-pub(crate) fn unorm(x: u16) -> f32 {
-    x as f32 / 65535.0
-}
-
-/// A SNORM16 texel value as the GPU decodes it.
-pub(crate) fn snorm(x: i16) -> f32 {
-    (x as f32 / 32767.0).max(-1.0)
 }
 
 impl HairTextures {

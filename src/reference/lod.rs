@@ -3,6 +3,13 @@
 
 use glam::Vec3;
 
+/// Unit of the bundle LoD pass's demand counters (`FrameStats::soft_demand` and the
+/// others): segments or vertex slots, so a crowd's sum stays inside 32 bits.
+pub const LOD_DEMAND_UNIT: u32 = 64;
+/// The least LoD pressure: a view that cannot fit even one strand a bundle keeps one strand a
+/// bundle (and reports what its buffers drop).
+pub const LOD_LEAST_PRESSURE: f32 = 1e-6;
+
 /// Eq. 7, perspective: `L = min(1, h R alpha / (d tan theta))` for bundle size `h`, vertical
 /// resolution `R` in pixels, distance `d`, vertical field of view `theta` (radians).
 pub fn detail_level(h: f32, resolution: f32, distance: f32, fov_y: f32, alpha: f32) -> f32 {
@@ -87,15 +94,13 @@ pub fn thickness_scale(l: f32, n: u32) -> f32 {
 /// at least [`LOD_LEAST_PRESSURE`], so every visible bundle keeps a strand (GLSL:
 /// `lod_pressure` in `bundle_lod.glsl`).
 ///
-/// [`LOD_LEAST_PRESSURE`]: crate::render::shared::LOD_LEAST_PRESSURE
 ///
-/// [`LOD_DEMAND_UNIT`]: crate::render::shared::LOD_DEMAND_UNIT
 pub fn lod_pressure(demand: u32, slack: u32, budget: u32) -> f32 {
-    let unit = crate::render::shared::LOD_DEMAND_UNIT as f32;
+    let unit = LOD_DEMAND_UNIT as f32;
     let (demand, slack, budget) = (demand as f32 * unit, slack as f32 * unit, budget as f32);
     match demand <= budget {
         true => 1.0,
-        false => ((budget - slack) / demand).clamp(crate::render::shared::LOD_LEAST_PRESSURE, 1.0),
+        false => ((budget - slack) / demand).clamp(LOD_LEAST_PRESSURE, 1.0),
     }
 }
 
@@ -400,7 +405,7 @@ pub(crate) mod tests {
     /// 120% of the demand); a view that fits is left alone.
     #[test]
     fn pressure_fits_the_budget_and_thins_every_bundle_alike() {
-        use crate::render::shared::LOD_DEMAND_UNIT as UNIT;
+        use super::LOD_DEMAND_UNIT as UNIT;
         let mut rng = crate::rng::Pcg32::new(11);
         let wide = 1e9; // no cross-section cap
         for round in 0..40 {

@@ -6,4 +6,5 @@ pub mod generate;
 pub mod lhs;
 pub mod lod;
 pub mod root_surface;
+pub mod texel;
 pub mod volume;

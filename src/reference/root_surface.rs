@@ -16,7 +16,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::bake::{BakedHairMesh, BundleDesc};
-use crate::reference::generate::{snorm, unorm};
+use crate::reference::texel::{snorm, unorm};
 
 /// Phong tessellation's shape factor `alpha`. On a sphere, a cell of angular half-diagonal
 /// `t` bulges `alpha r sin^2(t) cos(t)` at its middle where the sphere is `r (1 - cos t)` above

@@ -69,12 +69,7 @@ pub const SOFT_BIN_GROUP: u32 = 256;
 /// vertex level e).
 pub const LOD_SOFT: u32 = 256;
 
-/// Unit of the bundle LoD pass's demand counters ([`FrameStats::soft_demand`] and the
-/// others): segments or vertex slots, so a crowd's sum stays inside 32 bits.
-pub const LOD_DEMAND_UNIT: u32 = 64;
-/// The least LoD pressure: a view that cannot fit even one strand a bundle keeps one strand a
-/// bundle (and reports what its buffers drop).
-pub const LOD_LEAST_PRESSURE: f32 = 1e-6;
+pub use crate::reference::lod::{LOD_DEMAND_UNIT, LOD_LEAST_PRESSURE};
 /// Invocations of one `hair_mesh_update.comp` workgroup.
 pub const DEFORM_GROUP_SIZE: u32 = 64;
 /// Invocations of one `hair_dynamics.comp` workgroup (one workgroup simulates one character)

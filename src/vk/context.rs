@@ -10,94 +10,8 @@ use ash::ext::debug_utils;
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
-use super::command::{CommandBuffer, CommandRecorder};
-use super::device;
-use super::sync::{Fence, Semaphore};
+use super::device::{self, ContextDesc, DeviceInfo, Surface};
 use super::{GpuError, GpuResult, VkContext};
-
-/// Raw handles of a window to present to (from winit through `raw-window-handle`; feature
-/// `window`).
-#[cfg(feature = "window")]
-#[derive(Clone, Copy, Debug)]
-pub struct WindowHandles {
-    /// The display connection.
-    pub display: raw_window_handle::RawDisplayHandle,
-    /// The window.
-    pub window: raw_window_handle::RawWindowHandle,
-}
-
-/// How to create a [`Context`].
-#[derive(Clone, Debug, Default)]
-pub struct ContextDesc {
-    /// Present to this window: creates its surface, requires a queue that can present to it
-    /// and enables `VK_KHR_swapchain` (feature `window`).
-    #[cfg(feature = "window")]
-    pub window: Option<WindowHandles>,
-    /// Enable `VK_LAYER_KHRONOS_validation`; validation errors are counted and printed.
-    pub validation: bool,
-    /// With `validation`: also enable synchronization validation (hazards between commands
-    /// that no barrier orders are reported as errors). Slow: for the test that covers every
-    /// pass combination.
-    pub sync_validation: bool,
-    /// Pick the device whose name contains this string (case-insensitive).
-    pub device: Option<String>,
-}
-
-impl ContextDesc {
-    /// Validation on (tests, debug builds).
-    pub fn validation(mut self, on: bool) -> Self {
-        self.validation = on;
-        self
-    }
-
-    /// Validation with synchronization validation.
-    pub fn sync_validation(mut self, on: bool) -> Self {
-        self.validation |= on;
-        self.sync_validation = on;
-        self
-    }
-
-    /// Choose a device by name substring.
-    pub fn device(mut self, name: Option<String>) -> Self {
-        self.device = name;
-        self
-    }
-
-    /// Present to `window`.
-    #[cfg(feature = "window")]
-    pub fn window(mut self, window: WindowHandles) -> Self {
-        self.window = Some(window);
-        self
-    }
-}
-
-/// What the chosen device can do.
-#[derive(Clone, Debug)]
-pub struct DeviceInfo {
-    /// Device name, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
-    pub name: String,
-    /// Driver name and version.
-    pub driver: String,
-    /// Nanoseconds per timestamp tick.
-    pub timestamp_period: f32,
-    /// Whether VK_EXT_mesh_shader (task + mesh) is available and enabled.
-    pub mesh_shader: bool,
-    /// Whether VK_EXT_mesh_shader queries (`MESH_PRIMITIVES_GENERATED_EXT`) are enabled.
-    pub mesh_queries: bool,
-    /// Mesh shader limits, when available.
-    pub mesh_limits: Option<vk::PhysicalDeviceMeshShaderPropertiesEXT<'static>>,
-    /// `maxStorageBufferRange`: the largest storage buffer binding.
-    pub max_storage_buffer_range: u64,
-    /// Most sampled images one bindless set may hold (the smaller of the per-stage and
-    /// per-set update-after-bind limits).
-    pub max_bindless_sampled_images: u32,
-    /// Sample counts usable for both colour and depth attachments (bit `n` set: `2^n`).
-    pub attachment_sample_counts: u32,
-    /// Whether 64-bit integers and 64-bit storage-buffer atomics are enabled (k-buffer OIT).
-    pub int64_atomics: bool,
-    /// Whether the device is a CPU (lavapipe): some passes pick other workgroup sizes.
-    pub cpu_device: bool,
-}
 
 /// GPU memory the allocator holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -238,12 +152,6 @@ fn window_surface(
     _desc: &ContextDesc,
 ) -> Result<Option<Surface>, vk::Result> {
     Ok(None)
-}
-
-/// A window surface and its instance-level functions.
-pub(crate) struct Surface {
-    pub(crate) loader: ash::khr::surface::Instance,
-    pub(crate) raw: vk::SurfaceKHR,
 }
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -570,55 +478,6 @@ impl Context {
             // SAFETY: handle belongs to this device; the name lives for the call.
             let _ = unsafe { d.set_debug_utils_object_name(&info) };
         }
-    }
-
-    /// Record commands with `record`, submit them and wait for completion (uploads).
-    pub fn submit_and_wait<R>(
-        self: &Arc<Self>,
-        record: impl FnOnce(&mut CommandRecorder) -> R,
-    ) -> GpuResult<R> {
-        let mut cmd = CommandBuffer::new(self, "one-shot")?;
-        let fence = Fence::new(self, false)?;
-        let out = {
-            let mut rec = cmd.begin()?;
-            record(&mut rec)
-        };
-        cmd.end()?;
-        self.submit(&cmd, &fence)?;
-        fence.wait()?;
-        Ok(out)
-    }
-
-    /// Submit `cmd` to the queue; `fence` is signalled when it completes.
-    pub fn submit(&self, cmd: &CommandBuffer, fence: &Fence) -> GpuResult<()> {
-        self.submit_with(cmd, fence, None, None)
-    }
-
-    /// Submit `cmd`, first waiting for `wait` (before colour output and transfers) and
-    /// signalling `signal` when done; `fence` is signalled when it completes.
-    pub fn submit_with(
-        &self,
-        cmd: &CommandBuffer,
-        fence: &Fence,
-        wait: Option<&Semaphore>,
-        signal: Option<&Semaphore>,
-    ) -> GpuResult<()> {
-        let cmds = [cmd.raw()];
-        let waits: Vec<vk::Semaphore> = wait.iter().map(|s| s.raw()).collect();
-        let stages = vec![
-            vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT
-                | vk::PipelineStageFlags::TRANSFER;
-            waits.len()
-        ];
-        let signals: Vec<vk::Semaphore> = signal.iter().map(|s| s.raw()).collect();
-        let submit = [vk::SubmitInfo::default()
-            .command_buffers(&cmds)
-            .wait_semaphores(&waits)
-            .wait_dst_stage_mask(&stages)
-            .signal_semaphores(&signals)];
-        // SAFETY: the command buffer finished recording; the fence is unsignalled; the
-        // semaphores are owned by the caller and alive until the submission completes.
-        unsafe { self.device.queue_submit(self.queue, &submit, fence.raw()) }.ctx("queue submit")
     }
 
     pub(crate) fn queue(&self) -> vk::Queue {

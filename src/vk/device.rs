@@ -3,8 +3,97 @@
 
 use ash::vk;
 
-use super::context::{ContextDesc, DeviceInfo, Surface};
 use super::{GpuError, GpuResult};
+
+/// Raw handles of a window to present to (from winit through `raw-window-handle`; feature
+/// `window`).
+#[cfg(feature = "window")]
+#[derive(Clone, Copy, Debug)]
+pub struct WindowHandles {
+    /// The display connection.
+    pub display: raw_window_handle::RawDisplayHandle,
+    /// The window.
+    pub window: raw_window_handle::RawWindowHandle,
+}
+
+/// How to create a [`Context`](super::Context).
+#[derive(Clone, Debug, Default)]
+pub struct ContextDesc {
+    /// Present to this window: creates its surface, requires a queue that can present to it
+    /// and enables `VK_KHR_swapchain` (feature `window`).
+    #[cfg(feature = "window")]
+    pub window: Option<WindowHandles>,
+    /// Enable `VK_LAYER_KHRONOS_validation`; validation errors are counted and printed.
+    pub validation: bool,
+    /// With `validation`: also enable synchronization validation (hazards between commands
+    /// that no barrier orders are reported as errors). Slow: for the test that covers every
+    /// pass combination.
+    pub sync_validation: bool,
+    /// Pick the device whose name contains this string (case-insensitive).
+    pub device: Option<String>,
+}
+
+impl ContextDesc {
+    /// Validation on (tests, debug builds).
+    pub fn validation(mut self, on: bool) -> Self {
+        self.validation = on;
+        self
+    }
+
+    /// Validation with synchronization validation.
+    pub fn sync_validation(mut self, on: bool) -> Self {
+        self.validation |= on;
+        self.sync_validation = on;
+        self
+    }
+
+    /// Choose a device by name substring.
+    pub fn device(mut self, name: Option<String>) -> Self {
+        self.device = name;
+        self
+    }
+
+    /// Present to `window`.
+    #[cfg(feature = "window")]
+    pub fn window(mut self, window: WindowHandles) -> Self {
+        self.window = Some(window);
+        self
+    }
+}
+
+/// What the chosen device can do.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    /// Device name, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
+    pub name: String,
+    /// Driver name and version.
+    pub driver: String,
+    /// Nanoseconds per timestamp tick.
+    pub timestamp_period: f32,
+    /// Whether VK_EXT_mesh_shader (task + mesh) is available and enabled.
+    pub mesh_shader: bool,
+    /// Whether VK_EXT_mesh_shader queries (`MESH_PRIMITIVES_GENERATED_EXT`) are enabled.
+    pub mesh_queries: bool,
+    /// Mesh shader limits, when available.
+    pub mesh_limits: Option<vk::PhysicalDeviceMeshShaderPropertiesEXT<'static>>,
+    /// `maxStorageBufferRange`: the largest storage buffer binding.
+    pub max_storage_buffer_range: u64,
+    /// Most sampled images one bindless set may hold (the smaller of the per-stage and
+    /// per-set update-after-bind limits).
+    pub max_bindless_sampled_images: u32,
+    /// Sample counts usable for both colour and depth attachments (bit `n` set: `2^n`).
+    pub attachment_sample_counts: u32,
+    /// Whether 64-bit integers and 64-bit storage-buffer atomics are enabled (k-buffer OIT).
+    pub int64_atomics: bool,
+    /// Whether the device is a CPU (lavapipe): some passes pick other workgroup sizes.
+    pub cpu_device: bool,
+}
+
+/// A window surface and its instance-level functions.
+pub(crate) struct Surface {
+    pub(crate) loader: ash::khr::surface::Instance,
+    pub(crate) raw: vk::SurfaceKHR,
+}
 
 /// The best Vulkan 1.3 device (discrete > integrated > virtual > CPU), optionally by name, and
 /// its graphics + compute queue family with timestamps.

@@ -10,6 +10,7 @@ mod device;
 pub mod image;
 pub mod pipeline;
 pub mod profiler;
+mod queue;
 pub mod shader;
 pub mod swapchain;
 pub mod sync;
@@ -21,11 +22,12 @@ pub mod wgpu_host;
 pub use access::Access;
 pub use buffer::{Buffer, BufferDesc};
 pub use command::{Attachment, BarrierImage, CommandBuffer, CommandRecorder, ImageBarrier};
-#[cfg(feature = "window")]
-pub use context::WindowHandles;
-pub use context::{Context, ContextDesc, DeviceInfo, HostDevice, MemoryReport};
+pub use context::{Context, HostDevice, MemoryReport};
 pub use descriptor::{BindingDesc, DescriptorKind, DescriptorSet, DescriptorSetLayout};
+#[cfg(feature = "window")]
+pub use device::WindowHandles;
 pub use device::create_host_device;
+pub use device::{ContextDesc, DeviceInfo};
 pub use image::{Image, ImageDesc, Sampler};
 pub use pipeline::{BlendMode, CullMode, DepthMode, GraphicsDesc, Pipeline, PipelineLayout};
 pub use profiler::{FrameTimes, MeshPrimitivesQuery, Profiler};
