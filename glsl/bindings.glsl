@@ -1,5 +1,5 @@
 // Resources of every hair pass. Binding numbers, constants and structs come from the generated
-// include shared.glsl (src/render/shared.rs); nothing here restates them.
+// include shared.glsl (src/render/core/shared.rs); nothing here restates them.
 #ifndef BINDINGS_GLSL
 #define BINDINGS_GLSL
 #extension GL_EXT_nonuniform_qualifier : require

@@ -1,4 +1,4 @@
-//! The CPU/GPU contract: every struct emitted into `shared.glsl` (src/render/shared.rs) has the
+//! The CPU/GPU contract: every struct emitted into `shared.glsl` (src/render/core/shared.rs) has the
 //! same std430 layout as its Rust `#[repr(C)]` twin, field by field, and the copy of the
 //! generated header in `glsl/generated/` is current.
 

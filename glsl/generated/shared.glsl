@@ -1,4 +1,4 @@
-// GENERATED from src/render/shared.rs by render::shared::glsl_header(); do not edit.
+// GENERATED from src/render/core/shared.rs by render::shared::glsl_header(); do not edit.
 // Shaders are compiled with this text; this copy is for reading.
 #ifndef SHARED_GLSL
 #define SHARED_GLSL

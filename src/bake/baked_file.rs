@@ -8,7 +8,7 @@
 //! 12      4     CRC-32 (IEEE) of the payload
 //! 16      8     payload length in bytes (u64)
 //! 24      ...   payload:
-//!               MeshInfo   (64 bytes, see src/render/shared.rs)
+//!               MeshInfo   (64 bytes, see src/render/core/shared.rs)
 //!               HairStyle  (96 bytes)
 //!               BundleDesc x bundle_count (32 bytes each)
 //!               hair mesh texture  W*H*(4(L-1)+1) x 8 bytes  (R16G16B16A16_UNORM)

@@ -11,7 +11,7 @@
 use glam::Vec3;
 
 use super::human::Eye;
-use crate::render::shared::PropVertex;
+use crate::render::core::shared::PropVertex;
 
 /// Half-angle of the pupil seen from the eyeball's centre, radians.
 pub const PUPIL_HALF_ANGLE: f32 = 0.148;

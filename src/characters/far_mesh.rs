@@ -9,7 +9,7 @@ use std::collections::{HashMap, HashSet};
 use glam::Vec3;
 
 use super::human::smooth_prop_mesh;
-use crate::render::shared::PropVertex;
+use crate::render::core::shared::PropVertex;
 
 /// The far version of triangle list `mesh` with vertices clustered into `cell`-sized cubes.
 pub fn far_mesh(mesh: &[PropVertex], cell: f32) -> Vec<PropVertex> {

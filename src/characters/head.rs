@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use super::human::direction;
 
 use crate::model::hair_mesh::Face;
-use crate::render::shared::PropVertex;
+use crate::render::core::shared::PropVertex;
 
 /// The head ellipsoid: centre and radii (x width, y height, z depth).
 #[derive(Clone, Copy, Debug, PartialEq)]

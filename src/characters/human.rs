@@ -15,7 +15,7 @@ use glam::Vec3;
 
 use crate::dynamics::RadialMap;
 use crate::error::{HairError, Result};
-use crate::render::shared::PropVertex;
+use crate::render::core::shared::PropVertex;
 
 /// The bust file's units (centimetres) to metres.
 pub const FILE_SCALE: f32 = 0.01;

@@ -295,7 +295,7 @@ const LASH_LINE: f32 = 0.12;
 /// `roughness` (corners with the same position, normal and colour welded).
 fn welded(
     name: &str,
-    list: &[crate::render::shared::PropVertex],
+    list: &[crate::render::core::shared::PropVertex],
     colors: &[Vec3],
     (joint, roughness): (u16, f32),
 ) -> crate::skin::SkinnedMesh {

@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 use super::human::{HumanHead, direction, human_head, smooth_prop_mesh};
 use crate::dynamics::Collider;
 use crate::error::Result;
-use crate::render::shared::PropVertex;
+use crate::render::core::shared::PropVertex;
 use crate::rng::Pcg32;
 
 /// How one person differs from the canonical figure.

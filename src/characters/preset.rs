@@ -10,7 +10,7 @@ use super::person::PersonShape;
 use crate::animate::walk::{MIN_RING_RADIUS, Rig, WalkPath, Walker};
 use crate::error::{HairError, Result};
 use crate::render::StrandParams;
-use crate::render::shared::{PropInstance, PropVertex};
+use crate::render::core::shared::{PropInstance, PropVertex};
 use crate::rng::Pcg32;
 
 /// Most characters a preset makes.
@@ -413,7 +413,7 @@ pub fn world_props() -> Vec<(usize, PropInstance)> {
             model: Mat4::IDENTITY.to_cols_array_2d(),
             color: [0.32, 0.34, 0.3, 1.0],
             clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
-            skin: [crate::render::shared::SKIN_NONE, 0, 0, 0],
+            skin: [crate::render::core::shared::SKIN_NONE, 0, 0, 0],
         },
     )]
 }
@@ -429,7 +429,7 @@ pub fn character_props(c: &CrowdCharacter) -> Result<Vec<(usize, PropInstance)>>
                 model: model.to_cols_array_2d(),
                 color,
                 clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
-                skin: [crate::render::shared::SKIN_NONE, 0, 0, 0],
+                skin: [crate::render::core::shared::SKIN_NONE, 0, 0, 0],
             },
         )
     };

@@ -9,7 +9,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::model::hair_mesh::{Face, vertex_normals};
-use crate::render::shared::PropVertex;
+use crate::render::core::shared::PropVertex;
 
 /// Control points of the 10 patch definitions (Newell's data, public domain).
 const POINTS: [[f32; 3]; 127] = [

@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::render::shared::SoftSegment;
+use crate::render::core::shared::SoftSegment;
 use crate::render::{Camera, Renderer};
 use crate::vk::GpuResult;
 

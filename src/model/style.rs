@@ -2,7 +2,7 @@
 //! styling frame with object-space amplitudes, so styling follows a deforming hair mesh without
 //! being stretched by it.
 //!
-//! [`HairStyle`] is `#[repr(C)]`; `src/render/shared.rs` emits it field for field as
+//! [`HairStyle`] is `#[repr(C)]`; `src/render/core/shared.rs` emits it field for field as
 //! `struct HairStyle` into the generated `shared.glsl` (std430), and a test checks the layouts
 //! agree. Operations, applied to strand vertex `k` of `ns` (`s = k / ns`, `w` the styling
 //! coordinate, `ramp` = `smoothstep(0, root_ramp, w)`):

@@ -2,7 +2,7 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use super::shared::FrameBlock;
+use super::core::shared::FrameBlock;
 
 /// Default viewing direction (target toward eye) of `render`, `bench` and the tests: a 3/4 view
 /// from behind and above, where the sample heads show their hair.

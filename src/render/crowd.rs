@@ -9,10 +9,10 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Mat4;
 
-use super::deform::PoseUpdate;
-use super::shared::{
+use super::core::shared::{
     CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, SimJob, TextureBinding,
 };
+use super::deform::PoseUpdate;
 use crate::bake::blue_noise::MAX_STRANDS_PER_BUNDLE;
 use crate::bake::{BakedHairMesh, MeshInfo};
 use crate::model::style::HairStyle;

@@ -4,12 +4,12 @@
 
 use ash::vk;
 
+use super::core::graph::{FrameGraph, ImageState};
+use super::core::shared::{FrameBlock, HairVertex, SoftSegment, TextureBinding};
 use super::crowd::CharacterId;
-use super::graph::{FrameGraph, ImageState};
 use super::passes::{FrameRes, FrameSources, FrameTransients, PassSets};
 use super::renderer::Renderer;
 use super::settings::{FrameSettings, RenderPath};
-use super::shared::{FrameBlock, HairVertex, SoftSegment, TextureBinding};
 use super::soft::StrandRaster;
 use super::transparency::Transparency;
 use crate::vk::{Access, Buffer, BufferDesc, GpuError, GpuResult};

@@ -12,12 +12,12 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec3;
 
+use super::core::shared::SimJob;
+use super::core::shared::TextureBinding;
+use super::core::shared::{DeformBinding, DeformParams};
+use super::core::slots::FRAMES_IN_FLIGHT;
 use super::crowd::CharacterTextures;
 use super::dynamics::{HairSimulation, HeadMaps};
-use super::shared::SimJob;
-use super::shared::TextureBinding;
-use super::shared::{DeformBinding, DeformParams};
-use super::slots::FRAMES_IN_FLIGHT;
 use crate::bake::deform::DeformBasis;
 use crate::vk::{
     Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult, Image,
@@ -30,7 +30,7 @@ pub const POSED_TEXTURES: [TextureBinding; 3] = [
     TextureBinding::V,
 ];
 
-pub use super::shared::DEFORM_GROUP_SIZE;
+pub use super::core::shared::DEFORM_GROUP_SIZE;
 
 /// One animated character's update state.
 pub struct DeformState {

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, Vec3};
 
-use super::shared::{
+use super::core::shared::{
     COLLIDER_CAPSULE, COLLIDER_ELLIPSOID, COLLIDER_HEAD, MAX_SIM_COLLIDERS, SimCollider,
     SimConstraint, SimJob, SimState, SimVertex,
 };

@@ -1,6 +1,6 @@
 //! A frame, from settings to submission: check the settings, size the buffers, write the frame
 //! blocks, build the frame graph from the passes, run it, submit (the frames in flight are
-//! [`super::slots`]).
+//! [`super::core::slots`]).
 
 use std::sync::Arc;
 
@@ -10,8 +10,13 @@ use std::time::Instant;
 
 use super::RenderPath;
 use super::camera::View;
-use super::graph::FrameGraph;
-use super::graph::ImageState::Tracked;
+use super::core::graph::FrameGraph;
+use super::core::graph::ImageState::Tracked;
+use super::core::shared::{FrameBlock, HairVertex, PropInstance};
+use super::core::slots::{
+    FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
+};
+use super::core::workspace::FrameBuffers;
 use super::host::{DepthMapping, HostImage};
 use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::host_targets::{HostTargetPasses, HostTargetRes};
@@ -23,14 +28,9 @@ use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSe
 use super::renderer::{PresentTarget, Renderer};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
-use super::shared::{FrameBlock, HairVertex, PropInstance};
-use super::slots::{
-    FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
-};
 use super::soft::StrandRaster;
 use super::temporal::{FrameMotion, PreviousFrame, Temporal, TemporalTuning, jittered};
 use super::transparency::Transparency;
-use super::workspace::FrameBuffers;
 use crate::vk::{Access, Buffer, BufferDesc, CommandRecorder, Context, GpuError, GpuResult};
 
 /// The density volumes of a frame.
@@ -207,7 +207,7 @@ impl Renderer {
             volume_characters: (work_draw.alone, work_draw.blended),
             probe_roots: opts.probe_roots.then_some(self.crowd.bundle_count()),
             unscoped_commands,
-            budgets: super::slots::ViewBudgets {
+            budgets: super::core::slots::ViewBudgets {
                 segments: self.soft_budget.segments,
                 pool: match path {
                     RenderPath::Compute => block.counts[3],
@@ -227,12 +227,12 @@ impl Renderer {
     fn write_sim_jobs(
         &mut self,
         i: usize,
-        steps: &[(usize, super::shared::SimJob)],
+        steps: &[(usize, super::core::shared::SimJob)],
     ) -> GpuResult<Vec<usize>> {
         if steps.is_empty() {
             return Ok(Vec::new());
         }
-        let jobs: Vec<super::shared::SimJob> = steps.iter().map(|(_, j)| *j).collect();
+        let jobs: Vec<super::core::shared::SimJob> = steps.iter().map(|(_, j)| *j).collect();
         let bytes = bytemuck::cast_slice(&jobs);
         let table = &mut self.frames[i].sim_jobs;
         write_address_table(&self.ctx, table, "hair dynamics jobs", bytes)?;
@@ -246,7 +246,7 @@ impl Renderer {
     fn write_density_jobs(
         &mut self,
         i: usize,
-        records: &mut [super::shared::CharacterRecord],
+        records: &mut [super::core::shared::CharacterRecord],
         (tier, block): (&super::volume::VolumeTier, &FrameBlock),
         pose_updates: &[usize],
     ) -> GpuResult<DensityWork> {
@@ -261,7 +261,7 @@ impl Renderer {
         if tier.enabled() {
             for id in self.crowd.ids() {
                 let slot = id.slot() as usize;
-                let visible = records[slot].flags & super::shared::CHARACTER_VISIBLE != 0;
+                let visible = records[slot].flags & super::core::shared::CHARACTER_VISIBLE != 0;
                 let needed = tier.occlusion || weights[slot] > 0.0;
                 if visible
                     && needed
@@ -303,7 +303,7 @@ impl Renderer {
         &self,
         pose_updates: &[usize],
         motion: Option<&FrameMotion>,
-    ) -> Vec<super::shared::CharacterRecord> {
+    ) -> Vec<super::core::shared::CharacterRecord> {
         let mut records = self.crowd.records(pose_updates);
         if let Some(motion) = motion {
             for (slot, r) in records.iter_mut().enumerate() {
@@ -318,12 +318,12 @@ impl Renderer {
     /// with accumulation its history the next frame's to read.
     fn remember_frame(
         &mut self,
-        records: &[super::shared::CharacterRecord],
+        records: &[super::core::shared::CharacterRecord],
         motion: &FrameMotion,
         temporal: Option<TemporalWork>,
     ) {
         let models = records.iter().map(|r| {
-            (r.flags & super::shared::CHARACTER_VISIBLE != 0)
+            (r.flags & super::core::shared::CHARACTER_VISIBLE != 0)
                 .then(|| glam::Mat4::from_cols_array_2d(&r.model))
         });
         let previous = PreviousFrame {
@@ -502,7 +502,7 @@ impl Renderer {
         &mut self,
         i: usize,
         (block, light_block): (&FrameBlock, Option<&FrameBlock>),
-        records: &[super::shared::CharacterRecord],
+        records: &[super::core::shared::CharacterRecord],
         motion: Option<&FrameMotion>,
         opts: &FrameOptions,
     ) -> GpuResult<(PropDraws, (u32, u32))> {
@@ -551,7 +551,8 @@ impl Renderer {
         slot.records.write(0, bytemuck::cast_slice(records))?;
         slot.prop_instances
             .write(0, bytemuck::cast_slice(&prop_instances))?;
-        let posed_bytes = skin.vertices as u64 * size_of::<super::shared::SkinnedVertex>() as u64;
+        let posed_bytes =
+            skin.vertices as u64 * size_of::<super::core::shared::SkinnedVertex>() as u64;
         if posed_bytes > slot.skinned.size {
             return Err(GpuError::Unsupported(format!(
                 "this frame poses {} body vertices ({posed_bytes} bytes), more than one storage \
@@ -779,7 +780,9 @@ impl Renderer {
         }
         let slots = self.crowd.slot_count();
         let slot = &mut self.frames[i];
-        if slot.records.size < slots as u64 * size_of::<super::shared::CharacterRecord>() as u64 {
+        if slot.records.size
+            < slots as u64 * size_of::<super::core::shared::CharacterRecord>() as u64
+        {
             slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
         }
         let skin = self.skinned.capacity();
@@ -791,8 +794,11 @@ impl Renderer {
         grow_skin_buffers(&self.ctx, slot, skin)?;
         let probe_bytes = self.crowd.bundle_count() as u64 * 16;
         if slot.root_probe.size < probe_bytes {
-            slot.root_probe =
-                super::slots::host_table(&self.ctx, "root probe", probe_bytes.next_power_of_two())?;
+            slot.root_probe = super::core::slots::host_table(
+                &self.ctx,
+                "root probe",
+                probe_bytes.next_power_of_two(),
+            )?;
         }
         let slot = &self.frames[i];
         for (set, ubo) in [
@@ -824,7 +830,11 @@ impl Renderer {
 
     /// The light's view for `view`: fitted around the visible characters whose hair is in the
     /// camera's frustum. `None` when shadows are off or no hair is in view.
-    fn light_view(&self, view: &View, block: &super::shared::FrameBlock) -> Option<LightView> {
+    fn light_view(
+        &self,
+        view: &View,
+        block: &super::core::shared::FrameBlock,
+    ) -> Option<LightView> {
         if view.shadows == ShadowMode::Off {
             return None;
         }
@@ -839,7 +849,11 @@ impl Renderer {
 
     /// The bodies' light view for `view`: fitted to the bodies in the camera's frustum. `None`
     /// when shadows are off or no body is in view.
-    fn body_light_view(&self, view: &View, block: &super::shared::FrameBlock) -> Option<LightView> {
+    fn body_light_view(
+        &self,
+        view: &View,
+        block: &super::core::shared::FrameBlock,
+    ) -> Option<LightView> {
         if view.shadows == ShadowMode::Off {
             return None;
         }
@@ -908,8 +922,8 @@ fn grow_skin_buffers(
     slot: &mut FrameSlot,
     skin: super::skinned_props::SkinCapacity,
 ) -> GpuResult<()> {
-    use super::shared::{SkinJob, SkinnedVertex};
-    use super::slots::{host_table, skinned_buffer};
+    use super::core::shared::{SkinJob, SkinnedVertex};
+    use super::core::slots::{host_table, skinned_buffer};
     let (jobs, matrices) = (skin.jobs, skin.matrices);
     let job_bytes = jobs as u64 * size_of::<SkinJob>() as u64;
     if slot.skin_jobs.size < job_bytes {

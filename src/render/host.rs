@@ -14,12 +14,12 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use super::camera::{Camera, View};
+use super::core::slots::FRAMES_IN_FLIGHT;
+use super::core::targets::{COLOR_FORMAT, DEPTH_FORMAT};
 use super::frame::{FrameTarget, HostTargets};
 use super::passes::TargetFormats;
 use super::passes::host_targets::HostTargetPasses;
 use super::settings::{FrameOptions, FrameTicket};
-use super::slots::FRAMES_IN_FLIGHT;
-use super::targets::{COLOR_FORMAT, DEPTH_FORMAT};
 use super::{Renderer, Temporal};
 use crate::vk::{Access, GpuError, GpuResult, Image};
 

@@ -4,12 +4,12 @@
 //! -> colour image ([`targets`]). The CPU/GPU contract lives in [`shared`].
 
 pub mod camera;
+pub mod core;
 pub mod crowd;
 pub mod debug;
 pub mod deform;
 pub mod dynamics;
 pub mod frame;
-pub mod graph;
 pub mod host;
 pub mod passes;
 pub mod payload;
@@ -18,17 +18,16 @@ pub mod renderer;
 pub mod scene;
 pub mod settings;
 pub mod shadow;
-pub mod shared;
 pub mod skinned_props;
-pub mod slots;
 pub mod soft;
 pub mod soft_pixel;
-pub mod targets;
 pub mod temporal;
 pub mod transparency;
 pub mod volume;
-pub mod workspace;
 
+pub use self::core::shared::FrameStats;
+pub use self::core::slots::{Dropped, FRAMES_IN_FLIGHT, FrameReport, ViewBudgets};
+pub use self::core::{graph, shared, slots, targets, workspace};
 pub use camera::{
     CROWD_ALPHA_STRANDS, CROWD_AREA_BELOW, CROWD_STRANDS_PER_PIXEL, Camera, DEFAULT_VIEW_DIR,
     LodSettings, View,
@@ -41,8 +40,6 @@ pub use renderer::{
 };
 pub use settings::{LightRaster, parse_switch};
 pub use shadow::ShadowMode;
-pub use shared::FrameStats;
-pub use slots::{Dropped, FRAMES_IN_FLIGHT, FrameReport, ViewBudgets};
 pub use soft::StrandRaster;
 pub use temporal::Temporal;
 pub use transparency::Transparency;

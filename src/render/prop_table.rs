@@ -6,9 +6,9 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, Vec3};
 
+use super::core::shared::{PropInstance, PropVertex};
 use super::crowd::CharacterId;
 use super::passes::props::PropDraw;
-use super::shared::{PropInstance, PropVertex};
 use crate::vk::{Buffer, Context, GpuError, GpuResult};
 
 /// A far version of a prop mesh: instances whose bounding sphere spans fewer than

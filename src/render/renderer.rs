@@ -11,8 +11,14 @@ use std::sync::Arc;
 use glam::Mat4;
 
 use super::camera::View;
+use super::core::graph::TransientPool;
+use super::core::shared::{
+    FrameBinding, GenerateArgs, HairVertex, PropInstance, SET_FRAME, SET_TEXTURES,
+};
+use super::core::slots::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Retired};
+use super::core::targets::{RenderTargets, ShadowMaps};
+use super::core::workspace::Workspace;
 use super::crowd::{CharacterId, Crowd, StrandParams};
-use super::graph::TransientPool;
 use super::passes::FramePasses;
 pub use super::passes::output::Overlay;
 use super::prop_table::Props;
@@ -20,13 +26,7 @@ pub use super::settings::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, RenderPath, RendererDesc, check_msaa,
     software_raster_conflict, supported_msaa,
 };
-use super::shared::{
-    FrameBinding, GenerateArgs, HairVertex, PropInstance, SET_FRAME, SET_TEXTURES,
-};
-use super::slots::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Retired};
 use super::soft::SoftBudget;
-use super::targets::{RenderTargets, ShadowMaps};
-use super::workspace::Workspace;
 use crate::bake::BakedHairMesh;
 use crate::model::style::HairStyle;
 use crate::vk::{
@@ -361,15 +361,15 @@ impl Renderer {
     pub fn read_posed_vertices(
         &mut self,
         vertices: usize,
-    ) -> GpuResult<Vec<super::shared::SkinnedVertex>> {
+    ) -> GpuResult<Vec<super::core::shared::SkinnedVertex>> {
         self.finish()?;
         let last = (self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT;
         let buffer = &self.frames[last].skinned;
-        let bytes = vertices as u64 * size_of::<super::shared::SkinnedVertex>() as u64;
+        let bytes = vertices as u64 * size_of::<super::core::shared::SkinnedVertex>() as u64;
         if bytes > buffer.size {
             return Err(GpuError::Unsupported(format!(
                 "{vertices} posed vertices asked for, the frame holds {}",
-                buffer.size / size_of::<super::shared::SkinnedVertex>() as u64
+                buffer.size / size_of::<super::core::shared::SkinnedVertex>() as u64
             )));
         }
         let data = super::debug::read_device_buffer(&self.ctx, buffer, bytes)?;
@@ -427,7 +427,10 @@ impl Renderer {
 
     /// Upload the prop meshes (triangle lists); instances refer to them by index. Replaces
     /// earlier meshes and clears the instances.
-    pub fn set_prop_meshes(&mut self, meshes: &[Vec<super::shared::PropVertex>]) -> GpuResult<()> {
+    pub fn set_prop_meshes(
+        &mut self,
+        meshes: &[Vec<super::core::shared::PropVertex>],
+    ) -> GpuResult<()> {
         if let Some(old) = self.props.set_meshes(&self.ctx, meshes)? {
             self.retire(Retired::Resource(Box::new(old)));
         }
@@ -707,7 +710,7 @@ fn check_desc(ctx: &Context, desc: &RendererDesc) -> GpuResult<SoftBudget> {
         )));
     }
     // Visibility ids carry the character slot in 16 bits (temporal.glsl).
-    let most = super::shared::VISIBILITY_INDEX + 1;
+    let most = super::core::shared::VISIBILITY_INDEX + 1;
     if desc.max_characters > most {
         return Err(GpuError::Unsupported(format!(
             "room for {} characters: at most {most} (motion vectors name a character in 16 bits)",

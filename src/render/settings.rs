@@ -1,33 +1,6 @@
 //! Renderer and frame settings.
 
-/// Which generation path draws the strands.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RenderPath {
-    /// Task + mesh shaders (VK_EXT_mesh_shader).
-    Mesh,
-    /// Compute generation + vertex pulling.
-    Compute,
-    /// Static strands, the raster limit: draw the strands the last compute-path frame
-    /// generated again (world space, as they were), with no culling, LoD or generation. Valid
-    /// until the crowd changes (characters added, removed, moved, restyled or reposed).
-    Static,
-    /// Linear hair skinning, the paper's baseline: the static strands moved each frame by
-    /// their guides (`Renderer::capture_lhs`, `Renderer::set_lhs_guides`), then drawn.
-    Lhs,
-}
-
-impl std::str::FromStr for RenderPath {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "mesh" => Ok(RenderPath::Mesh),
-            "compute" => Ok(RenderPath::Compute),
-            "static" => Ok(RenderPath::Static),
-            "lhs" => Ok(RenderPath::Lhs),
-            _ => Err(format!("path {s:?}: mesh, compute, static or lhs")),
-        }
-    }
-}
+pub use super::core::path::RenderPath;
 
 /// How the light's passes draw the hair into the shadow maps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -60,33 +33,12 @@ impl std::fmt::Display for LightRaster {
     }
 }
 
-impl std::fmt::Display for RenderPath {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        f.write_str(match self {
-            RenderPath::Mesh => "mesh",
-            RenderPath::Compute => "compute",
-            RenderPath::Static => "static",
-            RenderPath::Lhs => "lhs",
-        })
-    }
-}
-
 /// A switch flag: `on`/`true` or `off`/`false` (the tools' `--lod`, `--animate`, `--orbit`).
 pub fn parse_switch(s: &str) -> Result<bool, String> {
     match s {
         "on" | "true" => Ok(true),
         "off" | "false" => Ok(false),
         _ => Err(format!("{s:?}: on or off")),
-    }
-}
-
-impl RenderPath {
-    /// Whether strands are drawn from the vertex pool (compute and static paths).
-    pub fn pulls_vertices(self) -> bool {
-        matches!(
-            self,
-            RenderPath::Compute | RenderPath::Static | RenderPath::Lhs
-        )
     }
 }
 
@@ -128,7 +80,7 @@ impl Default for RendererDesc {
         RendererDesc {
             path: None,
             vertex_pool_bytes: 96 << 20,
-            task_bundles: super::shared::TASK_PAYLOAD_BUNDLES,
+            task_bundles: super::core::shared::TASK_PAYLOAD_BUNDLES,
             max_characters: 1024,
             width: 1280,
             height: 720,
@@ -408,11 +360,11 @@ pub const DEFAULT_SHADOW_RESOLUTION: u32 = 1024;
 pub enum ShadowMode {
     /// No shadows.
     #[default]
-    Off = super::shared::SHADOW_OFF,
+    Off = super::core::shared::SHADOW_OFF,
     /// Deep opacity maps (two light passes).
-    DeepOpacity = super::shared::SHADOW_DEEP_OPACITY,
+    DeepOpacity = super::core::shared::SHADOW_DEEP_OPACITY,
     /// Approximate deep shadow maps (one light pass).
-    Approximate = super::shared::SHADOW_APPROXIMATE,
+    Approximate = super::core::shared::SHADOW_APPROXIMATE,
 }
 
 impl ShadowMode {
@@ -430,33 +382,5 @@ impl ShadowMode {
             ShadowMode::DeepOpacity => "deep-opacity",
             ShadowMode::Approximate => "approximate",
         }
-    }
-}
-
-/// What a user changes to make transient buffer `name` smaller: its contents in a user's
-/// words and the flags (scene keys have the same names) that size it.
-pub fn transient_in_user_terms(name: &str) -> (&'static str, &'static str) {
-    match name {
-        "oit nodes" | "oit tail" => (
-            "per-pixel fragment lists",
-            "lower --size, or K of --transparency oit:K",
-        ),
-        "peel depth" | "peel accumulation" => ("depth peeling layers", "lower --size"),
-        "visibility" | "motion" | "frame colour" | "vertex motion" | "segment motion" => (
-            "temporal accumulation's history",
-            "lower --size, or use --temporal off",
-        ),
-        "soft tiles" | "soft depth" => (
-            "the software rasterizer's per-pixel depth",
-            "lower --size, or use --draw hw",
-        ),
-        "soft segments" | "soft entries" => (
-            "the software rasterizer's budget",
-            "use fewer strands, or --draw hw",
-        ),
-        "soft shadow depth" | "soft shadow layers" => {
-            ("the software shadow maps", "use --shadow-draw hw")
-        }
-        _ => ("frame storage", "lower --size"),
     }
 }

@@ -16,13 +16,10 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use super::camera::{LodSettings, box_corners, frustum_planes};
-use super::shared::FrameBlock;
+use super::core::shared::{FrameBlock, STRAND_SHADOW_OPACITY};
 
 /// Deep opacity layers (the 4 channels of one RGBA16F map).
 pub const SHADOW_LAYERS: u32 = 4;
-/// Opacity of one strand to the light: fibres pass part of the light (the TT lobe), so one
-/// strand does not block it all.
-pub const STRAND_SHADOW_OPACITY: f32 = 0.5;
 
 /// The light's passes choose strand and vertex level of detail with eq. 7's alphas times this
 /// (paper 003 sec. 3.6): as if the map had this share of its resolution. Shadows are soft and
@@ -195,7 +192,12 @@ impl LightView {
         let (tx, ty) = super::soft::tile_grid(self.resolution, self.resolution);
         let (soft, soft_grid) = match soft {
             Some(b) => (
-                [super::shared::RASTER_LIGHT, 0, b.segments, b.tile_entries],
+                [
+                    super::core::shared::RASTER_LIGHT,
+                    0,
+                    b.segments,
+                    b.tile_entries,
+                ],
                 [tx, ty, 0, 0],
             ),
             None => ([0; 4], [0; 4]),

@@ -9,10 +9,10 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, Vec3};
 
+use super::core::shared::{PropInstance, SKIN_GROUP_SIZE, SkinJob, SkinRestVertex};
 use super::crowd::CharacterId;
 use super::passes::props::PropDraw;
 use super::prop_table::{Projection, PropLod};
-use super::shared::{PropInstance, SKIN_GROUP_SIZE, SkinJob, SkinRestVertex};
 use crate::skin::SkinnedMesh;
 use crate::vk::{Buffer, Context, GpuError, GpuResult};
 

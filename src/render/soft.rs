@@ -30,9 +30,9 @@
 
 use glam::Vec2;
 
-use super::graph::TransientBuffer;
+use super::core::graph::TransientBuffer;
+use super::core::shared::{FrameBinding, FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
 use super::settings::ShadowMode;
-use super::shared::{FrameBinding, FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
 
 /// Default number of fragments per pixel the software rasterizer keeps sorted.
 pub const DEFAULT_SOFT_K: u32 = 8;
@@ -66,9 +66,9 @@ impl StrandRaster {
     /// Mode number in `FrameBlock::soft.x`.
     pub fn mode(self) -> u32 {
         match self {
-            StrandRaster::Hardware => super::shared::RASTER_HARDWARE,
-            StrandRaster::Software { .. } => super::shared::RASTER_SOFTWARE,
-            StrandRaster::Auto { .. } => super::shared::RASTER_AUTO,
+            StrandRaster::Hardware => super::core::shared::RASTER_HARDWARE,
+            StrandRaster::Software { .. } => super::core::shared::RASTER_SOFTWARE,
+            StrandRaster::Auto { .. } => super::core::shared::RASTER_AUTO,
         }
     }
 
@@ -236,6 +236,14 @@ impl SoftBudget {
             tx as u64 * ty as u64 * 16
         };
         let any = camera.is_some() || light.is_some();
+        const BUDGET: (&str, &str) = (
+            "the software rasterizer's budget",
+            "use fewer strands, or --draw hw",
+        );
+        const DEPTH: (&str, &str) = (
+            "the software rasterizer's per-pixel depth",
+            "lower --size, or use --draw hw",
+        );
         let need = [
             any as u64 * self.segments as u64 * size_of::<SoftSegment>() as u64,
             camera
@@ -245,10 +253,14 @@ impl SoftBudget {
             camera.map_or(0, |(w, h)| w as u64 * h as u64 * 4),
         ];
         [
-            TransientBuffer::storage("soft segments", need[0], FrameBinding::SoftSegments as u32),
-            TransientBuffer::storage("soft tiles", need[1], FrameBinding::SoftTiles as u32),
-            TransientBuffer::storage("soft entries", need[2], FrameBinding::SoftEntries as u32),
-            TransientBuffer::storage("soft depth", need[3], FrameBinding::SoftDepth as u32),
+            TransientBuffer::storage("soft segments", need[0], FrameBinding::SoftSegments as u32)
+                .for_user(BUDGET.0, BUDGET.1),
+            TransientBuffer::storage("soft tiles", need[1], FrameBinding::SoftTiles as u32)
+                .for_user(DEPTH.0, DEPTH.1),
+            TransientBuffer::storage("soft entries", need[2], FrameBinding::SoftEntries as u32)
+                .for_user(BUDGET.0, BUDGET.1),
+            TransientBuffer::storage("soft depth", need[3], FrameBinding::SoftDepth as u32)
+                .for_user(DEPTH.0, DEPTH.1),
         ]
     }
 }
@@ -264,12 +276,14 @@ pub fn shadow_buffers(light: Option<(u32, ShadowMode)>) -> [TransientBuffer; 2] 
             "soft shadow depth",
             texels * 4,
             FrameBinding::SoftShadowDepth as u32,
-        ),
+        )
+        .for_user("the software shadow maps", "use --shadow-draw hw"),
         TransientBuffer::storage(
             "soft shadow layers",
             layers as u64 * texels * 8,
             FrameBinding::SoftShadowLayers as u32,
-        ),
+        )
+        .for_user("the software shadow maps", "use --shadow-draw hw"),
     ]
 }
 
@@ -295,7 +309,7 @@ mod tests {
     /// Each raster reaches the shaders as its own mode number (`FrameBlock::soft.x`).
     #[test]
     fn each_raster_has_its_shader_mode() {
-        use crate::render::shared::{RASTER_AUTO, RASTER_HARDWARE, RASTER_SOFTWARE};
+        use crate::render::core::shared::{RASTER_AUTO, RASTER_HARDWARE, RASTER_SOFTWARE};
         assert_eq!(StrandRaster::Hardware.mode(), RASTER_HARDWARE);
         assert_eq!(StrandRaster::Software { k: 4 }.mode(), RASTER_SOFTWARE);
         assert_eq!(StrandRaster::Auto { k: 4 }.mode(), RASTER_AUTO);

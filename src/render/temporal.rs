@@ -26,7 +26,7 @@
 //! clamp erases strands. A pixel moves with the nearest hair of its 3x3 neighbourhood (a
 //! strand thinner than a pixel drags its history along) but never with a neighbouring solid
 //! (its silhouette would smear). Moving solid surfaces keep a shorter history
-//! ([`super::shared::TEMPORAL_SOLID_MOVING_WEIGHT`]) against blur and lag on their edges. The
+//! ([`super::core::shared::TEMPORAL_SOLID_MOVING_WEIGHT`]) against blur and lag on their edges. The
 //! jitter (Halton 2, 3 over 8 frames) moves the raster by under a pixel each frame, so the
 //! history integrates 8 sample positions per pixel.
 
@@ -35,11 +35,12 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use super::graph::TransientBuffer;
-use super::shared::{
+use super::core::graph::TransientBuffer;
+use super::core::shared::{
     FrameBinding, VISIBILITY_DEPTH_SHIFT, VISIBILITY_EMPTY, VISIBILITY_INDEX, VISIBILITY_PROP,
     VISIBILITY_RESIDUAL_STEPS, VISIBILITY_SOLID,
 };
+pub use super::core::slots::PixelMotion;
 use crate::vk::{Buffer, BufferDesc, Context, GpuResult};
 
 /// Temporal accumulation of a frame.
@@ -372,37 +373,35 @@ pub fn transient_buffers(
     let accumulate = work.is_some_and(|t| t.accumulate);
     let on = |bytes: u64, used: bool| if used { bytes * pixels } else { 0 };
     let residuals = |count: u64| if motion { 4 * count } else { 0 };
+    const HISTORY: (&str, &str) = (
+        "temporal accumulation's history",
+        "lower --size, or use --temporal off",
+    );
     [
-        TransientBuffer::storage("visibility", on(8, motion), FrameBinding::Visibility as u32),
-        TransientBuffer::storage("motion", on(16, motion), FrameBinding::Motion as u32),
+        TransientBuffer::storage("visibility", on(8, motion), FrameBinding::Visibility as u32)
+            .for_user(HISTORY.0, HISTORY.1),
+        TransientBuffer::storage("motion", on(16, motion), FrameBinding::Motion as u32)
+            .for_user(HISTORY.0, HISTORY.1),
         // The frame's colour, then the accumulated one.
         TransientBuffer::storage(
             "frame colour",
             on(8, accumulate),
             FrameBinding::FrameColor as u32,
-        ),
+        )
+        .for_user(HISTORY.0, HISTORY.1),
         TransientBuffer::storage(
             "vertex motion",
             residuals(work.map_or(0, |t| t.vertex_slots)),
             FrameBinding::VertexMotion as u32,
-        ),
+        )
+        .for_user(HISTORY.0, HISTORY.1),
         TransientBuffer::storage(
             "segment motion",
             residuals(segments as u64),
             FrameBinding::SegmentMotion as u32,
-        ),
+        )
+        .for_user(HISTORY.0, HISTORY.1),
     ]
-}
-
-/// One pixel of the motion target as read back.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelMotion {
-    /// This frame's position minus the previous frame's, pixels.
-    pub motion: Vec2,
-    /// Visibility id of the nearest surface ([`VISIBILITY_EMPTY`]: none).
-    pub id: u32,
-    /// Depth (0..1) of the nearest surface (1 where none).
-    pub depth: f32,
 }
 
 impl PixelMotion {

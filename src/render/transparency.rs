@@ -16,11 +16,11 @@
 
 use ash::vk;
 
-use super::graph::TransientBuffer;
-use super::shared::FrameBinding;
+use super::core::graph::TransientBuffer;
+use super::core::shared::FrameBinding;
 use crate::vk::ImageDesc;
 
-pub use super::shared::{MAX_OIT_BUDGET, STRAND_OPACITY};
+pub use super::core::shared::{MAX_OIT_BUDGET, STRAND_OPACITY};
 /// Default k-buffer budget.
 pub const DEFAULT_OIT_BUDGET: u32 = 8;
 /// Largest number of peeled layers.
@@ -50,9 +50,9 @@ impl Transparency {
     /// Mode number in `FrameBlock::transparency.x`.
     pub fn mode(self) -> u32 {
         match self {
-            Transparency::Opaque => super::shared::TRANSPARENCY_OPAQUE,
-            Transparency::KBuffer { .. } => super::shared::TRANSPARENCY_KBUFFER,
-            Transparency::DepthPeeling { .. } => super::shared::TRANSPARENCY_PEELING,
+            Transparency::Opaque => super::core::shared::TRANSPARENCY_OPAQUE,
+            Transparency::KBuffer { .. } => super::core::shared::TRANSPARENCY_KBUFFER,
+            Transparency::DepthPeeling { .. } => super::core::shared::TRANSPARENCY_PEELING,
         }
     }
 
@@ -146,18 +146,31 @@ impl Transparency {
     pub fn buffers(self, pixels: u64) -> [TransientBuffer; 4] {
         let [nodes, tail, depth, accum] = self.buffer_bytes(pixels);
         [
-            TransientBuffer::storage("oit nodes", nodes, FrameBinding::OitNodes as u32),
-            TransientBuffer::storage("oit tail", tail, FrameBinding::OitTail as u32),
-            TransientBuffer::storage("peel depth", depth, FrameBinding::PeelDepth as u32),
-            TransientBuffer::storage("peel accumulation", accum, FrameBinding::PeelAccum as u32),
+            TransientBuffer::storage("oit nodes", nodes, FrameBinding::OitNodes as u32).for_user(
+                "per-pixel fragment lists",
+                "lower --size, or K of --transparency oit:K",
+            ),
+            TransientBuffer::storage("oit tail", tail, FrameBinding::OitTail as u32).for_user(
+                "per-pixel fragment lists",
+                "lower --size, or K of --transparency oit:K",
+            ),
+            TransientBuffer::storage("peel depth", depth, FrameBinding::PeelDepth as u32)
+                .for_user("depth peeling layers", "lower --size"),
+            TransientBuffer::storage("peel accumulation", accum, FrameBinding::PeelAccum as u32)
+                .for_user("depth peeling layers", "lower --size"),
         ]
     }
 }
 
 /// The depth attachment of depth peeling's layers (single sample, target size).
 pub fn peel_image(width: u32, height: u32) -> ImageDesc {
-    ImageDesc::new_2d("peel depth", super::targets::DEPTH_FORMAT, width, height)
-        .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC)
+    ImageDesc::new_2d(
+        "peel depth",
+        super::core::targets::DEPTH_FORMAT,
+        width,
+        height,
+    )
+    .usage(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC)
 }
 
 #[cfg(test)]

@@ -14,11 +14,11 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, UVec3, Vec3};
 
-use super::crowd::CharacterId;
-use super::shared::{
+use super::core::shared::{
     CHARACTER_VISIBLE, CHARACTER_VOLUME_ONLY, CharacterRecord, DensityJob, FrameBlock,
     VOLUME_BUILT, VOLUME_DIMS_BITS, VOLUME_FIXED, VOLUME_OCCLUSION, VOLUME_SKIP_EMPTY, VolumeCell,
 };
+use super::crowd::CharacterId;
 use crate::reference::volume::{
     DensityVolume, VolumeSampling, cell_size, occupancy_words, volume_box,
 };

@@ -9,8 +9,8 @@
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets, device_shader_options, dispatch_2d};
-use crate::render::graph::FrameGraph;
-use crate::render::shared::CULL_GROUP_SIZE;
+use crate::render::core::graph::FrameGraph;
+use crate::render::core::shared::CULL_GROUP_SIZE;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 

@@ -6,12 +6,12 @@
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets, TemporalRes, device_shader_options, dispatch_2d};
-use crate::render::graph::FrameGraph;
-use crate::render::shared::{GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
+use crate::render::core::graph::FrameGraph;
+use crate::render::core::shared::{GenerateArgs, SCAN_BLOCK, SCAN_THREADS};
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 
-pub use crate::render::workspace::{ScanLevel, scan_plan};
+pub use crate::render::core::workspace::{ScanLevel, scan_plan};
 
 /// Which view a generation serves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -9,8 +9,8 @@
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets};
-use crate::render::graph::FrameGraph;
-use crate::render::shared::DENSITY_PASS_OCCUPANCY;
+use crate::render::core::graph::FrameGraph;
+use crate::render::core::shared::DENSITY_PASS_OCCUPANCY;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 

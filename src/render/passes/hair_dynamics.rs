@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use crate::render::graph::{FrameGraph, Res};
+use crate::render::core::graph::{FrameGraph, Res};
 use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One simulated character's buffers this frame.

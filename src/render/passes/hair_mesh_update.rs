@@ -7,8 +7,8 @@
 use std::sync::Arc;
 
 use super::{FrameRes, dispatch_2d};
-use crate::render::graph::{FrameGraph, ImageState, Res};
-use crate::render::shared::DeformBinding;
+use crate::render::core::graph::{FrameGraph, ImageState, Res};
+use crate::render::core::shared::DeformBinding;
 use crate::vk::{
     Access, Buffer, Context, DescriptorSet, DescriptorSetLayout, GpuResult, Image, Pipeline,
 };

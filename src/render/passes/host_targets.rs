@@ -13,9 +13,9 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::{FrameRes, TargetFormats};
-use crate::render::graph::{FrameGraph, Res};
+use crate::render::core::graph::{FrameGraph, Res};
+use crate::render::core::slots::FRAMES_IN_FLIGHT;
 use crate::render::host::DepthMapping;
-use crate::render::slots::FRAMES_IN_FLIGHT;
 use crate::vk::shader::compile;
 use crate::vk::{
     Access, Attachment, BindingDesc, BlendMode, Context, DepthMode, DescriptorKind, DescriptorSet,

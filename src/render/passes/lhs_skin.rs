@@ -9,15 +9,15 @@ use ash::vk;
 
 use super::{FrameRes, dispatch_2d};
 use crate::reference::lhs::LhsModel;
-use crate::render::graph::FrameGraph;
-use crate::render::shared::{HairVertex, LhsBinding, LhsWeights};
-use crate::render::slots::FRAMES_IN_FLIGHT;
+use crate::render::core::graph::FrameGraph;
+use crate::render::core::shared::{HairVertex, LhsBinding, LhsWeights};
+use crate::render::core::slots::FRAMES_IN_FLIGHT;
 use crate::vk::{
     Access, Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, GpuError, GpuResult,
     Pipeline,
 };
 
-use crate::render::shared::LHS_GROUP_SIZE as GROUP;
+use crate::render::core::shared::LHS_GROUP_SIZE as GROUP;
 
 /// The stored strands on the GPU and one guide-displacement buffer per frame slot.
 pub struct LhsState {

@@ -406,7 +406,7 @@ pub fn check_frame_storage(
     match t.buffers().find(|b| b.bytes > limit) {
         None => Ok(()),
         Some(b) => {
-            let (what, remedy) = super::settings::transient_in_user_terms(b.name);
+            let super::graph::UserTerms { what, remedy } = b.user_terms;
             Err(format!(
                 "a {width}x{height} image with transparency {transparency} needs {} of {what}, more than the {} this device's largest storage buffer holds; {remedy}",
                 size(b.bytes),
@@ -456,7 +456,7 @@ impl FrameTransients {
 impl<'a> FrameRes<'a> {
     /// Import the frame's persistent resources into `g` and create its transients.
     pub fn new(g: &mut FrameGraph<'a>, src: FrameSources<'a>, t: &FrameTransients) -> Self {
-        use crate::render::graph::ImageState::Tracked;
+        use crate::render::core::graph::ImageState::Tracked;
         let w = src.work.buffers();
         let RenderTargets {
             color,
@@ -538,9 +538,9 @@ impl FrameRes<'_> {
     /// device address.
     pub fn shading_uses<'g, 'a>(
         &self,
-        p: crate::render::graph::PassBuilder<'g, 'a>,
+        p: crate::render::core::graph::PassBuilder<'g, 'a>,
         read: Access,
-    ) -> crate::render::graph::PassBuilder<'g, 'a> {
+    ) -> crate::render::core::graph::PassBuilder<'g, 'a> {
         p.read_all(&self.shadow, Access::SampledRead)
             .read(self.volumes, read)
     }
@@ -565,7 +565,7 @@ pub struct FrameInputs<'a> {
     /// Skinning jobs and the most vertices of one (0 jobs: no skinning pass).
     pub skin: (u32, u32),
     /// The root probe's output and the bundles to probe, when the frame probes roots.
-    pub probe: Option<(crate::render::graph::Res, u32)>,
+    pub probe: Option<(crate::render::core::graph::Res, u32)>,
     /// Shadow mode of this frame; `None` when off (or nothing to shadow).
     pub shadow: Option<super::shadow::ShadowMode>,
     /// How the strands are composited.

@@ -3,8 +3,8 @@
 //! and the host's reads after the submission completes.
 
 use super::FrameRes;
-use crate::render::graph::{FrameGraph, Res};
-use crate::render::shared::GenerateArgs;
+use crate::render::core::graph::{FrameGraph, Res};
+use crate::render::core::shared::GenerateArgs;
 use crate::vk::{Access, Buffer, CommandRecorder, GpuResult, Image, SwapchainImage};
 
 /// Something drawn over a frame's output image before it is presented (the control panel):

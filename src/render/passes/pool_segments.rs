@@ -7,8 +7,8 @@
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets, TemporalRes, device_shader_options};
-use crate::render::graph::FrameGraph;
-use crate::render::shared::GenerateArgs;
+use crate::render::core::graph::FrameGraph;
+use crate::render::core::shared::GenerateArgs;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 
@@ -63,7 +63,7 @@ impl PoolSegments {
 
 #[cfg(test)]
 mod tests {
-    use crate::render::shared::{FrameStats, GenerateArgs};
+    use crate::render::core::shared::{FrameStats, GenerateArgs};
 
     /// The clear covers the four software counters and nothing after them (the LoD demand
     /// that follows is the compute frame's).

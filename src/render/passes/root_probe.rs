@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets, device_shader_options, dispatch_2d};
-use crate::render::graph::{FrameGraph, Res};
+use crate::render::core::graph::{FrameGraph, Res};
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 

@@ -10,7 +10,7 @@ use super::props::{PropList, PropPass};
 use super::strands::{StrandDraw, StrandUse, strand_uses};
 use super::{DrawTarget, FrameRes, PassSets};
 use crate::render::RenderPath;
-use crate::render::graph::FrameGraph;
+use crate::render::core::graph::FrameGraph;
 use crate::render::shadow::ShadowMode;
 use crate::vk::{Access, Attachment, Context, GpuResult, PipelineLayout};
 

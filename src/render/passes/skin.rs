@@ -7,8 +7,8 @@
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets, device_shader_options};
-use crate::render::graph::FrameGraph;
-use crate::render::shared::SKIN_GROUP_SIZE;
+use crate::render::core::graph::FrameGraph;
+use crate::render::core::shared::SKIN_GROUP_SIZE;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};
 

@@ -7,8 +7,8 @@
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets, TemporalRes, device_shader_options, dispatch_2d};
-use crate::render::graph::FrameGraph;
-use crate::render::shared::GenerateArgs;
+use crate::render::core::graph::FrameGraph;
+use crate::render::core::shared::GenerateArgs;
 use crate::render::soft::tile_grid;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Context, GpuResult, Pipeline, PipelineLayout};

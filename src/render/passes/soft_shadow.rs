@@ -13,7 +13,7 @@ use super::shadow::{ShadowDraw, ShadowPass};
 use super::soft_raster::SoftRasterPass;
 use super::{FrameRes, device_shader_options};
 use crate::render::RenderPath;
-use crate::render::graph::{FrameGraph, Res};
+use crate::render::core::graph::{FrameGraph, Res};
 use crate::render::shadow::ShadowMode;
 use crate::render::soft::tile_grid;
 use crate::vk::shader::compile;

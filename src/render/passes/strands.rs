@@ -9,8 +9,8 @@ use ash::vk;
 
 use super::{DrawTarget, FrameRes, PassSets, TemporalRes, device_shader_options, dispatch_2d};
 use crate::render::RenderPath;
-use crate::render::graph::PassBuilder;
-use crate::render::shared::{
+use crate::render::core::graph::PassBuilder;
+use crate::render::core::shared::{
     DISPATCH_ROW, GenerateArgs, MAX_SEGMENTS, STRAND_GROUP_SIZE, TASK_PAYLOAD_BUNDLES, TaskPayload,
 };
 use crate::vk::Access;

@@ -7,8 +7,8 @@
 use std::sync::Arc;
 
 use super::{FrameRes, PassSets, device_shader_options};
-use crate::render::graph::FrameGraph;
-use crate::render::shared::TEMPORAL_GROUP;
+use crate::render::core::graph::FrameGraph;
+use crate::render::core::shared::TEMPORAL_GROUP;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 

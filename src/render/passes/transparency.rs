@@ -11,7 +11,7 @@ use ash::vk;
 use super::strands::{StrandDraw, StrandUse, strand_uses};
 use super::{DrawTarget, FrameRes, PassSets, TargetFormats, device_shader_options};
 use crate::render::RenderPath;
-use crate::render::graph::FrameGraph;
+use crate::render::core::graph::FrameGraph;
 use crate::render::transparency::Transparency;
 use crate::vk::shader::compile;
 use crate::vk::{

@@ -10,7 +10,7 @@
 use std::sync::Arc;
 
 use super::{DrawTarget, FrameRes, PassSets, TargetFormats, device_shader_options};
-use crate::render::graph::FrameGraph;
+use crate::render::core::graph::FrameGraph;
 use crate::vk::shader::compile;
 use crate::vk::{
     Access, Attachment, BlendMode, Context, CullMode, GpuResult, Pipeline, PipelineLayout,

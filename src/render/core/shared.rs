@@ -70,6 +70,10 @@ pub const SOFT_BIN_GROUP: u32 = 256;
 pub const LOD_SOFT: u32 = 256;
 
 pub use crate::reference::lod::{LOD_DEMAND_UNIT, LOD_LEAST_PRESSURE};
+
+/// Opacity of one strand to the light: fibres pass part of the light (the TT lobe), so one
+/// strand does not block it all.
+pub const STRAND_SHADOW_OPACITY: f32 = 0.5;
 /// Invocations of one `hair_mesh_update.comp` workgroup.
 pub const DEFORM_GROUP_SIZE: u32 = 64;
 /// Invocations of one `hair_dynamics.comp` workgroup (one workgroup simulates one character)
@@ -124,7 +128,7 @@ pub const VISIBILITY_SOLID: u32 = 1 << 30;
 /// Temporal: the character slot or prop instance of a visibility id (16 bits: the software
 /// rasterizer's segments carry it in half a word).
 pub const VISIBILITY_INDEX: u32 = (1 << 16) - 1;
-/// Temporal: the visibility word (`temporal.glsl`, [`super::temporal::VisibilityWord`]) keeps
+/// Temporal: the visibility word (`temporal.glsl`, `render::temporal::VisibilityWord`) keeps
 /// the depth's float bits shifted right by this (24 bits: depths lie in [0, 1], so the top two
 /// bits are zero).
 pub const VISIBILITY_DEPTH_SHIFT: u32 = 6;
@@ -1269,10 +1273,7 @@ fn float_constants() -> Vec<(&'static str, f32)> {
             "MARCH_MIN_TRANSMITTANCE",
             crate::shade::volume::MARCH_MIN_TRANSMITTANCE,
         ),
-        (
-            "STRAND_SHADOW_OPACITY",
-            super::shadow::STRAND_SHADOW_OPACITY,
-        ),
+        ("STRAND_SHADOW_OPACITY", STRAND_SHADOW_OPACITY),
     ]
 }
 
@@ -1291,7 +1292,7 @@ pub fn glsl_header() -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "// GENERATED from src/render/shared.rs by render::shared::glsl_header(); do not edit.\n\
+        "// GENERATED from src/render/core/shared.rs by render::shared::glsl_header(); do not edit.\n\
          // Shaders are compiled with this text; this copy is for reading.\n\
          #ifndef SHARED_GLSL\n#define SHARED_GLSL\n"
     );

@@ -27,7 +27,7 @@ use crate::vk::{
     Access, BarrierImage, Buffer, CommandRecorder, DescriptorSet, GpuError, GpuResult, Image,
     ImageBarrier, ImageDesc, Profiler, SwapchainImage,
 };
-pub use transient::{Realized, SHRINK_AFTER_FRAMES, TransientBuffer, TransientPool};
+pub use transient::{Realized, SHRINK_AFTER_FRAMES, TransientBuffer, TransientPool, UserTerms};
 
 /// A resource of the frame graph.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -35,6 +35,26 @@ pub struct TransientBuffer {
     pub usage: vk::BufferUsageFlags,
     /// The binding of set 0 it is written to, when shaders read it there.
     pub binding: Option<u32>,
+    /// What it holds in a user's words, and what a user changes to make it smaller (the
+    /// feature that sizes it says so; the pool's refusal quotes it).
+    pub user_terms: UserTerms,
+}
+
+/// A transient buffer in a user's words: what it holds and the flags that size it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UserTerms {
+    /// What the buffer holds, e.g. "per-pixel fragment lists".
+    pub what: &'static str,
+    /// What to change, e.g. "lower --size".
+    pub remedy: &'static str,
+}
+
+impl UserTerms {
+    /// Storage of a frame that only its size sets.
+    pub const FRAME_STORAGE: UserTerms = UserTerms {
+        what: "frame storage",
+        remedy: "lower --size",
+    };
 }
 
 impl TransientBuffer {
@@ -48,7 +68,14 @@ impl TransientBuffer {
                 | vk::BufferUsageFlags::TRANSFER_DST
                 | vk::BufferUsageFlags::TRANSFER_SRC,
             binding: Some(binding),
+            user_terms: UserTerms::FRAME_STORAGE,
         }
+    }
+
+    /// The same buffer, described to a user as `what`, made smaller by `remedy`.
+    pub fn for_user(mut self, what: &'static str, remedy: &'static str) -> Self {
+        self.user_terms = UserTerms { what, remedy };
+        self
     }
 }
 
@@ -112,7 +139,7 @@ impl TransientPool {
     pub fn check(&self, desc: &TransientBuffer) -> GpuResult<()> {
         let limit = self.ctx.info.max_storage_buffer_range;
         if desc.usage.contains(vk::BufferUsageFlags::STORAGE_BUFFER) && desc.bytes > limit {
-            let (what, remedy) = crate::render::settings::transient_in_user_terms(desc.name);
+            let UserTerms { what, remedy } = desc.user_terms;
             return Err(GpuError::Unsupported(format!(
                 "this frame's {what} ({}) needs {} bytes, more than the {limit} this device's largest storage buffer holds; {remedy}",
                 desc.name, desc.bytes

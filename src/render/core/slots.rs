@@ -7,8 +7,9 @@ use std::any::Any;
 use std::sync::Arc;
 
 use ash::vk;
+use glam::Vec2;
 
-use super::settings::RenderPath;
+use super::path::RenderPath;
 use super::shared::{CharacterRecord, FrameBlock, FrameStats, GenerateArgs};
 use crate::vk::{
     Buffer, BufferDesc, CommandBuffer, Context, DescriptorSet, DescriptorSetLayout, Fence,
@@ -61,9 +62,9 @@ pub struct FrameReport {
     pub rgba: Option<Vec<u8>>,
     /// Motion vectors and nearest surfaces per pixel, top row first, when requested
     /// (`FrameOptions::read_motion`).
-    pub motion: Option<Vec<super::temporal::PixelMotion>>,
+    pub motion: Option<Vec<PixelMotion>>,
     /// The frame graph's passes, uses and derived dependencies, when
-    /// [`super::FrameOptions::describe_frame`] was set.
+    /// `FrameOptions::describe_frame` was set.
     pub frame_graph: Option<String>,
     /// The volume tier: characters drawn as their density volume alone, and those blended
     /// between strands and volume.
@@ -341,4 +342,15 @@ pub(crate) fn records_buffer(ctx: &Arc<Context>, n: u32) -> GpuResult<Buffer> {
         )
         .host_visible(),
     )
+}
+
+/// One pixel of the motion target as read back.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelMotion {
+    /// This frame's position minus the previous frame's, pixels.
+    pub motion: Vec2,
+    /// Visibility id of the nearest surface ([`VISIBILITY_EMPTY`](super::shared::VISIBILITY_EMPTY): none).
+    pub id: u32,
+    /// Depth (0..1) of the nearest surface (1 where none).
+    pub depth: f32,
 }

@@ -1,0 +1,12 @@
+//! The renderer's core, which every feature builds on and which imports nothing above it: the
+//! frame graph and its pool of transient resources ([`graph`]), the CPU/GPU contract
+//! ([`shared`], a leaf), the camera's targets and shadow maps ([`targets`]), the frames in
+//! flight and what a finished frame reports ([`slots`]), the working buffers that outlive a
+//! frame ([`workspace`]) and the generation path every feature reads ([`path`]).
+
+pub mod graph;
+pub mod path;
+pub mod shared;
+pub mod slots;
+pub mod targets;
+pub mod workspace;
