@@ -10,7 +10,9 @@ mod common;
 use std::sync::Arc;
 
 use ash::vk;
-use hairmesh::render::graph::{FrameGraph, SHRINK_AFTER_FRAMES, TransientBuffer, TransientPool};
+use hairmesh::render::graph::{
+    FrameGraph, SHRINK_AFTER_FRAMES, TransientBuffer, TransientPool, UserTerms,
+};
 use hairmesh::vk::{Access, Buffer, BufferDesc, Context, ImageDesc, Profiler};
 
 use common::{assert_no_validation_errors, context};
@@ -25,6 +27,7 @@ fn scratch(bytes: u64) -> TransientBuffer {
             | vk::BufferUsageFlags::TRANSFER_DST
             | vk::BufferUsageFlags::TRANSFER_SRC,
         binding: None,
+        user_terms: UserTerms::FRAME_STORAGE,
     }
 }
 

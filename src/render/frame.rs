@@ -17,19 +17,18 @@ use super::core::slots::{
     FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
 };
 use super::core::workspace::FrameBuffers;
+use super::features::temporal::{FrameMotion, PreviousFrame, TemporalFeature, TemporalWork};
 use super::host::{DepthMapping, HostImage};
 use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::host_targets::{HostTargetPasses, HostTargetRes};
 use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::{PropDraw, PropList};
-use super::passes::temporal::TemporalWork;
 use super::passes::write_address_table;
 use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets};
 use super::renderer::{PresentTarget, Renderer};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
 use super::soft::StrandRaster;
-use super::temporal::{FrameMotion, PreviousFrame, Temporal, TemporalTuning, jittered};
 use super::transparency::Transparency;
 use crate::vk::{Access, Buffer, BufferDesc, CommandRecorder, Context, GpuError, GpuResult};
 
@@ -135,15 +134,20 @@ impl Renderer {
         mut target: FrameTarget,
     ) -> GpuResult<FrameTicket> {
         let (path, kbuffer_budget) = self.check_frame(view, opts)?;
-        let temporal = self.temporal_work(view, opts, path)?;
+        let vertex_slots = match path {
+            RenderPath::Compute => self.desc.vertex_pool_bytes / size_of::<HairVertex>() as u64,
+            _ => 0,
+        };
+        let temporal = self
+            .temporal
+            .work(view.temporal, opts.read_motion, vertex_slots)?;
         // What draws the frame's bundles, decided once (`auto` with k-buffer OIT is all
         // software): the passes, buffers and frame blocks all follow it.
         let raster = opts.raster.under(view.transparency);
         self.retire_slot(i)?;
-        if temporal.is_some_and(|t| t.accumulate)
-            && let Some(old) = self
-                .temporal
-                .ensure_history(&self.ctx, self.targets.size())?
+        if let Some(old) = self
+            .temporal
+            .prepare(&self.ctx, temporal, self.targets.size())?
         {
             self.frames[i]
                 .retired
@@ -154,7 +158,9 @@ impl Renderer {
         let simulated = self.write_sim_jobs(i, &updates.simulated)?;
         let pose_updates = updates.updated;
         let (mut block, light_block) = self.frame_blocks(view, opts, (raster, kbuffer_budget));
-        let motion = self.temporal_fields(&mut block, temporal);
+        let motion = self
+            .temporal
+            .write_block(&mut block, temporal, self.targets.size());
         // Software light passes only where there is a light view this frame.
         let light_raster = match light_block {
             Some(_) => opts.light_raster,
@@ -331,59 +337,7 @@ impl Renderer {
             models: models.collect(),
             size: self.targets.size(),
         };
-        self.temporal
-            .advance(previous, temporal.is_some_and(|t| t.accumulate));
-    }
-
-    /// This frame's temporal work (`None`: no motion vectors), or why this device cannot
-    /// do it.
-    fn temporal_work(
-        &self,
-        view: &View,
-        opts: &FrameOptions,
-        path: RenderPath,
-    ) -> GpuResult<Option<TemporalWork>> {
-        let accumulate = view.temporal == Temporal::Taa;
-        if !accumulate && !opts.read_motion {
-            return Ok(None);
-        }
-        if !self.passes.has_temporal() {
-            return Err(GpuError::Unsupported(format!(
-                "{}: motion vectors and temporal accumulation need shaderInt64 and 64-bit buffer atomics",
-                self.ctx.info.name
-            )));
-        }
-        let vertex_slots = match path {
-            RenderPath::Compute => self.desc.vertex_pool_bytes / size_of::<HairVertex>() as u64,
-            _ => 0,
-        };
-        Ok(Some(TemporalWork {
-            accumulate,
-            vertex_slots,
-        }))
-    }
-
-    /// The camera block's temporal fields for `work` (the view-projection jittered when
-    /// accumulating), and the frame's motion matrices.
-    fn temporal_fields(&self, block: &mut FrameBlock, work: Option<TemporalWork>) -> FrameMotion {
-        let size = self.targets.size();
-        let view_proj = glam::Mat4::from_cols_array_2d(&block.unjittered_view_proj);
-        let motion = FrameMotion::new(view_proj, self.temporal.previous(size));
-        let Some(work) = work else {
-            return motion;
-        };
-        let jitter = match work.accumulate {
-            true => self.temporal.jitter(),
-            false => glam::Vec2::ZERO,
-        };
-        let valid = work.accumulate && self.temporal.history_valid(size);
-        let tuning = TemporalTuning::default();
-        block.view_proj = jittered(view_proj, jitter, size).to_cols_array_2d();
-        let residuals = work.vertex_slots > 0;
-        block.temporal = [1, work.accumulate as u32, valid as u32, residuals as u32];
-        block.temporal_params = [jitter.x, jitter.y, tuning.current_weight, tuning.hair_clamp];
-        block.clip_to_prev = motion.camera().to_cols_array_2d();
-        motion
+        self.temporal.remember(previous, temporal);
     }
 
     /// Refuse a frame this renderer cannot draw (path state, 32-bit counters, settings);
@@ -676,7 +630,13 @@ impl Renderer {
             draws,
             skin_indices,
         });
-        let mut inputs = frame_inputs(&work, (sets, props), clear, size, mesh_query.as_mut());
+        let mut inputs = frame_inputs(
+            &work,
+            (sets, props),
+            clear,
+            size,
+            (mesh_query.as_mut(), &self.temporal),
+        );
         if opts.probe_roots {
             let probe = g.import_buffer("root probe", root_probe);
             inputs.probe = Some((probe, work.bundles));
@@ -972,7 +932,10 @@ fn frame_inputs<'a>(
     ((sets, light_sets), [props, light_props]): ((PassSets<'a>, PassSets<'a>), [PropList<'a>; 2]),
     clear: Option<[f32; 4]>,
     size: (u32, u32),
-    mesh_query: Option<&'a mut crate::vk::MeshPrimitivesQuery>,
+    (mesh_query, temporal_feature): (
+        Option<&'a mut crate::vk::MeshPrimitivesQuery>,
+        &'a TemporalFeature,
+    ),
 ) -> FrameInputs<'a> {
     FrameInputs {
         sets,
@@ -992,6 +955,7 @@ fn frame_inputs<'a>(
         size,
         mesh_query,
         temporal: work.temporal,
+        temporal_feature,
         motion_readback: None,
         volume_slots: work.density.draw.slots,
     }

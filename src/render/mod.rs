@@ -9,6 +9,7 @@ pub mod crowd;
 pub mod debug;
 pub mod deform;
 pub mod dynamics;
+pub mod features;
 pub mod frame;
 pub mod host;
 pub mod passes;
@@ -21,7 +22,6 @@ pub mod shadow;
 pub mod skinned_props;
 pub mod soft;
 pub mod soft_pixel;
-pub mod temporal;
 pub mod transparency;
 pub mod volume;
 
@@ -33,6 +33,7 @@ pub use camera::{
     LodSettings, View,
 };
 pub use crowd::{CharacterId, Crowd, StrandParams};
+pub use features::temporal;
 pub use host::{HostCamera, HostFrame, HostImage};
 pub use renderer::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,

@@ -76,7 +76,7 @@ pub struct Renderer {
     pub(super) lhs: Option<(u64, super::passes::lhs_skin::LhsState)>,
     pub(super) work: Workspace,
     /// The previous frame's matrices and the temporal history.
-    pub(super) temporal: super::temporal::TemporalState,
+    pub(super) temporal: super::features::temporal::TemporalFeature,
     pub(super) completed: VecDeque<FrameReport>,
     /// Requested strand density volumes.
     pub(super) volumes: super::volume::DensityVolumes,
@@ -103,6 +103,7 @@ impl Renderer {
         check_msaa(ctx, desc.msaa)
             .map_err(|why| GpuError::Unsupported(format!("{}x MSAA: {why}", desc.msaa)))?;
         let passes = FramePasses::new(ctx, &layout, desc.task_bundles, desc.msaa)?;
+        let temporal = super::features::temporal::TemporalFeature::new(ctx, &layout)?;
         if desc.path == Some(RenderPath::Mesh) && !passes.has_mesh_path() {
             return Err(GpuError::Unsupported(format!(
                 "{}: no usable VK_EXT_mesh_shader for the mesh path",
@@ -131,7 +132,7 @@ impl Renderer {
             args_structure: None,
             lhs: None,
             work,
-            temporal: Default::default(),
+            temporal,
             completed: VecDeque::new(),
             volumes: Default::default(),
             host_passes: None,
@@ -569,7 +570,7 @@ impl Renderer {
                 (Some(b), true) => {
                     let bytes = b.read_range(0, (p.width * p.height * 16) as usize)?;
                     let words: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
-                    let decode = super::temporal::PixelMotion::from_words;
+                    let decode = super::core::slots::PixelMotion::from_words;
                     Some(words.iter().copied().map(decode).collect())
                 }
                 _ => None,

@@ -2,8 +2,10 @@
 //! frame graph and its pool of transient resources ([`graph`]), the CPU/GPU contract
 //! ([`shared`], a leaf), the camera's targets and shadow maps ([`targets`]), the frames in
 //! flight and what a finished frame reports ([`slots`]), the working buffers that outlive a
-//! frame ([`workspace`]) and the generation path every feature reads ([`path`]).
+//! frame ([`workspace`]) the generation path every feature reads ([`path`]), and what every pass binds and compiles
+//! with ([`binding`]).
 
+pub mod binding;
 pub mod graph;
 pub mod path;
 pub mod shared;

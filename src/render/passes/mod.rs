@@ -18,13 +18,14 @@ pub mod skin;
 pub mod soft_raster;
 pub mod soft_shadow;
 pub mod strands;
-pub mod temporal;
 pub mod transparency;
 pub mod volume_hair;
 
 use std::sync::Arc;
 
 use super::RenderPath;
+pub use super::core::binding::{PassSets, device_shader_options, shader_options};
+use super::features::temporal::{TemporalFeature, TemporalInputs, TemporalRes, TemporalWork};
 use super::graph::TransientBuffer;
 use super::graph::{FrameGraph, Res};
 use super::settings::{LightRaster, ShadowMode};
@@ -34,9 +35,8 @@ use super::targets::{COLOR_FORMAT, DEPTH_FORMAT, RenderTargets, ShadowMaps};
 use super::transparency::Transparency;
 use super::workspace::Workspace;
 use crate::vk::{
-    Access, Attachment, Buffer, Context, DescriptorSet, GpuResult, Image, ImageDesc,
-    MeshPrimitivesQuery, PipelineLayout,
-    shader::{ShaderOptions, compile},
+    Access, Attachment, Buffer, Context, GpuResult, Image, ImageDesc, MeshPrimitivesQuery,
+    PipelineLayout, shader::compile,
 };
 use compute_generate::{ComputeGenerate, GenerateView};
 use props::{PropList, PropPass};
@@ -44,50 +44,6 @@ use scalp::ScalpPass;
 use shadow::{ShadowDraw, ShadowPass};
 use strands::StrandDraw;
 use transparency::{TransparencyPass, TransparentDraw};
-
-/// The two descriptor sets every pass binds: set 0 (frame and crowd tables) and set 1 (the
-/// bindless textures).
-#[derive(Clone, Copy)]
-pub struct PassSets<'a> {
-    /// Set 0.
-    pub frame: &'a DescriptorSet,
-    /// Set 1.
-    pub textures: &'a DescriptorSet,
-}
-
-impl<'a> PassSets<'a> {
-    /// The camera's sets and the light's: each frame block's set with the crowd's textures.
-    pub fn camera_and_light(
-        (camera, light): (&'a DescriptorSet, &'a DescriptorSet),
-        textures: &'a DescriptorSet,
-    ) -> (Self, Self) {
-        let of = |frame| PassSets { frame, textures };
-        (of(camera), of(light))
-    }
-
-    /// As a slice for binding.
-    pub fn both(&self) -> [&'a DescriptorSet; 2] {
-        [self.frame, self.textures]
-    }
-}
-
-/// Compile options of every hair shader: the generated `shared.glsl` and the task workgroup
-/// width.
-pub fn shader_options(task_bundles: u32) -> ShaderOptions {
-    ShaderOptions::default()
-        .include("shared.glsl", super::shared::glsl_header())
-        .define("TASK_BUNDLES", task_bundles)
-}
-
-/// [`shader_options`] for `ctx`'s device: with `VISIBILITY` where it has 64-bit buffer
-/// atomics (camera passes note each pixel's nearest surface for the motion vectors,
-/// `temporal.glsl`).
-pub fn device_shader_options(ctx: &Context, task_bundles: u32) -> ShaderOptions {
-    match ctx.info.int64_atomics {
-        true => shader_options(task_bundles).define("VISIBILITY", 1),
-        false => shader_options(task_bundles),
-    }
-}
 
 /// Formats and sample count of the targets the graphics passes draw into.
 #[derive(Clone, Copy, Debug)]
@@ -276,65 +232,6 @@ pub struct FrameRes<'a> {
     pub images: FrameImages<'a>,
 }
 
-/// The temporal passes' resources besides the visibility words.
-#[derive(Clone, Copy)]
-pub struct TemporalRes {
-    /// Motion vectors.
-    pub motion: Res,
-    /// The frame's colour as a buffer (accumulation).
-    pub frame_color: Res,
-    /// Deformation residuals of the compute path's vertices.
-    pub vertex_motion: Res,
-    /// Deformation residuals of the software rasterizer's segments.
-    pub segment_motion: Res,
-    /// The history read and the one written (placeholders without accumulation).
-    pub history: (Res, Res),
-}
-
-impl TemporalRes {
-    /// The vertex residuals of `t`, if the frame has motion vectors.
-    pub fn vertex_motion(t: Option<Self>) -> Option<Res> {
-        t.map(|t| t.vertex_motion)
-    }
-
-    /// The segment residuals of `t`, if the frame has motion vectors.
-    pub fn segment_motion(t: Option<Self>) -> Option<Res> {
-        t.map(|t| t.segment_motion)
-    }
-
-    /// Create the temporal transients of `t` (visibility, motion, frame colour) and import
-    /// the history buffers: the visibility words and the rest, in frames with motion vectors.
-    fn new<'a>(
-        g: &mut FrameGraph<'a>,
-        t: &FrameTransients,
-        history: Option<(&'a Buffer, &'a Buffer)>,
-    ) -> Option<(Res, Self)> {
-        let [
-            visibility,
-            motion,
-            frame_color,
-            vertex_motion,
-            segment_motion,
-        ] = t.temporal.map(|d| g.create_buffer(d));
-        let history = history.map(|(read, write)| {
-            (
-                g.import_buffer("temporal history read", read),
-                g.import_buffer("temporal history written", write),
-            )
-        });
-        t.motion.then_some((
-            visibility,
-            TemporalRes {
-                motion,
-                frame_color,
-                vertex_motion,
-                segment_motion,
-                history: history.unwrap_or((frame_color, frame_color)),
-            },
-        ))
-    }
-}
-
 /// The imported images of a frame that passes' commands name.
 #[derive(Clone, Copy)]
 pub struct FrameImages<'a> {
@@ -393,7 +290,7 @@ pub fn check_frame_storage(
     temporal: bool,
     soft: bool,
 ) -> Result<(), String> {
-    let work = temporal.then_some(temporal::TemporalWork {
+    let work = temporal.then_some(TemporalWork {
         accumulate: true,
         vertex_slots: 0,
     });
@@ -425,7 +322,7 @@ impl FrameTransients {
         transparency: Transparency,
         (camera, light): (Option<SoftBudget>, Option<(SoftBudget, u32, ShadowMode)>),
         (width, height): (u32, u32),
-        temporal: Option<temporal::TemporalWork>,
+        temporal: Option<TemporalWork>,
     ) -> Self {
         let segments = camera.map_or(0, |b| b.segments);
         let temporal_buffers =
@@ -483,7 +380,7 @@ impl<'a> FrameRes<'a> {
         let [soft_segments, soft_tiles, soft_entries, soft_depth] =
             t.soft.map(|d| g.create_buffer(d));
         let [soft_shadow_depth, soft_shadow_layers] = t.soft_shadow.map(|d| g.create_buffer(d));
-        let temporal = TemporalRes::new(g, t, src.history);
+        let temporal = TemporalRes::create(g, &t.temporal, t.motion, src.history);
         let visibility = temporal.map(|t| t.0);
         FrameRes {
             constants: g.host_input("frame constants"),
@@ -582,7 +479,9 @@ pub struct FrameInputs<'a> {
     /// The mesh path's primitive query (wraps the strand draw).
     pub mesh_query: Option<&'a mut MeshPrimitivesQuery>,
     /// Motion vectors and accumulation, when the frame has them.
-    pub temporal: Option<temporal::TemporalWork>,
+    pub temporal: Option<TemporalWork>,
+    /// The temporal feature that adds their passes.
+    pub temporal_feature: &'a TemporalFeature,
     /// Where the motion vectors are copied for the host, when asked for.
     pub motion_readback: Option<&'a Buffer>,
     /// Character slots whose hair may be drawn from their density volume this frame (the
@@ -608,8 +507,6 @@ pub struct FramePasses {
     transparency: TransparencyPass,
     /// The software rasterizer's passes, on devices with 64-bit shared and buffer atomics.
     soft: Option<SoftPasses>,
-    /// Motion vectors and temporal accumulation, on devices with 64-bit buffer atomics.
-    temporal: Option<temporal::TemporalPass>,
     hair_mesh_update: hair_mesh_update::HairMeshUpdate,
     hair_dynamics: hair_dynamics::HairDynamicsPass,
     lhs_skin: lhs_skin::LhsSkin,
@@ -720,10 +617,6 @@ impl FramePasses {
                 }),
                 false => None,
             },
-            temporal: match ctx.info.int64_atomics {
-                true => Some(temporal::TemporalPass::new(ctx, layout)?),
-                false => None,
-            },
             hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
             hair_dynamics: hair_dynamics::HairDynamicsPass::new(ctx)?,
             lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
@@ -795,11 +688,6 @@ impl FramePasses {
     /// Whether the software rasterizer is available.
     pub fn has_software_raster(&self) -> bool {
         self.soft.is_some()
-    }
-
-    /// Whether motion vectors and temporal accumulation are available.
-    pub fn has_temporal(&self) -> bool {
-        self.temporal.is_some()
     }
 
     /// The software rasterizer alone over the targets (cleared to black first): `segments`
@@ -883,7 +771,7 @@ impl FramePasses {
             let view = GenerateView::Camera;
             self.generate.add(g, r, inp.sets, inp.bundles, view);
         }
-        temporal::TemporalPass::add_clear(g, r);
+        TemporalFeature::add_clear(g, r.visibility);
         let soft = inp.bundles > 0 && inp.raster.uses_software();
         // Bundles drawn as hardware strips: every one without the software rasterizer, the
         // thick ones with `auto` (never the static and LHS paths' stored strands, which all go
@@ -934,9 +822,20 @@ impl FramePasses {
             let peel = matches!(inp.transparency, super::Transparency::DepthPeeling { .. });
             self.transparency.add_resolve(g, r, peel, inp.sets)?;
         }
-        if let (Some(pass), Some(work)) = (&self.temporal, inp.temporal) {
-            pass.add(g, r, (inp.sets, inp.size), work, inp.motion_readback);
-        }
+        let temporal = match (r.visibility, r.temporal, inp.temporal) {
+            (Some(visibility), Some(res), Some(work)) => Some(TemporalInputs {
+                constants: r.constants,
+                visibility,
+                res,
+                output: (r.output, r.images.output),
+                sets: inp.sets,
+                size: inp.size,
+                work,
+                readback: inp.motion_readback,
+            }),
+            _ => None,
+        };
+        inp.temporal_feature.add(g, temporal);
         Ok(())
     }
 

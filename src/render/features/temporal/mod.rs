@@ -26,7 +26,7 @@
 //! clamp erases strands. A pixel moves with the nearest hair of its 3x3 neighbourhood (a
 //! strand thinner than a pixel drags its history along) but never with a neighbouring solid
 //! (its silhouette would smear). Moving solid surfaces keep a shorter history
-//! ([`super::core::shared::TEMPORAL_SOLID_MOVING_WEIGHT`]) against blur and lag on their edges. The
+//! ([`TEMPORAL_SOLID_MOVING_WEIGHT`](crate::render::core::shared::TEMPORAL_SOLID_MOVING_WEIGHT)) against blur and lag on their edges. The
 //! jitter (Halton 2, 3 over 8 frames) moves the raster by under a pixel each frame, so the
 //! history integrates 8 sample positions per pixel.
 
@@ -35,13 +35,17 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use super::core::graph::TransientBuffer;
-use super::core::shared::{
-    FrameBinding, VISIBILITY_DEPTH_SHIFT, VISIBILITY_EMPTY, VISIBILITY_INDEX, VISIBILITY_PROP,
-    VISIBILITY_RESIDUAL_STEPS, VISIBILITY_SOLID,
+mod pass;
+
+pub use pass::{TemporalInputs, TemporalPass, TemporalRes};
+
+use crate::render::core::graph::{FrameGraph, Res, TransientBuffer};
+use crate::render::core::shared::{
+    FrameBinding, FrameBlock, VISIBILITY_DEPTH_SHIFT, VISIBILITY_EMPTY, VISIBILITY_INDEX,
+    VISIBILITY_PROP, VISIBILITY_RESIDUAL_STEPS, VISIBILITY_SOLID,
 };
-pub use super::core::slots::PixelMotion;
-use crate::vk::{Buffer, BufferDesc, Context, GpuResult};
+pub use crate::render::core::slots::PixelMotion;
+use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult, PipelineLayout};
 
 /// Temporal accumulation of a frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -228,6 +232,128 @@ pub struct TemporalState {
     valid: bool,
     /// Frames accumulated since the history was reset (jitter phase).
     index: u64,
+}
+
+/// Temporal stability as one feature of the renderer: its state between frames (the previous
+/// frame's matrices, the accumulated history) and its pipeline, what it writes into the
+/// camera's frame block, and the passes it adds to a frame.
+pub struct TemporalFeature {
+    state: TemporalState,
+    /// The motion and accumulation pipeline, on devices with 64-bit buffer atomics.
+    pass: Option<TemporalPass>,
+    /// The device's name, for the refusal where it has no such atomics.
+    device: String,
+}
+
+impl TemporalFeature {
+    /// The feature for `ctx`'s device (without its pipeline where the device lacks 64-bit
+    /// buffer atomics: frames that ask for motion are then refused).
+    pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
+        let pass = match ctx.info.int64_atomics {
+            true => Some(TemporalPass::new(ctx, layout)?),
+            false => None,
+        };
+        Ok(TemporalFeature {
+            state: TemporalState::default(),
+            pass,
+            device: ctx.info.name.clone(),
+        })
+    }
+
+    /// Forget the previous frame and the history (a camera cut).
+    pub fn reset(&mut self) {
+        self.state.reset();
+    }
+
+    /// This frame's work for `mode` (`None`: no motion vectors), or why this device cannot do
+    /// it; `vertex_slots` are the compute path's vertices that carry deformation residuals.
+    pub fn work(
+        &self,
+        mode: Temporal,
+        read_motion: bool,
+        vertex_slots: u64,
+    ) -> GpuResult<Option<TemporalWork>> {
+        let accumulate = mode == Temporal::Taa;
+        if !accumulate && !read_motion {
+            return Ok(None);
+        }
+        if self.pass.is_none() {
+            return Err(GpuError::Unsupported(format!(
+                "{}: motion vectors and temporal accumulation need shaderInt64 and 64-bit buffer atomics",
+                self.device
+            )));
+        }
+        Ok(Some(TemporalWork {
+            accumulate,
+            vertex_slots,
+        }))
+    }
+
+    /// Make the history buffers for `size` when `work` accumulates; returns the old ones to
+    /// retire with the frame.
+    pub fn prepare(
+        &mut self,
+        ctx: &Arc<Context>,
+        work: Option<TemporalWork>,
+        size: (u32, u32),
+    ) -> GpuResult<Option<[Buffer; 2]>> {
+        match work.is_some_and(|t| t.accumulate) {
+            true => self.state.ensure_history(ctx, size),
+            false => Ok(None),
+        }
+    }
+
+    /// The camera block's temporal fields for `work` (the view-projection jittered when
+    /// accumulating), and the frame's motion matrices.
+    pub fn write_block(
+        &self,
+        block: &mut FrameBlock,
+        work: Option<TemporalWork>,
+        size: (u32, u32),
+    ) -> FrameMotion {
+        let view_proj = Mat4::from_cols_array_2d(&block.unjittered_view_proj);
+        let motion = FrameMotion::new(view_proj, self.state.previous(size));
+        let Some(work) = work else {
+            return motion;
+        };
+        let jitter = match work.accumulate {
+            true => self.state.jitter(),
+            false => Vec2::ZERO,
+        };
+        let valid = work.accumulate && self.state.history_valid(size);
+        let tuning = TemporalTuning::default();
+        block.view_proj = jittered(view_proj, jitter, size).to_cols_array_2d();
+        let residuals = work.vertex_slots > 0;
+        block.temporal = [1, work.accumulate as u32, valid as u32, residuals as u32];
+        block.temporal_params = [jitter.x, jitter.y, tuning.current_weight, tuning.hair_clamp];
+        block.clip_to_prev = motion.camera().to_cols_array_2d();
+        motion
+    }
+
+    /// The history buffers as `(read, write)` this frame, once made.
+    pub fn history(&self) -> Option<(&Buffer, &Buffer)> {
+        self.state.history()
+    }
+
+    /// After a frame is submitted: its matrices become the next frame's previous ones, and
+    /// with accumulation its history the next frame's to read.
+    pub fn remember(&mut self, previous: PreviousFrame, work: Option<TemporalWork>) {
+        self.state
+            .advance(previous, work.is_some_and(|t| t.accumulate));
+    }
+
+    /// Add the pass that empties the visibility words (before any camera pass notes them).
+    pub fn add_clear(g: &mut FrameGraph<'_>, visibility: Option<Res>) {
+        TemporalPass::add_clear(g, visibility);
+    }
+
+    /// Add the motion pass and, with accumulation, the accumulation around it (after every
+    /// camera pass).
+    pub fn add<'a>(&'a self, g: &mut FrameGraph<'a>, inputs: Option<TemporalInputs<'a>>) {
+        if let (Some(pass), Some(inputs)) = (&self.pass, inputs) {
+            pass.add(g, inputs);
+        }
+    }
 }
 
 /// What a frame leaves for the next one's motion.
@@ -589,12 +715,32 @@ mod tests {
         }
     }
 
+    /// A perspective camera at `eye` looking at the origin (45 degrees, Vulkan depth 0..1, y
+    /// down, as the renderer's): the maths below holds for any projection.
+    fn perspective_at(eye: Vec3, aspect: f32) -> Mat4 {
+        let f = (-eye).normalize();
+        let s = f.cross(Vec3::Y).normalize();
+        let u = s.cross(f);
+        let view = Mat4::from_cols(
+            Vec4::new(s.x, u.x, -f.x, 0.0),
+            Vec4::new(s.y, u.y, -f.y, 0.0),
+            Vec4::new(s.z, u.z, -f.z, 0.0),
+            Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
+        );
+        let (g, n, far) = (1.0 / 22.5f32.to_radians().tan(), 0.05, 100.0);
+        let proj = Mat4::from_cols(
+            Vec4::new(g / aspect, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, -g, 0.0, 0.0),
+            Vec4::new(0.0, 0.0, far / (n - far), -1.0),
+            Vec4::new(0.0, 0.0, n * far / (n - far), 0.0),
+        );
+        proj * view
+    }
+
     #[test]
     fn motion_of_a_camera_move_is_the_projected_difference() {
         let size = Vec2::new(320.0, 180.0);
-        let view = |eye: Vec3| {
-            crate::render::Camera::look_at(eye, Vec3::ZERO, 45.0).view_proj(size.x / size.y)
-        };
+        let view = |eye: Vec3| perspective_at(eye, size.x / size.y);
         let (before, now) = (
             view(Vec3::new(0.1, 0.0, 3.0)),
             view(Vec3::new(0.0, 0.0, 3.0)),
@@ -643,8 +789,7 @@ mod tests {
     #[test]
     fn jittered_projection_moves_every_point_by_the_jitter() {
         let size = (200u32, 100u32);
-        let vp = crate::render::Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 45.0)
-            .view_proj(2.0);
+        let vp = perspective_at(Vec3::new(0.0, 0.0, 3.0), 2.0);
         let j = jittered(vp, Vec2::new(0.25, -0.5), size);
         for p in [Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.5, 0.3, -4.0)] {
             let a = vp * p.extend(1.0);
