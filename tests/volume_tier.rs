@@ -16,7 +16,7 @@ const SIZE: u32 = 128;
 /// of a `SIZE`-pixel frame (`render::volume::hair_pixels`).
 fn camera_at(name: &str, pixels: f32) -> Camera {
     let (baked, _) = sample(name);
-    hairmesh::render::volume::camera_spanning(&baked.info, pixels, SIZE)
+    hairmesh::render::camera::camera_spanning(&baked.info, pixels, SIZE)
 }
 
 /// One frame of `name` (64 strands per bundle, 16 segments) seen by `camera`, with `tier`.
@@ -35,7 +35,7 @@ fn frame(
     )
     .unwrap();
     upload(&mut r, &baked, &style, 64, 4);
-    let (view, opts) = hairmesh::render::volume::switch_look(camera, tier);
+    let (view, opts) = hairmesh::render::camera::switch_look(camera, tier);
     let view = View { lod, ..view };
     let rgba = r.render_one(&view, &opts).unwrap().rgba.unwrap();
     assert_no_validation_errors(ctx);

@@ -430,6 +430,38 @@ impl View {
     }
 }
 
+/// The camera from [`DEFAULT_VIEW_DIR`] (vertical field of view 40 degrees) at which
+/// the bounding sphere of the hair box of `info` spans `pixels` pixels of a frame `height`
+/// pixels tall: the inverse of [`hair_pixels`](super::volume::hair_pixels) for a character at the origin, where the switch
+/// is measured (tests/volume_tier.rs) and shown (`bench crowd --band-strip`).
+pub fn camera_spanning(info: &crate::bake::MeshInfo, pixels: f32, height: u32) -> Camera {
+    let lo = Vec3::from_slice(&info.pos_origin[..3]);
+    let extent = Vec3::from_slice(&info.pos_extent[..3]);
+    let (centre, radius, fov) = (lo + 0.5 * extent, 0.5 * extent.length(), 40.0f32);
+    let distance = radius / (fov.to_radians() * 0.5).tan() * height as f32 / pixels;
+    let dir = DEFAULT_VIEW_DIR.normalize();
+    Camera::look_at(centre + dir * distance, centre, fov)
+}
+
+/// The look the switch between strands and volume is measured and shown with, for `camera`
+/// and `tier`: Marschner, deep opacity shadows, software strands (`auto:8`) and light passes,
+/// the image read back.
+pub fn switch_look(camera: Camera, tier: super::VolumeTier) -> (View, super::FrameOptions) {
+    let view = View {
+        shading: crate::shade::ShadingModel::Marschner,
+        shadows: super::ShadowMode::DeepOpacity,
+        volumes: tier,
+        ..View::new(camera)
+    };
+    let opts = super::FrameOptions {
+        read_image: true,
+        raster: super::StrandRaster::Auto { k: 8 },
+        light_raster: super::LightRaster::Software,
+        ..Default::default()
+    };
+    (view, opts)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -513,5 +545,44 @@ mod tests {
             crate::shade::volume::ray_length_to_depth(view_proj, eye, forward, 1.0),
             f32::INFINITY
         );
+    }
+
+    /// The switch is measured with the look its doc names (what `bench volume-tier` and
+    /// `tests/volume_tier.rs` compare).
+    #[test]
+    fn the_switch_look_is_the_documented_one() {
+        let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, 40.0);
+        let (view, opts) = switch_look(camera, crate::render::VolumeTier::on());
+        assert_eq!(view.shading, crate::shade::ShadingModel::Marschner);
+        assert_eq!(view.shadows, crate::render::ShadowMode::DeepOpacity);
+        assert_eq!(view.volumes, crate::render::VolumeTier::on());
+        assert_eq!(opts.raster, crate::render::StrandRaster::Auto { k: 8 });
+        assert_eq!(opts.light_raster, crate::render::LightRaster::Software);
+        assert!(opts.read_image);
+    }
+
+    /// `camera_spanning` is the inverse of `hair_pixels` for a character at the origin: its
+    /// camera looks at the hair box's centre along the default view direction, from where the
+    /// box's sphere spans the pixels asked for, at the 40-degree field of view.
+    #[test]
+    fn camera_spanning_is_the_inverse_of_hair_pixels() {
+        let mut r: crate::render::core::shared::CharacterRecord = bytemuck::Zeroable::zeroed();
+        r.model = glam::Mat4::IDENTITY.to_cols_array_2d();
+        r.mesh.pos_origin = [1.0, 2.0, -3.0, 0.0];
+        r.mesh.pos_extent = [4.0, 2.0, 1.0, 0.0];
+        r.model_scale = 1.0;
+        let centre = Vec3::new(3.0, 3.0, -2.5);
+        for (pixels, height) in [(20.0, 720), (64.0, 720), (300.0, 1080)] {
+            let cam = camera_spanning(&r.mesh, pixels, height);
+            assert!((cam.fov_y - 40f32.to_radians()).abs() < 1e-6);
+            assert!(cam.target.distance(centre) < 1e-5, "{}", cam.target);
+            let dir = (cam.eye - centre).normalize();
+            assert!(dir.dot(DEFAULT_VIEW_DIR.normalize()) > 0.99999);
+            let mut block: crate::render::core::shared::FrameBlock = bytemuck::Zeroable::zeroed();
+            block.camera_pos = cam.eye.extend(height as f32).to_array();
+            block.light_dir[3] = 1.0 / (cam.fov_y * 0.5).tan();
+            let spans = crate::render::volume::hair_pixels(&r, &block);
+            assert!((spans / pixels - 1.0).abs() < 1e-4, "{pixels}: {spans}");
+        }
     }
 }

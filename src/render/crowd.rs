@@ -9,6 +9,7 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Mat4;
 
+pub use super::core::ids::CharacterId;
 use super::core::shared::{
     CHARACTER_VISIBLE, CharacterRecord, GpuBundle, MAX_VERTS_LOG2, SimJob, TextureBinding,
 };
@@ -110,29 +111,6 @@ fn check_model(model: &Mat4) -> GpuResult<()> {
         Err(GpuError::Unsupported(
             "character transform is not finite".into(),
         ))
-    }
-}
-
-/// A character handle (slot + generation, so a stale handle is refused).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct CharacterId {
-    slot: u32,
-    generation: u32,
-}
-
-impl CharacterId {
-    /// The character's slot (its index in the character table and texture arrays).
-    pub fn slot(&self) -> u32 {
-        self.slot
-    }
-
-    /// The id of slot `slot`, generation 0 (unit tests of the tables keyed by it).
-    #[cfg(test)]
-    pub(super) fn test_id(slot: u32) -> Self {
-        CharacterId {
-            slot,
-            generation: 0,
-        }
     }
 }
 
@@ -332,7 +310,7 @@ impl Crowd {
             textures,
         });
         self.dirty = true;
-        Ok(CharacterId { slot, generation })
+        Ok(CharacterId::new(slot, generation))
     }
 
     fn upload(&self, slot: u32, baked: &BakedHairMesh) -> GpuResult<CharacterTextures> {
@@ -369,34 +347,34 @@ impl Crowd {
 
     fn get(&self, id: CharacterId) -> GpuResult<&Character> {
         self.slots
-            .get(id.slot as usize)
+            .get(id.slot() as usize)
             .and_then(|c| c.as_ref())
-            .filter(|c| c.generation == id.generation)
+            .filter(|c| c.generation == id.generation())
             .ok_or_else(|| GpuError::Unsupported(format!("no character {id:?}")))
     }
 
     fn get_mut(&mut self, id: CharacterId) -> GpuResult<&mut Character> {
         self.slots
-            .get_mut(id.slot as usize)
+            .get_mut(id.slot() as usize)
             .and_then(|c| c.as_mut())
-            .filter(|c| c.generation == id.generation)
+            .filter(|c| c.generation == id.generation())
             .ok_or_else(|| GpuError::Unsupported(format!("no character {id:?}")))
     }
 
     /// Whether `id` names a character of the crowd.
     pub fn contains(&self, id: CharacterId) -> bool {
         self.slots
-            .get(id.slot as usize)
+            .get(id.slot() as usize)
             .and_then(|c| c.as_ref())
-            .is_some_and(|c| c.generation == id.generation)
+            .is_some_and(|c| c.generation == id.generation())
     }
 
     /// Where character `id` is drawn this frame: its model, or `None` if it is hidden or gone.
     pub fn drawn_model(&self, id: CharacterId) -> Option<Mat4> {
         self.slots
-            .get(id.slot as usize)
+            .get(id.slot() as usize)
             .and_then(|c| c.as_ref())
-            .filter(|c| c.generation == id.generation && c.visible)
+            .filter(|c| c.generation == id.generation() && c.visible)
             .map(|c| c.model)
     }
 
@@ -406,13 +384,13 @@ impl Crowd {
         self.version += 1;
         self.structure_version += 1;
         self.get_mut(id)?;
-        let c = self.slots[id.slot as usize]
+        let c = self.slots[id.slot() as usize]
             .take()
             .expect("checked by get_mut");
         self.dirty = true;
         Ok(RemovedCharacter {
             textures: c.textures,
-            slot: id.slot,
+            slot: id.slot(),
         })
     }
 
@@ -425,7 +403,7 @@ impl Crowd {
         layout: &Arc<DescriptorSetLayout>,
     ) -> GpuResult<()> {
         self.get_mut(id)?;
-        let c = self.slots[id.slot as usize]
+        let c = self.slots[id.slot() as usize]
             .as_mut()
             .expect("checked by get_mut");
         if basis.info != c.info {
@@ -438,10 +416,11 @@ impl Crowd {
                 "character {id:?} is already deformable"
             )));
         }
-        let state = super::deform::DeformState::new(&self.ctx, basis, layout, &c.textures)?;
+        let own = super::deform::POSED_TEXTURES.map(|b| c.textures.own_image(b));
+        let state = super::deform::DeformState::new(&self.ctx, basis, layout, own)?;
         // The other texture set: its own position, u and v; the shared uv and w. No frame
         // reads those elements before the first pose update.
-        let other = id.slot + self.capacity;
+        let other = id.slot() + self.capacity;
         for (binding, _) in TextureBinding::ALL {
             let image = state
                 .alternate(binding)
@@ -572,9 +551,9 @@ impl Crowd {
     /// The image of character `id`'s texture `binding` (tests and tools read it back).
     pub fn texture(&self, id: CharacterId, binding: TextureBinding) -> GpuResult<&Image> {
         self.slots
-            .get(id.slot as usize)
+            .get(id.slot() as usize)
             .and_then(|c| c.as_ref())
-            .filter(|c| c.generation == id.generation)
+            .filter(|c| c.generation == id.generation())
             .map(|c| c.textures.image(binding))
             .ok_or_else(|| GpuError::Unsupported(format!("no character {id:?}")))
     }
@@ -686,10 +665,8 @@ impl Crowd {
             .iter()
             .enumerate()
             .filter_map(|(slot, c)| {
-                c.as_ref().map(|c| CharacterId {
-                    slot: slot as u32,
-                    generation: c.generation,
-                })
+                c.as_ref()
+                    .map(|c| CharacterId::new(slot as u32, c.generation))
             })
             .collect()
     }

@@ -12,40 +12,10 @@ use super::renderer::Renderer;
 use super::settings::{FrameSettings, RenderPath};
 use super::soft::StrandRaster;
 use super::transparency::Transparency;
-use crate::vk::{Access, Buffer, BufferDesc, GpuError, GpuResult};
+use crate::vk::{Access, Buffer, GpuError, GpuResult};
 
-fn readback(ctx: &std::sync::Arc<crate::vk::Context>, name: &str, bytes: u64) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new(name, bytes, vk::BufferUsageFlags::TRANSFER_DST).readback(),
-    )
-}
-
-/// The first `bytes` of device-local `buffer` (it needs `TRANSFER_SRC` usage), copied to the
-/// host; the caller has waited for the frames that write it.
-pub(super) fn read_device_buffer(
-    ctx: &std::sync::Arc<crate::vk::Context>,
-    buffer: &Buffer,
-    bytes: u64,
-) -> GpuResult<Vec<u8>> {
-    let bytes = bytes.min(buffer.size);
-    let mut out = readback(ctx, "buffer readback", bytes)?;
-    ctx.submit_and_wait(|rec| {
-        let mut g = FrameGraph::new(false);
-        let src = g.import_buffer("read buffer", buffer);
-        let dst = g.import_buffer("buffer readback", &out);
-        g.pass("copy buffer")
-            .read(src, Access::TransferRead)
-            .discard(dst, Access::TransferWrite)
-            .record(|rec, _| {
-                rec.copy_buffer(buffer, 0, &out, 0, bytes);
-                Ok(())
-            });
-        g.pass("host reads").read(dst, Access::HostRead).done();
-        g.run_untimed(rec).map(|_| ())
-    })??;
-    out.read()
-}
+pub(super) use super::core::readback::read_device_buffer;
+use super::core::readback::readback;
 
 impl Renderer {
     /// Draw `segments` (screen space and shaded, as generation appends them) with the

@@ -16,7 +16,6 @@ use super::core::shared::SimJob;
 use super::core::shared::TextureBinding;
 use super::core::shared::{DeformBinding, DeformParams};
 use super::core::slots::FRAMES_IN_FLIGHT;
-use super::crowd::CharacterTextures;
 use super::dynamics::{HairSimulation, HeadMaps};
 use crate::bake::deform::DeformBasis;
 use crate::vk::{
@@ -88,18 +87,12 @@ fn with_data(ctx: &Arc<Context>, name: &str, bytes: &[u8]) -> GpuResult<Buffer> 
     Buffer::device_local_with_data(ctx, name, vk::BufferUsageFlags::STORAGE_BUFFER, &padded)
 }
 
-/// The other set of posed textures, made like `textures`' (zeroed: the first update writes
-/// it).
-fn alternates(ctx: &Arc<Context>, textures: &CharacterTextures) -> GpuResult<[Image; 3]> {
-    let alternate = |b: TextureBinding| {
-        let own = textures.own_image(b);
-        Image::with_data(ctx, &own.desc, &vec![0; own.byte_size() as usize])
-    };
-    Ok([
-        alternate(POSED_TEXTURES[0])?,
-        alternate(POSED_TEXTURES[1])?,
-        alternate(POSED_TEXTURES[2])?,
-    ])
+/// The other set of posed textures, made like `own` (the character's [`POSED_TEXTURES`] as
+/// made when it was added; zeroed: the first update writes them).
+fn alternates(ctx: &Arc<Context>, own: [&Image; 3]) -> GpuResult<[Image; 3]> {
+    let alternate =
+        |own: &Image| Image::with_data(ctx, &own.desc, &vec![0; own.byte_size() as usize]);
+    Ok([alternate(own[0])?, alternate(own[1])?, alternate(own[2])?])
 }
 
 /// An update set reading `pose`.
@@ -141,14 +134,14 @@ impl SimulatedPose {
 
 impl DeformState {
     /// Buffers for `basis`; sets from `layout` (the update pass's); the other texture set
-    /// made like `textures`'.
+    /// made like `own` (the character's [`POSED_TEXTURES`] as made when it was added).
     pub fn new(
         ctx: &Arc<Context>,
         basis: DeformBasis,
         layout: &Arc<DescriptorSetLayout>,
-        textures: &CharacterTextures,
+        own: [&Image; 3],
     ) -> GpuResult<Self> {
-        let alternates = alternates(ctx, textures)?;
+        let alternates = alternates(ctx, own)?;
         let info = &basis.info;
         let slice = info.slice_texels() as u64;
         let layers = info.layers as u64;

@@ -16,15 +16,20 @@ use super::core::shared::{FrameBlock, HairVertex, PropInstance};
 use super::core::slots::{
     FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
 };
+use super::core::targets::{COLOR_FORMAT, DEPTH_FORMAT};
 use super::core::workspace::FrameBuffers;
-use super::features::temporal::{FrameMotion, PreviousFrame, TemporalFeature, TemporalWork};
-use super::host::{DepthMapping, HostImage};
+use super::features::temporal::{
+    FrameMotion, PreviousFrame, Temporal, TemporalFeature, TemporalWork,
+};
+use super::host::{DepthMapping, HostFrame, HostImage};
 use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::host_targets::{HostTargetPasses, HostTargetRes};
 use super::passes::output::{FrameOutputs, add_outputs};
 use super::passes::props::{PropDraw, PropList};
 use super::passes::write_address_table;
-use super::passes::{FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets};
+use super::passes::{
+    FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets, TargetFormats,
+};
 use super::renderer::{PresentTarget, Renderer};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
@@ -958,5 +963,91 @@ fn frame_inputs<'a>(
         temporal_feature,
         motion_readback: None,
         volume_slots: work.density.draw.slots,
+    }
+}
+
+impl Renderer {
+    /// Record the hair of one frame into a host's command buffer: seen through the host's
+    /// camera, hidden behind the host's depth, composited over the host's colour, with `look`
+    /// for everything else (light, shading, shadows, LoD; its camera is replaced). The host
+    /// submits the buffer, and once that submission has completed, [`Renderer::wait`] with the
+    /// ticket returns the frame's report without waiting (host frames complete when the host
+    /// says so). The renderer's targets follow the host colour's size. `opts.clear` does not
+    /// apply (the hair is drawn over a transparent layer, which `opts.read_image` reads back).
+    /// Refused: temporal accumulation (the host's own anti-aliasing jitters its projection,
+    /// which host frames follow), a slot out of range, images the host wants back unused.
+    pub fn record_host_frame(
+        &mut self,
+        look: &View,
+        opts: &FrameOptions,
+        frame: HostFrame,
+    ) -> GpuResult<FrameTicket> {
+        let refuse = |what: String| GpuError::Unsupported(format!("host frame: {what}"));
+        if frame.slot >= FRAMES_IN_FLIGHT {
+            return Err(refuse(format!(
+                "slot {} is not below {FRAMES_IN_FLIGHT}",
+                frame.slot
+            )));
+        }
+        if look.temporal == Temporal::Taa {
+            return Err(refuse(
+                "temporal accumulation is the host's (host frames follow its jittered projection)"
+                    .into(),
+            ));
+        }
+        if !(0.0..1e3).contains(&frame.depth_slack) {
+            return Err(refuse(format!(
+                "depth slack {} is not a distance in 0..1000",
+                frame.depth_slack
+            )));
+        }
+        let images = std::iter::once(&frame.color).chain(frame.depth.as_ref());
+        if images.into_iter().any(|i| i.after == Access::Nothing) {
+            return Err(refuse("an image cannot be handed back unused".into()));
+        }
+        let [width, height, _] = frame.color.image.desc.extent;
+        self.resize(width, height)?;
+        if self.host_passes.is_none() {
+            let targets = TargetFormats {
+                color: COLOR_FORMAT,
+                depth: DEPTH_FORMAT,
+                samples: self.desc.msaa,
+            };
+            self.host_passes = Some(HostTargetPasses::new(&self.ctx, targets)?);
+        }
+        let depth_image = frame.depth.as_ref().map(|d| d.image);
+        let passes = self.host_passes.as_mut().expect("made above");
+        passes.prepare(frame.color.image, depth_image)?;
+        passes.bind(frame.slot, depth_image, self.targets.output())?;
+        // The renderer's depth range: the host's near plane, and far enough for the hair.
+        let size = (width, height);
+        let mut host = frame
+            .camera
+            .view(size, self.hair_far(frame.camera.eye()))
+            .map_err(refuse)?;
+        host.depth.slack = frame.depth_slack;
+        let view = View {
+            camera: host.camera,
+            ..*look
+        };
+        let target = FrameTarget::Host(HostTargets {
+            cmd: frame.cmd,
+            color: &frame.color,
+            depth: frame.depth.as_ref(),
+            mapping: host.depth,
+        });
+        self.draw_frame(frame.slot, &view, opts, target)
+    }
+
+    /// A far plane beyond every character's hair seen from `eye` (with a tenth to spare).
+    fn hair_far(&self, eye: glam::Vec3) -> f32 {
+        let far = self
+            .crowd
+            .hair_bounds()
+            .into_iter()
+            .flat_map(|(lo, hi)| super::camera::box_corners(lo, hi))
+            .map(|c| c.distance(eye))
+            .fold(0.0f32, f32::max);
+        (far * 1.1).max(1e-3)
     }
 }

@@ -13,15 +13,8 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use super::camera::{Camera, View};
-use super::core::slots::FRAMES_IN_FLIGHT;
-use super::core::targets::{COLOR_FORMAT, DEPTH_FORMAT};
-use super::frame::{FrameTarget, HostTargets};
-use super::passes::TargetFormats;
-use super::passes::host_targets::HostTargetPasses;
-use super::settings::{FrameOptions, FrameTicket};
-use super::{Renderer, Temporal};
-use crate::vk::{Access, GpuError, GpuResult, Image};
+use super::camera::Camera;
+use crate::vk::{Access, Image};
 
 /// A host's camera: its world-to-view and view-to-clip matrices, in Vulkan's clip space (x to
 /// the right, depth in `[0, 1]`). View space may be right-handed (looking down -z) or
@@ -300,92 +293,6 @@ pub struct HostFrame<'a> {
     /// smooth head sits a fraction of a millimetre above it; the mesh's flat triangles cut
     /// through that) is not hidden by it. 0: exact; the Bevy plugin uses 4 mm.
     pub depth_slack: f32,
-}
-
-impl Renderer {
-    /// Record the hair of one frame into a host's command buffer: seen through the host's
-    /// camera, hidden behind the host's depth, composited over the host's colour, with `look`
-    /// for everything else (light, shading, shadows, LoD; its camera is replaced). The host
-    /// submits the buffer, and once that submission has completed, [`Renderer::wait`] with the
-    /// ticket returns the frame's report without waiting (host frames complete when the host
-    /// says so). The renderer's targets follow the host colour's size. `opts.clear` does not
-    /// apply (the hair is drawn over a transparent layer, which `opts.read_image` reads back).
-    /// Refused: temporal accumulation (the host's own anti-aliasing jitters its projection,
-    /// which host frames follow), a slot out of range, images the host wants back unused.
-    pub fn record_host_frame(
-        &mut self,
-        look: &View,
-        opts: &FrameOptions,
-        frame: HostFrame,
-    ) -> GpuResult<FrameTicket> {
-        let refuse = |what: String| GpuError::Unsupported(format!("host frame: {what}"));
-        if frame.slot >= FRAMES_IN_FLIGHT {
-            return Err(refuse(format!(
-                "slot {} is not below {FRAMES_IN_FLIGHT}",
-                frame.slot
-            )));
-        }
-        if look.temporal == Temporal::Taa {
-            return Err(refuse(
-                "temporal accumulation is the host's (host frames follow its jittered projection)"
-                    .into(),
-            ));
-        }
-        if !(0.0..1e3).contains(&frame.depth_slack) {
-            return Err(refuse(format!(
-                "depth slack {} is not a distance in 0..1000",
-                frame.depth_slack
-            )));
-        }
-        let images = std::iter::once(&frame.color).chain(frame.depth.as_ref());
-        if images.into_iter().any(|i| i.after == Access::Nothing) {
-            return Err(refuse("an image cannot be handed back unused".into()));
-        }
-        let [width, height, _] = frame.color.image.desc.extent;
-        self.resize(width, height)?;
-        if self.host_passes.is_none() {
-            let targets = TargetFormats {
-                color: COLOR_FORMAT,
-                depth: DEPTH_FORMAT,
-                samples: self.desc.msaa,
-            };
-            self.host_passes = Some(HostTargetPasses::new(&self.ctx, targets)?);
-        }
-        let depth_image = frame.depth.as_ref().map(|d| d.image);
-        let passes = self.host_passes.as_mut().expect("made above");
-        passes.prepare(frame.color.image, depth_image)?;
-        passes.bind(frame.slot, depth_image, self.targets.output())?;
-        // The renderer's depth range: the host's near plane, and far enough for the hair.
-        let size = (width, height);
-        let mut host = frame
-            .camera
-            .view(size, self.hair_far(frame.camera.eye()))
-            .map_err(refuse)?;
-        host.depth.slack = frame.depth_slack;
-        let view = View {
-            camera: host.camera,
-            ..*look
-        };
-        let target = FrameTarget::Host(HostTargets {
-            cmd: frame.cmd,
-            color: &frame.color,
-            depth: frame.depth.as_ref(),
-            mapping: host.depth,
-        });
-        self.draw_frame(frame.slot, &view, opts, target)
-    }
-
-    /// A far plane beyond every character's hair seen from `eye` (with a tenth to spare).
-    fn hair_far(&self, eye: Vec3) -> f32 {
-        let far = self
-            .crowd
-            .hair_bounds()
-            .into_iter()
-            .flat_map(|(lo, hi)| super::camera::box_corners(lo, hi))
-            .map(|c| c.distance(eye))
-            .fold(0.0f32, f32::max);
-        (far * 1.1).max(1e-3)
-    }
 }
 
 #[cfg(test)]

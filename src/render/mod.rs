@@ -23,7 +23,6 @@ pub mod skinned_props;
 pub mod soft;
 pub mod soft_pixel;
 pub mod transparency;
-pub mod volume;
 
 pub use self::core::shared::FrameStats;
 pub use self::core::slots::{Dropped, FRAMES_IN_FLIGHT, FrameReport, ViewBudgets};
@@ -33,7 +32,7 @@ pub use camera::{
     LodSettings, View,
 };
 pub use crowd::{CharacterId, Crowd, StrandParams};
-pub use features::temporal;
+pub use features::{temporal, volume};
 pub use host::{HostCamera, HostFrame, HostImage};
 pub use renderer::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,

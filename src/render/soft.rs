@@ -32,7 +32,6 @@ use glam::Vec2;
 
 use super::core::graph::TransientBuffer;
 use super::core::shared::{FrameBinding, FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
-use super::settings::ShadowMode;
 
 /// Default number of fragments per pixel the software rasterizer keeps sorted.
 pub const DEFAULT_SOFT_K: u32 = 8;
@@ -265,12 +264,12 @@ impl SoftBudget {
     }
 }
 
-/// The software shadow passes' outputs for a `side x side` map in `mode` (`None`: hardware
-/// light passes, sized 0): the hair depth (a float per texel) and, for deep opacity maps, the
-/// layers (an RGBA16F texel each), which transfers copy into the maps.
-pub fn shadow_buffers(light: Option<(u32, ShadowMode)>) -> [TransientBuffer; 2] {
+/// The software shadow passes' outputs for a `side x side` map, with deep opacity layers or
+/// not (`None`: hardware light passes, sized 0): the hair depth (a float per texel) and, for
+/// deep opacity maps, the layers (an RGBA16F texel each), which transfers copy into the maps.
+pub fn shadow_buffers(light: Option<(u32, bool)>) -> [TransientBuffer; 2] {
     let texels = light.map_or(0, |(side, _)| side as u64 * side as u64);
-    let layers = matches!(light, Some((_, ShadowMode::DeepOpacity)));
+    let layers = matches!(light, Some((_, true)));
     [
         TransientBuffer::storage(
             "soft shadow depth",

@@ -100,8 +100,8 @@ pub fn band_strip(
             };
             r.add_character(baked, style, params, glam::Mat4::IDENTITY)?;
             let camera =
-                hairmesh::render::volume::camera_spanning(&baked.info, pixels, STRIP_FRAME);
-            let (view, opts) = hairmesh::render::volume::switch_look(camera, tier);
+                hairmesh::render::camera::camera_spanning(&baked.info, pixels, STRIP_FRAME);
+            let (view, opts) = hairmesh::render::camera::switch_look(camera, tier);
             let rgba = r.render_one(&view, &opts)?.rgba.unwrap_or_default();
             let full = image::RgbaImage::from_raw(STRIP_FRAME, STRIP_FRAME, rgba)
                 .ok_or_else(|| anyhow::anyhow!("frame size"))?;

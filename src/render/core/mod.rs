@@ -7,7 +7,9 @@
 
 pub mod binding;
 pub mod graph;
+pub mod ids;
 pub mod path;
+pub mod readback;
 pub mod shared;
 pub mod slots;
 pub mod targets;

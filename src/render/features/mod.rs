@@ -4,3 +4,4 @@
 //! folder only, never from each other or the renderer (`tests/module_house.rs` checks).
 
 pub mod temporal;
+pub mod volume;

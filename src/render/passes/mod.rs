@@ -333,7 +333,9 @@ impl FrameTransients {
         FrameTransients {
             transparency: transparency.buffers(width as u64 * height as u64),
             soft: SoftBudget::buffers(budget, views.0, views.1),
-            soft_shadow: super::soft::shadow_buffers(light.map(|l| (l.1, l.2))),
+            soft_shadow: super::soft::shadow_buffers(
+                light.map(|l| (l.1, l.2 == ShadowMode::DeepOpacity)),
+            ),
             peel_image: peel.then(|| super::transparency::peel_image(width, height)),
             temporal: temporal_buffers,
             motion: temporal.is_some(),

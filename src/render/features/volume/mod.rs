@@ -14,13 +14,13 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, UVec3, Vec3};
 
-use super::core::shared::{
-    CHARACTER_VISIBLE, CHARACTER_VOLUME_ONLY, CharacterRecord, DensityJob, FrameBlock,
-    VOLUME_BUILT, VOLUME_DIMS_BITS, VOLUME_FIXED, VOLUME_OCCLUSION, VOLUME_SKIP_EMPTY, VolumeCell,
-};
-use super::crowd::CharacterId;
 use crate::reference::volume::{
     DensityVolume, VolumeSampling, cell_size, occupancy_words, volume_box,
+};
+use crate::render::core::ids::CharacterId;
+use crate::render::core::shared::{
+    CHARACTER_VISIBLE, CHARACTER_VOLUME_ONLY, CharacterRecord, DensityJob, FrameBlock,
+    VOLUME_BUILT, VOLUME_DIMS_BITS, VOLUME_FIXED, VOLUME_OCCLUSION, VOLUME_SKIP_EMPTY, VolumeCell,
 };
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
 
@@ -144,38 +144,6 @@ pub fn hair_pixels(r: &CharacterRecord, block: &FrameBlock) -> f32 {
         return f32::INFINITY;
     }
     radius * inv_tan * height / distance
-}
-
-/// The camera from [`super::DEFAULT_VIEW_DIR`] (vertical field of view 40 degrees) at which
-/// the bounding sphere of the hair box of `info` spans `pixels` pixels of a frame `height`
-/// pixels tall: the inverse of [`hair_pixels`] for a character at the origin, where the switch
-/// is measured (tests/volume_tier.rs) and shown (`bench crowd --band-strip`).
-pub fn camera_spanning(info: &crate::bake::MeshInfo, pixels: f32, height: u32) -> super::Camera {
-    let lo = Vec3::from_slice(&info.pos_origin[..3]);
-    let extent = Vec3::from_slice(&info.pos_extent[..3]);
-    let (centre, radius, fov) = (lo + 0.5 * extent, 0.5 * extent.length(), 40.0f32);
-    let distance = radius / (fov.to_radians() * 0.5).tan() * height as f32 / pixels;
-    let dir = super::DEFAULT_VIEW_DIR.normalize();
-    super::Camera::look_at(centre + dir * distance, centre, fov)
-}
-
-/// The look the switch between strands and volume is measured and shown with, for `camera`
-/// and `tier`: Marschner, deep opacity shadows, software strands (`auto:8`) and light passes,
-/// the image read back.
-pub fn switch_look(camera: super::Camera, tier: VolumeTier) -> (super::View, super::FrameOptions) {
-    let view = super::View {
-        shading: crate::shade::ShadingModel::Marschner,
-        shadows: super::ShadowMode::DeepOpacity,
-        volumes: tier,
-        ..super::View::new(camera)
-    };
-    let opts = super::FrameOptions {
-        read_image: true,
-        raster: super::StrandRaster::Auto { k: 8 },
-        light_raster: super::LightRaster::Software,
-        ..Default::default()
-    };
-    (view, opts)
 }
 
 /// Byte offset of the occupancy mask in a volume's buffer of `dims` cells: after the cells and
@@ -438,7 +406,7 @@ impl DensityVolumes {
                 "the density volume has not been built yet (render a frame first)".into(),
             ));
         };
-        let bytes = super::debug::read_device_buffer(ctx, &e.cells, e.cells.size)?;
+        let bytes = crate::render::core::readback::read_device_buffer(ctx, &e.cells, e.cells.size)?;
         Ok((e.sampling, built, bytes))
     }
 }
@@ -518,20 +486,6 @@ mod tests {
         assert!((numeric - 0.0015).abs() < 1e-9);
     }
 
-    /// The switch is measured with the look its doc names (what `bench volume-tier` and
-    /// `tests/volume_tier.rs` compare).
-    #[test]
-    fn the_switch_look_is_the_documented_one() {
-        let camera = super::super::Camera::look_at(Vec3::Z, Vec3::ZERO, 40.0);
-        let (view, opts) = switch_look(camera, VolumeTier::on());
-        assert_eq!(view.shading, crate::shade::ShadingModel::Marschner);
-        assert_eq!(view.shadows, super::super::ShadowMode::DeepOpacity);
-        assert_eq!(view.volumes, VolumeTier::on());
-        assert_eq!(opts.raster, super::super::StrandRaster::Auto { k: 8 });
-        assert_eq!(opts.light_raster, super::super::LightRaster::Software);
-        assert!(opts.read_image);
-    }
-
     /// A character's hair spans its bounding sphere's projected diameter: `2 r / (2 d tan)`
     /// of the screen height in perspective, `2 r / view height` of it in orthographic views.
     #[test]
@@ -551,31 +505,6 @@ mod tests {
         block.light_dir[3] = 0.0;
         block.lod_ortho[0] = 4.0;
         assert!((hair_pixels(&r, &block) - 720.0).abs() < 1e-3);
-    }
-
-    /// `camera_spanning` is the inverse of `hair_pixels` for a character at the origin: its
-    /// camera looks at the hair box's centre along the default view direction, from where the
-    /// box's sphere spans the pixels asked for, at the 40-degree field of view.
-    #[test]
-    fn camera_spanning_is_the_inverse_of_hair_pixels() {
-        let mut r: CharacterRecord = bytemuck::Zeroable::zeroed();
-        r.model = Mat4::IDENTITY.to_cols_array_2d();
-        r.mesh.pos_origin = [1.0, 2.0, -3.0, 0.0];
-        r.mesh.pos_extent = [4.0, 2.0, 1.0, 0.0];
-        r.model_scale = 1.0;
-        let centre = Vec3::new(3.0, 3.0, -2.5);
-        for (pixels, height) in [(20.0, 720), (64.0, 720), (300.0, 1080)] {
-            let cam = camera_spanning(&r.mesh, pixels, height);
-            assert!((cam.fov_y - 40f32.to_radians()).abs() < 1e-6);
-            assert!(cam.target.distance(centre) < 1e-5, "{}", cam.target);
-            let dir = (cam.eye - centre).normalize();
-            assert!(dir.dot(super::super::DEFAULT_VIEW_DIR.normalize()) > 0.99999);
-            let mut block: FrameBlock = bytemuck::Zeroable::zeroed();
-            block.camera_pos = cam.eye.extend(height as f32).to_array();
-            block.light_dir[3] = 1.0 / (cam.fov_y * 0.5).tan();
-            let spans = hair_pixels(&r, &block);
-            assert!((spans / pixels - 1.0).abs() < 1e-4, "{pixels}: {spans}");
-        }
     }
 
     #[test]
