@@ -28,8 +28,6 @@ const KNOWN_LONG: &[&str] = &[
     "src/model/hair_mesh.rs::validate",
     "src/model/obj_io.rs::parse_hair_mesh_obj",
     "src/model/obj_io.rs::scan_lines",
-    "src/render/core/graph/mod.rs::run_with",
-    "src/render/core/shared.rs::int_constants",
     "src/render/frame.rs::draw_frame",
     "src/render/frame.rs::record",
     "src/render/frame.rs::write_slot",
@@ -297,7 +295,13 @@ fn use_paths(toks: &[(String, usize)], mut i: usize) -> (Vec<Vec<String>>, usize
                     out.push(path);
                     return;
                 }
-                "as" => *i += 2,
+                "as" => {
+                    // The name the item is known by here: kept as a last `as:` segment.
+                    if let Some(alias) = toks.get(*i + 1) {
+                        path.push(format!("as:{}", alias.0));
+                    }
+                    *i += 2;
+                }
                 "*" => {
                     path.push("*".into());
                     *i += 1;
@@ -322,6 +326,8 @@ fn use_paths(toks: &[(String, usize)], mut i: usize) -> (Vec<Vec<String>>, usize
 struct Reference {
     scope: Vec<String>,
     path: Vec<String>,
+    /// The name a `use ... as name` gives the item.
+    alias: Option<String>,
     is_use: bool,
     is_pub_use: bool,
 }
@@ -356,10 +362,18 @@ fn references(file: &SourceFile) -> Vec<Reference> {
             "use" => {
                 let is_pub = i > 0 && (toks[i - 1].0 == "pub" || toks[i - 1].0 == ")");
                 let (paths, next) = use_paths(&toks, i + 1);
-                for path in paths {
+                for mut path in paths {
+                    let alias = path
+                        .last()
+                        .and_then(|l| l.strip_prefix("as:"))
+                        .map(String::from);
+                    if alias.is_some() {
+                        path.pop();
+                    }
                     out.push(Reference {
                         scope: scope.clone(),
                         path,
+                        alias,
                         is_use: true,
                         is_pub_use: is_pub,
                     });
@@ -382,6 +396,7 @@ fn references(file: &SourceFile) -> Vec<Reference> {
                 out.push(Reference {
                     scope: scope.clone(),
                     path,
+                    alias: None,
                     is_use: false,
                     is_pub_use: false,
                 });
@@ -453,7 +468,8 @@ impl CrateTree {
                 continue;
             }
             let last = r.path.last().map(String::as_str);
-            if last != Some(item.as_str()) && last != Some("*") {
+            let known_as = r.alias.as_deref().or(last);
+            if known_as != Some(item.as_str()) && last != Some("*") {
                 continue;
             }
             let Some(mut next) = self.absolute(&r) else {
@@ -774,7 +790,12 @@ fn the_module_graph_has_no_cycles_and_no_function_is_over_80_lines() {
             long.push(format!("{}::{name}", rel(&f, root)));
         }
     }
+    let mut sources = Vec::new();
+    rust_files(&root.join("src"), &mut sources);
+    let sources: BTreeSet<String> = sources.iter().map(|f| rel(f, &root.join("src"))).collect();
+    let chapter = std::fs::read_to_string(root.join("src/guide/layout.md")).unwrap();
     let mut problems = check_against(&cycles, &[], "cycle");
+    problems.extend(layout_problems(&chapter, &sources));
     problems.extend(layers.into_iter().map(|l| format!("layer: {l}")));
     for p in problems.iter_mut() {
         if let Some(why) = p.strip_prefix("new cycle: ").and_then(|c| explained.get(c)) {
@@ -788,6 +809,39 @@ fn the_module_graph_has_no_cycles_and_no_function_is_over_80_lines() {
         long.len()
     );
     assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// What the layout chapter gets wrong: files it does not name and names that are not files.
+/// Its headings name folders (`### \`render/core/\``, `### \`src/\`` for the root) and its
+/// bullets the files in them (`- \`shared.rs\`: ...`).
+fn layout_problems(chapter: &str, files: &BTreeSet<String>) -> Vec<String> {
+    let mut named = BTreeSet::new();
+    let mut folder: Option<String> = None;
+    for line in chapter.lines() {
+        if let Some(h) = line.strip_prefix("### `") {
+            let dir = h.split('`').next().unwrap_or("");
+            folder = Some(if dir == "src/" {
+                String::new()
+            } else {
+                dir.to_string()
+            });
+        } else if let (Some(b), Some(dir)) = (line.strip_prefix("- `"), &folder) {
+            let file = b.split('`').next().unwrap_or("");
+            if file.ends_with(".rs") {
+                named.insert(format!("{dir}{file}"));
+            }
+        }
+    }
+    let mut out: Vec<String> = files
+        .difference(&named)
+        .map(|f| format!("layout chapter does not name src/{f}"))
+        .collect();
+    out.extend(
+        named
+            .difference(files)
+            .map(|f| format!("layout chapter names src/{f}, which does not exist")),
+    );
+    out
 }
 
 /// A tree of its own under the target folder, written file by file.
@@ -884,6 +938,23 @@ fn a_core_or_feature_that_takes_from_above_is_found() {
                 .to_string(),
             "src/render/features/a/mod.rs takes from src/render/features/b/mod.rs (super::b::B)"
                 .to_string(),
+        ]
+    );
+}
+
+#[test]
+fn a_layout_chapter_that_misses_a_file_or_names_a_missing_one_is_refused() {
+    let files: BTreeSet<String> = ["lib.rs", "render/mod.rs", "render/core/shared.rs"]
+        .map(String::from)
+        .into();
+    let good = "### `src/`\n\n- `lib.rs`: root.\n\n### `render/`\n- `mod.rs`: x.\n### `render/core/`\n- `shared.rs`: y.\n";
+    assert!(layout_problems(good, &files).is_empty());
+    let missing = good.replace("- `shared.rs`: y.\n", "- `slots.rs`: y.\n");
+    assert_eq!(
+        layout_problems(&missing, &files),
+        vec![
+            "layout chapter does not name src/render/core/shared.rs".to_string(),
+            "layout chapter names src/render/core/slots.rs, which does not exist".to_string(),
         ]
     );
 }

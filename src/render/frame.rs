@@ -148,7 +148,7 @@ impl Renderer {
             .work(view.temporal, opts.read_motion, vertex_slots)?;
         // What draws the frame's bundles, decided once (`auto` with k-buffer OIT is all
         // software): the passes, buffers and frame blocks all follow it.
-        let raster = opts.raster.under(view.transparency);
+        let raster = super::settings::raster_under(opts.raster, view.transparency);
         self.retire_slot(i)?;
         if let Some(old) = self
             .temporal

@@ -13,16 +13,12 @@ pub mod features;
 pub mod frame;
 pub mod host;
 pub mod passes;
-pub mod payload;
 pub mod prop_table;
 pub mod renderer;
 pub mod scene;
 pub mod settings;
 pub mod shadow;
 pub mod skinned_props;
-pub mod soft;
-pub mod soft_pixel;
-pub mod transparency;
 
 pub use self::core::shared::FrameStats;
 pub use self::core::slots::{Dropped, FRAMES_IN_FLIGHT, FrameReport, ViewBudgets};
@@ -32,7 +28,8 @@ pub use camera::{
     LodSettings, View,
 };
 pub use crowd::{CharacterId, Crowd, StrandParams};
-pub use features::{temporal, volume};
+pub use features::soft_raster::{payload, pixel as soft_pixel};
+pub use features::{soft_raster as soft, temporal, transparency, volume};
 pub use host::{HostCamera, HostFrame, HostImage};
 pub use renderer::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,

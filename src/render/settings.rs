@@ -1,6 +1,19 @@
 //! Renderer and frame settings.
 
 pub use super::core::path::RenderPath;
+use super::features::soft_raster::StrandRaster;
+use super::features::transparency::Transparency;
+
+/// What draws each bundle in a frame composited with `transparency`: `Auto` with k-buffer
+/// OIT sends every bundle to software, since the software rasterizer is never slower than
+/// hardware strips inserted into a k-buffer (guide, soft_raster chapter, `bench raster`); in
+/// opaque frames thick bundles stay opaque hardware strips, which need no k-buffer.
+pub fn raster_under(raster: StrandRaster, transparency: Transparency) -> StrandRaster {
+    match (raster, transparency) {
+        (StrandRaster::Auto { k }, Transparency::KBuffer { .. }) => StrandRaster::Software { k },
+        _ => raster,
+    }
+}
 
 /// How the light's passes draw the hair into the shadow maps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -382,5 +395,27 @@ impl ShadowMode {
             ShadowMode::DeepOpacity => "deep-opacity",
             ShadowMode::Approximate => "approximate",
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Under k-buffer transparency `Auto` sends every bundle to software, keeping its `k`;
+    /// everything else is left as asked (returning the default, hardware, survived the
+    /// 2026-12-06 sample).
+    #[test]
+    fn auto_raster_goes_software_under_a_k_buffer() {
+        let oit = Transparency::KBuffer { budget: 8 };
+        let auto = StrandRaster::Auto { k: 3 };
+        assert_eq!(raster_under(auto, oit), StrandRaster::Software { k: 3 });
+        assert_eq!(raster_under(auto, Transparency::Opaque), auto);
+        let soft = StrandRaster::Software { k: 5 };
+        assert_eq!(raster_under(soft, oit), soft);
+        assert_eq!(
+            raster_under(StrandRaster::Hardware, oit),
+            StrandRaster::Hardware
+        );
     }
 }

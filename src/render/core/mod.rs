@@ -8,6 +8,7 @@
 pub mod binding;
 pub mod graph;
 pub mod ids;
+pub mod mode_name;
 pub mod path;
 pub mod readback;
 pub mod shared;

@@ -1145,7 +1145,13 @@ pub fn std430_layout(
 /// Integer constants shared with GLSL. Those used in layout qualifiers (set numbers, local
 /// sizes, mesh output limits) are written as `int`, the rest as `uint`.
 fn int_constants() -> Vec<(&'static str, u32, bool)> {
-    use crate::shade::ShadingModel;
+    let mut all = sizes_and_flags();
+    all.extend(enum_numbers());
+    all
+}
+
+/// Sizes, limits and flag bits shared with GLSL (`true`: usable in layout qualifiers).
+fn sizes_and_flags() -> Vec<(&'static str, u32, bool)> {
     let layout = |n, v| (n, v, true);
     let uint = |n, v| (n, v, false);
     vec![
@@ -1209,7 +1215,14 @@ fn int_constants() -> Vec<(&'static str, u32, bool)> {
             crate::reference::generate::STRAND_RAND_THINNING,
         ),
         uint("EMPTY_TEXEL", crate::bake::layout::EMPTY_TEXEL),
-        // Enum numbers the frame block carries.
+    ]
+}
+
+/// Enum numbers the frame block carries, and the visibility word's constants.
+fn enum_numbers() -> Vec<(&'static str, u32, bool)> {
+    use crate::shade::ShadingModel;
+    let uint = |n, v| (n, v, false);
+    vec![
         uint("SHADING_PLACEHOLDER", ShadingModel::Placeholder as u32),
         uint("SHADING_KAJIYA_KAY", ShadingModel::KajiyaKay as u32),
         uint("SHADING_MARSCHNER", ShadingModel::Marschner as u32),

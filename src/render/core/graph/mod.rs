@@ -560,7 +560,18 @@ impl<'a> FrameGraph<'a> {
         if self.describe {
             self.describe_transients(&mut text, &realized, pool.as_deref());
         }
-        for (r, taken) in self.resources.iter_mut().zip(&realized) {
+        self.keep_last_uses(&realized, pool);
+        Ok(self.describe.then_some(text))
+    }
+
+    /// After the frame: tracked images keep their last state, and pooled transients their
+    /// last uses, for the next frame's barriers.
+    fn keep_last_uses(
+        &mut self,
+        realized: &[Option<(usize, Realized)>],
+        mut pool: Option<&mut TransientPool>,
+    ) {
+        for (r, taken) in self.resources.iter_mut().zip(realized) {
             if let Some(t) = r.tracked.as_deref_mut() {
                 *t = r.tracker.last;
             }
@@ -574,7 +585,6 @@ impl<'a> FrameGraph<'a> {
                 _ => {}
             }
         }
-        Ok(self.describe.then_some(text))
     }
 
     /// The barriers that return fixed-state images to their use, if any are needed.

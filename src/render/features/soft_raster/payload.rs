@@ -10,7 +10,7 @@
 //! leaving 22 of 32 threads idle. A run never shares a workgroup with another: the workgroup
 //! binds one character and builds one vertex level.
 
-use super::core::shared::{PAYLOAD_LANE_BITS, STRAND_GROUP_SIZE};
+use crate::render::core::shared::{PAYLOAD_LANE_BITS, STRAND_GROUP_SIZE};
 
 /// One visible bundle of a task workgroup, as the placement sees it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -28,10 +28,13 @@
 //! widened by the LoD thickness, over the pixel size at the bundle's nearest distance) goes
 //! to software, thicker ones stay on hardware strips.
 
+pub mod payload;
+pub mod pixel;
+
 use glam::Vec2;
 
-use super::core::graph::TransientBuffer;
-use super::core::shared::{FrameBinding, FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
+use crate::render::core::graph::TransientBuffer;
+use crate::render::core::shared::{FrameBinding, FrameBlock, SOFT_MAX_K, SOFT_TILE, SoftSegment};
 
 /// Default number of fragments per pixel the software rasterizer keeps sorted.
 pub const DEFAULT_SOFT_K: u32 = 8;
@@ -65,28 +68,15 @@ impl StrandRaster {
     /// Mode number in `FrameBlock::soft.x`.
     pub fn mode(self) -> u32 {
         match self {
-            StrandRaster::Hardware => super::core::shared::RASTER_HARDWARE,
-            StrandRaster::Software { .. } => super::core::shared::RASTER_SOFTWARE,
-            StrandRaster::Auto { .. } => super::core::shared::RASTER_AUTO,
+            StrandRaster::Hardware => crate::render::core::shared::RASTER_HARDWARE,
+            StrandRaster::Software { .. } => crate::render::core::shared::RASTER_SOFTWARE,
+            StrandRaster::Auto { .. } => crate::render::core::shared::RASTER_AUTO,
         }
     }
 
     /// Whether the software rasterizer runs.
     pub fn uses_software(self) -> bool {
         self != StrandRaster::Hardware
-    }
-
-    /// What draws each bundle in a frame composited with `transparency`: `Auto` with k-buffer
-    /// OIT sends every bundle to software, since the software rasterizer is never slower than
-    /// hardware strips inserted into a k-buffer (guide, soft_raster chapter, `bench raster`); in opaque frames
-    /// thick bundles stay opaque hardware strips, which need no k-buffer.
-    pub fn under(self, transparency: super::Transparency) -> Self {
-        match (self, transparency) {
-            (StrandRaster::Auto { k }, super::Transparency::KBuffer { .. }) => {
-                StrandRaster::Software { k }
-            }
-            _ => self,
-        }
     }
 
     /// Fragments per pixel kept sorted (0 for hardware).
@@ -124,7 +114,7 @@ impl std::str::FromStr for StrandRaster {
     type Err = String;
     /// `hw`, `soft` or `soft:K`, `auto` or `auto:K` (K fragments per pixel kept sorted).
     fn from_str(s: &str) -> Result<Self, String> {
-        let (name, k) = super::transparency::name_and_count("draw", s)?;
+        let (name, k) = crate::render::core::mode_name::name_and_count("draw", s)?;
         let k_or_default = k.unwrap_or(DEFAULT_SOFT_K);
         let r = match name {
             "hw" if k.is_none() => StrandRaster::Hardware,
@@ -289,21 +279,6 @@ pub fn shadow_buffers(light: Option<(u32, bool)>) -> [TransientBuffer; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Under k-buffer transparency `Auto` sends every bundle to software, keeping its `k`;
-    /// everything else is left as asked (`under` returning the default, hardware, survived
-    /// the 2026-12-06 sample).
-    #[test]
-    fn auto_raster_goes_software_under_a_k_buffer() {
-        use crate::render::Transparency;
-        let oit = Transparency::KBuffer { budget: 8 };
-        let auto = StrandRaster::Auto { k: 3 };
-        assert_eq!(auto.under(oit), StrandRaster::Software { k: 3 });
-        assert_eq!(auto.under(Transparency::Opaque), auto);
-        let soft = StrandRaster::Software { k: 5 };
-        assert_eq!(soft.under(oit), soft);
-        assert_eq!(StrandRaster::Hardware.under(oit), StrandRaster::Hardware);
-    }
 
     /// Each raster reaches the shaders as its own mode number (`FrameBlock::soft.x`).
     #[test]

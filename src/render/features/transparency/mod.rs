@@ -16,11 +16,11 @@
 
 use ash::vk;
 
-use super::core::graph::TransientBuffer;
-use super::core::shared::FrameBinding;
+use crate::render::core::graph::TransientBuffer;
+use crate::render::core::shared::FrameBinding;
 use crate::vk::ImageDesc;
 
-pub use super::core::shared::{MAX_OIT_BUDGET, STRAND_OPACITY};
+pub use crate::render::core::shared::{MAX_OIT_BUDGET, STRAND_OPACITY};
 /// Default k-buffer budget.
 pub const DEFAULT_OIT_BUDGET: u32 = 8;
 /// Largest number of peeled layers.
@@ -50,9 +50,9 @@ impl Transparency {
     /// Mode number in `FrameBlock::transparency.x`.
     pub fn mode(self) -> u32 {
         match self {
-            Transparency::Opaque => super::core::shared::TRANSPARENCY_OPAQUE,
-            Transparency::KBuffer { .. } => super::core::shared::TRANSPARENCY_KBUFFER,
-            Transparency::DepthPeeling { .. } => super::core::shared::TRANSPARENCY_PEELING,
+            Transparency::Opaque => crate::render::core::shared::TRANSPARENCY_OPAQUE,
+            Transparency::KBuffer { .. } => crate::render::core::shared::TRANSPARENCY_KBUFFER,
+            Transparency::DepthPeeling { .. } => crate::render::core::shared::TRANSPARENCY_PEELING,
         }
     }
 
@@ -103,23 +103,11 @@ impl std::fmt::Display for Transparency {
     }
 }
 
-/// `name` or `name:count` (a whole number) of a mode flag such as `oit:8`; `what` names the
-/// flag in errors.
-pub(crate) fn name_and_count<'a>(what: &str, s: &'a str) -> Result<(&'a str, Option<u32>), String> {
-    match s.split_once(':') {
-        Some((n, c)) => c
-            .parse::<u32>()
-            .map(|c| (n, Some(c)))
-            .map_err(|_| format!("{what} '{s}': '{c}' is not a whole number")),
-        None => Ok((s, None)),
-    }
-}
-
 impl std::str::FromStr for Transparency {
     type Err = String;
     /// `opaque`, `oit` or `oit:K` (K nodes per pixel), `peel` or `peel:N` (N layers).
     fn from_str(s: &str) -> Result<Self, String> {
-        let (name, count) = name_and_count("transparency", s)?;
+        let (name, count) = crate::render::core::mode_name::name_and_count("transparency", s)?;
         let t = match name {
             "opaque" if count.is_none() => Transparency::Opaque,
             "oit" => Transparency::KBuffer {
@@ -166,7 +154,7 @@ impl Transparency {
 pub fn peel_image(width: u32, height: u32) -> ImageDesc {
     ImageDesc::new_2d(
         "peel depth",
-        super::core::targets::DEPTH_FORMAT,
+        crate::render::core::targets::DEPTH_FORMAT,
         width,
         height,
     )

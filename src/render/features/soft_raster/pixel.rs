@@ -9,8 +9,8 @@
 //! the pixel, seen front to back, is below that transmittance; through the tail, which
 //! averages what it holds, a pixel can still change by more (`tests` measure it).
 
-use super::core::shared::{OIT_FIXED, SOFT_HIDDEN_TRANSMITTANCE};
-use super::soft::{pack_fragment, unpack_fragment};
+use super::{pack_fragment, unpack_fragment};
+use crate::render::core::shared::{OIT_FIXED, SOFT_HIDDEN_TRANSMITTANCE};
 
 /// An empty node (`OIT_EMPTY` of `oit.glsl`).
 const EMPTY: u64 = u64::MAX;
@@ -63,7 +63,7 @@ impl PixelFragments {
 
     /// The same with another bound on hiding (0 hides nothing; for comparisons).
     pub fn with_hidden_transmittance(k: usize, opaque_depth: f32, bound: f32) -> Self {
-        assert!((1..=super::core::shared::SOFT_MAX_K as usize).contains(&k));
+        assert!((1..=crate::render::core::shared::SOFT_MAX_K as usize).contains(&k));
         Self {
             nodes: vec![EMPTY; k],
             tail: [0; 4],
