@@ -101,8 +101,9 @@ impl Reader<'_> {
     }
 }
 
-/// Parse a bake from bytes; `name` is used in errors.
-pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<BakedHairMesh> {
+/// The payload of a `.hmb` file after its header's magic, version, length and checksum are
+/// checked.
+fn checked_payload<'b>(name: &str, bytes: &'b [u8]) -> Result<&'b [u8]> {
     let bad = |what: String| HairError::invalid(name, what);
     if bytes.len() < HEADER {
         return Err(bad(format!(
@@ -131,6 +132,13 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<BakedHairMesh> {
     if crc32fast::hash(payload) != crc {
         return Err(bad("checksum mismatch: the file is corrupt".into()));
     }
+    Ok(payload)
+}
+
+/// Parse a bake from bytes; `name` is used in errors.
+pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<BakedHairMesh> {
+    let bad = |what: String| HairError::invalid(name, what);
+    let payload = checked_payload(name, bytes)?;
     let mut r = Reader {
         name,
         data: payload,

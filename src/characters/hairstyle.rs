@@ -1040,25 +1040,7 @@ fn lift_bundle_interiors(
                     {
                         continue;
                     }
-                    // The least raise of the corners around r that lifts this point by
-                    // `need` (each in proportion to its weight; the root layer stays on the
-                    // scalp).
-                    let tau = r.fract();
-                    let layer_weights = [(r.floor() as usize, 1.0 - tau), (r.ceil() as usize, tau)];
-                    let norm: f32 = layer_weights
-                        .iter()
-                        .filter(|(k, _)| *k > 0)
-                        .flat_map(|(_, lw)| w.iter().map(move |wi| (lw * wi).powi(2)))
-                        .sum();
-                    for (k, lw) in layer_weights {
-                        if k == 0 || lw == 0.0 {
-                            continue;
-                        }
-                        for (i, &v) in quad.iter().enumerate() {
-                            let slot = &mut raise[k * verts + v as usize];
-                            *slot = slot.max(need * lw * w[i] / norm.max(1e-6));
-                        }
-                    }
+                    raise_corners(&mut raise, verts, (quad, w), r, need);
                 }
             }
         }
@@ -1075,6 +1057,35 @@ fn lift_bundle_interiors(
                 total[slot] += step;
                 *p += (*p - centre).normalize_or(Vec3::Y) * step;
             }
+        }
+    }
+}
+
+/// The least raise of the corners around layer position `r` of a bundle (its corner
+/// columns `quad` with bilinear weights `w`) that lifts the point there by `need`, each in
+/// proportion to its weight; the root layer stays on the scalp. Kept per corner as the most
+/// any point asks (`raise`, `verts` columns a layer).
+fn raise_corners(
+    raise: &mut [f32],
+    verts: usize,
+    (quad, w): ([u32; 4], [f32; 4]),
+    r: f32,
+    need: f32,
+) {
+    let tau = r.fract();
+    let layer_weights = [(r.floor() as usize, 1.0 - tau), (r.ceil() as usize, tau)];
+    let norm: f32 = layer_weights
+        .iter()
+        .filter(|(k, _)| *k > 0)
+        .flat_map(|(_, lw)| w.iter().map(move |wi| (lw * wi).powi(2)))
+        .sum();
+    for (k, lw) in layer_weights {
+        if k == 0 || lw == 0.0 {
+            continue;
+        }
+        for (i, &v) in quad.iter().enumerate() {
+            let slot = &mut raise[k * verts + v as usize];
+            *slot = slot.max(need * lw * w[i] / norm.max(1e-6));
         }
     }
 }
@@ -1238,6 +1249,23 @@ fn fitted_sintel(seed: u32, site: &GrowthSite, rng: &mut Pcg32) -> Result<Hairst
     fitted_sintel_parted(seed, site, rng, true)
 }
 
+/// The fitted groom's style on a head `scale` times the file's: its own lengths scaled, this
+/// person's width and colour (drawn from `rng`, as every family's).
+fn fitted_style(fitted: HairStyle, seed: u32, scale: f32, rng: &mut Pcg32) -> HairStyle {
+    let own = style_for(StyleFamily::Fitted, seed, rng);
+    HairStyle {
+        seed,
+        strand_width: own.strand_width,
+        root_ramp: fitted.root_ramp * scale,
+        frizz_amplitude: fitted.frizz_amplitude * scale,
+        frizz_frequency: fitted.frizz_frequency / scale,
+        curl_radius: fitted.curl_radius * scale,
+        curl_frequency: fitted.curl_frequency / scale,
+        color: own.color,
+        ..fitted
+    }
+}
+
 /// [`fitted_sintel`], parted around the face ([`part_around_face`]) or, for comparison, not.
 fn fitted_sintel_parted(
     seed: u32,
@@ -1299,18 +1327,7 @@ fn fitted_sintel_parted(
         uv,
         faces,
     } = cols;
-    let own = style_for(StyleFamily::Fitted, seed, rng);
-    let style = HairStyle {
-        seed,
-        strand_width: own.strand_width,
-        root_ramp: fitted.root_ramp * scale,
-        frizz_amplitude: fitted.frizz_amplitude * scale,
-        frizz_frequency: fitted.frizz_frequency / scale,
-        curl_radius: fitted.curl_radius * scale,
-        curl_frequency: fitted.curl_frequency / scale,
-        color: own.color,
-        ..fitted
-    };
+    let style = fitted_style(fitted, seed, scale, rng);
     let margin = interior_margin(&style);
     lift_bundle_interiors(&mut layers, &faces, &head, margin, MAX_TOTAL_RAISE_FITTED);
     // No hairline thinning: the fit's border follows the Sintel guide strands, whose roots

@@ -390,6 +390,42 @@ struct SkeletonRead {
     skin_to_sorted: Vec<usize>,
 }
 
+/// Vertex `k`'s four joints (in the skeleton's `order`) and weights (normalised to sum 1),
+/// from the primitive's JOINTS_0 and WEIGHTS_0; a weight that is negative or not finite, a
+/// weighted joint outside the skin, or no weight at all is an error naming the vertex.
+fn vertex_influences(
+    data: &Data,
+    at: &str,
+    k: usize,
+    (joints, weights): (&[f32], &[f32]),
+    order: &[usize],
+) -> Result<([u16; 4], [f32; 4])> {
+    let joint_count = order.len();
+    let mut j = [0u16; 4];
+    let mut w = [0f32; 4];
+    for c in 0..4 {
+        let joint = joints[k * 4 + c];
+        w[c] = weights[k * 4 + c];
+        if !(w[c].is_finite() && w[c] >= 0.0) {
+            return Err(data.bad(format!(
+                "{at}: vertex {k} has weight {} (finite, >= 0 expected)",
+                w[c]
+            )));
+        }
+        if w[c] > 0.0 && (joint < 0.0 || joint as usize >= joint_count) {
+            return Err(data.bad(format!(
+                "{at}: vertex {k} names joint {joint} of {joint_count}"
+            )));
+        }
+        j[c] = order.get(joint as usize).copied().unwrap_or(0) as u16;
+    }
+    let sum: f32 = w.iter().sum();
+    if sum <= 0.0 {
+        return Err(data.bad(format!("{at}: vertex {k} has no weight")));
+    }
+    Ok((j, w.map(|x| x / sum)))
+}
+
 /// One primitive as a skinned mesh.
 fn read_primitive(
     data: &Data,
@@ -397,7 +433,6 @@ fn read_primitive(
     prim: &gltf::Primitive,
     order: &[usize],
 ) -> Result<SkinnedMesh> {
-    let joint_count = order.len();
     let at = format!("mesh {} primitive {}", mesh.index(), prim.index());
     if prim.mode() != gltf::mesh::Mode::Triangles {
         return Err(data.bad(format!(
@@ -443,35 +478,14 @@ fn read_primitive(
     let roughness = material_roughness(data, prim, &at)?;
     let mut vertices = Vec::with_capacity(n);
     for k in 0..n {
-        let mut j = [0u16; 4];
-        let mut w = [0f32; 4];
-        for c in 0..4 {
-            let joint = joints[k * 4 + c];
-            w[c] = weights[k * 4 + c];
-            if !(w[c].is_finite() && w[c] >= 0.0) {
-                return Err(data.bad(format!(
-                    "{at}: vertex {k} has weight {} (finite, >= 0 expected)",
-                    w[c]
-                )));
-            }
-            if w[c] > 0.0 && (joint < 0.0 || joint as usize >= joint_count) {
-                return Err(data.bad(format!(
-                    "{at}: vertex {k} names joint {joint} of {joint_count}"
-                )));
-            }
-            j[c] = order.get(joint as usize).copied().unwrap_or(0) as u16;
-        }
-        let sum: f32 = w.iter().sum();
-        if sum <= 0.0 {
-            return Err(data.bad(format!("{at}: vertex {k} has no weight")));
-        }
+        let (j, w) = vertex_influences(data, &at, k, (&joints, &weights), order)?;
         vertices.push(SkinVertex {
             position: positions[k],
             normal: normals[k].normalize_or(Vec3::Y),
             color: colors[k],
             roughness,
             joints: j,
-            weights: w.map(|x| x / sum),
+            weights: w,
         });
     }
     let name = mesh

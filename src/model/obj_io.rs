@@ -136,30 +136,7 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
                 }
                 idx.vertex_lines.push(line_no);
             }
-            "g" => {
-                let mut layers = 0;
-                for g in &args {
-                    match layer_group(g) {
-                        Ok(Some(_)) => layers += 1,
-                        Ok(None) => {}
-                        Err(()) => {
-                            return Err(HairError::invalid(
-                                name,
-                                format!(
-                                    "line {line_no}: group '{g}' is not a layer name (layer0, layer1, ... without leading zeros)"
-                                ),
-                            ));
-                        }
-                    }
-                }
-                if layers > 0 && args.len() > 1 {
-                    return Err(HairError::invalid(
-                        name,
-                        format!("line {line_no}: a layer group line must name one group"),
-                    ));
-                }
-                in_layer = layers > 0;
-            }
+            "g" => in_layer = names_a_layer(name, line_no, &args)?,
             "vt" => {
                 vt_count += 1;
                 if args.len() != 3 {
@@ -198,6 +175,33 @@ fn scan_lines(name: &str, text: &str) -> Result<LineIndex> {
     }
     idx.all_vt_have_w &= vt_count > 0;
     Ok(idx)
+}
+
+/// Whether group line `line_no` (its names `args`) starts a layer: one `layerN` name; names
+/// that look like layers but are not, or a layer among other groups, are refused.
+fn names_a_layer(name: &str, line_no: usize, args: &[&str]) -> Result<bool> {
+    let mut layers = 0;
+    for g in args {
+        match layer_group(g) {
+            Ok(Some(_)) => layers += 1,
+            Ok(None) => {}
+            Err(()) => {
+                return Err(HairError::invalid(
+                    name,
+                    format!(
+                        "line {line_no}: group '{g}' is not a layer name (layer0, layer1, ... without leading zeros)"
+                    ),
+                ));
+            }
+        }
+    }
+    if layers > 0 && args.len() > 1 {
+        return Err(HairError::invalid(
+            name,
+            format!("line {line_no}: a layer group line must name one group"),
+        ));
+    }
+    Ok(layers > 0)
 }
 
 /// A line without its comment, and whether it continues on the next line (ends in `\\`).

@@ -501,7 +501,6 @@ impl Renderer {
         // is then never shaded.
         prop_draws.sort_by_key(|d| !d.skinned);
         light_draws.sort_by_key(|d| !d.skinned);
-        let (width, height) = self.targets.size();
         let slot = &mut self.frames[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;
         if let Some(lb) = light_block {
@@ -524,7 +523,19 @@ impl Renderer {
             slot.skin_matrices
                 .write(0, bytemuck::cast_slice(&skin.matrices))?;
         }
+        self.size_readbacks(i, opts)?;
+        let draws = PropDraws {
+            camera: prop_draws,
+            light: light_draws,
+        };
+        Ok((draws, (skin.jobs.len() as u32, skin.widest)))
+    }
+
+    /// Size frame slot `i`'s image and motion readbacks for what `opts` reads back.
+    fn size_readbacks(&mut self, i: usize, opts: &FrameOptions) -> GpuResult<()> {
+        let (width, height) = self.targets.size();
         let pixels = width as u64 * height as u64;
+        let slot = &mut self.frames[i];
         size_readback(
             &self.ctx,
             &mut slot.image_readback,
@@ -536,12 +547,7 @@ impl Renderer {
             &mut slot.motion_readback,
             opts.read_motion,
             pixels * 16,
-        )?;
-        let draws = PropDraws {
-            camera: prop_draws,
-            light: light_draws,
-        };
-        Ok((draws, (skin.jobs.len() as u32, skin.widest)))
+        )
     }
 
     /// Record frame slot `i` into `target`'s command buffer: build the frame graph (hair mesh

@@ -387,10 +387,9 @@ mod tests {
             .to_vec()
     }
 
-    /// A prop is drawn with its far version exactly when its bounding sphere spans fewer
-    /// pixels than the threshold, and bad far versions are refused.
-    #[test]
-    fn far_versions_replace_small_props() {
+    /// Three one-triangle props, the first with a far version below 50 pixels; a 60-degree,
+    /// 720-pixel camera at the first one's centre; and the distance where it spans 50 pixels.
+    fn three_props() -> (Props, Projection, f32) {
         let mut props = Props {
             meshes: vec![(0, 3), (3, 3), (6, 3)],
             bounds: [Vec3::ZERO; 3]
@@ -399,15 +398,7 @@ mod tests {
             far: vec![None; 3],
             ..Default::default()
         };
-        let (c, r) = props.bounds[0];
-        assert!((c - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6 && (r - 0.5f32.sqrt()).abs() < 1e-6);
-        props
-            .set_lods(&[PropLod {
-                mesh: 0,
-                far_mesh: 1,
-                below_pixels: 50.0,
-            }])
-            .unwrap();
+        props.set_lods(&[lod(0, 1, 50.0)]).unwrap();
         // 60 degrees, 720 pixels: the sphere spans r * 720 * cot(30) / d pixels.
         let camera = Projection {
             eye: Vec3::new(0.5, 0.5, 0.0),
@@ -415,8 +406,30 @@ mod tests {
             cot_half_fov: 1.0 / 30f32.to_radians().tan(),
             texel: 0.0,
         };
-        let at = |d: f32| Mat4::from_translation(Vec3::new(0.0, 0.0, -d));
-        let d50 = r * 720.0 * camera.cot_half_fov / 50.0;
+        let d50 = props.bounds[0].1 * 720.0 * camera.cot_half_fov / 50.0;
+        (props, camera, d50)
+    }
+
+    fn lod(mesh: usize, far_mesh: usize, below_pixels: f32) -> PropLod {
+        PropLod {
+            mesh,
+            far_mesh,
+            below_pixels,
+        }
+    }
+
+    /// `d` in front of the camera.
+    fn at(d: f32) -> Mat4 {
+        Mat4::from_translation(Vec3::new(0.0, 0.0, -d))
+    }
+
+    /// A prop is drawn with its far version exactly when its bounding sphere spans fewer
+    /// pixels than the threshold.
+    #[test]
+    fn far_versions_replace_small_props() {
+        let (props, camera, d50) = three_props();
+        let (c, r) = props.bounds[0];
+        assert!((c - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6 && (r - 0.5f32.sqrt()).abs() < 1e-6);
         assert_eq!(props.mesh_for(0, &at(d50 * 0.99), &camera), 0);
         assert_eq!(props.mesh_for(0, &at(d50 * 1.01), &camera), 1);
         assert_eq!(props.mesh_for(2, &at(1e4), &camera), 2);
@@ -428,43 +441,35 @@ mod tests {
             ..camera
         };
         assert_eq!(props.mesh_for(0, &at(1e4), &ortho), 0);
+    }
+
+    /// Bad far versions are refused: a missing mesh, itself, a threshold not a count of
+    /// pixels.
+    #[test]
+    fn bad_far_versions_are_refused() {
+        let (mut props, _, _) = three_props();
         for bad in [
-            PropLod {
-                mesh: 0,
-                far_mesh: 3,
-                below_pixels: 1.0,
-            },
-            PropLod {
-                mesh: 0,
-                far_mesh: 0,
-                below_pixels: 1.0,
-            },
-            PropLod {
-                mesh: 0,
-                far_mesh: 1,
-                below_pixels: f32::NAN,
-            },
-            PropLod {
-                mesh: 0,
-                far_mesh: 1,
-                below_pixels: -1.0,
-            },
+            lod(0, 3, 1.0),
+            lod(0, 0, 1.0),
+            lod(0, 1, f32::NAN),
+            lod(0, 1, -1.0),
         ] {
             assert!(props.set_lods(&[bad]).is_err(), "{bad:?}");
         }
-        let lod = |mesh, far_mesh, below_pixels| PropLod {
-            mesh,
-            far_mesh,
-            below_pixels,
-        };
-        // A chain of levels: 0 -> 1 below 50 pixels, 1 -> 2 below 20.
+    }
+
+    /// A chain of levels switches at each threshold, a level drawn directly follows its own
+    /// chain, and chains that do not shrink or that loop are refused.
+    #[test]
+    fn far_versions_chain() {
+        let (mut props, camera, d50) = three_props();
+        // 0 -> 1 below 50 pixels, 1 -> 2 below 20.
         props.set_lods(&[lod(0, 1, 50.0), lod(1, 2, 20.0)]).unwrap();
         let d20 = d50 * 2.5;
         assert_eq!(props.mesh_for(0, &at(d50 * 0.99), &camera), 0);
         assert_eq!(props.mesh_for(0, &at(d50 * 1.01), &camera), 1);
         assert_eq!(props.mesh_for(0, &at(d20 * 0.99), &camera), 1);
         assert_eq!(props.mesh_for(0, &at(d20 * 1.01), &camera), 2);
-        // A level drawn directly follows its own chain.
         assert_eq!(props.mesh_for(1, &at(d20 * 1.01), &camera), 2);
         for bad in [
             vec![lod(0, 1, 20.0), lod(1, 2, 50.0)],

@@ -409,23 +409,11 @@ unsafe fn enable_in(
                 return true;
             }
             S::PHYSICAL_DEVICE_VULKAN_1_2_FEATURES => {
-                let v = &mut *(node as *mut vk::PhysicalDeviceVulkan12Features);
-                v.runtime_descriptor_array = on;
-                v.descriptor_binding_partially_bound = on;
-                v.descriptor_binding_sampled_image_update_after_bind = on;
-                v.descriptor_binding_update_unused_while_pending = on;
-                v.shader_sampled_image_array_non_uniform_indexing = on;
-                v.buffer_device_address = on;
-                v.shader_buffer_int64_atomics |= int64;
-                v.shader_shared_int64_atomics |= int64;
-                v.host_query_reset |= f.host_query_reset as u32;
+                enable_vulkan12(&mut *(node as *mut vk::PhysicalDeviceVulkan12Features), f);
                 found.vulkan12 = true;
             }
             S::PHYSICAL_DEVICE_VULKAN_1_3_FEATURES => {
-                let v = &mut *(node as *mut vk::PhysicalDeviceVulkan13Features);
-                v.dynamic_rendering = on;
-                v.synchronization2 = on;
-                v.maintenance4 |= f.maintenance4 as u32;
+                enable_vulkan13(&mut *(node as *mut vk::PhysicalDeviceVulkan13Features), f);
                 found.vulkan13 = true;
             }
             S::PHYSICAL_DEVICE_DESCRIPTOR_INDEXING_FEATURES => {
@@ -472,6 +460,29 @@ unsafe fn enable_in(
         }
     }
     false
+}
+
+/// The renderer's Vulkan 1.2 features: bindless textures, device addresses, 64-bit atomics
+/// where wanted, host query reset where the device has it.
+fn enable_vulkan12(v: &mut vk::PhysicalDeviceVulkan12Features, f: &DeviceFeatures) {
+    let int64 = if f.int64_atomics { vk::TRUE } else { vk::FALSE };
+    v.runtime_descriptor_array = vk::TRUE;
+    v.descriptor_binding_partially_bound = vk::TRUE;
+    v.descriptor_binding_sampled_image_update_after_bind = vk::TRUE;
+    v.descriptor_binding_update_unused_while_pending = vk::TRUE;
+    v.shader_sampled_image_array_non_uniform_indexing = vk::TRUE;
+    v.buffer_device_address = vk::TRUE;
+    v.shader_buffer_int64_atomics |= int64;
+    v.shader_shared_int64_atomics |= int64;
+    v.host_query_reset |= f.host_query_reset as u32;
+}
+
+/// The renderer's Vulkan 1.3 features: dynamic rendering, synchronization2, maintenance4
+/// where the device has it.
+fn enable_vulkan13(v: &mut vk::PhysicalDeviceVulkan13Features, f: &DeviceFeatures) {
+    v.dynamic_rendering = vk::TRUE;
+    v.synchronization2 = vk::TRUE;
+    v.maintenance4 |= f.maintenance4 as u32;
 }
 
 /// The renderer's Vulkan 1.0 features, on top of what `core` has.
