@@ -478,28 +478,35 @@ fn bench_crowd(
         }
         return Ok(());
     }
+    let last_picture = crowd_table(&run, &counts)?;
+    if let (Some(out), Some(rgba)) = (picture, last_picture) {
+        write_png(&out, rgba, width, height)?;
+    }
+    Ok(())
+}
+
+/// `bench crowd`'s table: every count on every path (the mesh path with 32 and 1 bundles a
+/// task where the device has it); the last picture taken, if any.
+fn crowd_table(run: &CrowdRun, counts: &[usize]) -> Result<Option<Vec<u8>>> {
     outln!(
         "| N | path | LoD | strands drawn (demanded) | triangles | GPU ms per pass | GPU ms | CPU record ms | GPU MiB | per-character KiB (textures) | peak RSS MiB | frame wall ms |"
     )?;
     outln!("|---|---|---|---|---|---|---|---|---|---|---|---|")?;
     let mut configs = Vec::new();
-    if hairmesh::render::passes::strands::mesh_path_supported(&ctx) {
+    if hairmesh::render::passes::strands::mesh_path_supported(run.ctx) {
         configs.push(("mesh (32/task)", 32, RenderPath::Mesh));
         configs.push(("mesh (1/task)", 1, RenderPath::Mesh));
     }
     configs.push(("compute", 32, RenderPath::Compute));
     let mut last_picture = None;
-    for &count in &counts {
+    for &count in counts {
         for &(label, task_bundles, path) in &configs {
             if let Some(p) = run.measure(count, label, task_bundles, path)? {
                 last_picture = Some(p);
             }
         }
     }
-    if let (Some(out), Some(rgba)) = (picture, last_picture) {
-        write_png(&out, rgba, width, height)?;
-    }
-    Ok(())
+    Ok(last_picture)
 }
 
 /// The benchmarks' view: `camera`, a fixed light, default LoD on or LoD off.

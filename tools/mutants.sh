@@ -14,8 +14,8 @@
 #
 # Groups (files -> tests): shade (src/shade -> unit tests, shading_twin), reference
 # (src/reference -> unit tests, generator, gpu_oracle, lhs, volume), bake (src/bake -> unit tests,
-# bake_file, bake_cli, deform, generator, hair_mesh_update, gpu_oracle), render (the CPU halves of soft.rs,
-# temporal.rs, volume.rs -> unit tests, volume), io (budget.rs, fsutil.rs -> unit tests,
+# bake_file, bake_cli, deform, generator, hair_mesh_update, gpu_oracle), render (the CPU halves of the soft raster,
+# temporal and volume features -> unit tests, volume), io (budget.rs, fsutil.rs -> unit tests,
 # bake_cli, export). A CPU twin's first guard is its GPU comparison (gpu_oracle, shading_twin,
 # hair_mesh_update, volume: a few seconds each on lavapipe), so those run with their group.
 #
@@ -37,7 +37,7 @@ files[reference]="src/reference/*.rs"
 tests[reference]="--lib --test=generator --test=gpu_oracle --test=lhs --test=volume"
 files[bake]="src/bake/*.rs"
 tests[bake]="--lib --test=bake_file --test=bake_cli --test=deform --test=generator --test=hair_mesh_update --test=gpu_oracle"
-files[render]="src/render/soft.rs src/render/temporal.rs src/render/volume.rs"
+files[render]="src/render/features/soft_raster/mod.rs src/render/features/temporal/mod.rs src/render/features/volume/mod.rs"
 tests[render]="--lib --test=volume"
 files[io]="src/budget.rs src/fsutil.rs"
 tests[io]="--lib --test=bake_cli --test=export"

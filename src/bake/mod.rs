@@ -229,16 +229,9 @@ pub fn memory_estimate(vertices: u64, layers: u64, slice: u64) -> Estimate {
         .with("the textures' file image", copy, 1)
 }
 
-/// Bake `mesh` with `style` into the five textures; `progress(done, total)` is called per layer.
-pub fn bake(
-    mesh: &HairMesh,
-    style: &HairStyle,
-    options: BakeOptions,
-    mut progress: impl FnMut(usize, usize),
-) -> Result<BakedHairMesh> {
-    mesh.validate()?;
-    style.validate(&mesh.name)?;
-    let layout: RootLayout = layout_root_slice(mesh, options.charts);
+/// Refuse a bake whose textures exceed a side or whose working memory exceeds the budget,
+/// before anything is allocated.
+fn check_size(mesh: &HairMesh, layout: &RootLayout, options: &BakeOptions) -> Result<()> {
     let layers = mesh.layer_count();
     let depth = SLICES_PER_SEGMENT as usize * (layers - 1) + 1;
     if layout.width > MAX_TEXTURE_SIDE
@@ -260,7 +253,66 @@ pub fn bake(
         &format!("baking {n} vertices x {layers} layers"),
         &estimate,
         "use fewer layers or a smaller mesh",
-    )?;
+    )
+}
+
+/// The uv-texture (each root texel's uv over the mesh's uv box `(lo, extent)`) and the
+/// w-texture (every layer's w over `w_scale`), UNORM16.
+fn encode_uv_w(
+    mesh: &HairMesh,
+    layout: &RootLayout,
+    (uv_lo, uv_extent): (glam::Vec2, glam::Vec2),
+    w_scale: f32,
+) -> (Vec<[u16; 2]>, Vec<u16>) {
+    let (slice, layers) = (layout.texels.len(), mesh.layer_count());
+    let mut uv = vec![[0u16; 2]; slice];
+    let mut w = vec![0u16; slice * layers];
+    for (t, &vert) in layout.texels.iter().enumerate() {
+        if vert == EMPTY_TEXEL {
+            continue;
+        }
+        let vi = vert as usize;
+        let q = (mesh.uv[vi] - uv_lo) / uv_extent;
+        uv[t] = [to_unorm16(q.x), to_unorm16(q.y)];
+        for k in 0..layers {
+            w[k * slice + t] = to_unorm16(mesh.w[k][vi] / w_scale);
+        }
+    }
+    (uv, w)
+}
+
+/// One entry a bundle: its root cell, shape, rest size and density (area over the mean).
+fn bundle_table(mesh: &HairMesh, layout: &RootLayout) -> Vec<BundleDesc> {
+    let sizes = mesh.bundle_sizes();
+    let areas = mesh.bundle_areas();
+    let mean_area = areas.iter().sum::<f32>() / areas.len() as f32;
+    layout
+        .bundles
+        .iter()
+        .enumerate()
+        .map(|(f, b)| BundleDesc {
+            origin: b.origin,
+            flags: if b.triangle { BUNDLE_TRIANGLE } else { 0 },
+            rest_size: sizes[f],
+            density: areas[f] / mean_area,
+            _pad: [0; 3],
+        })
+        .collect()
+}
+
+/// Bake `mesh` with `style` into the five textures; `progress(done, total)` is called per layer.
+pub fn bake(
+    mesh: &HairMesh,
+    style: &HairStyle,
+    options: BakeOptions,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<BakedHairMesh> {
+    mesh.validate()?;
+    style.validate(&mesh.name)?;
+    let layout: RootLayout = layout_root_slice(mesh, options.charts);
+    let layers = mesh.layer_count();
+    let n = mesh.vertices_per_layer();
+    check_size(mesh, &layout, &options)?;
     let total_steps = n + layers;
 
     // Control points of every vertex column along r*.
@@ -290,21 +342,8 @@ pub fn bake(
         .fold(0.0f32, |a, &b| a.max(b))
         .max(1e-12);
 
-    let slice = layout.texels.len();
     let position = deform::encode_columns(&layout.texels, &ctrl, &mesh.root_thinning, lo, extent);
-    let mut uv = vec![[0u16; 2]; slice];
-    let mut w = vec![0u16; slice * layers];
-    for (t, &vert) in layout.texels.iter().enumerate() {
-        if vert == EMPTY_TEXEL {
-            continue;
-        }
-        let vi = vert as usize;
-        let q = (mesh.uv[vi] - uv_lo.truncate()) / uv_extent;
-        uv[t] = [to_unorm16(q.x), to_unorm16(q.y)];
-        for k in 0..layers {
-            w[k * slice + t] = to_unorm16(mesh.w[k][vi] / w_scale);
-        }
-    }
+    let (uv, w) = encode_uv_w(mesh, &layout, (uv_lo.truncate(), uv_extent), w_scale);
     let styling = deform::StylingBasis::new(mesh);
     let mut dirs = Vec::with_capacity(layers);
     for k in 0..layers {
@@ -313,21 +352,7 @@ pub fn bake(
     }
     let [u_dir, v_dir] = deform::encode_directions(&layout.texels, &dirs);
 
-    let sizes = mesh.bundle_sizes();
-    let areas = mesh.bundle_areas();
-    let mean_area = areas.iter().sum::<f32>() / areas.len() as f32;
-    let bundles = layout
-        .bundles
-        .iter()
-        .enumerate()
-        .map(|(f, b)| BundleDesc {
-            origin: b.origin,
-            flags: if b.triangle { BUNDLE_TRIANGLE } else { 0 },
-            rest_size: sizes[f],
-            density: areas[f] / mean_area,
-            _pad: [0; 3],
-        })
-        .collect();
+    let bundles = bundle_table(mesh, &layout);
 
     Ok(BakedHairMesh {
         info: MeshInfo {

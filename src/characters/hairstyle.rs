@@ -304,6 +304,18 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
         tie: None,
     };
     match family {
+        StyleFamily::Buzz | StyleFamily::ShortCrop | StyleFamily::Mohawk | StyleFamily::Afro => {
+            short_cut(family, base)
+        }
+        StyleFamily::Ponytail | StyleFamily::Bun => tied_cut(family, base, rng),
+        StyleFamily::Fitted | StyleFamily::Fur => base,
+        _ => long_cut(family, base, rng),
+    }
+}
+
+/// The short families' cuts: buzz, short crop, the mohawk's strip, the afro.
+fn short_cut(family: StyleFamily, base: Cut) -> Cut {
+    match family {
         StyleFamily::Buzz => Cut {
             grid: 11,
             layers: 3,
@@ -328,6 +340,35 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
             spacing: 1.0,
             ..base
         },
+        StyleFamily::Mohawk => Cut {
+            region: Region::Strip,
+            layers: 5,
+            length: (0.08, 0.14),
+            comb: Comb::Crest,
+            lift: (0.0, 0.0),
+            rise: 0.0,
+            gravity: 4.0,
+            spacing: 1.0,
+            ..base
+        },
+        StyleFamily::Afro => Cut {
+            region: Region::Full(1.02),
+            layers: 4,
+            length: (0.09, 0.13),
+            comb: Comb::Out,
+            lift: (0.007, 0.01),
+            rise: 1.1,
+            gravity: 3.0,
+            spacing: 1.0,
+            ..base
+        },
+        _ => base,
+    }
+}
+
+/// The long families' cuts: bob, long straight and wavy, long curly, side bangs.
+fn long_cut(family: StyleFamily, base: Cut, rng: &mut Pcg32) -> Cut {
+    match family {
         StyleFamily::Bob => Cut {
             layers: 6,
             length: (0.26, 0.32),
@@ -348,6 +389,20 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
             gravity: 18.0,
             ..base
         },
+        StyleFamily::SideBangs => Cut {
+            layers: 6,
+            length: (0.26, 0.34),
+            hem: Some((0.14, 0.2)),
+            comb: Comb::Parting(if rng.next_f32() < 0.5 { -0.04 } else { 0.04 }),
+            ..base
+        },
+        _ => base,
+    }
+}
+
+/// The tied families' cuts: ponytail and bun, each tied at a place drawn from `rng`.
+fn tied_cut(family: StyleFamily, base: Cut, rng: &mut Pcg32) -> Cut {
+    match family {
         StyleFamily::Ponytail => Cut {
             layers: 8,
             spacing: 2.0,
@@ -376,36 +431,7 @@ fn cut(family: StyleFamily, rng: &mut Pcg32) -> Cut {
             }),
             ..base
         },
-        StyleFamily::SideBangs => Cut {
-            layers: 6,
-            length: (0.26, 0.34),
-            hem: Some((0.14, 0.2)),
-            comb: Comb::Parting(if rng.next_f32() < 0.5 { -0.04 } else { 0.04 }),
-            ..base
-        },
-        StyleFamily::Mohawk => Cut {
-            region: Region::Strip,
-            layers: 5,
-            length: (0.08, 0.14),
-            comb: Comb::Crest,
-            lift: (0.0, 0.0),
-            rise: 0.0,
-            gravity: 4.0,
-            spacing: 1.0,
-            ..base
-        },
-        StyleFamily::Afro => Cut {
-            region: Region::Full(1.02),
-            layers: 4,
-            length: (0.09, 0.13),
-            comb: Comb::Out,
-            lift: (0.007, 0.01),
-            rise: 1.1,
-            gravity: 3.0,
-            spacing: 1.0,
-            ..base
-        },
-        StyleFamily::Fitted | StyleFamily::Fur => base,
+        _ => base,
     }
 }
 

@@ -301,12 +301,146 @@ fn fit_widths(model: &StrandModel) -> Option<(f32, f32)> {
 
 /// Fit a hair mesh and style to `model`; `head` (triangles) places the scalp on its surface.
 pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -> Result<Fitted> {
-    let bad = |what: String| HairError::invalid(&model.name, what);
+    let layers = checked_layer_count(model, opts)?;
+    let strands = &model.strands;
+    let roots: Vec<Vec3> = strands.iter().map(|s| s[0]).collect();
+    let dirs: Vec<Vec3> = strands
+        .iter()
+        .map(|s| (s[1] - s[0]).normalize_or_zero())
+        .collect();
+    let chart = Chart::new(&roots, &dirs);
+    let x: Vec<Vec2> = roots.iter().map(|&r| chart.to_chart(r)).collect();
+    let (lo, hi) = x.iter().fold(
+        (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let extent = (hi - lo).max_element().max(1e-6);
+    // Step 2: the cell size whose occupied cells come closest to the target.
+    let target = opts.bundles.min(strands.len());
+    // Cells no smaller than 1/1024 of the chart (65,536 bundles need 1/256 when they fill it):
+    // with fewer strands than bundles asked for, every strand already has its own cell well
+    // before that, and smaller cells only make root faces too small to be told from a point
+    // (the hair mesh's degenerate-face test).
+    let h = cell_size(&x, lo, extent, target);
+    let cell_of = |p: Vec2| {
+        let c = ((p - lo) / h).floor();
+        (c.x as i64, c.y as i64)
+    };
+    let mut cells: Vec<(i64, i64)> = x.iter().map(|&p| cell_of(p)).collect();
+    cells.sort_unstable();
+    cells.dedup();
+    let (corners, faces) = cell_faces(&cells);
+    let corner_chart: Vec<Vec2> = corners
+        .iter()
+        .map(|&(i, j)| lo + Vec2::new(i as f32, j as f32) * h)
+        .collect();
+    let neighbours = corner_neighbours(&x, &corner_chart, h);
+    // Corner roots: on the head, else at the weighted distance of the nearby roots.
+    let root_of = |k: usize| -> Vec3 {
+        let dir = chart.direction(corner_chart[k]);
+        let (s, w) = neighbours[k].iter().fold((0.0, 0.0), |(s, w), &(i, wi)| {
+            (s + wi * roots[i].distance(chart.centre), w + wi)
+        });
+        let from_roots = s / w;
+        // On the head: of the surfaces the ray crosses, the one nearest the roots around.
+        let hit = head.and_then(|tris| {
+            tris.iter()
+                .filter_map(|t| crate::model::obj_io::ray_triangle(chart.centre, dir, t))
+                .min_by(|a, b| (a - from_roots).abs().total_cmp(&(b - from_roots).abs()))
+        });
+        chart.centre + dir * hit.unwrap_or(from_roots)
+    };
+    // Step 3: layers.
+    let lengths: Vec<f32> = strands.iter().map(|s| polyline_length(s)).collect();
+    let length_variation = fit_length_variation(&neighbours, &lengths);
+    let mut layer_pos = vec![vec![Vec3::ZERO; corners.len()]; layers];
+    for k in 0..corners.len() {
+        let (curve, wsum, len) = mean_curve(strands, &lengths, &neighbours[k]);
+        let bundle_len = len / wsum / (1.0 - 0.5 * length_variation);
+        let mean_len = polyline_length(&curve).max(1e-12);
+        let root = root_of(k);
+        for (l, layer) in layer_pos.iter_mut().enumerate() {
+            let s =
+                l as f32 / (layers - 1) as f32 * bundle_len * (mean_len / (len / wsum).max(1e-12));
+            layer[k] = point_at_length(&curve, s) - curve[0] + root;
+        }
+    }
+    let uv: Vec<Vec2> = corner_chart.iter().map(|&g| (g - lo) / extent).collect();
+    let mesh = HairMesh::new(model.name.clone(), layer_pos, None, uv, faces)?;
+    // Step 4: style.
+    let bundle_size = mean_root_edge(&mesh);
+    let clump_strength = fit_clump(strands, &lengths, &x, &cells, &cell_of, &mesh);
+    let style = fit_style(model, &lengths, length_variation, clump_strength);
+    style.validate(&model.name)?;
+    Ok(Fitted {
+        mesh,
+        style,
+        bundle_size,
+    })
+}
+
+/// Neighbour strands of every corner (at `corner_chart`, cells `h` wide) with weights: found
+/// through a grid of the roots' chart positions `x`, so the work and memory grow with strands
+/// + corners, not their product.
+fn corner_neighbours(x: &[Vec2], corner_chart: &[Vec2], h: f32) -> Vec<Vec<(usize, f32)>> {
+    let grid = ChartGrid::new(x, 1.5 * h);
+    corner_chart
+        .iter()
+        .map(|&g| {
+            let soft = (0.25 * h) * (0.25 * h);
+            grid.nearest(x, g, 1.5 * h, 4)
+                .into_iter()
+                .map(|(i, d2)| (i, 1.0 / (d2 + soft)))
+                .collect()
+        })
+        .collect()
+}
+
+/// How much strand lengths vary inside a bundle: one less the median over corners with four
+/// neighbours or more of their 10th over 90th length percentile (at most 0.8).
+fn fit_length_variation(neighbours: &[Vec<(usize, f32)>], lengths: &[f32]) -> f32 {
+    let ratios: Vec<f32> = neighbours
+        .iter()
+        .filter(|n| n.len() >= 4)
+        .map(|n| {
+            let mut l: Vec<f32> = n.iter().map(|&(i, _)| lengths[i]).collect();
+            percentile(&mut l, 0.1) / percentile(&mut l, 0.9).max(1e-12)
+        })
+        .collect();
+    (1.0 - median(ratios)).clamp(0.0, 0.8)
+}
+
+/// The weighted mean of a corner's `neighbours` strands, each resampled at 33 points by
+/// length; with the sum of weights and the weighted sum of lengths.
+fn mean_curve(
+    strands: &[Vec<Vec3>],
+    lengths: &[f32],
+    neighbours: &[(usize, f32)],
+) -> (Vec<Vec3>, f32, f32) {
+    const SAMPLES: usize = 33;
+    let (mut curve, mut wsum, mut len) = (vec![Vec3::ZERO; SAMPLES], 0.0, 0.0);
+    for &(i, wi) in neighbours {
+        for (j, c) in curve.iter_mut().enumerate() {
+            let f = j as f32 / (SAMPLES - 1) as f32;
+            *c += wi * point_at_length(&strands[i], f * lengths[i]);
+        }
+        wsum += wi;
+        len += wi * lengths[i];
+    }
+    curve.iter_mut().for_each(|c| *c /= wsum);
+    (curve, wsum, len)
+}
+
+/// Step 3's layer count (from the strands' turning where not given), after the bundle count
+/// and the memory estimate are checked: the estimate needs it.
+fn checked_layer_count(model: &StrandModel, opts: &FitOptions) -> Result<usize> {
     if !(1..=65536).contains(&opts.bundles) {
-        return Err(bad(format!("{} bundles: 1..=65536", opts.bundles)));
+        return Err(HairError::invalid(
+            &model.name,
+            format!("{} bundles: 1..=65536", opts.bundles),
+        ));
     }
     let strands = &model.strands;
-    // Step 3's layer count comes first: the memory estimate needs it.
     let layers = match opts.layers {
         Some(l) => l,
         None => {
@@ -332,45 +466,31 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
         &estimate,
         "lower --bundles or --layers",
     )?;
-    let roots: Vec<Vec3> = strands.iter().map(|s| s[0]).collect();
-    let dirs: Vec<Vec3> = strands
-        .iter()
-        .map(|s| (s[1] - s[0]).normalize_or_zero())
-        .collect();
-    let chart = Chart::new(&roots, &dirs);
-    let x: Vec<Vec2> = roots.iter().map(|&r| chart.to_chart(r)).collect();
-    let (lo, hi) = x.iter().fold(
-        (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    let extent = (hi - lo).max_element().max(1e-6);
-    // Step 2: the cell size whose occupied cells come closest to the target.
-    let target = opts.bundles.min(strands.len());
-    // Cells no smaller than 1/1024 of the chart (65,536 bundles need 1/256 when they fill it):
-    // with fewer strands than bundles asked for, every strand already has its own cell well
-    // before that, and smaller cells only make root faces too small to be told from a point
-    // (the hair mesh's degenerate-face test).
+    Ok(layers)
+}
+
+/// Step 2: the cell size whose occupied cells (of the roots' chart positions `x`) come
+/// closest to `target`, found by bisection between 1/1024 of the chart's `extent` and all of
+/// it.
+fn cell_size(x: &[Vec2], lo: Vec2, extent: f32, target: usize) -> f32 {
     let (mut a, mut b) = ((extent / 1024.0).ln(), (extent * 1.01).ln());
     for _ in 0..40 {
         let mid = 0.5 * (a + b);
-        if occupied(&x, lo, mid.exp()) > target {
+        if occupied(x, lo, mid.exp()) > target {
             a = mid;
         } else {
             b = mid;
         }
     }
-    let h = b.exp();
-    let cell_of = |p: Vec2| {
-        let c = ((p - lo) / h).floor();
-        (c.x as i64, c.y as i64)
-    };
-    let mut cells: Vec<(i64, i64)> = x.iter().map(|&p| cell_of(p)).collect();
-    cells.sort_unstable();
-    cells.dedup();
+    b.exp()
+}
+
+/// A quad face a occupied cell, over the cells' corners (shared between neighbours).
+fn cell_faces(cells: &[(i64, i64)]) -> (Vec<(i64, i64)>, Vec<Face>) {
     let mut corner_index = std::collections::HashMap::new();
     let mut corners: Vec<(i64, i64)> = Vec::new();
     let mut faces = Vec::with_capacity(cells.len());
-    for &(i, j) in &cells {
+    for &(i, j) in cells {
         let mut v = [0u32; 4];
         for (k, c) in [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
             .into_iter()
@@ -383,92 +503,36 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
         }
         faces.push(Face::Quad(v));
     }
-    let corner_chart: Vec<Vec2> = corners
+    (corners, faces)
+}
+
+/// The mean edge length of the root faces: the fitted bundles' size.
+fn mean_root_edge(mesh: &HairMesh) -> f32 {
+    let edges: Vec<f32> = mesh
+        .faces
         .iter()
-        .map(|&(i, j)| lo + Vec2::new(i as f32, j as f32) * h)
-        .collect();
-    // Neighbour strands of every corner, with weights: found through a grid of the roots'
-    // chart positions, so the work and memory grow with strands + corners, not their product.
-    let grid = ChartGrid::new(&x, 1.5 * h);
-    let neighbours: Vec<Vec<(usize, f32)>> = corner_chart
-        .iter()
-        .map(|&g| {
-            let soft = (0.25 * h) * (0.25 * h);
-            grid.nearest(&x, g, 1.5 * h, 4)
-                .into_iter()
-                .map(|(i, d2)| (i, 1.0 / (d2 + soft)))
-                .collect()
+        .flat_map(|f| {
+            let v = f.vertices();
+            (0..v.len()).map(move |c| (v[c], v[(c + 1) % v.len()]))
         })
+        .map(|(a, b)| mesh.layers[0][a as usize].distance(mesh.layers[0][b as usize]))
         .collect();
-    // Corner roots: on the head, else at the weighted distance of the nearby roots.
-    let root_of = |k: usize| -> Vec3 {
-        let dir = chart.direction(corner_chart[k]);
-        let (s, w) = neighbours[k].iter().fold((0.0, 0.0), |(s, w), &(i, wi)| {
-            (s + wi * roots[i].distance(chart.centre), w + wi)
-        });
-        let from_roots = s / w;
-        // On the head: of the surfaces the ray crosses, the one nearest the roots around.
-        let hit = head.and_then(|tris| {
-            tris.iter()
-                .filter_map(|t| crate::model::obj_io::ray_triangle(chart.centre, dir, t))
-                .min_by(|a, b| (a - from_roots).abs().total_cmp(&(b - from_roots).abs()))
-        });
-        chart.centre + dir * hit.unwrap_or(from_roots)
-    };
-    // Step 3: layers.
-    let lengths: Vec<f32> = strands.iter().map(|s| polyline_length(s)).collect();
-    let ratios: Vec<f32> = neighbours
-        .iter()
-        .filter(|n| n.len() >= 4)
-        .map(|n| {
-            let mut l: Vec<f32> = n.iter().map(|&(i, _)| lengths[i]).collect();
-            percentile(&mut l, 0.1) / percentile(&mut l, 0.9).max(1e-12)
-        })
-        .collect();
-    let length_variation = (1.0 - median(ratios)).clamp(0.0, 0.8);
-    const SAMPLES: usize = 33;
-    let mut layer_pos = vec![vec![Vec3::ZERO; corners.len()]; layers];
-    for k in 0..corners.len() {
-        let (mut curve, mut wsum, mut len) = (vec![Vec3::ZERO; SAMPLES], 0.0, 0.0);
-        for &(i, wi) in &neighbours[k] {
-            for (j, c) in curve.iter_mut().enumerate() {
-                let f = j as f32 / (SAMPLES - 1) as f32;
-                *c += wi * point_at_length(&strands[i], f * lengths[i]);
-            }
-            wsum += wi;
-            len += wi * lengths[i];
-        }
-        curve.iter_mut().for_each(|c| *c /= wsum);
-        let bundle_len = len / wsum / (1.0 - 0.5 * length_variation);
-        let mean_len = polyline_length(&curve).max(1e-12);
-        let root = root_of(k);
-        for (l, layer) in layer_pos.iter_mut().enumerate() {
-            let s =
-                l as f32 / (layers - 1) as f32 * bundle_len * (mean_len / (len / wsum).max(1e-12));
-            layer[k] = point_at_length(&curve, s) - curve[0] + root;
-        }
-    }
-    let uv: Vec<Vec2> = corner_chart.iter().map(|&g| (g - lo) / extent).collect();
-    let mesh = HairMesh::new(model.name.clone(), layer_pos, None, uv, faces)?;
-    // Step 4: style.
-    let bundle_size = {
-        let edges: Vec<f32> = mesh
-            .faces
-            .iter()
-            .flat_map(|f| {
-                let v = f.vertices();
-                (0..v.len()).map(move |c| (v[c], v[(c + 1) % v.len()]))
-            })
-            .map(|(a, b)| mesh.layers[0][a as usize].distance(mesh.layers[0][b as usize]))
-            .collect();
-        edges.iter().sum::<f32>() / edges.len().max(1) as f32
-    };
-    let clump_strength = fit_clump(strands, &lengths, &x, &cells, &cell_of, &mesh);
+    edges.iter().sum::<f32>() / edges.len().max(1) as f32
+}
+
+/// Step 4: the style the strands show: widths, curl, frizz (what smoothing removes, less
+/// what a fitted curl explains), with the length variation and clumping already fitted.
+fn fit_style(
+    model: &StrandModel,
+    lengths: &[f32],
+    length_variation: f32,
+    clump_strength: f32,
+) -> HairStyle {
+    let strands = &model.strands;
     let diag = model.diagonal();
     let mean_segment = lengths.iter().sum::<f32>()
         / model.point_count().saturating_sub(strands.len()).max(1) as f32;
     let curl = fit_curl(strands);
-    // Frizz: what smoothing removes, less what a fitted curl explains.
     // x3: calibrated on the round trips (smoothing keeps much of slow noise).
     let residual = median(strands.iter().map(|s| residual_rms(s)).collect()) * 3.0;
     let frizz_amplitude = match curl {
@@ -476,7 +540,7 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
         None => residual,
     };
     let (strand_width, tip_width_ratio) = fit_widths(model).unwrap_or((diag * 0.0015, 0.3));
-    let style = HairStyle {
+    HairStyle {
         strand_width,
         tip_width_ratio,
         length_variation,
@@ -489,13 +553,7 @@ pub fn fit(model: &StrandModel, head: Option<&[[Vec3; 3]]>, opts: &FitOptions) -
         wave_frequency: 0.0,
         root_ramp: 0.05 * diag,
         ..HairStyle::default()
-    };
-    style.validate(&model.name)?;
-    Ok(Fitted {
-        mesh,
-        style,
-        bundle_size,
-    })
+    }
 }
 
 /// Curl (radius, turns per unit length) when the strands are helices: a helix of radius r

@@ -63,6 +63,44 @@ pub struct HairFile {
     pub hair_count: u32,
 }
 
+/// The counts of a `.hair` header (hairs, points, array flags) after its signature, flags,
+/// point limit and the file's length are checked.
+fn checked_header(name: &str, bytes: &[u8]) -> Result<(u32, u32, u32)> {
+    let bad = |what: String| HairError::invalid(name, what);
+    if bytes.len() < HEADER_BYTES || &bytes[..4] != b"HAIR" {
+        return Err(bad(
+            "not a .hair file (no 128-byte header with signature HAIR)".into(),
+        ));
+    }
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
+    let (hair_count, point_count, arrays) = (u32_at(4), u32_at(8), u32_at(12));
+    if arrays & !0x1F != 0 {
+        return Err(bad(format!("unknown array flags {arrays:#x}")));
+    }
+    if arrays & HAS_POINTS == 0 {
+        return Err(bad("the file has no point array".into()));
+    }
+    if point_count as u64 > MAX_POINTS {
+        return Err(bad(format!(
+            "{point_count} points: more than {MAX_POINTS} this reader accepts"
+        )));
+    }
+    let (hairs, points) = (hair_count as u64, point_count as u64);
+    let per_point = 12
+        + 4 * (arrays & HAS_THICKNESS != 0) as u64
+        + 4 * (arrays & HAS_TRANSPARENCY != 0) as u64
+        + 12 * (arrays & HAS_COLORS != 0) as u64;
+    let expected =
+        HEADER_BYTES as u64 + 2 * hairs * (arrays & HAS_SEGMENTS != 0) as u64 + per_point * points;
+    if bytes.len() as u64 != expected {
+        return Err(bad(format!(
+            "{} bytes, but the header ({hair_count} hairs, {point_count} points, arrays {arrays:#x}) needs {expected}",
+            bytes.len()
+        )));
+    }
+    Ok((hair_count, point_count, arrays))
+}
+
 impl HairFile {
     /// Segments of hair `i`.
     pub fn hair_segments(&self, i: usize) -> u32 {
@@ -127,39 +165,10 @@ impl HairFile {
     /// the points, and that every value is finite, before allocating.
     pub fn parse(name: &str, bytes: &[u8]) -> Result<Self> {
         let bad = |what: String| HairError::invalid(name, what);
-        if bytes.len() < HEADER_BYTES || &bytes[..4] != b"HAIR" {
-            return Err(bad(
-                "not a .hair file (no 128-byte header with signature HAIR)".into(),
-            ));
-        }
+        let (hair_count, point_count, arrays) = checked_header(name, bytes)?;
         let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
         let f32_at = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
-        let (hair_count, point_count, arrays) = (u32_at(4), u32_at(8), u32_at(12));
-        if arrays & !0x1F != 0 {
-            return Err(bad(format!("unknown array flags {arrays:#x}")));
-        }
-        if arrays & HAS_POINTS == 0 {
-            return Err(bad("the file has no point array".into()));
-        }
-        if point_count as u64 > MAX_POINTS {
-            return Err(bad(format!(
-                "{point_count} points: more than {MAX_POINTS} this reader accepts"
-            )));
-        }
         let (hairs, points) = (hair_count as u64, point_count as u64);
-        let per_point = 12
-            + 4 * (arrays & HAS_THICKNESS != 0) as u64
-            + 4 * (arrays & HAS_TRANSPARENCY != 0) as u64
-            + 12 * (arrays & HAS_COLORS != 0) as u64;
-        let expected = HEADER_BYTES as u64
-            + 2 * hairs * (arrays & HAS_SEGMENTS != 0) as u64
-            + per_point * points;
-        if bytes.len() as u64 != expected {
-            return Err(bad(format!(
-                "{} bytes, but the header ({hair_count} hairs, {point_count} points, arrays {arrays:#x}) needs {expected}",
-                bytes.len()
-            )));
-        }
         let default_segments = u32_at(16);
         let mut o = HEADER_BYTES;
         let segments = if arrays & HAS_SEGMENTS != 0 {

@@ -181,6 +181,13 @@ impl HairMesh {
                 return Err(self.err(format!("root vertex {i}: non-finite uv {uv:?}")));
             }
         }
+        self.validate_faces()
+    }
+
+    /// Every face names root vertices, none twice, with area on the root layer and in uv at
+    /// every corner (eq. 2 needs an invertible `T_i`).
+    fn validate_faces(&self) -> Result<()> {
+        let n = self.uv.len();
         let extent = self.root_extent().max(f32::MIN_POSITIVE);
         let uv_extent = self.uv_extent().max(f32::MIN_POSITIVE);
         for (f, face) in self.faces.iter().enumerate() {

@@ -300,10 +300,54 @@ pub fn load_hair_mesh_obj(path: &Path) -> Result<HairMesh> {
 
 /// Parse a hair mesh OBJ held in memory; `name` names it in errors.
 pub fn parse_hair_mesh_obj(name: &str, bytes: &[u8]) -> Result<HairMesh> {
-    let name = name.to_string();
-    let (raw, lines) = parse(&name, bytes)?;
-    let err = |what: String| HairError::invalid(&name, what);
-    let layer_count = layer_group_count(&raw);
+    let (raw, lines) = parse(name, bytes)?;
+    let layer_count = checked_layer_count(name, &raw, &lines)?;
+    let root_polys = group_polygons(&raw, "layer0");
+    if root_polys.is_empty() {
+        return Err(HairError::invalid(
+            name,
+            "empty hair mesh: layer0 has no faces",
+        ));
+    }
+    let (root_corners, root_faces) = root_vertices(name, &raw, &lines, &root_polys)?;
+    let uv: Vec<Vec2> = root_corners
+        .iter()
+        .map(|&(_, t)| {
+            let t = raw.tex_coords[t.unwrap_or(0)];
+            Vec2::new(t.0, t.1)
+        })
+        .collect();
+    let mut layers = Vec::with_capacity(layer_count);
+    let mut w_layers = Vec::with_capacity(layer_count);
+    for k in 0..layer_count {
+        let columns = LayerColumns {
+            root_polys: &root_polys,
+            root_faces: &root_faces,
+            roots: root_corners.len(),
+        };
+        let (layer, w) = read_layer(name, (&raw, &lines), k, columns)?;
+        layers.push(layer);
+        w_layers.push(w);
+    }
+    let mut faces = Vec::new();
+    for face in &root_faces {
+        for part in split_polygon(face.len()) {
+            let v: Vec<u32> = part.iter().map(|&c| face[c]).collect();
+            faces.push(match v.len() {
+                3 => Face::Tri([v[0], v[1], v[2]]),
+                _ => Face::Quad([v[0], v[1], v[2], v[3]]),
+            });
+        }
+    }
+    let w = lines.all_vt_have_w.then_some(w_layers);
+    HairMesh::new(name.to_string(), layers, w, uv, faces)
+}
+
+/// The number of layer groups, numbered 0..N without gaps, 2 to `MAX_LAYERS`, every face in
+/// one of them.
+fn checked_layer_count(name: &str, raw: &RawObj, lines: &LineIndex) -> Result<usize> {
+    let err = |what: String| HairError::invalid(name, what);
+    let layer_count = layer_group_count(raw);
     if let Some(extra) = raw
         .groups
         .keys()
@@ -332,25 +376,36 @@ pub fn parse_hair_mesh_obj(name: &str, bytes: &[u8]) -> Result<HairMesh> {
             "line {line}: face outside any layer group (every face belongs to a 'g layerK')"
         )));
     }
-    let root_polys = group_polygons(&raw, "layer0");
-    if root_polys.is_empty() {
-        return Err(err("empty hair mesh: layer0 has no faces".into()));
-    }
-    let face_line = |p: usize| lines.face_lines.get(p).copied().unwrap_or(0);
+    Ok(layer_count)
+}
 
-    // Root vertices are unique (position, uv) pairs of layer0.
+/// The file line of polygon `p` (0 where unknown).
+fn face_line(lines: &LineIndex, p: usize) -> usize {
+    lines.face_lines.get(p).copied().unwrap_or(0)
+}
+
+/// The root vertices (unique position and uv pairs of layer0) and layer0's faces over them.
+fn root_vertices(
+    name: &str,
+    raw: &RawObj,
+    lines: &LineIndex,
+    root_polys: &[usize],
+) -> Result<(Vec<Corner>, Vec<Vec<u32>>)> {
     let mut root_index: HashMap<Corner, u32> = HashMap::new();
     let mut root_corners: Vec<Corner> = Vec::new();
     let mut root_faces: Vec<Vec<u32>> = Vec::new();
-    for &p in &root_polys {
+    for &p in root_polys {
         let cs = corners(&raw.polygons[p]);
         let mut face = Vec::with_capacity(cs.len());
         for &c in &cs {
             if c.1.is_none() {
-                return Err(err(format!(
-                    "line {}: layer0 face has no vt index; root vertices need uv coordinates",
-                    face_line(p)
-                )));
+                return Err(HairError::invalid(
+                    name,
+                    format!(
+                        "line {}: layer0 face has no vt index; root vertices need uv coordinates",
+                        face_line(lines, p)
+                    ),
+                ));
             }
             let next = root_corners.len() as u32;
             let id = *root_index.entry(c).or_insert_with(|| {
@@ -361,83 +416,76 @@ pub fn parse_hair_mesh_obj(name: &str, bytes: &[u8]) -> Result<HairMesh> {
         }
         root_faces.push(face);
     }
-    let n = root_corners.len();
-    let uv: Vec<Vec2> = root_corners
-        .iter()
-        .map(|&(_, t)| {
-            let t = raw.tex_coords[t.unwrap_or(0)];
-            Vec2::new(t.0, t.1)
-        })
-        .collect();
+    Ok((root_corners, root_faces))
+}
 
-    let mut layers = Vec::with_capacity(layer_count);
-    let mut w_layers = Vec::with_capacity(layer_count);
-    for k in 0..layer_count {
-        let polys = group_polygons(&raw, &format!("layer{k}"));
-        if polys.len() != root_polys.len() {
+/// Layer0's polygons, its faces over the root vertices, and how many root vertices there are.
+struct LayerColumns<'a> {
+    root_polys: &'a [usize],
+    root_faces: &'a [Vec<u32>],
+    roots: usize,
+}
+
+/// Layer `k`'s position and `w` (from its `vt`'s third value, where the file gives one) at
+/// every root vertex: its faces must match layer0's corner for corner, each root vertex one
+/// vertex of the layer.
+fn read_layer(
+    name: &str,
+    (raw, lines): (&RawObj, &LineIndex),
+    k: usize,
+    columns: LayerColumns,
+) -> Result<(Vec<Vec3>, Vec<f32>)> {
+    let err = |what: String| HairError::invalid(name, what);
+    let polys = group_polygons(raw, &format!("layer{k}"));
+    if polys.len() != columns.root_polys.len() {
+        return Err(err(format!(
+            "layer{k} has {} faces but layer0 has {} (layers must share face topology)",
+            polys.len(),
+            columns.root_polys.len()
+        )));
+    }
+    let mut pos_of: Vec<Option<usize>> = vec![None; columns.roots];
+    let mut w_of: Vec<f32> = vec![0.0; columns.roots];
+    for (f, &p) in polys.iter().enumerate() {
+        let cs = corners(&raw.polygons[p]);
+        let root_face = &columns.root_faces[f];
+        if cs.len() != root_face.len() {
             return Err(err(format!(
-                "layer{k} has {} faces but layer0 has {} (layers must share face topology)",
-                polys.len(),
-                root_polys.len()
+                "line {}: layer{k} face {f} has {} corners but layer0 face {f} has {}",
+                face_line(lines, p),
+                cs.len(),
+                root_face.len()
             )));
         }
-        let mut pos_of: Vec<Option<usize>> = vec![None; n];
-        let mut w_of: Vec<f32> = vec![0.0; n];
-        for (f, &p) in polys.iter().enumerate() {
-            let cs = corners(&raw.polygons[p]);
-            if cs.len() != root_faces[f].len() {
-                return Err(err(format!(
-                    "line {}: layer{k} face {f} has {} corners but layer0 face {f} has {}",
-                    face_line(p),
-                    cs.len(),
-                    root_faces[f].len()
-                )));
+        for (c, &(pi, ti)) in cs.iter().enumerate() {
+            let r = root_face[c] as usize;
+            match pos_of[r] {
+                Some(prev) if prev != pi => {
+                    return Err(err(format!(
+                        "line {}: layer{k} face {f} corner {c} uses vertex {} but the same root vertex is vertex {} elsewhere on this layer (inconsistent layer topology)",
+                        face_line(lines, p),
+                        pi + 1,
+                        prev + 1
+                    )));
+                }
+                _ => pos_of[r] = Some(pi),
             }
-            for (c, &(pi, ti)) in cs.iter().enumerate() {
-                let r = root_faces[f][c] as usize;
-                match pos_of[r] {
-                    Some(prev) if prev != pi => {
-                        return Err(err(format!(
-                            "line {}: layer{k} face {f} corner {c} uses vertex {} but the same root vertex is vertex {} elsewhere on this layer (inconsistent layer topology)",
-                            face_line(p),
-                            pi + 1,
-                            prev + 1
-                        )));
-                    }
-                    _ => pos_of[r] = Some(pi),
-                }
-                if lines.all_vt_have_w && k > 0 {
-                    let Some(t) = ti else {
-                        return Err(err(format!(
-                            "line {}: layer{k} face {f} has no vt index, but the file gives w in vt",
-                            face_line(p)
-                        )));
-                    };
-                    w_of[r] = raw.tex_coords[t].2;
-                }
+            if lines.all_vt_have_w && k > 0 {
+                let Some(t) = ti else {
+                    return Err(err(format!(
+                        "line {}: layer{k} face {f} has no vt index, but the file gives w in vt",
+                        face_line(lines, p)
+                    )));
+                };
+                w_of[r] = raw.tex_coords[t].2;
             }
         }
-        layers.push(
-            pos_of
-                .iter()
-                .map(|p| position(&raw, p.unwrap_or(0)))
-                .collect::<Vec<_>>(),
-        );
-        w_layers.push(w_of);
     }
-
-    let mut faces = Vec::new();
-    for face in &root_faces {
-        for part in split_polygon(face.len()) {
-            let v: Vec<u32> = part.iter().map(|&c| face[c]).collect();
-            faces.push(match v.len() {
-                3 => Face::Tri([v[0], v[1], v[2]]),
-                _ => Face::Quad([v[0], v[1], v[2], v[3]]),
-            });
-        }
-    }
-    let w = lines.all_vt_have_w.then_some(w_layers);
-    HairMesh::new(name, layers, w, uv, faces)
+    let layer = pos_of
+        .iter()
+        .map(|p| position(raw, p.unwrap_or(0)))
+        .collect();
+    Ok((layer, w_of))
 }
 
 /// A scalp: positions, uvs and faces of an OBJ without layer groups (input of `extrude`).

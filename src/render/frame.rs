@@ -139,25 +139,12 @@ impl Renderer {
         mut target: FrameTarget,
     ) -> GpuResult<FrameTicket> {
         let (path, kbuffer_budget) = self.check_frame(view, opts)?;
-        let vertex_slots = match path {
-            RenderPath::Compute => self.desc.vertex_pool_bytes / size_of::<HairVertex>() as u64,
-            _ => 0,
-        };
-        let temporal = self
-            .temporal
-            .work(view.temporal, opts.read_motion, vertex_slots)?;
+        let temporal = self.temporal_work(view, opts, path)?;
         // What draws the frame's bundles, decided once (`auto` with k-buffer OIT is all
         // software): the passes, buffers and frame blocks all follow it.
         let raster = super::settings::raster_under(opts.raster, view.transparency);
         self.retire_slot(i)?;
-        if let Some(old) = self
-            .temporal
-            .prepare(&self.ctx, temporal, self.targets.size())?
-        {
-            self.frames[i]
-                .retired
-                .push(Retired::Resource(Box::new(old)));
-        }
+        self.prepare_history(i, temporal)?;
         self.prepare_workspace(i, path)?;
         let updates = self.crowd.write_pending_poses(i)?;
         let simulated = self.write_sim_jobs(i, &updates.simulated)?;
@@ -167,10 +154,7 @@ impl Renderer {
             .temporal
             .write_block(&mut block, temporal, self.targets.size());
         // Software light passes only where there is a light view this frame.
-        let light_raster = match light_block {
-            Some(_) => opts.light_raster,
-            None => LightRaster::Hardware,
-        };
+        let light_raster = light_block.map_or(LightRaster::Hardware, |_| opts.light_raster);
         let soft_light = (light_raster == LightRaster::Software).then_some(view.shadows);
         let transients = self.frame_transients(
             (view.transparency, raster),
@@ -218,19 +202,58 @@ impl Renderer {
             volume_characters: (work_draw.alone, work_draw.blended),
             probe_roots: opts.probe_roots.then_some(self.crowd.bundle_count()),
             unscoped_commands,
-            budgets: super::core::slots::ViewBudgets {
-                segments: self.soft_budget.segments,
-                pool: match path {
-                    RenderPath::Compute => block.counts[3],
-                    _ => 0,
-                },
-            },
+            budgets: self.view_budgets(path, &block),
         };
         self.hand_over(i, pending, target)?;
         self.remember_frame(&records, &motion, temporal);
         self.after_submit(path, raster);
         self.next = (i + 1) % FRAMES_IN_FLIGHT;
         Ok(FrameTicket(self.frame_number - 1))
+    }
+
+    /// This frame's temporal work (`None`: no motion vectors), or why this device cannot do
+    /// it: the compute path's vertices carry deformation residuals.
+    fn temporal_work(
+        &self,
+        view: &View,
+        opts: &FrameOptions,
+        path: RenderPath,
+    ) -> GpuResult<Option<TemporalWork>> {
+        let vertex_slots = match path {
+            RenderPath::Compute => self.desc.vertex_pool_bytes / size_of::<HairVertex>() as u64,
+            _ => 0,
+        };
+        self.temporal
+            .work(view.temporal, opts.read_motion, vertex_slots)
+    }
+
+    /// The temporal history for this frame's size where it accumulates; history buffers it
+    /// replaces are retired with frame slot `i`.
+    fn prepare_history(&mut self, i: usize, temporal: Option<TemporalWork>) -> GpuResult<()> {
+        if let Some(old) = self
+            .temporal
+            .prepare(&self.ctx, temporal, self.targets.size())?
+        {
+            self.frames[i]
+                .retired
+                .push(Retired::Resource(Box::new(old)));
+        }
+        Ok(())
+    }
+
+    /// The buffers the views' LoD had to fit this frame (the LoD pressure's budgets).
+    fn view_budgets(
+        &self,
+        path: RenderPath,
+        block: &FrameBlock,
+    ) -> super::core::slots::ViewBudgets {
+        super::core::slots::ViewBudgets {
+            segments: self.soft_budget.segments,
+            pool: match path {
+                RenderPath::Compute => block.counts[3],
+                _ => 0,
+            },
+        }
     }
 
     /// Write this frame's GPU hair dynamics steps into frame slot `i`'s job table (grown as

@@ -55,6 +55,19 @@ pub(crate) struct AccessInfo {
 impl Access {
     pub(crate) fn info(self) -> AccessInfo {
         use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+        // Shader stages read storage and uniform buffers, or read and write storage.
+        let read = |s| {
+            (
+                s,
+                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
+                L::UNDEFINED,
+                false,
+            )
+        };
+        let read_write = |s| {
+            let access = A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE;
+            (s, access, L::GENERAL, true)
+        };
         let (stage, access, layout, writes) = match self {
             Access::Nothing => (S::NONE, A::NONE, L::UNDEFINED, false),
             Access::IndirectRead => (
@@ -63,60 +76,19 @@ impl Access {
                 L::UNDEFINED,
                 false,
             ),
-            Access::ComputeRead => (
-                S::COMPUTE_SHADER,
-                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
-                L::GENERAL,
-                false,
-            ),
-            Access::TaskRead => (
-                S::TASK_SHADER_EXT,
-                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
-                L::UNDEFINED,
-                false,
-            ),
-            Access::ComputeReadWrite => (
-                S::COMPUTE_SHADER,
-                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-                L::GENERAL,
-                true,
-            ),
-            Access::VertexRead => (
-                S::VERTEX_SHADER,
-                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
-                L::UNDEFINED,
-                false,
-            ),
-            Access::TaskReadWrite => (
-                S::TASK_SHADER_EXT,
-                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-                L::GENERAL,
-                true,
-            ),
-            Access::MeshRead => (
-                S::MESH_SHADER_EXT,
-                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
-                L::UNDEFINED,
-                false,
-            ),
-            Access::MeshReadWrite => (
-                S::MESH_SHADER_EXT,
-                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-                L::GENERAL,
-                true,
-            ),
-            Access::FragmentRead => (
-                S::FRAGMENT_SHADER,
-                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
-                L::UNDEFINED,
-                false,
-            ),
-            Access::FragmentReadWrite => (
-                S::FRAGMENT_SHADER,
-                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-                L::GENERAL,
-                true,
-            ),
+            // Compute reads storage images too, in the general layout.
+            Access::ComputeRead => {
+                let (stage, access, _, writes) = read(S::COMPUTE_SHADER);
+                (stage, access, L::GENERAL, writes)
+            }
+            Access::TaskRead => read(S::TASK_SHADER_EXT),
+            Access::VertexRead => read(S::VERTEX_SHADER),
+            Access::MeshRead => read(S::MESH_SHADER_EXT),
+            Access::FragmentRead => read(S::FRAGMENT_SHADER),
+            Access::ComputeReadWrite => read_write(S::COMPUTE_SHADER),
+            Access::TaskReadWrite => read_write(S::TASK_SHADER_EXT),
+            Access::MeshReadWrite => read_write(S::MESH_SHADER_EXT),
+            Access::FragmentReadWrite => read_write(S::FRAGMENT_SHADER),
             Access::SampledRead => (
                 S::ALL_COMMANDS,
                 A::SHADER_SAMPLED_READ,

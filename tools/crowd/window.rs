@@ -567,6 +567,24 @@ impl App {
 }
 
 impl Running {
+    /// The cursor moved to `(x, y)`: a drag with the left button turns the camera.
+    fn cursor_moved(&mut self, x: f64, y: f64) {
+        if let Some((x0, y0)) = self.dragging {
+            self.camera.drag((x - x0) as f32, (y - y0) as f32);
+            self.dragging = Some((x, y));
+        }
+        self.cursor = (x, y);
+    }
+
+    /// The wheel moved by `delta`: the camera comes closer or goes back (0.3 to 200 m).
+    fn zoom(&mut self, delta: MouseScrollDelta) {
+        let d = match delta {
+            MouseScrollDelta::LineDelta(_, y) => y,
+            MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+        };
+        self.camera.distance = (self.camera.distance * (1.0 - 0.1 * d)).clamp(0.3, 200.0);
+    }
+
     fn size_changed(&mut self, width: u32, height: u32) {
         self.size = (width, height);
         self.recreate = true;
@@ -1037,20 +1055,11 @@ impl ApplicationHandler for App {
                 Ok(())
             }
             WindowEvent::CursorMoved { position, .. } => {
-                if let Some((x, y)) = r.dragging {
-                    r.camera
-                        .drag((position.x - x) as f32, (position.y - y) as f32);
-                    r.dragging = Some((position.x, position.y));
-                }
-                r.cursor = (position.x, position.y);
+                r.cursor_moved(position.x, position.y);
                 Ok(())
             }
             WindowEvent::MouseWheel { delta, .. } => {
-                let d = match delta {
-                    MouseScrollDelta::LineDelta(_, y) => y,
-                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
-                };
-                r.camera.distance = (r.camera.distance * (1.0 - 0.1 * d)).clamp(0.3, 200.0);
+                r.zoom(delta);
                 Ok(())
             }
             WindowEvent::RedrawRequested => match r.draw(scene_len) {

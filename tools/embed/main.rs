@@ -443,27 +443,7 @@ impl<'e> Scene<'e> {
                     vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
                 ),
             );
-            let color = [vk::RenderingAttachmentInfo::default()
-                .image_view(t.color.view)
-                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue {
-                    color: vk::ClearColorValue {
-                        float32: [0.45, 0.55, 0.7, 1.0],
-                    },
-                })];
-            let depth = vk::RenderingAttachmentInfo::default()
-                .image_view(t.depth.view)
-                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: 0.0,
-                        stencil: 0,
-                    },
-                });
+            let (color, depth) = attachments(t);
             let area = vk::Rect2D {
                 offset: vk::Offset2D::default(),
                 extent: vk::Extent2D {
@@ -517,6 +497,37 @@ impl<'e> Scene<'e> {
             d.cmd_end_rendering(cmd);
         }
     }
+}
+
+/// The engine's colour (cleared to sky blue) and depth (cleared to 0) attachments.
+fn attachments(
+    t: &Targets,
+) -> (
+    [vk::RenderingAttachmentInfo<'static>; 1],
+    vk::RenderingAttachmentInfo<'static>,
+) {
+    let color = [vk::RenderingAttachmentInfo::default()
+        .image_view(t.color.view)
+        .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(vk::ClearValue {
+            color: vk::ClearColorValue {
+                float32: [0.45, 0.55, 0.7, 1.0],
+            },
+        })];
+    let depth = vk::RenderingAttachmentInfo::default()
+        .image_view(t.depth.view)
+        .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(vk::ClearValue {
+            depth_stencil: vk::ClearDepthStencilValue {
+                depth: 0.0,
+                stencil: 0,
+            },
+        });
+    (color, depth)
 }
 
 impl Drop for Scene<'_> {

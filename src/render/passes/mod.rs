@@ -491,6 +491,24 @@ pub struct FrameInputs<'a> {
     pub volume_slots: u32,
 }
 
+/// What the temporal passes take from frame `r` drawn with `inp`, in frames with motion
+/// vectors.
+fn temporal_inputs<'a>(r: &FrameRes<'a>, inp: &FrameInputs<'a>) -> Option<TemporalInputs<'a>> {
+    match (r.visibility, r.temporal, inp.temporal) {
+        (Some(visibility), Some(res), Some(work)) => Some(TemporalInputs {
+            constants: r.constants,
+            visibility,
+            res,
+            output: (r.output, r.images.output),
+            sets: inp.sets,
+            size: inp.size,
+            work,
+            readback: inp.motion_readback,
+        }),
+        _ => None,
+    }
+}
+
 /// The pipelines of every pass of a frame; [`FramePasses::add`] adds them to the frame graph
 /// in order: statistics reset; with shadows, the light's generation (compute path) and passes,
 /// then a second reset; generation (compute path); the opaque pass (props, scalps, and opaque
@@ -748,31 +766,7 @@ impl FramePasses {
         r: &FrameRes<'a>,
         mut inp: FrameInputs<'a>,
     ) -> GpuResult<()> {
-        // Statistics accumulate from zero every frame; the static path keeps the last compute
-        // frame's draw arguments (and statistics).
-        let keep_args = matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
-        if !keep_args {
-            add_clear_args(g, r);
-        }
-        let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
-        self.skin.add(g, r, inp.sets, inp.skin);
-        if let Some(probe) = inp.probe {
-            self.root_probe.add(g, r, inp.sets, probe);
-        }
-        if let Some(mode) = inp.shadow {
-            self.add_light(g, r, &inp, mode)?;
-            // The camera's statistics start from zero again; the light's are kept.
-            if !keep_args {
-                add_clear_args_for_camera(g, r);
-            }
-        }
-        if inp.bundles > 0 && !keep_args {
-            self.lod.add(g, r, (inp.sets, "cull"), inp.bundles, compute);
-        }
-        if compute {
-            let view = GenerateView::Camera;
-            self.generate.add(g, r, inp.sets, inp.bundles, view);
-        }
+        self.add_before_drawing(g, r, &inp)?;
         TemporalFeature::add_clear(g, r.visibility);
         let soft = inp.bundles > 0 && inp.raster.uses_software();
         // Bundles drawn as hardware strips: every one without the software rasterizer, the
@@ -824,20 +818,43 @@ impl FramePasses {
             let peel = matches!(inp.transparency, super::Transparency::DepthPeeling { .. });
             self.transparency.add_resolve(g, r, peel, inp.sets)?;
         }
-        let temporal = match (r.visibility, r.temporal, inp.temporal) {
-            (Some(visibility), Some(res), Some(work)) => Some(TemporalInputs {
-                constants: r.constants,
-                visibility,
-                res,
-                output: (r.output, r.images.output),
-                sets: inp.sets,
-                size: inp.size,
-                work,
-                readback: inp.motion_readback,
-            }),
-            _ => None,
-        };
-        inp.temporal_feature.add(g, temporal);
+        inp.temporal_feature.add(g, temporal_inputs(r, &inp));
+        Ok(())
+    }
+
+    /// What runs before the camera draws: statistics cleared, skinning, the root probe, the
+    /// light's passes, the camera's culling and LoD and, on the compute path, its generation.
+    fn add_before_drawing<'a>(
+        &'a self,
+        g: &mut FrameGraph<'a>,
+        r: &FrameRes<'a>,
+        inp: &FrameInputs<'a>,
+    ) -> GpuResult<()> {
+        // Statistics accumulate from zero every frame; the static path keeps the last compute
+        // frame's draw arguments (and statistics).
+        let keep_args = matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
+        if !keep_args {
+            add_clear_args(g, r);
+        }
+        let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
+        self.skin.add(g, r, inp.sets, inp.skin);
+        if let Some(probe) = inp.probe {
+            self.root_probe.add(g, r, inp.sets, probe);
+        }
+        if let Some(mode) = inp.shadow {
+            self.add_light(g, r, inp, mode)?;
+            // The camera's statistics start from zero again; the light's are kept.
+            if !keep_args {
+                add_clear_args_for_camera(g, r);
+            }
+        }
+        if inp.bundles > 0 && !keep_args {
+            self.lod.add(g, r, (inp.sets, "cull"), inp.bundles, compute);
+        }
+        if compute {
+            let view = GenerateView::Camera;
+            self.generate.add(g, r, inp.sets, inp.bundles, view);
+        }
         Ok(())
     }
 
