@@ -605,24 +605,12 @@ impl Renderer {
             FrameTarget::Host(h) => CommandRecorder::host(&self.ctx, h.cmd),
             FrameTarget::Own(_) => cmd.begin()?,
         };
-        profiler.reset(&mut rec);
-        if let Some(q) = mesh_query.as_mut() {
-            q.reset(&mut rec);
-        }
-        profiler.begin_frame(&mut rec);
+        begin_timing(&mut rec, profiler, mesh_query.as_mut());
         let jobs = self.crowd.update_jobs(i, &work.pose_updates);
-        let simulated: Vec<SimulatedCharacter> = self
-            .crowd
-            .simulated_buffers(&work.simulated)
-            .into_iter()
-            .map(|(state, pose)| SimulatedCharacter { state, pose })
-            .collect();
+        let simulated = simulated_characters(&self.crowd, &work.simulated);
         let size = self.targets.size();
         let (mut host_color_use, mut host_depth_use) = target.host_uses();
-        let mut g = FrameGraph::new(opts.describe_frame);
-        if let Some((pass, resource, access)) = &self.desc.omit_use {
-            g.omit_use(pass, resource, *access);
-        }
+        let mut g = new_graph(opts, &self.desc);
         let sources = FrameSources {
             work: &self.work,
             targets: &mut self.targets,
@@ -643,12 +631,15 @@ impl Renderer {
         let textures = self.crowd.texture_set();
         let bg = self.background;
         let sets = PassSets::camera_and_light((set, light_set), textures);
-        if let Some(table) = density_jobs.as_ref()
-            && !work.density.built.is_empty()
-        {
-            let volumes = self.volumes.buffers(&work.density.built);
-            let build = (table, volumes.as_slice(), work.density.most_bundles);
-            self.passes.add_density_volumes(&mut g, &r, sets.0, build);
+        if let Some(table) = density_jobs.as_ref() {
+            let volumes = &self.volumes;
+            add_volume_builds(
+                &mut g,
+                (&r, sets.0),
+                (&self.passes, volumes),
+                table,
+                &work.density,
+            );
         }
         let host_uses = (&mut host_color_use, &mut host_depth_use);
         let host = add_host_start(
@@ -659,11 +650,7 @@ impl Renderer {
             i,
         );
         let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
-        let skin_indices = self.skinned.indices.as_ref();
-        let props = [&work.props.camera, &work.props.light].map(|draws| PropList {
-            draws,
-            skin_indices,
-        });
+        let props = prop_lists(&work.props, self.skinned.indices.as_ref());
         let mut inputs = frame_inputs(
             &work,
             (sets, props),
@@ -671,10 +658,10 @@ impl Renderer {
             size,
             (mesh_query.as_mut(), &self.temporal),
         );
-        if opts.probe_roots {
-            let probe = g.import_buffer("root probe", root_probe);
-            inputs.probe = Some((probe, work.bundles));
-        }
+        let probe = opts
+            .probe_roots
+            .then(|| g.import_buffer("root probe", root_probe));
+        inputs.probe = probe.map(|p| (p, work.bundles));
         inputs.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
         self.passes.add(&mut g, &r, inputs)?;
         let image_readback = image_readback.as_ref().filter(|_| opts.read_image);
@@ -682,12 +669,8 @@ impl Renderer {
         if let Some((passes, res)) = host {
             passes.add_composite(&mut g, &r, i, res)?;
         }
-        let result = g.run(&mut rec, profiler, &mut self.transients);
-        profiler.end_frame(&mut rec);
-        let unscoped = rec.unscoped_commands();
-        let released = self.transients.take_released();
-        retired.extend(released.into_iter().map(Retired::Resource));
-        let description = result?;
+        let (description, unscoped) =
+            run_graph(g, &mut rec, profiler, &mut self.transients, retired)?;
         drop(rec);
         if let FrameTarget::Own(_) = target {
             cmd.end()?;
@@ -958,6 +941,86 @@ pub(super) fn image_readback(ctx: &Arc<Context>, bytes: u64) -> GpuResult<Buffer
         ctx,
         &BufferDesc::new("image readback", bytes, vk::BufferUsageFlags::TRANSFER_DST).readback(),
     )
+}
+
+/// A frame's graph, described where `opts` asks, with the use `desc` omits on purpose (the
+/// tests that check the graph's validation).
+fn new_graph<'a>(opts: &FrameOptions, desc: &'a super::settings::RendererDesc) -> FrameGraph<'a> {
+    let mut g = FrameGraph::new(opts.describe_frame);
+    if let Some((pass, resource, access)) = &desc.omit_use {
+        g.omit_use(pass, resource, *access);
+    }
+    g
+}
+
+/// Run the frame graph into `rec` and close the frame's outer timing pair; the transients
+/// the pool released are retired with the frame. The graph's description (when asked for)
+/// and the commands recorded outside every timing scope.
+fn run_graph(
+    g: FrameGraph,
+    rec: &mut CommandRecorder,
+    profiler: &mut crate::vk::Profiler,
+    transients: &mut super::core::graph::TransientPool,
+    retired: &mut Vec<Retired>,
+) -> GpuResult<(Option<String>, u32)> {
+    let result = g.run(rec, profiler, transients);
+    profiler.end_frame(rec);
+    let unscoped = rec.unscoped_commands();
+    let released = transients.take_released();
+    retired.extend(released.into_iter().map(Retired::Resource));
+    Ok((result?, unscoped))
+}
+
+/// The density volumes this frame builds (`density.built`), from the slot's job `table`.
+fn add_volume_builds<'a>(
+    g: &mut FrameGraph<'a>,
+    (r, set): (&FrameRes, PassSets<'a>),
+    (passes, volumes): (
+        &'a super::passes::FramePasses,
+        &'a super::features::volume::DensityVolumes,
+    ),
+    table: &'a Buffer,
+    density: &DensityWork,
+) {
+    if density.built.is_empty() {
+        return;
+    }
+    let buffers = volumes.buffers(&density.built);
+    let build = (table, buffers.as_slice(), density.most_bundles);
+    passes.add_density_volumes(g, r, set, build);
+}
+
+/// Reset the frame's timestamp and mesh queries and open its outer timing pair.
+fn begin_timing(
+    rec: &mut CommandRecorder,
+    profiler: &mut crate::vk::Profiler,
+    mesh_query: Option<&mut crate::vk::MeshPrimitivesQuery>,
+) {
+    profiler.reset(rec);
+    if let Some(q) = mesh_query {
+        q.reset(rec);
+    }
+    profiler.begin_frame(rec);
+}
+
+/// The GPU-simulated characters' state and pose buffers, for the dynamics pass.
+fn simulated_characters<'a>(
+    crowd: &'a super::crowd::Crowd,
+    simulated: &[usize],
+) -> Vec<SimulatedCharacter<'a>> {
+    crowd
+        .simulated_buffers(simulated)
+        .into_iter()
+        .map(|(state, pose)| SimulatedCharacter { state, pose })
+        .collect()
+}
+
+/// The camera's and the light's prop lists, with the skinned bodies' index buffer.
+fn prop_lists<'a>(props: &'a PropDraws, skin_indices: Option<&'a Buffer>) -> [PropList<'a>; 2] {
+    [&props.camera, &props.light].map(|draws| PropList {
+        draws,
+        skin_indices,
+    })
 }
 
 /// What the frame's passes draw: the frame's work, its sets and props, and the slot's query.

@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::device::Surface;
 use super::sync::Semaphore;
 use super::{Context, GpuError, GpuResult, VkContext};
 
@@ -57,22 +58,24 @@ pub struct Swapchain {
     pub present_mode: PresentMode,
 }
 
-impl Swapchain {
-    /// A swapchain of `width x height` (clamped to what the surface allows) with
-    /// `present_mode` where offered; `old` is retired by the new one.
-    pub fn new(
-        ctx: &Arc<Context>,
-        width: u32,
-        height: u32,
+/// What a swapchain on a surface is made with: an sRGB format where offered, the asked
+/// present mode where supported (else FIFO), the surface's extent (or the asked size within
+/// its limits), one image more than the least, and the surface's transform.
+struct SurfaceChoice {
+    format: vk::SurfaceFormatKHR,
+    present_mode: PresentMode,
+    extent: vk::Extent2D,
+    count: u32,
+    transform: vk::SurfaceTransformFlagsKHR,
+}
+
+impl SurfaceChoice {
+    fn of(
+        surface: &Surface,
+        physical: vk::PhysicalDevice,
+        (width, height): (u32, u32),
         present_mode: PresentMode,
-        old: Option<Swapchain>,
     ) -> GpuResult<Self> {
-        let (Some(surface), Some(ext)) = (&ctx.surface, &ctx.swapchain_ext) else {
-            return Err(GpuError::Unsupported(
-                "the context was created without a window".into(),
-            ));
-        };
-        let physical = ctx.physical();
         // SAFETY: plain surface queries on a valid physical device and surface.
         let (caps, formats, modes) = unsafe {
             (
@@ -118,6 +121,38 @@ impl Swapchain {
         if caps.max_image_count > 0 {
             count = count.min(caps.max_image_count);
         }
+        Ok(SurfaceChoice {
+            format,
+            present_mode,
+            extent,
+            count,
+            transform: caps.current_transform,
+        })
+    }
+}
+
+impl Swapchain {
+    /// A swapchain of `width x height` (clamped to what the surface allows) with
+    /// `present_mode` where offered; `old` is retired by the new one.
+    pub fn new(
+        ctx: &Arc<Context>,
+        width: u32,
+        height: u32,
+        present_mode: PresentMode,
+        old: Option<Swapchain>,
+    ) -> GpuResult<Self> {
+        let (Some(surface), Some(ext)) = (&ctx.surface, &ctx.swapchain_ext) else {
+            return Err(GpuError::Unsupported(
+                "the context was created without a window".into(),
+            ));
+        };
+        let SurfaceChoice {
+            format,
+            present_mode,
+            extent,
+            count,
+            transform,
+        } = SurfaceChoice::of(surface, ctx.physical(), (width, height), present_mode)?;
         let info = vk::SwapchainCreateInfoKHR::default()
             .surface(surface.raw)
             .min_image_count(count)
@@ -127,7 +162,7 @@ impl Swapchain {
             .image_array_layers(1)
             .image_usage(vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::COLOR_ATTACHMENT)
             .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
-            .pre_transform(caps.current_transform)
+            .pre_transform(transform)
             .composite_alpha(vk::CompositeAlphaFlagsKHR::OPAQUE)
             .present_mode(present_mode.raw())
             .clipped(true)
