@@ -650,7 +650,7 @@ impl Renderer {
             i,
         );
         let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
-        let props = prop_lists(&work.props, self.skinned.indices.as_ref());
+        let props = prop_lists(work.props, self.skinned.indices.as_ref());
         let mut inputs = frame_inputs(
             &work,
             (sets, props),
