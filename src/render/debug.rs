@@ -14,8 +14,7 @@ use super::soft::StrandRaster;
 use super::transparency::Transparency;
 use crate::vk::{Access, Buffer, GpuError, GpuResult};
 
-pub(super) use super::core::readback::read_device_buffer;
-use super::core::readback::readback;
+use super::core::readback::{read_device_buffer, readback};
 
 impl Renderer {
     /// Draw `segments` (screen space and shaded, as generation appends them) with the

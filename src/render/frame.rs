@@ -4,8 +4,6 @@
 
 use std::sync::Arc;
 
-use ash::vk;
-
 use std::time::Instant;
 
 use super::RenderPath;
@@ -35,7 +33,7 @@ use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
 use super::soft::StrandRaster;
 use super::transparency::Transparency;
-use crate::vk::{Access, Buffer, BufferDesc, CommandRecorder, Context, GpuError, GpuResult};
+use crate::vk::{Access, Buffer, CommandRecorder, Context, GpuError, GpuResult};
 
 /// The density volumes of a frame.
 struct DensityWork {
@@ -632,14 +630,8 @@ impl Renderer {
         let bg = self.background;
         let sets = PassSets::camera_and_light((set, light_set), textures);
         if let Some(table) = density_jobs.as_ref() {
-            let volumes = &self.volumes;
-            add_volume_builds(
-                &mut g,
-                (&r, sets.0),
-                (&self.passes, volumes),
-                table,
-                &work.density,
-            );
+            let owners = (&self.passes, &self.volumes);
+            add_volume_builds(&mut g, (&r, sets.0), owners, table, &work.density);
         }
         let host_uses = (&mut host_color_use, &mut host_depth_use);
         let host = add_host_start(
@@ -930,17 +922,13 @@ fn size_readback(
     bytes: u64,
 ) -> GpuResult<()> {
     if wants && readback.as_ref().is_none_or(|b| b.size != bytes) {
-        *readback = Some(image_readback(ctx, bytes)?);
+        *readback = Some(super::core::readback::readback(
+            ctx,
+            "image readback",
+            bytes,
+        )?);
     }
     Ok(())
-}
-
-/// A host-readable buffer for the frame's image.
-pub(super) fn image_readback(ctx: &Arc<Context>, bytes: u64) -> GpuResult<Buffer> {
-    Buffer::new(
-        ctx,
-        &BufferDesc::new("image readback", bytes, vk::BufferUsageFlags::TRANSFER_DST).readback(),
-    )
 }
 
 /// A frame's graph, described where `opts` asks, with the use `desc` omits on purpose (the

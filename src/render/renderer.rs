@@ -303,8 +303,11 @@ impl Renderer {
     ) -> GpuResult<(crate::dynamics::HairState, crate::dynamics::StepClock)> {
         self.finish()?;
         let sim = self.crowd.simulation(id)?.sim();
-        let bytes =
-            super::debug::read_device_buffer(&self.ctx, sim.state_buffer(), sim.state_bytes())?;
+        let bytes = super::core::readback::read_device_buffer(
+            &self.ctx,
+            sim.state_buffer(),
+            sim.state_bytes(),
+        )?;
         Ok((super::dynamics::hair_state(&bytes), *sim.clock()))
     }
 
@@ -346,7 +349,7 @@ impl Renderer {
     pub fn read_hair_pose(&mut self, id: CharacterId) -> GpuResult<Vec<glam::Vec3>> {
         self.finish()?;
         let s = self.crowd.simulation(id)?;
-        let bytes = super::debug::read_device_buffer(&self.ctx, s.pose(), s.pose().size)?;
+        let bytes = super::core::readback::read_device_buffer(&self.ctx, s.pose(), s.pose().size)?;
         let poses: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
         let n = s.sim().vertex_count();
         Ok(poses
@@ -373,7 +376,7 @@ impl Renderer {
                 buffer.size / size_of::<super::core::shared::SkinnedVertex>() as u64
             )));
         }
-        let data = super::debug::read_device_buffer(&self.ctx, buffer, bytes)?;
+        let data = super::core::readback::read_device_buffer(&self.ctx, buffer, bytes)?;
         Ok(bytemuck::pod_collect_to_vec(&data))
     }
 

@@ -77,10 +77,12 @@ impl Access {
                 false,
             ),
             // Compute reads storage images too, in the general layout.
-            Access::ComputeRead => {
-                let (stage, access, _, writes) = read(S::COMPUTE_SHADER);
-                (stage, access, L::GENERAL, writes)
-            }
+            Access::ComputeRead => (
+                S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ | A::UNIFORM_READ,
+                L::GENERAL,
+                false,
+            ),
             Access::TaskRead => read(S::TASK_SHADER_EXT),
             Access::VertexRead => read(S::VERTEX_SHADER),
             Access::MeshRead => read(S::MESH_SHADER_EXT),
