@@ -5,28 +5,14 @@
 //! own parent module file defines is allowed (the parent declares the child; that is not a
 //! loop). The negative controls plant a cycle and a long function in a tree of their own.
 //!
-//! No cycle is allowed. While functions are split in steps (issue 65), [`KNOWN_LONG`] lists
-//! what is left: the test fails on any long function not listed and on any listed one that
-//! is gone, so the list only shrinks. `MODULE_HOUSE_EXPLAIN=1` prints the edges of every cycle.
+//! No cycle and no long function is allowed. `MODULE_HOUSE_EXPLAIN=1` prints the edges of
+//! every cycle.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Longest function allowed, in lines from its `fn` line to its closing brace.
 const MAX_FUNCTION_LINES: usize = 80;
-
-/// Functions still over [`MAX_FUNCTION_LINES`]: "path::name".
-const KNOWN_LONG: &[&str] = &[
-    "src/render/frame.rs::record",
-    "tools/bake.rs::run",
-    "tools/bench.rs::run",
-    "tools/bench/raster.rs::bench_raster",
-    "tools/crowd/main.rs::run",
-    "tools/crowd/window.rs::draw",
-    "tools/crowd/window.rs::show",
-    "tools/crowd/window.rs::start",
-    "tools/fit.rs::run",
-];
 
 /// One source file: its module path inside its crate and its text with comments and string
 /// contents blanked (newlines kept).
@@ -781,7 +767,7 @@ fn the_module_graph_has_no_cycles_and_no_function_is_over_80_lines() {
             *p = format!("{p}\n{why}");
         }
     }
-    problems.extend(check_against(&long, KNOWN_LONG, "function over 80 lines"));
+    problems.extend(check_against(&long, &[], "function over 80 lines"));
     eprintln!(
         "{} cycles, {} functions over {MAX_FUNCTION_LINES} lines",
         cycles.len(),

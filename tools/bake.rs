@@ -14,7 +14,7 @@ use hairmesh::bake::{BakeOptions, texels_per_face};
 use hairmesh::budget::{self, MemoryBudget};
 use hairmesh::fsutil::OutputPath;
 use hairmesh::model::obj_io::{load_hair_mesh_obj, load_scalp};
-use hairmesh::{ExtrudeDesc, HairStyle, extrude, outln};
+use hairmesh::{BakedHairMesh, ExtrudeDesc, HairMesh, HairStyle, extrude, outln};
 
 /// Bake a hair mesh into the five textures of the hair-meshes paper.
 #[derive(Parser)]
@@ -57,6 +57,44 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
             .map_err(anyhow::Error::msg)?;
     }
     let args = parsed.args;
+    check_args(&args)?;
+    let style_path = args
+        .style
+        .clone()
+        .or_else(|| HairStyle::beside(&args.input));
+    let mut inputs = vec![args.input.as_path()];
+    inputs.extend(style_path.as_deref());
+    let output = OutputPath::check(&args.output, &inputs)?;
+    let mesh = load_mesh(&args)?;
+    let style = match &style_path {
+        Some(p) => HairStyle::load(p)?,
+        None => HairStyle::default(),
+    };
+    let baked = bake_with_progress(&mesh, &style, &args)?;
+    let bytes = baked_file::to_bytes(&baked);
+    outln!("{}", args.input.display())?;
+    outln!(
+        "  {} vertices ({} per layer x {} layers), {} bundles, style {}",
+        mesh.vertex_count(),
+        mesh.vertices_per_layer(),
+        mesh.layer_count(),
+        mesh.faces.len(),
+        style_path.map_or("defaults".into(), |p| p.display().to_string())
+    )?;
+    print_textures(&baked)?;
+    // The last line comes before the file: a stdout that fails leaves no output behind.
+    outln!(
+        "  writing {} ({} bytes with bundle table and header), baked in {:.2} s",
+        args.output.display(),
+        bytes.len(),
+        start.elapsed().as_secs_f32()
+    )?;
+    output.write(&bytes)?;
+    Ok(())
+}
+
+/// The numeric flags and the output's name, checked before anything is read.
+fn check_args(args: &Args) -> Result<()> {
     if !(args.step.is_finite() && args.step > 0.0 && args.step <= 1e3) {
         bail!("--step {} must be in (0, 1000]", args.step);
     }
@@ -69,45 +107,41 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
             args.output.display()
         );
     }
-    let style_path = args
-        .style
-        .clone()
-        .or_else(|| HairStyle::beside(&args.input));
-    let mut inputs = vec![args.input.as_path()];
-    inputs.extend(style_path.as_deref());
-    let output = OutputPath::check(&args.output, &inputs)?;
-    let mesh = match args.extrude {
-        Some(layers) => {
-            let layers = layers as usize;
-            let scalp = load_scalp(&args.input)?;
-            // The extrusion and its bake are estimated before either allocates; the root
-            // slice holds at least one texel per scalp vertex.
-            let n = scalp.positions.len() as u64;
-            let estimate = hairmesh::bake::memory_estimate(n, layers as u64, n);
-            args.memory_budget_mib.check(
-                &args.input.display().to_string(),
-                &format!("--extrude {layers} of {n} scalp vertices"),
-                &estimate,
-                "lower --extrude",
-            )?;
-            extrude(
-                args.input.display().to_string(),
-                &scalp.positions,
-                &scalp.uv,
-                &scalp.faces,
-                &ExtrudeDesc::new(layers, args.step).gravity(args.gravity, glam::Vec3::NEG_Y),
-            )?
-        }
-        None => load_hair_mesh_obj(&args.input)?,
+    Ok(())
+}
+
+/// The hair mesh to bake: the input OBJ, or its scalp extruded (`--extrude`), estimated
+/// against the memory budget before either allocates.
+fn load_mesh(args: &Args) -> Result<HairMesh> {
+    let Some(layers) = args.extrude else {
+        return Ok(load_hair_mesh_obj(&args.input)?);
     };
-    let style = match &style_path {
-        Some(p) => HairStyle::load(p)?,
-        None => HairStyle::default(),
-    };
+    let layers = layers as usize;
+    let scalp = load_scalp(&args.input)?;
+    // The root slice holds at least one texel per scalp vertex.
+    let n = scalp.positions.len() as u64;
+    let estimate = hairmesh::bake::memory_estimate(n, layers as u64, n);
+    args.memory_budget_mib.check(
+        &args.input.display().to_string(),
+        &format!("--extrude {layers} of {n} scalp vertices"),
+        &estimate,
+        "lower --extrude",
+    )?;
+    Ok(extrude(
+        args.input.display().to_string(),
+        &scalp.positions,
+        &scalp.uv,
+        &scalp.faces,
+        &ExtrudeDesc::new(layers, args.step).gravity(args.gravity, glam::Vec3::NEG_Y),
+    )?)
+}
+
+/// Bake `mesh`, printing progress on stderr for big meshes.
+fn bake_with_progress(mesh: &HairMesh, style: &HairStyle, args: &Args) -> Result<BakedHairMesh> {
     let big = mesh.vertex_count() > 200_000;
     let baked = hairmesh::bake(
-        &mesh,
-        &style,
+        mesh,
+        style,
         BakeOptions {
             motion_margin: 0.0,
             charts: !args.no_charts,
@@ -126,21 +160,16 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     if big {
         let _ = writeln!(std::io::stderr());
     }
-    let bytes = baked_file::to_bytes(&baked);
-    outln!("{}", args.input.display())?;
-    outln!(
-        "  {} vertices ({} per layer x {} layers), {} bundles, style {}",
-        mesh.vertex_count(),
-        mesh.vertices_per_layer(),
-        mesh.layer_count(),
-        mesh.faces.len(),
-        style_path.map_or("defaults".into(), |p| p.display().to_string())
-    )?;
+    Ok(baked)
+}
+
+/// The root slice and every texture's extent, format and size.
+fn print_textures(baked: &BakedHairMesh) -> Result<()> {
     outln!(
         "  root slice {}x{} texels, {:.2} texels per face",
         baked.info.root_size[0],
         baked.info.root_size[1],
-        texels_per_face(&baked)
+        texels_per_face(baked)
     )?;
     for t in baked.textures() {
         outln!(
@@ -160,14 +189,6 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
         total,
         total as f64 / 1024.0
     )?;
-    // The last line comes before the file: a stdout that fails leaves no output behind.
-    outln!(
-        "  writing {} ({} bytes with bundle table and header), baked in {:.2} s",
-        args.output.display(),
-        bytes.len(),
-        start.elapsed().as_secs_f32()
-    )?;
-    output.write(&bytes)?;
     Ok(())
 }
 

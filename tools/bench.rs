@@ -28,7 +28,7 @@
 //! texture rebuild and of the frame (medians), and with `--volumes` of rebuilding every
 //! character's density volume every frame; optionally a strip of frames side by side.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[path = "bench/animate.rs"]
@@ -185,44 +185,7 @@ enum Cmd {
     /// Copies of one hair mesh in wind, simulated and re-textured every frame (30 Hz), for
     /// each character count and dynamics path: CPU and GPU ms of the dynamics, GPU ms of the
     /// texture rebuild and of the frame; optionally a strip of frames.
-    Animate {
-        /// Hair mesh OBJ (style: the .toml beside it).
-        #[arg(long, default_value = "hairmeshes/head_long.obj")]
-        mesh: PathBuf,
-        /// Frames (1/30 s apart).
-        #[arg(long, default_value_t = 90, value_parser = clap::value_parser!(u32).range(1..=100000))]
-        frames: u32,
-        /// Wind strength on the tips, m/s^2 (0..=100).
-        #[arg(long, default_value_t = 30.0)]
-        wind: f32,
-        /// Image size.
-        #[arg(long, default_value = "240x240")]
-        size: String,
-        /// Strands per bundle.
-        #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=16384))]
-        strands_per_bundle: u32,
-        /// Character counts, one run each (copies of the mesh on a grid, all simulated every
-        /// frame on all cores).
-        #[arg(long, value_delimiter = ',', default_value = "1")]
-        counts: Vec<u32>,
-        /// Where the dynamics run, one run each: gpu (one dispatch for every character) and/or
-        /// cpu (all cores, poses uploaded).
-        #[arg(long, value_delimiter = ',', default_value = "gpu,cpu")]
-        dynamics: Vec<hairmesh::animate::DynamicsPath>,
-        /// Write frames (of the first count and path) side by side here.
-        #[arg(long)]
-        strip: Option<PathBuf>,
-        /// Frames in the strip (evenly spaced).
-        #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=32))]
-        strip_frames: u32,
-        /// Choose the GPU by name substring.
-        #[arg(long)]
-        device: Option<String>,
-        /// Also rebuild every character's strand density volume (32^3 cells, 16 strands per
-        /// bundle) every frame, and report its GPU ms.
-        #[arg(long)]
-        volumes: bool,
-    },
+    Animate(AnimateFlags),
     /// A crowd of mixed sample meshes on a ground plane seen from human height: GPU ms per
     /// pass, CPU ms to record a frame, peak RSS and GPU memory, for N characters, LoD on/off,
     /// both paths (and the mesh path with 1 vs 32 bundles per task workgroup).
@@ -269,6 +232,66 @@ enum Cmd {
         #[arg(long, requires = "volume_tier")]
         band_strip: Option<PathBuf>,
     },
+}
+
+/// `bench animate`'s flags.
+#[derive(clap::Args)]
+struct AnimateFlags {
+    /// Hair mesh OBJ (style: the .toml beside it).
+    #[arg(long, default_value = "hairmeshes/head_long.obj")]
+    mesh: PathBuf,
+    /// Frames (1/30 s apart).
+    #[arg(long, default_value_t = 90, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    frames: u32,
+    /// Wind strength on the tips, m/s^2 (0..=100).
+    #[arg(long, default_value_t = 30.0)]
+    wind: f32,
+    /// Image size.
+    #[arg(long, default_value = "240x240")]
+    size: String,
+    /// Strands per bundle.
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    strands_per_bundle: u32,
+    /// Character counts, one run each (copies of the mesh on a grid, all simulated every
+    /// frame on all cores).
+    #[arg(long, value_delimiter = ',', default_value = "1")]
+    counts: Vec<u32>,
+    /// Where the dynamics run, one run each: gpu (one dispatch for every character) and/or
+    /// cpu (all cores, poses uploaded).
+    #[arg(long, value_delimiter = ',', default_value = "gpu,cpu")]
+    dynamics: Vec<hairmesh::animate::DynamicsPath>,
+    /// Write frames (of the first count and path) side by side here.
+    #[arg(long)]
+    strip: Option<PathBuf>,
+    /// Frames in the strip (evenly spaced).
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=32))]
+    strip_frames: u32,
+    /// Choose the GPU by name substring.
+    #[arg(long)]
+    device: Option<String>,
+    /// Also rebuild every character's strand density volume (32^3 cells, 16 strands per
+    /// bundle) every frame, and report its GPU ms.
+    #[arg(long)]
+    volumes: bool,
+}
+
+impl AnimateFlags {
+    /// The run's settings, the image size parsed.
+    fn into_args(self) -> Result<animate::AnimateArgs> {
+        Ok(animate::AnimateArgs {
+            size: hairmesh::render::scene::parse_size(&self.size).map_err(anyhow::Error::msg)?,
+            mesh: self.mesh,
+            frames: self.frames,
+            wind: self.wind,
+            strands_per_bundle: self.strands_per_bundle,
+            counts: self.counts,
+            dynamics: self.dynamics,
+            strip: self.strip,
+            strip_frames: self.strip_frames,
+            device: self.device,
+            volumes: self.volumes,
+        })
+    }
 }
 
 /// Cameras on the line from the mesh's framing view (40 degrees, `DEFAULT_VIEW_DIR`) to its
@@ -670,8 +693,8 @@ fn check_unused(p: &hairmesh::cli::Parsed<Args>) -> Result<(), String> {
                 "--compare-defaults writes no picture",
             )
         }
-        Cmd::Animate { strip, .. } => {
-            p.unused_unless("strip_frames", strip.is_some(), "--strip is not given")
+        Cmd::Animate(a) => {
+            p.unused_unless("strip_frames", a.strip.is_some(), "--strip is not given")
         }
         _ => Ok(()),
     }
@@ -705,31 +728,7 @@ fn run(args: Args) -> Result<()> {
             device,
             scenes,
         })?,
-        Cmd::Animate {
-            mesh,
-            frames,
-            wind,
-            size,
-            strands_per_bundle,
-            counts,
-            dynamics,
-            strip,
-            strip_frames,
-            device,
-            volumes,
-        } => animate::bench_animate(animate::AnimateArgs {
-            mesh,
-            frames,
-            wind,
-            size: hairmesh::render::scene::parse_size(&size).map_err(anyhow::Error::msg)?,
-            strands_per_bundle,
-            counts,
-            dynamics,
-            strip,
-            strip_frames,
-            device,
-            volumes,
-        })?,
+        Cmd::Animate(flags) => animate::bench_animate(flags.into_args()?)?,
         Cmd::Temporal(args) => temporal::bench_temporal(args)?,
         Cmd::Compare(args) => compare::bench_compare(args)?,
         Cmd::Scalp(args) => scalp::bench_scalp(args)?,
@@ -755,11 +754,7 @@ fn run(args: Args) -> Result<()> {
             volume_tier,
             band_strip,
         } => bench_crowd(
-            counts.unwrap_or(match (compare_defaults, volume_tier) {
-                (true, _) => vec![100],
-                (_, true) => vec![100, 1000],
-                _ => vec![1, 16, 64, 256],
-            }),
+            counts.unwrap_or_else(|| default_crowd_counts(compare_defaults, volume_tier)),
             width,
             height,
             strands_per_bundle,
@@ -776,45 +771,60 @@ fn run(args: Args) -> Result<()> {
             strands,
             verts_log2,
             runs,
-        } => {
-            let vertices = strands as u64 * ((1u64 << verts_log2) + 1);
-            if vertices > MAX_CPU_VERTICES {
-                bail!(
-                    "--strands {strands} x {} vertices = {vertices} vertices, more than the {MAX_CPU_VERTICES} this benchmark allocates",
-                    (1u64 << verts_log2) + 1
-                );
-            }
-            let m = load_hair_mesh_obj(&mesh)?;
-            let style = match HairStyle::beside(&mesh) {
-                Some(p) => HairStyle::load(&p)?,
-                None => HairStyle::default(),
-            };
-            let baked = bake(&m, &style, BakeOptions::default(), |_, _| {})?;
-            let generator = CpuGenerator::new(&baked, style);
-            let n = (strands / baked.bundles.len() as u32).max(1);
-            let warm = generator.generate(n, verts_log2);
-            let mut times = Vec::new();
-            for i in 0..runs {
-                let t = Instant::now();
-                let set = generator.generate(n, verts_log2);
-                let s = t.elapsed().as_secs_f64();
-                outln!("run {i}: {:.3} s ({} strands)", s, set.strand_count())?;
-                times.push(s);
-            }
-            let med = median(times);
-            let verts = warm.positions.len();
-            outln!(
-                "cpu-generate {}: {} strands x {} vertices = {} vertices, median {:.3} s, {:.1} M vertices/s (1 thread)",
-                mesh.display(),
-                warm.strand_count(),
-                warm.verts_per_strand,
-                verts,
-                med,
-                verts as f64 / med / 1e6
-            )?;
-        }
+        } => bench_cpu_generate(&mesh, strands, verts_log2, runs)?,
     }
     Ok(())
+}
+
+
+/// `bench cpu-generate`: the CPU oracle's strands per second on one thread.
+fn bench_cpu_generate(mesh: &Path, strands: u32, verts_log2: u32, runs: u16) -> Result<()> {
+    let vertices = strands as u64 * ((1u64 << verts_log2) + 1);
+    if vertices > MAX_CPU_VERTICES {
+        bail!(
+            "--strands {strands} x {} vertices = {vertices} vertices, more than the {MAX_CPU_VERTICES} this benchmark allocates",
+            (1u64 << verts_log2) + 1
+        );
+    }
+    let m = load_hair_mesh_obj(mesh)?;
+    let style = match HairStyle::beside(mesh) {
+        Some(p) => HairStyle::load(&p)?,
+        None => HairStyle::default(),
+    };
+    let baked = bake(&m, &style, BakeOptions::default(), |_, _| {})?;
+    let generator = CpuGenerator::new(&baked, style);
+    let n = (strands / baked.bundles.len() as u32).max(1);
+    let warm = generator.generate(n, verts_log2);
+    let mut times = Vec::new();
+    for i in 0..runs {
+        let t = Instant::now();
+        let set = generator.generate(n, verts_log2);
+        let s = t.elapsed().as_secs_f64();
+        outln!("run {i}: {:.3} s ({} strands)", s, set.strand_count())?;
+        times.push(s);
+    }
+    let med = median(times);
+    let verts = warm.positions.len();
+    outln!(
+        "cpu-generate {}: {} strands x {} vertices = {} vertices, median {:.3} s, {:.1} M vertices/s (1 thread)",
+        mesh.display(),
+        warm.strand_count(),
+        warm.verts_per_strand,
+        verts,
+        med,
+        verts as f64 / med / 1e6
+    )?;
+    Ok(())
+}
+
+/// `bench crowd`'s counts when none are given: 100 to compare defaults, 100 and 1000 for the
+/// volume tier, else 1 to 256.
+fn default_crowd_counts(compare_defaults: bool, volume_tier: bool) -> Vec<usize> {
+    match (compare_defaults, volume_tier) {
+        (true, _) => vec![100],
+        (_, true) => vec![100, 1000],
+        _ => vec![1, 16, 64, 256],
+    }
 }
 
 #[cfg(test)]

@@ -15,13 +15,13 @@ use glam::Vec3;
 use hairmesh::budget::{self, MemoryBudget, VEC_HEADER};
 use hairmesh::fit::metric::compare;
 use hairmesh::fit::picture::{StrandLook, draw_strands};
-use hairmesh::fit::{FitOptions, fit};
+use hairmesh::fit::{FitOptions, Fitted, fit};
 use hairmesh::fsutil::RunFiles;
 use hairmesh::model::strands::StrandModel;
 use hairmesh::reference::generate::strands_per_bundle_for;
 use hairmesh::render::{Camera, Renderer, RendererDesc};
 use hairmesh::vk::{Context, ContextDesc};
-use hairmesh::{BakeOptions, CpuGenerator, bake, outln};
+use hairmesh::{BakeOptions, BakedHairMesh, CpuGenerator, bake, outln};
 
 /// Fit a hair mesh to a strand model.
 #[derive(Parser)]
@@ -66,12 +66,8 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
             .map_err(anyhow::Error::msg)?;
     }
     let args = parsed.args;
-    let mut inputs = vec![args.strands.as_path()];
-    if let Some(h) = &args.head {
-        inputs.push(h.as_path());
-    }
     let mut files = RunFiles::new();
-    files.inputs(inputs.iter().copied());
+    files.inputs(std::iter::once(args.strands.as_path()).chain(args.head.as_deref()));
     let obj_out = files.output(&args.output, "-o")?;
     let toml_path = args.output.with_extension("toml");
     if toml_path == args.output {
@@ -101,40 +97,10 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
         memory_budget: args.memory_budget_mib,
     };
     if args.report {
-        // The report adds about as many generated strands (33 points of position, tangent and
-        // width each) and the metric's copies of both sets.
-        let s = model.strands.len() as u64;
-        let estimate = hairmesh::fit::memory_estimate(
-            s,
-            model.point_count() as u64,
-            model.file_bytes,
-            opts.bundles as u64,
-            opts.layers.unwrap_or(16) as u64,
-        )
-        .with("generated strands", s, VEC_HEADER + 33 * 32)
-        .with(
-            "metric samples",
-            s.saturating_add(model.point_count() as u64),
-            32,
-        );
-        args.memory_budget_mib.check(
-            &args.strands.display().to_string(),
-            &format!("--report on {s} strands"),
-            &estimate,
-            "drop --report",
-        )?;
+        check_report_memory(&args, &model, &opts)?;
     }
     let fitted = fit(&model, head.as_deref(), &opts)?;
-    // What fit writes, bake must read: OBJ coordinates are limited (obj_io::MAX_COORDINATE).
-    let (lo, hi) = hairmesh::model::hair_mesh::bounds(fitted.mesh.layers.iter().flatten().copied());
-    let reach = lo.abs().max(hi.abs()).max_element();
-    let limit = hairmesh::model::obj_io::MAX_COORDINATE;
-    if reach > limit {
-        bail!(
-            "{}: the fitted hair mesh reaches {reach:e}, beyond the {limit:e} an OBJ hair mesh may hold (bake refuses it); scale the model down",
-            args.strands.display()
-        );
-    }
+    check_reach(&args, &fitted)?;
     let baked = bake(
         &fitted.mesh,
         &fitted.style,
@@ -152,26 +118,7 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     );
     let obj = hairmesh::model::obj_io::hair_mesh_obj_bytes(&fitted.mesh, &comment)?;
     let toml = format!("# {comment}\n{}", toml::to_string(&fitted.style)?);
-    outln!(
-        "{}: {} strands, {} points -> {} bundles, {} layers; textures {:.1} KiB vs {:.1} KiB input (input / textures = {:.1})",
-        args.strands.display(),
-        model.strands.len(),
-        model.point_count(),
-        fitted.mesh.faces.len(),
-        fitted.mesh.layer_count(),
-        baked.texture_bytes() as f64 / 1024.0,
-        model.file_bytes as f64 / 1024.0,
-        model.file_bytes as f64 / baked.texture_bytes().max(1) as f64
-    )?;
-    let s = &fitted.style;
-    outln!(
-        "style: length_variation {:.3}, clump_strength {:.3}, frizz_amplitude {:.4}, frizz_frequency {:.3}, strand_width {:.4}",
-        s.length_variation,
-        s.clump_strength,
-        s.frizz_amplitude,
-        s.frizz_frequency,
-        s.strand_width
-    )?;
+    print_summary(&args, &model, &fitted, &baked)?;
     let mut png = None;
     if args.report {
         png = report(&args, &model, &fitted, &baked)?;
@@ -274,4 +221,74 @@ fn main() {
         let _ = std::io::stdout().flush();
         hairmesh::fsutil::exit_with_error("fit", &e, 1);
     }
+}
+
+/// The report's memory (about as many generated strands again, and the metric's copies of
+/// both sets), checked against the budget before anything is fitted.
+fn check_report_memory(args: &Args, model: &StrandModel, opts: &FitOptions) -> Result<()> {
+    let s = model.strands.len() as u64;
+    let estimate = hairmesh::fit::memory_estimate(
+        s,
+        model.point_count() as u64,
+        model.file_bytes,
+        opts.bundles as u64,
+        opts.layers.unwrap_or(16) as u64,
+    )
+    .with("generated strands", s, VEC_HEADER + 33 * 32)
+    .with(
+        "metric samples",
+        s.saturating_add(model.point_count() as u64),
+        32,
+    );
+    args.memory_budget_mib.check(
+        &args.strands.display().to_string(),
+        &format!("--report on {s} strands"),
+        &estimate,
+        "drop --report",
+    )?;
+    Ok(())
+}
+
+/// What fit writes, bake must read: OBJ coordinates are limited (obj_io::MAX_COORDINATE).
+fn check_reach(args: &Args, fitted: &Fitted) -> Result<()> {
+    let (lo, hi) = hairmesh::model::hair_mesh::bounds(fitted.mesh.layers.iter().flatten().copied());
+    let reach = lo.abs().max(hi.abs()).max_element();
+    let limit = hairmesh::model::obj_io::MAX_COORDINATE;
+    if reach > limit {
+        bail!(
+            "{}: the fitted hair mesh reaches {reach:e}, beyond the {limit:e} an OBJ hair mesh may hold (bake refuses it); scale the model down",
+            args.strands.display()
+        );
+    }
+    Ok(())
+}
+
+/// One line on the fit's sizes and one on the style it found.
+fn print_summary(
+    args: &Args,
+    model: &StrandModel,
+    fitted: &Fitted,
+    baked: &BakedHairMesh,
+) -> Result<()> {
+    outln!(
+        "{}: {} strands, {} points -> {} bundles, {} layers; textures {:.1} KiB vs {:.1} KiB input (input / textures = {:.1})",
+        args.strands.display(),
+        model.strands.len(),
+        model.point_count(),
+        fitted.mesh.faces.len(),
+        fitted.mesh.layer_count(),
+        baked.texture_bytes() as f64 / 1024.0,
+        model.file_bytes as f64 / 1024.0,
+        model.file_bytes as f64 / baked.texture_bytes().max(1) as f64
+    )?;
+    let s = &fitted.style;
+    outln!(
+        "style: length_variation {:.3}, clump_strength {:.3}, frizz_amplitude {:.4}, frizz_frequency {:.3}, strand_width {:.4}",
+        s.length_variation,
+        s.clump_strength,
+        s.frizz_amplitude,
+        s.frizz_frequency,
+        s.strand_width
+    )?;
+    Ok(())
 }

@@ -9,7 +9,6 @@ use std::time::Instant;
 use super::RenderPath;
 use super::camera::View;
 use super::core::graph::FrameGraph;
-use super::core::graph::ImageState::Tracked;
 use super::core::shared::{FrameBlock, HairVertex, PropInstance};
 use super::core::slots::{
     FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
@@ -21,14 +20,15 @@ use super::features::temporal::{
 };
 use super::host::{DepthMapping, HostFrame, HostImage};
 use super::passes::hair_dynamics::SimulatedCharacter;
-use super::passes::host_targets::{HostTargetPasses, HostTargetRes};
-use super::passes::output::{FrameOutputs, add_outputs};
+use super::passes::host_targets::HostTargetPasses;
+use super::passes::output::FrameOutputs;
 use super::passes::props::{PropDraw, PropList};
 use super::passes::write_address_table;
 use super::passes::{
     FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets, TargetFormats,
 };
 use super::renderer::{PresentTarget, Renderer};
+use super::schedule::{FramePlan, FrameUpdates, HostStart, add_frame};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
 use super::soft::StrandRaster;
@@ -571,11 +571,10 @@ impl Renderer {
         )
     }
 
-    /// Record frame slot `i` into `target`'s command buffer: build the frame graph (hair mesh
-    /// updates, LHS skinning, the frame's passes, overlay, readbacks, presentation, or a host
-    /// frame's depth and composite) and run it, between the frame's outer timestamps. Returns
-    /// the graph's description when `opts` asks for it, and the commands recorded outside
-    /// every timing scope.
+    /// Record frame slot `i` into `target`'s command buffer: the frame graph of
+    /// [`super::schedule::add_frame`], run between the frame's outer timestamps. Returns the
+    /// graph's description when `opts` asks for it, and the commands recorded outside every
+    /// timing scope.
     fn record(
         &mut self,
         i: usize,
@@ -606,7 +605,6 @@ impl Renderer {
         begin_timing(&mut rec, profiler, mesh_query.as_mut());
         let jobs = self.crowd.update_jobs(i, &work.pose_updates);
         let simulated = simulated_characters(&self.crowd, &work.simulated);
-        let size = self.targets.size();
         let (mut host_color_use, mut host_depth_use) = target.host_uses();
         let mut g = new_graph(opts, &self.desc);
         let sources = FrameSources {
@@ -616,51 +614,38 @@ impl Renderer {
             history: self.temporal.history(),
             skinned,
         };
+        let size = sources.targets.size();
         let r = FrameRes::new(&mut g, sources, &work.transients);
         g.bind_transients(set);
         g.bind_transients(light_set);
-        let dynamics = sim_jobs.as_ref().map(|t| (t, simulated.as_slice()));
-        self.passes.add_updates(&mut g, &r, &jobs, dynamics);
-        if work.path == RenderPath::Lhs
-            && let Some((_, lhs)) = self.lhs.as_mut()
-        {
-            self.passes.add_lhs_skin(&mut g, &r, lhs, i)?;
-        }
-        let textures = self.crowd.texture_set();
-        let bg = self.background;
-        let sets = PassSets::camera_and_light((set, light_set), textures);
-        if let Some(table) = density_jobs.as_ref() {
-            let owners = (&self.passes, &self.volumes);
-            add_volume_builds(&mut g, (&r, sets.0), owners, table, &work.density);
-        }
+        let updates = FrameUpdates {
+            jobs: &jobs,
+            dynamics: sim_jobs.as_ref().map(|t| (t, simulated.as_slice())),
+            lhs: match (work.path, self.lhs.as_mut()) {
+                (RenderPath::Lhs, Some((_, lhs))) => Some((lhs, i)),
+                _ => None,
+            },
+            volume_builds: volume_builds(density_jobs.as_ref(), &self.volumes, &work.density),
+        };
         let host_uses = (&mut host_color_use, &mut host_depth_use);
-        let host = add_host_start(
-            &mut g,
-            &r,
-            (&*target, self.host_passes.as_ref()),
-            host_uses,
-            i,
-        );
-        let clear = (opts.clear && host.is_none()).then_some([bg[0], bg[1], bg[2], 1.0]);
+        let host = host_start(&*target, self.host_passes.as_ref(), host_uses, i);
+        let clear = (opts.clear && host.is_none()).then_some(opaque(self.background));
+        let sets = PassSets::camera_and_light((set, light_set), self.crowd.texture_set());
         let props = prop_lists(work.props, self.skinned.indices.as_ref());
-        let mut inputs = frame_inputs(
-            &work,
-            (sets, props),
-            clear,
-            size,
-            (mesh_query.as_mut(), &self.temporal),
-        );
-        let probe = opts
-            .probe_roots
-            .then(|| g.import_buffer("root probe", root_probe));
-        inputs.probe = probe.map(|p| (p, work.bundles));
-        inputs.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
-        self.passes.add(&mut g, &r, inputs)?;
-        let image_readback = image_readback.as_ref().filter(|_| opts.read_image);
-        add_outputs(&mut g, &r, outputs(target, stats_readback, image_readback));
-        if let Some((passes, res)) = host {
-            passes.add_composite(&mut g, &r, i, res)?;
+        let query = (mesh_query.as_mut(), &self.temporal);
+        let mut draw = frame_inputs(&work, (sets, props), clear, size, query);
+        if opts.probe_roots {
+            draw.probe = Some((g.import_buffer("root probe", root_probe), work.bundles));
         }
+        draw.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
+        let image_readback = image_readback.as_ref().filter(|_| opts.read_image);
+        let plan = FramePlan {
+            updates,
+            host,
+            draw,
+            outputs: outputs(target, stats_readback, image_readback),
+        };
+        add_frame(&mut g, &self.passes, &r, plan)?;
         let (description, unscoped) =
             run_graph(g, &mut rec, profiler, &mut self.transients, retired)?;
         drop(rec);
@@ -861,27 +846,30 @@ fn outputs<'a, 'o>(
     }
 }
 
-/// A host frame's images in the graph (their uses start from `uses`, the host's), and its
-/// start: the host's depth in the renderer's and a transparent colour instead of a clear.
-/// `None` for the renderer's own frames.
-fn add_host_start<'a>(
-    g: &mut FrameGraph<'a>,
-    r: &FrameRes<'a>,
-    (target, passes): (&FrameTarget<'a, '_>, Option<&'a HostTargetPasses>),
-    (color_use, depth_use): (&'a mut Access, &'a mut Access),
+/// `rgb` as an opaque colour.
+fn opaque([r, g, b]: [f32; 3]) -> [f32; 4] {
+    [r, g, b, 1.0]
+}
+
+/// A host frame's start for the schedule: its images, the uses the host left them in, its
+/// depth mapping. `None` for the renderer's own frames.
+fn host_start<'a>(
+    target: &FrameTarget<'a, '_>,
+    passes: Option<&'a HostTargetPasses>,
+    uses: (&'a mut Access, &'a mut Access),
     slot: usize,
-) -> Option<(&'a HostTargetPasses, HostTargetRes<'a>)> {
+) -> Option<HostStart<'a>> {
     let (FrameTarget::Host(h), Some(passes)) = (target, passes) else {
         return None;
     };
-    let color = g.import_image("host colour", h.color.image, Tracked(color_use));
-    let depth = h.depth.map(|d| {
-        let res = g.import_image("host depth", d.image, Tracked(depth_use));
-        (res, d.after)
-    });
-    passes.add_depth(g, r, slot, (depth.map(|d| d.0), h.mapping));
-    let color = (color, h.color.image, h.color.after);
-    Some((passes, HostTargetRes { color, depth }))
+    Some(HostStart {
+        passes,
+        color: h.color,
+        depth: h.depth,
+        mapping: h.mapping,
+        uses,
+        slot,
+    })
 }
 
 /// Grow frame slot `slot`'s skinning buffers for `(instances, matrices, posed vertices)`
@@ -959,23 +947,15 @@ fn run_graph(
     Ok((result?, unscoped))
 }
 
-/// The density volumes this frame builds (`density.built`), from the slot's job `table`.
-fn add_volume_builds<'a>(
-    g: &mut FrameGraph<'a>,
-    (r, set): (&FrameRes, PassSets<'a>),
-    (passes, volumes): (
-        &'a super::passes::FramePasses,
-        &'a super::features::volume::DensityVolumes,
-    ),
-    table: &'a Buffer,
+/// The density volumes this frame builds (`density.built`), from the slot's job `table`:
+/// the table, their cells in its order, the most bundles among their characters.
+fn volume_builds<'a>(
+    table: Option<&'a Buffer>,
+    volumes: &'a super::features::volume::DensityVolumes,
     density: &DensityWork,
-) {
-    if density.built.is_empty() {
-        return;
-    }
-    let buffers = volumes.buffers(&density.built);
-    let build = (table, buffers.as_slice(), density.most_bundles);
-    passes.add_density_volumes(g, r, set, build);
+) -> Option<(&'a Buffer, Vec<&'a Buffer>, u32)> {
+    let table = table.filter(|_| !density.built.is_empty())?;
+    Some((table, volumes.buffers(&density.built), density.most_bundles))
 }
 
 /// Reset the frame's timestamp and mesh queries and open its outer timing pair.

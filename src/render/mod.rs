@@ -16,6 +16,7 @@ pub mod passes;
 pub mod prop_table;
 pub mod renderer;
 pub mod scene;
+pub mod schedule;
 pub mod settings;
 pub mod shadow;
 pub mod skinned_props;

@@ -168,6 +168,10 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
         bail!("--crowd: 1..=1024 characters");
     }
     check_scene_names(&a)?;
+    const DRAWS: [&str; 4] = ["hw-opaque", "hw-oit", "soft", "auto"];
+    if let Some(d) = a.draws.iter().find(|d| !DRAWS.contains(&d.as_str())) {
+        bail!("--draws {d}: one of {}", DRAWS.join(", "));
+    }
     let ctx = Arc::new(Context::new(
         &ContextDesc::default().device(a.device.clone()),
     )?);
@@ -180,10 +184,6 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
         hairmesh::render::soft::DEFAULT_SOFT_K,
         a.auto_split
     )?;
-    const DRAWS: [&str; 4] = ["hw-opaque", "hw-oit", "soft", "auto"];
-    if let Some(d) = a.draws.iter().find(|d| !DRAWS.contains(&d.as_str())) {
-        bail!("--draws {d}: one of {}", DRAWS.join(", "));
-    }
     let mut scenes = head_scenes(&ctx, &a)?;
     scenes.push(crowd_scene(&ctx, &a)?);
     scenes.retain(|s| a.scenes.is_empty() || a.scenes.iter().any(|n| s.name.starts_with(n)));
@@ -196,10 +196,7 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
             ctx.info.name
         );
     }
-    outln!(
-        "| scene | path | strands | hw opaque | hw oit | soft | auto | soft / hw oit | soft / hw opaque | auto / hw oit | segments (soft) |"
-    )?;
-    outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
+    print_table_header()?;
     let mut pass_lines = Vec::new();
     let oit = Transparency::KBuffer { budget: 8 };
     let soft = StrandRaster::Software { k: 8 };
@@ -239,42 +236,64 @@ pub fn bench_raster(a: RasterArgs) -> Result<()> {
                 passes(&hw_oit),
                 passes(&sw)
             ));
-            let ms = |t: &Option<Timing>| t.as_ref().map(|t| t.0);
-            let fmt = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.2}"));
-            let ratio = |x: Option<f64>, y: Option<f64>| fmt(x.zip(y).map(|(x, y)| x / y));
-            let stats = [&hw_opaque, &hw_oit, &sw, &au]
-                .into_iter()
-                .find_map(|t| t.as_ref().map(|t| t.1))
-                .unwrap_or_default();
-            let segments = sw.as_ref().map_or("-".into(), |t| {
-                let s = &t.1;
-                let dropped = s.segments_written < s.segments_demanded
-                    || s.tile_entries_written < s.tile_entries_demanded;
-                format!(
-                    "{}{}",
-                    s.segments_written,
-                    if dropped { " (overflow)" } else { "" }
-                )
-            });
-            outln!(
-                "| {} | {path:?} | {} | {} | {} | {} | {} | {} | {} | {} | {segments} |",
-                s.name,
-                stats.strands_drawn,
-                fmt(ms(&hw_opaque)),
-                fmt(ms(&hw_oit)),
-                fmt(ms(&sw)),
-                fmt(ms(&au)),
-                ratio(ms(&sw), ms(&hw_oit)),
-                ratio(ms(&sw), ms(&hw_opaque)),
-                ratio(ms(&au), ms(&hw_oit)),
-            )?;
+            print_row(&s.name, path, [&hw_opaque, &hw_oit, &sw, &au])?;
         }
     }
+    print_pass_table(&pass_lines)
+}
+
+/// The second table: the median GPU ms of every pass, hardware with OIT and software.
+fn print_pass_table(pass_lines: &[String]) -> Result<()> {
     outln!("\nMedian GPU ms per pass, hardware with oit and software:")?;
     outln!("| scene | path | hw oit passes | soft passes |")?;
     outln!("|---|---|---|---|")?;
     for l in pass_lines {
         outln!("{l}")?;
     }
+    Ok(())
+}
+
+/// One row of the raster table: the four draws' median GPU ms, their ratios and the software
+/// draw's segments.
+fn print_row(name: &str, path: RenderPath, cells: [&Option<Timing>; 4]) -> Result<()> {
+    let [hw_opaque, hw_oit, sw, au] = cells;
+    let ms = |t: &Option<Timing>| t.as_ref().map(|t| t.0);
+    let fmt = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.2}"));
+    let ratio = |x: Option<f64>, y: Option<f64>| fmt(x.zip(y).map(|(x, y)| x / y));
+    let stats = cells
+        .into_iter()
+        .find_map(|t| t.as_ref().map(|t| t.1))
+        .unwrap_or_default();
+    let segments = sw.as_ref().map_or("-".into(), |t| {
+        let s = &t.1;
+        let dropped = s.segments_written < s.segments_demanded
+            || s.tile_entries_written < s.tile_entries_demanded;
+        format!(
+            "{}{}",
+            s.segments_written,
+            if dropped { " (overflow)" } else { "" }
+        )
+    });
+    outln!(
+        "| {} | {path:?} | {} | {} | {} | {} | {} | {} | {} | {} | {segments} |",
+        name,
+        stats.strands_drawn,
+        fmt(ms(hw_opaque)),
+        fmt(ms(hw_oit)),
+        fmt(ms(sw)),
+        fmt(ms(au)),
+        ratio(ms(sw), ms(hw_oit)),
+        ratio(ms(sw), ms(hw_opaque)),
+        ratio(ms(au), ms(hw_oit)),
+    )?;
+    Ok(())
+}
+
+/// The first table's header.
+fn print_table_header() -> Result<()> {
+    outln!(
+        "| scene | path | strands | hw opaque | hw oit | soft | auto | soft / hw oit | soft / hw opaque | auto / hw oit | segments (soft) |"
+    )?;
+    outln!("|---|---|---|---|---|---|---|---|---|---|---|")?;
     Ok(())
 }

@@ -684,18 +684,43 @@ fn frame_name(f: u32) -> String {
     format!("frame_{f:05}.png")
 }
 
+/// The columns of `stats.csv`, one row per headless frame.
+const STATS_HEADER: &str = "frame,gpu_ms,unscoped_ms,unscoped_commands,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,lod_pressure,dropped_strands,dropped_segments,dropped_tile_entries,passes\n";
+
+/// The interactive window. It makes its own device once it exists; the flags are checked
+/// against the device before the crowd is built all the same.
+fn run_window(args: Args, size: (u32, u32)) -> Result<()> {
+    let probe = Context::new(&ContextDesc::default().device(args.device.clone()))?;
+    check_device_limits(&probe, &args, size)?;
+    drop(probe);
+    let scene = Scene::build(&args)?;
+    window::run(args, scene)
+}
+
+/// The headless run's first line: the device, the crowd, the time it took to make it.
+fn print_run_line(ctx: &Context, scene: &Scene, args: &Args, renderer: &Renderer) -> Result<()> {
+    outln!(
+        "device: {} ({}); {} characters ({}), generated and baked in {:.2} s, textures {:.1} MiB",
+        ctx.info.name,
+        ctx.info.driver,
+        scene.characters.len(),
+        match &scene.own {
+            Some(own) => own.name.clone(),
+            None => format!("{:?}", args.preset),
+        },
+        scene.generate_s,
+        renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64
+    )?;
+    Ok(())
+}
+
+/// Headless frames into `--out` (with `stats.csv`), or the window when there is no `--out`.
 fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     let Checked { volumes, out } = check_args(&parsed)?;
     let args = parsed.args;
     let (width, height) = parse_size(&args.size)?;
     let Some(mut out) = out else {
-        // The window makes its own device once it exists; the flags are checked against the
-        // device before the crowd is built all the same.
-        let probe = Context::new(&ContextDesc::default().device(args.device.clone()))?;
-        check_device_limits(&probe, &args, (width, height))?;
-        drop(probe);
-        let scene = Scene::build(&args)?;
-        return window::run(args, scene);
+        return run_window(args, (width, height));
     };
     // The device's limits are checked before the crowd is built.
     let ctx = Arc::new(Context::new(
@@ -706,7 +731,6 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     check_device_limits(&ctx, &args, (width, height))?;
     let scene = Scene::build(&args)?;
     let settings = args.frame_settings();
-    let generate_s = scene.generate_s;
     let characters = &scene.characters;
     let mut renderer = scene.renderer(&ctx, &args, width, height)?;
     let settings = hairmesh::render::FrameSettings {
@@ -716,71 +740,15 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
     .with_fastest((args.draw, args.shadow_draw), &renderer.caps());
     let mut animation = scene.animation(&mut renderer, &args)?;
     let csv_path = args.out.join("stats.csv");
-    let mut csv = String::from(
-        "frame,gpu_ms,unscoped_ms,unscoped_commands,record_ms,wall_ms,simulate_ms,simulated,root_gap,strands_drawn,strands_demanded,triangles,vertex_slots_written,vertex_slots_demanded,lod_pressure,dropped_strands,dropped_segments,dropped_tile_entries,passes\n",
-    );
-    outln!(
-        "device: {} ({}); {} characters ({}), generated and baked in {generate_s:.2} s, textures {:.1} MiB",
-        ctx.info.name,
-        ctx.info.driver,
-        characters.len(),
-        match &scene.own {
-            Some(own) => own.name.clone(),
-            None => format!("{:?}", args.preset),
-        },
-        renderer.crowd().texture_bytes() as f64 / (1 << 20) as f64
-    )?;
+    let mut csv = String::from(STATS_HEADER);
+    print_run_line(&ctx, &scene, &args, &renderer)?;
     let lod = args.lod_settings();
     let full = scene.full_strands(args.density(), args.verts_log2)?;
     for f in 0..args.frames {
-        let camera = match args.view.as_str() {
-            "orbit" => hairmesh::characters::preset::orbit_camera(
-                args.preset,
-                args.count,
-                if args.orbit { f } else { 0 },
-            ),
-            "eye" => {
-                let side = (args.count as f32).sqrt().ceil();
-                let depth = (side - 1.0) * SPACING;
-                Camera::look_at(
-                    Vec3::new(0.4, 1.65, -1.6),
-                    Vec3::new(0.0, 1.45, depth * 0.5),
-                    50.0,
-                )
-            }
-            // Where the first character will be drawn this frame: a person's head-bound frame
-            // at the time the animation is about to reach, else its placement.
-            view => {
-                let dt = if animation.moving { 1.0 / 30.0 } else { 0.0 };
-                let model = match &characters[0].walker {
-                    Some(w) => w.frame(animation.time() + dt)?.hair,
-                    None => characters[0].model,
-                };
-                preset::portrait_camera(model, view)
-            }
-        };
+        let camera = frame_camera(&args, f, &animation, characters)?;
         // Headless frames are 1/30 s apart in animation time.
         animation.advance(&mut renderer, 1.0 / 30.0, &camera, height)?;
-        let portrait = match args.light.as_str() {
-            "auto" => matches!(args.view.as_str(), "front" | "side" | "back"),
-            other => other == "portrait",
-        };
-        let view = View {
-            light_dir: if portrait {
-                hairmesh::render::camera::portrait_light(&camera)
-            } else {
-                hairmesh::render::camera::CROWD_LIGHT_DIR
-            },
-            lod,
-            shading: args.shading,
-            shadows: args.shadows,
-            transparency: args.transparency,
-            temporal: args.temporal,
-            lod_appearance: args.lod_appearance,
-            multiple_scattering: args.multiple_scattering,
-            volumes,
-            ..View::new(camera)
-        };
+        let view = frame_view(&args, camera, lod, volumes);
         let t = Instant::now();
         let report = renderer.render_one(
             &view,
@@ -800,42 +768,13 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
                 ctx.validation_errors()
             );
         }
-        let s = report.stats;
-        let (dropped, pressure) = (report.dropped(), report.lod_pressure());
-        if dropped.any() {
-            eprintln!("crowd: warning: frame {f}: {dropped} (buffers full)");
-        }
-        csv.push_str(&format!(
-            "{f},{:.3},{:.3},{},{:.3},{wall_ms:.1},{:.3},{},{root_gap:.6},{},{},{},{},{},{pressure:.4},{},{},{},{}\n",
-            report.gpu_ms(),
-            report.unscoped_ms().unwrap_or(f64::NAN),
-            report.unscoped_commands,
-            report.record_ms,
-            animation.stats.simulate_ms,
-            animation.stats.simulated,
-            s.strands_drawn,
-            s.strands_demanded,
-            s.triangles_drawn,
-            s.vertex_slots_written,
-            s.vertex_slots_demanded,
-            dropped.strands,
-            dropped.segments,
-            dropped.tile_entries,
-            report.scope_summary(" ")
-        ));
-        outln!(
-            "frame {f}: {:?} path, {} of {full} strands, {} triangles, LoD pressure {pressure:.3}, {dropped}, volumes {} alone + {} blended, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
-            report.path,
-            s.strands_drawn,
-            s.triangles_drawn,
-            report.volume_characters.0,
-            report.volume_characters.1,
-            report.gpu_ms(),
-            report.scope_summary(", "),
-            report.record_ms,
-            animation.stats.path,
-            animation.stats.simulate_ms,
-            animation.stats.simulated
+        report_frame(
+            &mut csv,
+            f,
+            &report,
+            (wall_ms, root_gap),
+            &animation.stats,
+            full,
         )?;
         let rgba = report.rgba.context("no image read back")?;
         let path = args.out.join(frame_name(f));
@@ -856,4 +795,119 @@ fn main() {
         let _ = std::io::stdout().flush();
         hairmesh::fsutil::exit_with_error("crowd", &e, 1);
     }
+}
+
+/// The camera of headless frame `f`: the orbit, the eye view down the crowd, or a portrait
+/// of the first character where it will be drawn this frame.
+fn frame_camera(
+    args: &Args,
+    f: u32,
+    animation: &CrowdAnimation,
+    characters: &[preset::CrowdCharacter],
+) -> Result<Camera> {
+    Ok(match args.view.as_str() {
+        "orbit" => hairmesh::characters::preset::orbit_camera(
+            args.preset,
+            args.count,
+            if args.orbit { f } else { 0 },
+        ),
+        "eye" => {
+            let side = (args.count as f32).sqrt().ceil();
+            let depth = (side - 1.0) * SPACING;
+            Camera::look_at(
+                Vec3::new(0.4, 1.65, -1.6),
+                Vec3::new(0.0, 1.45, depth * 0.5),
+                50.0,
+            )
+        }
+        // Where the first character will be drawn this frame: a person's head-bound frame
+        // at the time the animation is about to reach, else its placement.
+        view => {
+            let dt = if animation.moving { 1.0 / 30.0 } else { 0.0 };
+            let model = match &characters[0].walker {
+                Some(w) => w.frame(animation.time() + dt)?.hair,
+                None => characters[0].model,
+            };
+            preset::portrait_camera(model, view)
+        }
+    })
+}
+
+/// What headless frames show: `camera`, the crowd's or a portrait's light, and the look flags.
+fn frame_view(
+    args: &Args,
+    camera: Camera,
+    lod: LodSettings,
+    volumes: hairmesh::render::VolumeTier,
+) -> View {
+    let portrait = match args.light.as_str() {
+        "auto" => matches!(args.view.as_str(), "front" | "side" | "back"),
+        other => other == "portrait",
+    };
+    View {
+        light_dir: if portrait {
+            hairmesh::render::camera::portrait_light(&camera)
+        } else {
+            hairmesh::render::camera::CROWD_LIGHT_DIR
+        },
+        lod,
+        shading: args.shading,
+        shadows: args.shadows,
+        transparency: args.transparency,
+        temporal: args.temporal,
+        lod_appearance: args.lod_appearance,
+        multiple_scattering: args.multiple_scattering,
+        volumes,
+        ..View::new(camera)
+    }
+}
+
+/// One frame's row of `stats.csv` and its line on stdout; a warning on stderr when the
+/// frame's buffers were full.
+fn report_frame(
+    csv: &mut String,
+    f: u32,
+    report: &hairmesh::render::FrameReport,
+    (wall_ms, root_gap): (f64, f32),
+    sim: &hairmesh::animate::AnimationStats,
+    full: u64,
+) -> Result<()> {
+    let s = report.stats;
+    let (dropped, pressure) = (report.dropped(), report.lod_pressure());
+    if dropped.any() {
+        eprintln!("crowd: warning: frame {f}: {dropped} (buffers full)");
+    }
+    csv.push_str(&format!(
+        "{f},{:.3},{:.3},{},{:.3},{wall_ms:.1},{:.3},{},{root_gap:.6},{},{},{},{},{},{pressure:.4},{},{},{},{}\n",
+        report.gpu_ms(),
+        report.unscoped_ms().unwrap_or(f64::NAN),
+        report.unscoped_commands,
+        report.record_ms,
+        sim.simulate_ms,
+        sim.simulated,
+        s.strands_drawn,
+        s.strands_demanded,
+        s.triangles_drawn,
+        s.vertex_slots_written,
+        s.vertex_slots_demanded,
+        dropped.strands,
+        dropped.segments,
+        dropped.tile_entries,
+        report.scope_summary(" ")
+    ));
+    outln!(
+        "frame {f}: {:?} path, {} of {full} strands, {} triangles, LoD pressure {pressure:.3}, {dropped}, volumes {} alone + {} blended, GPU {:.1} ms ({}), record {:.3} ms, hair simulation ({}) {:.1} ms CPU ({} characters), root gap {root_gap:.5} head radii",
+        report.path,
+        s.strands_drawn,
+        s.triangles_drawn,
+        report.volume_characters.0,
+        report.volume_characters.1,
+        report.gpu_ms(),
+        report.scope_summary(", "),
+        report.record_ms,
+        sim.path,
+        sim.simulate_ms,
+        sim.simulated
+    )?;
+    Ok(())
 }

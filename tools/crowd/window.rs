@@ -75,164 +75,10 @@ impl Controls {
         egui::Window::new("crowd")
             .default_width(260.0)
             .show(ctx, |ui| {
-                ui.add(egui::Slider::new(&mut self.visible, 1..=total.max(1)).text("characters"));
-                match &mut self.strands.density {
-                    StrandDensity::PerCm2(d) => ui.add(
-                        egui::Slider::new(d, 1.0..=600.0)
-                            .logarithmic(true)
-                            .text("strands per cm²"),
-                    ),
-                    StrandDensity::PerReferenceBundle(n) => ui.add(
-                        egui::Slider::new(n, 1..=16384)
-                            .logarithmic(true)
-                            .text("strands per bundle"),
-                    ),
-                };
-                ui.add(
-                    egui::Slider::new(&mut self.strands.verts_log2, 0..=6).text("vertex level e"),
-                );
-                ui.checkbox(&mut self.lod.enabled, "level of detail");
-                ui.add_enabled(
-                    self.lod.enabled,
-                    egui::Slider::new(&mut self.lod.alpha_strands, 0.01..=1.0)
-                        .logarithmic(true)
-                        .text("alpha strands"),
-                );
-                ui.add_enabled(
-                    self.lod.enabled,
-                    egui::Slider::new(&mut self.lod.area_below, 0.0..=32.0)
-                        .text("strands by area below (px)"),
-                );
-                ui.add_enabled(
-                    self.lod.enabled,
-                    egui::Slider::new(&mut self.lod.alpha_verts, 0.01..=1.0)
-                        .logarithmic(true)
-                        .text("alpha vertices"),
-                );
-                ui.add_enabled(
-                    self.lod.enabled,
-                    egui::Slider::new(&mut self.lod.lambda, 0.05..=1.0).text("lambda"),
-                );
-                ui.horizontal(|ui| {
-                    ui.label("shading");
-                    ui.radio_value(&mut self.shading, ShadingModel::Placeholder, "placeholder");
-                    ui.radio_value(&mut self.shading, ShadingModel::KajiyaKay, "Kajiya-Kay");
-                    ui.radio_value(&mut self.shading, ShadingModel::Marschner, "Marschner");
-                });
-                ui.horizontal(|ui| {
-                    ui.label("shadows");
-                    for m in ShadowMode::ALL {
-                        ui.radio_value(&mut self.shadows, m, m.name());
-                    }
-                });
-                ui.horizontal(|ui| {
-                    ui.label("shadow draw");
-                    ui.radio_value(&mut self.light_raster, LightRaster::Hardware, "hardware");
-                    ui.radio_value(&mut self.light_raster, LightRaster::Software, "software");
-                });
-                ui.horizontal(|ui| {
-                    ui.label("temporal");
-                    for t in Temporal::ALL {
-                        ui.radio_value(&mut self.temporal, t, t.name());
-                    }
-                });
-                ui.horizontal(|ui| {
-                    ui.label("transparency");
-                    let oit = Transparency::KBuffer {
-                        budget: DEFAULT_OIT_BUDGET,
-                    };
-                    let peel = Transparency::DepthPeeling {
-                        layers: DEFAULT_PEEL_LAYERS,
-                    };
-                    let t = &mut self.transparency;
-                    ui.radio_value(t, Transparency::Opaque, "opaque");
-                    if ui
-                        .radio(matches!(t, Transparency::KBuffer { .. }), "OIT")
-                        .clicked()
-                    {
-                        *t = oit;
-                    }
-                    if ui
-                        .radio(matches!(t, Transparency::DepthPeeling { .. }), "peel")
-                        .clicked()
-                    {
-                        *t = peel;
-                    }
-                    match t {
-                        Transparency::KBuffer { budget } => {
-                            ui.add(egui::Slider::new(budget, 1..=MAX_OIT_BUDGET).text("K"));
-                        }
-                        Transparency::DepthPeeling { layers } => {
-                            ui.add(egui::Slider::new(layers, 1..=64).text("layers"));
-                        }
-                        Transparency::Opaque => {}
-                    }
-                });
-                ui.checkbox(&mut self.lod_appearance, "thick-strand appearance (LoD)");
-                ui.checkbox(
-                    &mut self.multiple_scattering,
-                    "multiple scattering (Marschner)",
-                );
-                ui.horizontal(|ui| {
-                    ui.checkbox(&mut self.volumes.occlusion, "volumetric AO");
-                    let mut far = self.volumes.far.is_some();
-                    ui.checkbox(&mut far, "far hair as volumes");
-                    self.volumes.far = match far {
-                        true => self.volumes.far.or(hairmesh::render::VolumeTier::on().far),
-                        false => None,
-                    };
-                });
-                ui.horizontal(|ui| {
-                    ui.checkbox(&mut self.moving, "motion");
-                    ui.checkbox(&mut self.simulating, "hair dynamics");
-                });
-                ui.horizontal(|ui| {
-                    use hairmesh::animate::DynamicsPath;
-                    ui.label("dynamics on");
-                    ui.radio_value(&mut self.dynamics, DynamicsPath::Gpu, "GPU");
-                    ui.radio_value(&mut self.dynamics, DynamicsPath::Cpu, "CPU");
-                    ui.checkbox(&mut self.schedule, "by screen size");
-                });
-                ui.add(egui::Slider::new(&mut self.wind.strength, 0.0..=60.0).text("wind m/s²"));
-                let mut angle = self
-                    .wind
-                    .direction
-                    .z
-                    .atan2(self.wind.direction.x)
-                    .to_degrees();
-                if ui
-                    .add(egui::Slider::new(&mut angle, -180.0..=180.0).text("wind direction °"))
-                    .changed()
-                {
-                    let a = angle.to_radians();
-                    self.wind.direction = Vec3::new(a.cos(), self.wind.direction.y, a.sin());
-                }
-                ui.horizontal(|ui| {
-                    ui.label("path");
-                    ui.add_enabled_ui(mesh_ok, |ui| {
-                        ui.radio_value(&mut self.path, RenderPath::Mesh, "mesh");
-                    });
-                    ui.radio_value(&mut self.path, RenderPath::Compute, "compute");
-                });
-                ui.horizontal(|ui| {
-                    ui.label("draw");
-                    ui.radio_value(&mut self.raster, StrandRaster::Hardware, "hw");
-                    ui.add_enabled_ui(soft_ok, |ui| {
-                        let k = DEFAULT_SOFT_K;
-                        ui.radio_value(&mut self.raster, StrandRaster::Software { k }, "soft");
-                        ui.radio_value(&mut self.raster, StrandRaster::Auto { k }, "auto");
-                    });
-                });
-                ui.horizontal(|ui| {
-                    ui.label("present");
-                    ui.radio_value(&mut self.present_mode, PresentMode::Fifo, "FIFO");
-                    ui.radio_value(&mut self.present_mode, PresentMode::Mailbox, "mailbox");
-                    ui.radio_value(&mut self.present_mode, PresentMode::Immediate, "immediate");
-                });
-                ui.horizontal(|ui| {
-                    ui.checkbox(&mut self.paused, "pause orbit");
-                    ui.checkbox(&mut self.fly, "fly camera");
-                });
+                self.detail_ui(ui, total);
+                self.look_ui(ui);
+                self.motion_ui(ui);
+                self.device_ui(ui, (mesh_ok, soft_ok));
                 ui.separator();
                 ui.label(stats);
                 ui.checkbox(&mut self.show_graph, "frame graph");
@@ -242,6 +88,178 @@ impl Controls {
                         .show(ui, |ui| ui.monospace(graph));
                 }
             });
+    }
+
+    /// How many characters, strands and vertices, and the level of detail.
+    fn detail_ui(&mut self, ui: &mut egui::Ui, total: usize) {
+        ui.add(egui::Slider::new(&mut self.visible, 1..=total.max(1)).text("characters"));
+        match &mut self.strands.density {
+            StrandDensity::PerCm2(d) => ui.add(
+                egui::Slider::new(d, 1.0..=600.0)
+                    .logarithmic(true)
+                    .text("strands per cm²"),
+            ),
+            StrandDensity::PerReferenceBundle(n) => ui.add(
+                egui::Slider::new(n, 1..=16384)
+                    .logarithmic(true)
+                    .text("strands per bundle"),
+            ),
+        };
+        ui.add(egui::Slider::new(&mut self.strands.verts_log2, 0..=6).text("vertex level e"));
+        ui.checkbox(&mut self.lod.enabled, "level of detail");
+        ui.add_enabled(
+            self.lod.enabled,
+            egui::Slider::new(&mut self.lod.alpha_strands, 0.01..=1.0)
+                .logarithmic(true)
+                .text("alpha strands"),
+        );
+        ui.add_enabled(
+            self.lod.enabled,
+            egui::Slider::new(&mut self.lod.area_below, 0.0..=32.0)
+                .text("strands by area below (px)"),
+        );
+        ui.add_enabled(
+            self.lod.enabled,
+            egui::Slider::new(&mut self.lod.alpha_verts, 0.01..=1.0)
+                .logarithmic(true)
+                .text("alpha vertices"),
+        );
+        ui.add_enabled(
+            self.lod.enabled,
+            egui::Slider::new(&mut self.lod.lambda, 0.05..=1.0).text("lambda"),
+        );
+    }
+
+    /// Shading, shadows, temporal, transparency and the volume tier.
+    fn look_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            ui.label("shading");
+            ui.radio_value(&mut self.shading, ShadingModel::Placeholder, "placeholder");
+            ui.radio_value(&mut self.shading, ShadingModel::KajiyaKay, "Kajiya-Kay");
+            ui.radio_value(&mut self.shading, ShadingModel::Marschner, "Marschner");
+        });
+        ui.horizontal(|ui| {
+            ui.label("shadows");
+            for m in ShadowMode::ALL {
+                ui.radio_value(&mut self.shadows, m, m.name());
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("shadow draw");
+            ui.radio_value(&mut self.light_raster, LightRaster::Hardware, "hardware");
+            ui.radio_value(&mut self.light_raster, LightRaster::Software, "software");
+        });
+        ui.horizontal(|ui| {
+            ui.label("temporal");
+            for t in Temporal::ALL {
+                ui.radio_value(&mut self.temporal, t, t.name());
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("transparency");
+            let oit = Transparency::KBuffer {
+                budget: DEFAULT_OIT_BUDGET,
+            };
+            let peel = Transparency::DepthPeeling {
+                layers: DEFAULT_PEEL_LAYERS,
+            };
+            let t = &mut self.transparency;
+            ui.radio_value(t, Transparency::Opaque, "opaque");
+            if ui
+                .radio(matches!(t, Transparency::KBuffer { .. }), "OIT")
+                .clicked()
+            {
+                *t = oit;
+            }
+            if ui
+                .radio(matches!(t, Transparency::DepthPeeling { .. }), "peel")
+                .clicked()
+            {
+                *t = peel;
+            }
+            match t {
+                Transparency::KBuffer { budget } => {
+                    ui.add(egui::Slider::new(budget, 1..=MAX_OIT_BUDGET).text("K"));
+                }
+                Transparency::DepthPeeling { layers } => {
+                    ui.add(egui::Slider::new(layers, 1..=64).text("layers"));
+                }
+                Transparency::Opaque => {}
+            }
+        });
+        ui.checkbox(&mut self.lod_appearance, "thick-strand appearance (LoD)");
+        ui.checkbox(
+            &mut self.multiple_scattering,
+            "multiple scattering (Marschner)",
+        );
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut self.volumes.occlusion, "volumetric AO");
+            let mut far = self.volumes.far.is_some();
+            ui.checkbox(&mut far, "far hair as volumes");
+            self.volumes.far = match far {
+                true => self.volumes.far.or(hairmesh::render::VolumeTier::on().far),
+                false => None,
+            };
+        });
+    }
+
+    /// Motion, hair dynamics and wind.
+    fn motion_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut self.moving, "motion");
+            ui.checkbox(&mut self.simulating, "hair dynamics");
+        });
+        ui.horizontal(|ui| {
+            use hairmesh::animate::DynamicsPath;
+            ui.label("dynamics on");
+            ui.radio_value(&mut self.dynamics, DynamicsPath::Gpu, "GPU");
+            ui.radio_value(&mut self.dynamics, DynamicsPath::Cpu, "CPU");
+            ui.checkbox(&mut self.schedule, "by screen size");
+        });
+        ui.add(egui::Slider::new(&mut self.wind.strength, 0.0..=60.0).text("wind m/s²"));
+        let mut angle = self
+            .wind
+            .direction
+            .z
+            .atan2(self.wind.direction.x)
+            .to_degrees();
+        if ui
+            .add(egui::Slider::new(&mut angle, -180.0..=180.0).text("wind direction °"))
+            .changed()
+        {
+            let a = angle.to_radians();
+            self.wind.direction = Vec3::new(a.cos(), self.wind.direction.y, a.sin());
+        }
+    }
+
+    /// The path, the strand draw, presentation and the camera.
+    fn device_ui(&mut self, ui: &mut egui::Ui, (mesh_ok, soft_ok): (bool, bool)) {
+        ui.horizontal(|ui| {
+            ui.label("path");
+            ui.add_enabled_ui(mesh_ok, |ui| {
+                ui.radio_value(&mut self.path, RenderPath::Mesh, "mesh");
+            });
+            ui.radio_value(&mut self.path, RenderPath::Compute, "compute");
+        });
+        ui.horizontal(|ui| {
+            ui.label("draw");
+            ui.radio_value(&mut self.raster, StrandRaster::Hardware, "hw");
+            ui.add_enabled_ui(soft_ok, |ui| {
+                let k = DEFAULT_SOFT_K;
+                ui.radio_value(&mut self.raster, StrandRaster::Software { k }, "soft");
+                ui.radio_value(&mut self.raster, StrandRaster::Auto { k }, "auto");
+            });
+        });
+        ui.horizontal(|ui| {
+            ui.label("present");
+            ui.radio_value(&mut self.present_mode, PresentMode::Fifo, "FIFO");
+            ui.radio_value(&mut self.present_mode, PresentMode::Mailbox, "mailbox");
+            ui.radio_value(&mut self.present_mode, PresentMode::Immediate, "immediate");
+        });
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut self.paused, "pause orbit");
+            ui.checkbox(&mut self.fly, "fly camera");
+        });
     }
 }
 
@@ -433,44 +451,14 @@ impl App {
                     .with_inner_size(PhysicalSize::new(w, h)),
             )?,
         );
-        let handles = WindowHandles {
-            display: window.display_handle()?.as_raw(),
-            window: window.window_handle()?.as_raw(),
-        };
-        let ctx = Arc::new(Context::new(
-            &ContextDesc::default()
-                .validation(self.args.validation)
-                .device(self.args.device.clone())
-                .window(handles),
-        )?);
+        let ctx = self.window_context(&window)?;
         let size = window.inner_size();
         let mut renderer =
             self.scene
                 .renderer(&ctx, &self.args, size.width.max(1), size.height.max(1))?;
         let animation = self.scene.animation(&mut renderer, &self.args)?;
         let path = renderer.default_path();
-        let egui_ctx = egui::Context::default();
-        let egui_state = egui_winit::State::new(
-            egui_ctx.clone(),
-            egui::ViewportId::ROOT,
-            &window,
-            Some(window.scale_factor() as f32),
-            None,
-            Some(4096),
-        );
-        let panel = Panel {
-            ui: UiRenderer::new(
-                &ctx,
-                hairmesh::render::targets::COLOR_FORMAT,
-                hairmesh::render::FRAMES_IN_FLIGHT,
-            )?,
-            egui_ctx,
-            egui_state,
-            pending_free: Vec::new(),
-            visible: self.scene.character_count(),
-            lod: self.args.lod_settings(),
-        };
-        let side = (self.scene.character_count() as f32).sqrt().ceil();
+        let panel = self.panel(&ctx, &window)?;
         let acquire = (0..hairmesh::render::FRAMES_IN_FLIGHT)
             .map(|_| Semaphore::new(&ctx))
             .collect::<Result<_, _>>()?;
@@ -494,17 +482,7 @@ impl App {
             size: (size.width, size.height),
             recreate: true,
             present_mode: present_mode(&self.args.present_mode),
-            camera: OrbitCamera {
-                centre: Vec3::new(
-                    0.0,
-                    self.args.preset.focus_height(),
-                    (side - 1.0) * 0.5 * preset::SPACING,
-                ),
-                yaw: std::f32::consts::PI,
-                pitch: 0.35,
-                distance: (side * 0.9 * 0.8).max(1.8),
-                fly: false,
-            },
+            camera: self.start_camera(),
             strands: Strands {
                 density: self.args.density(),
                 verts_log2: self.args.verts_log2,
@@ -536,6 +514,61 @@ impl App {
             window,
         });
         Ok(())
+    }
+
+    /// The first camera: the whole crowd in view, from behind its first row.
+    fn start_camera(&self) -> OrbitCamera {
+        let side = (self.scene.character_count() as f32).sqrt().ceil();
+        OrbitCamera {
+            centre: Vec3::new(
+                0.0,
+                self.args.preset.focus_height(),
+                (side - 1.0) * 0.5 * preset::SPACING,
+            ),
+            yaw: std::f32::consts::PI,
+            pitch: 0.35,
+            distance: (side * 0.9 * 0.8).max(1.8),
+            fly: false,
+        }
+    }
+
+    /// The device, made for `window`'s surface.
+    fn window_context(&self, window: &Window) -> Result<Arc<Context>> {
+        let handles = WindowHandles {
+            display: window.display_handle()?.as_raw(),
+            window: window.window_handle()?.as_raw(),
+        };
+        Ok(Arc::new(Context::new(
+            &ContextDesc::default()
+                .validation(self.args.validation)
+                .device(self.args.device.clone())
+                .window(handles),
+        )?))
+    }
+
+    /// The control panel: egui's state for `window` and its renderer.
+    fn panel(&self, ctx: &Arc<Context>, window: &Window) -> Result<Panel> {
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(4096),
+        );
+        Ok(Panel {
+            ui: UiRenderer::new(
+                ctx,
+                hairmesh::render::targets::COLOR_FORMAT,
+                hairmesh::render::FRAMES_IN_FLIGHT,
+            )?,
+            egui_ctx,
+            egui_state,
+            pending_free: Vec::new(),
+            visible: self.scene.character_count(),
+            lod: self.args.lod_settings(),
+        })
     }
 
     /// Test script of `--test-resize`, run once per redraw: a new size after 3 frames, a
@@ -597,17 +630,8 @@ impl Running {
             self.zero_skips += 1;
             return Ok(false); // minimised: nothing to present to
         }
-        if self.recreate || self.swapchain.is_none() {
-            let old = self.swapchain.take();
-            let chain = Swapchain::new(&self.ctx, w, h, self.present_mode, old)?;
-            let [cw, ch] = chain.extent();
-            if cw == 0 || ch == 0 {
-                return Ok(false);
-            }
-            self.renderer.resize(cw, ch)?;
-            self.swapchain = Some(chain);
-            self.recreate = false;
-            self.recreations += 1;
+        if (self.recreate || self.swapchain.is_none()) && !self.recreate_swapchain(w, h)? {
+            return Ok(false);
         }
         if !self.paused {
             self.camera.yaw += 0.004;
@@ -669,25 +693,48 @@ impl Running {
         self.frame += 1;
         // The previous frame has (nearly always) completed: its report costs no stall.
         if let Some(t) = self.last_ticket.replace(ticket) {
-            let report = self.renderer.wait(t)?;
-            let dropped = report.dropped();
-            // Nothing dropped goes unsaid: on stderr too, at most once a second of frames.
-            if dropped.any() && self.frame % 60 == 1 {
-                eprintln!("crowd: warning: frame {}: {dropped} (buffers full)", t.0);
-            }
-            self.last_report = Some(report);
-            let done: Vec<_> = self
-                .panel
-                .pending_free
-                .iter()
-                .filter(|(f, _)| f.0 <= t.0)
-                .flat_map(|(_, ids)| ids.clone())
-                .collect();
-            self.panel.pending_free.retain(|(f, _)| f.0 > t.0);
-            self.panel.ui.free_textures(&done)?;
+            self.collect_report(t)?;
         }
         self.update_title(scene_len);
         Ok(true)
+    }
+
+    /// A new swapchain of `w`x`h` (replacing the old one) and the renderer resized to it;
+    /// false when the surface has no area to present to.
+    fn recreate_swapchain(&mut self, w: u32, h: u32) -> Result<bool> {
+        let old = self.swapchain.take();
+        let chain = Swapchain::new(&self.ctx, w, h, self.present_mode, old)?;
+        let [cw, ch] = chain.extent();
+        if cw == 0 || ch == 0 {
+            return Ok(false);
+        }
+        self.renderer.resize(cw, ch)?;
+        self.swapchain = Some(chain);
+        self.recreate = false;
+        self.recreations += 1;
+        Ok(true)
+    }
+
+    /// Frame `t`'s report (warned about on stderr when it dropped work) and the panel
+    /// textures it no longer uses, freed.
+    fn collect_report(&mut self, t: FrameTicket) -> Result<()> {
+        let report = self.renderer.wait(t)?;
+        let dropped = report.dropped();
+        // Nothing dropped goes unsaid: on stderr too, at most once a second of frames.
+        if dropped.any() && self.frame % 60 == 1 {
+            eprintln!("crowd: warning: frame {}: {dropped} (buffers full)", t.0);
+        }
+        self.last_report = Some(report);
+        let done: Vec<_> = self
+            .panel
+            .pending_free
+            .iter()
+            .filter(|(f, _)| f.0 <= t.0)
+            .flat_map(|(_, ids)| ids.clone())
+            .collect();
+        self.panel.pending_free.retain(|(f, _)| f.0 > t.0);
+        self.panel.ui.free_textures(&done)?;
+        Ok(())
     }
 
     /// Run the control panel for this frame: returns its meshes, pixels per point and the

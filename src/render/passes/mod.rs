@@ -8,6 +8,7 @@ pub mod hair_dynamics;
 pub mod hair_mesh_update;
 pub mod host_targets;
 pub mod lhs_skin;
+pub mod opaque;
 pub mod output;
 pub mod pool_segments;
 pub mod props;
@@ -25,7 +26,7 @@ use std::sync::Arc;
 
 use super::RenderPath;
 pub use super::core::binding::{PassSets, device_shader_options, shader_options};
-use super::features::temporal::{TemporalFeature, TemporalInputs, TemporalRes, TemporalWork};
+use super::features::temporal::{TemporalFeature, TemporalRes, TemporalWork};
 use super::graph::TransientBuffer;
 use super::graph::{FrameGraph, Res};
 use super::settings::{LightRaster, ShadowMode};
@@ -38,12 +39,10 @@ use crate::vk::{
     Access, Attachment, Buffer, Context, GpuResult, Image, ImageDesc, MeshPrimitivesQuery,
     PipelineLayout, shader::compile,
 };
-use compute_generate::{ComputeGenerate, GenerateView};
-use props::{PropList, PropPass};
-use scalp::ScalpPass;
-use shadow::{ShadowDraw, ShadowPass};
-use strands::StrandDraw;
-use transparency::{TransparencyPass, TransparentDraw};
+use compute_generate::ComputeGenerate;
+use props::PropList;
+use shadow::ShadowPass;
+use transparency::TransparencyPass;
 
 /// Formats and sample count of the targets the graphics passes draw into.
 #[derive(Clone, Copy, Debug)]
@@ -491,57 +490,45 @@ pub struct FrameInputs<'a> {
     pub volume_slots: u32,
 }
 
-/// What the temporal passes take from frame `r` drawn with `inp`, in frames with motion
-/// vectors.
-fn temporal_inputs<'a>(r: &FrameRes<'a>, inp: &FrameInputs<'a>) -> Option<TemporalInputs<'a>> {
-    match (r.visibility, r.temporal, inp.temporal) {
-        (Some(visibility), Some(res), Some(work)) => Some(TemporalInputs {
-            constants: r.constants,
-            visibility,
-            res,
-            output: (r.output, r.images.output),
-            sets: inp.sets,
-            size: inp.size,
-            work,
-            readback: inp.motion_readback,
-        }),
-        _ => None,
-    }
-}
-
-/// The pipelines of every pass of a frame; [`FramePasses::add`] adds them to the frame graph
-/// in order: statistics reset; with shadows, the light's generation (compute path) and passes,
-/// then a second reset; generation (compute path); the opaque pass (props, scalps, and opaque
-/// strands; the mesh path generates inside it); with transparency, the transparent strand
-/// passes; the software rasterizer; the resolve.
+/// The pipelines of every pass of a frame; [`crate::render::schedule`] adds them to the frame
+/// graph in order.
 pub struct FramePasses {
     /// Culling, LoD and LoD pressure per view (both paths).
-    lod: bundle_lod::BundleLodPass,
-    generate: ComputeGenerate,
-    shadow: ShadowPass,
-    props: PropPass,
-    skin: skin::SkinPass,
-    root_probe: root_probe::RootProbePass,
-    scalp: ScalpPass,
-    strands: StrandDraw,
-    transparency: TransparencyPass,
+    pub(in crate::render) lod: bundle_lod::BundleLodPass,
+    /// The compute path's generation.
+    pub(in crate::render) generate: ComputeGenerate,
+    /// The light's hardware maps.
+    pub(in crate::render) shadow: ShadowPass,
+    /// Skinned props posed.
+    pub(in crate::render) skin: skin::SkinPass,
+    /// The root probe.
+    pub(in crate::render) root_probe: root_probe::RootProbePass,
+    /// Props, scalps and opaque strands.
+    pub(in crate::render) opaque: opaque::OpaquePass,
+    /// Transparent strands and the k-buffer resolve.
+    pub(in crate::render) transparency: TransparencyPass,
     /// The software rasterizer's passes, on devices with 64-bit shared and buffer atomics.
     soft: Option<SoftPasses>,
-    hair_mesh_update: hair_mesh_update::HairMeshUpdate,
-    hair_dynamics: hair_dynamics::HairDynamicsPass,
-    lhs_skin: lhs_skin::LhsSkin,
-    density_volume: density_volume::DensityVolumePass,
-    volume_hair: volume_hair::VolumeHairDraw,
+    /// Hair mesh textures rebuilt from new poses.
+    pub(in crate::render) hair_mesh_update: hair_mesh_update::HairMeshUpdate,
+    /// GPU hair dynamics.
+    pub(in crate::render) hair_dynamics: hair_dynamics::HairDynamicsPass,
+    /// The LHS baseline's skinning.
+    pub(in crate::render) lhs_skin: lhs_skin::LhsSkin,
+    /// Density volume builds.
+    pub(in crate::render) density_volume: density_volume::DensityVolumePass,
+    /// Far hair drawn from density volumes.
+    pub(in crate::render) volume_hair: volume_hair::VolumeHairDraw,
 }
 
 /// The software rasterizer's passes (they need 64-bit shared and buffer atomics).
-struct SoftPasses {
+pub(in crate::render) struct SoftPasses {
     /// Binning and raster (and the mesh path's segment pass).
-    raster: soft_raster::SoftRasterPass,
+    pub raster: soft_raster::SoftRasterPass,
     /// The light's maps.
-    shadow: soft_shadow::SoftShadowPass,
+    pub shadow: soft_shadow::SoftShadowPass,
     /// The static and LHS paths' stored strands as segments.
-    pool: pool_segments::PoolSegments,
+    pub pool: pool_segments::PoolSegments,
 }
 
 /// Write `bytes` into `table`, a host-visible table that shaders read by device address (the
@@ -582,7 +569,7 @@ pub(crate) fn add_clear_args<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
 
 /// After the light's view: keep its statistics in `GenerateArgs::light_stats`, then clear the
 /// rest for the camera's.
-fn add_clear_args_for_camera<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
+pub(crate) fn add_clear_args_for_camera<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>) {
     let args = r.args_buffer;
     let bytes = size_of::<super::shared::FrameStats>() as u64;
     g.pass("keep light statistics")
@@ -618,16 +605,13 @@ impl FramePasses {
             depth: DEPTH_FORMAT,
             samples,
         };
-        let camera = DrawTarget::Camera(targets);
         Ok(FramePasses {
             lod: bundle_lod::BundleLodPass::new(ctx, layout)?,
             generate: ComputeGenerate::new(ctx, layout)?,
             shadow: ShadowPass::new(ctx, layout, task_bundles)?,
-            props: PropPass::new(ctx, layout, camera)?,
             skin: skin::SkinPass::new(ctx, layout)?,
             root_probe: root_probe::RootProbePass::new(ctx, layout)?,
-            scalp: ScalpPass::new(ctx, layout, targets)?,
-            strands: StrandDraw::new(ctx, layout, camera, task_bundles)?,
+            opaque: opaque::OpaquePass::new(ctx, layout, targets, task_bundles)?,
             transparency: TransparencyPass::new(ctx, layout, targets, task_bundles),
             soft: match ctx.info.int64_atomics {
                 true => Some(SoftPasses {
@@ -655,46 +639,6 @@ impl FramePasses {
         &self.lhs_skin
     }
 
-    /// Add this frame's hair dynamics (the steps in `table`, of the characters in
-    /// `simulated`) and hair mesh texture rebuilds (before [`Self::add`]).
-    pub fn add_updates<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes,
-        jobs: &'a [hair_mesh_update::UpdateJob<'a>],
-        dynamics: Option<(&'a Buffer, &[hair_dynamics::SimulatedCharacter<'a>])>,
-    ) {
-        let poses = match dynamics {
-            Some((table, simulated)) => self.hair_dynamics.add(g, table, simulated),
-            None => Vec::new(),
-        };
-        self.hair_mesh_update.add(g, r, jobs, &poses);
-    }
-
-    /// Add the builds of this frame's requested density volumes (after the updates, before
-    /// [`Self::add`]): `volumes` are their cells, in the order of the jobs in `table`.
-    pub fn add_density_volumes<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes,
-        sets: PassSets<'a>,
-        (table, volumes, most_bundles): (&'a Buffer, &[&'a Buffer], u32),
-    ) {
-        self.density_volume
-            .add(g, r, sets, table, volumes, most_bundles);
-    }
-
-    /// Add the LHS baseline's skinning for frame slot `slot` (before [`Self::add`]).
-    pub fn add_lhs_skin<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes,
-        state: &'a mut lhs_skin::LhsState,
-        slot: usize,
-    ) -> GpuResult<()> {
-        self.lhs_skin.add(g, r, state, slot)
-    }
-
     /// Check and compile what `mode` needs, before a frame uses it.
     pub fn prepare_transparency(&mut self, mode: super::Transparency) -> GpuResult<()> {
         self.transparency.prepare(mode)
@@ -702,12 +646,17 @@ impl FramePasses {
 
     /// Whether the mesh path is available.
     pub fn has_mesh_path(&self) -> bool {
-        self.strands.has_mesh_path()
+        self.opaque.has_mesh_path()
     }
 
     /// Whether the software rasterizer is available.
     pub fn has_software_raster(&self) -> bool {
         self.soft.is_some()
+    }
+
+    /// The software rasterizer's passes, or why this device has none.
+    pub(in crate::render) fn soft(&self) -> GpuResult<&SoftPasses> {
+        self.soft.as_ref().ok_or_else(no_soft)
     }
 
     /// The software rasterizer alone over the targets (cleared to black first): `segments`
@@ -757,243 +706,5 @@ impl FramePasses {
         TransparencyPass::add_kbuffer_clear(g, r, budget, w as u64 * h as u64);
         pass.add(g, r, sets, (w, h), false);
         self.transparency.add_resolve(g, r, false, sets)
-    }
-
-    /// Add the frame's passes to `g`.
-    pub fn add<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes<'a>,
-        mut inp: FrameInputs<'a>,
-    ) -> GpuResult<()> {
-        self.add_before_drawing(g, r, &inp)?;
-        TemporalFeature::add_clear(g, r.visibility);
-        let soft = inp.bundles > 0 && inp.raster.uses_software();
-        // Bundles drawn as hardware strips: every one without the software rasterizer, the
-        // thick ones with `auto` (never the static and LHS paths' stored strands, which all go
-        // to software). They are drawn in the opaque pass, or with transparency in its passes.
-        let stored = matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
-        let hardware = inp.bundles > 0
-            && match inp.raster {
-                super::soft::StrandRaster::Hardware => true,
-                super::soft::StrandRaster::Auto { .. } => !stored,
-                super::soft::StrandRaster::Software { .. } => false,
-            };
-        let transparent = hardware && inp.transparency != super::Transparency::Opaque;
-        let query = inp.mesh_query.take();
-        // Far hair drawn from density volumes goes over the opaque pass, and then takes over
-        // its MSAA resolve.
-        let opaque_strands = hardware && !transparent;
-        let volumes = inp.volume_slots > 0;
-        let query = self.add_opaque(
-            g,
-            r,
-            &inp,
-            (opaque_strands, opaque_strands && !volumes),
-            query,
-        );
-        if volumes {
-            let flags = (opaque_strands, inp.raster.uses_software());
-            self.volume_hair
-                .add(g, r, inp.sets, inp.volume_slots, flags);
-        }
-        if transparent {
-            let draw = TransparentDraw {
-                mode: inp.transparency,
-                sets: inp.sets,
-                bundles: inp.bundles,
-                path: inp.path,
-                size: inp.size,
-                mesh_query: query,
-            };
-            self.transparency.add_layers(g, r, draw)?;
-        } else if soft {
-            let pixels = inp.size.0 as u64 * inp.size.1 as u64;
-            TransparencyPass::add_kbuffer_clear(g, r, inp.kbuffer_budget, pixels);
-        }
-        if soft {
-            self.add_software(g, r, &inp)?;
-        }
-        if transparent || soft {
-            let peel = matches!(inp.transparency, super::Transparency::DepthPeeling { .. });
-            self.transparency.add_resolve(g, r, peel, inp.sets)?;
-        }
-        inp.temporal_feature.add(g, temporal_inputs(r, &inp));
-        Ok(())
-    }
-
-    /// What runs before the camera draws: statistics cleared, skinning, the root probe, the
-    /// light's passes, the camera's culling and LoD and, on the compute path, its generation.
-    fn add_before_drawing<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes<'a>,
-        inp: &FrameInputs<'a>,
-    ) -> GpuResult<()> {
-        // Statistics accumulate from zero every frame; the static path keeps the last compute
-        // frame's draw arguments (and statistics).
-        let keep_args = matches!(inp.path, RenderPath::Static | RenderPath::Lhs);
-        if !keep_args {
-            add_clear_args(g, r);
-        }
-        let compute = inp.bundles > 0 && inp.path == RenderPath::Compute;
-        self.skin.add(g, r, inp.sets, inp.skin);
-        if let Some(probe) = inp.probe {
-            self.root_probe.add(g, r, inp.sets, probe);
-        }
-        if let Some(mode) = inp.shadow {
-            self.add_light(g, r, inp, mode)?;
-            // The camera's statistics start from zero again; the light's are kept.
-            if !keep_args {
-                add_clear_args_for_camera(g, r);
-            }
-        }
-        if inp.bundles > 0 && !keep_args {
-            self.lod.add(g, r, (inp.sets, "cull"), inp.bundles, compute);
-        }
-        if compute {
-            let view = GenerateView::Camera;
-            self.generate.add(g, r, inp.sets, inp.bundles, view);
-        }
-        Ok(())
-    }
-
-    /// The light's passes of a frame with shadows in `mode`: the light's generation (compute
-    /// path), then its hardware or software map passes.
-    fn add_light<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes<'a>,
-        inp: &FrameInputs<'a>,
-        mode: ShadowMode,
-    ) -> GpuResult<()> {
-        let soft_light = inp.light_raster == LightRaster::Software;
-        if inp.bundles > 0 && matches!(inp.path, RenderPath::Mesh | RenderPath::Compute) {
-            let pool = inp.path == RenderPath::Compute;
-            self.lod
-                .add(g, r, (inp.light_sets, "shadow cull"), inp.bundles, pool);
-        }
-        if inp.bundles > 0 && inp.path == RenderPath::Compute {
-            let view = match soft_light {
-                true => GenerateView::LightSoftware,
-                false => GenerateView::Light,
-            };
-            self.generate.add(g, r, inp.light_sets, inp.bundles, view);
-        }
-        let draw = ShadowDraw {
-            mode,
-            sets: inp.light_sets,
-            bundles: inp.bundles,
-            path: inp.path,
-            props: inp.light_props,
-        };
-        if soft_light {
-            let soft = self.soft.as_ref().ok_or_else(no_soft)?;
-            soft.shadow.add(g, r, (&self.shadow, &soft.raster), draw);
-        } else {
-            self.shadow.add(g, r, draw);
-        }
-        Ok(())
-    }
-
-    /// The software rasterizer's camera passes: the segments not yet appended (the mesh
-    /// path's segment pass; the static and LHS paths' stored strands), binning and raster.
-    fn add_software<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes<'a>,
-        inp: &FrameInputs<'a>,
-    ) -> GpuResult<()> {
-        let soft = self.soft.as_ref().ok_or_else(no_soft)?;
-        match inp.path {
-            RenderPath::Mesh => {
-                let view = (inp.sets, "soft segments");
-                soft.raster
-                    .add_mesh_segments(g, r, view, inp.bundles, inp.size);
-            }
-            RenderPath::Static | RenderPath::Lhs => soft.pool.add(g, r, inp.sets),
-            RenderPath::Compute => {}
-        }
-        soft.raster.add(g, r, inp.sets, inp.size, true);
-        Ok(())
-    }
-
-    /// The opaque pass: props, scalps and, with `strands`, the hardware-drawn strands; with
-    /// `resolve`, the colour's MSAA resolve ends here (MSAA frames draw no software strands).
-    /// Returns the mesh query when this pass did not use it.
-    fn add_opaque<'a>(
-        &'a self,
-        g: &mut FrameGraph<'a>,
-        r: &FrameRes<'a>,
-        inp: &FrameInputs<'a>,
-        (strands, resolve): (bool, bool),
-        query: Option<&'a mut MeshPrimitivesQuery>,
-    ) -> Option<&'a mut MeshPrimitivesQuery> {
-        let clear = inp.clear;
-        let mesh = inp.path == RenderPath::Mesh;
-        g.begin_scope(if mesh { "mesh draw" } else { "draw" });
-        let mut p = g.pass("opaque");
-        p = match clear {
-            Some(_) => p
-                .discard(r.color, Access::ColorAttachment)
-                .discard(r.depth, Access::DepthAttachment),
-            None => p
-                .write(r.color, Access::ColorAttachment)
-                .write(r.depth, Access::DepthAttachment),
-        };
-        let resolve_into = r.images.resolved.filter(|_| resolve);
-        if let (Some(res), true) = (r.resolved, resolve) {
-            p = p.discard(res, Access::ColorAttachment);
-        }
-        p = p
-            .read(r.constants, Access::VertexRead)
-            .read(r.skinned, Access::VertexRead)
-            .read(r.textures, Access::VertexRead)
-            .read_all(&r.shadow, Access::SampledRead)
-            .write_some(r.visibility, Access::FragmentReadWrite);
-        let strands = inp.bundles > 0 && strands;
-        if strands {
-            p = strands::strand_uses(p, r, inp.path, strands::StrandUse::CameraShaded);
-        }
-        let (mut query, rest) = match strands && mesh {
-            true => (query, None),
-            false => (None, query),
-        };
-        let (sets, bundles, props, args) = (inp.sets, inp.bundles, inp.props, r.args_buffer);
-        let (color, depth) = (r.images.color, r.images.depth);
-        p.record(move |rec, _| {
-            rec.begin_rendering(
-                Attachment {
-                    image: color,
-                    clear,
-                    resolve: resolve_into,
-                },
-                Attachment {
-                    image: depth,
-                    clear: clear.map(|_| [1.0; 4]),
-                    resolve: None,
-                },
-            );
-            self.props.record(rec, sets, props);
-            let mut result = Ok(());
-            if bundles > 0 {
-                self.scalp.record(rec, sets, bundles);
-            }
-            if strands && mesh {
-                if let Some(q) = query.as_deref_mut() {
-                    q.begin(rec);
-                }
-                result = self.strands.record_mesh(rec, sets, bundles);
-                if let Some(q) = query {
-                    q.end(rec);
-                }
-            } else if strands {
-                self.strands.record_pulled(rec, sets, args);
-            }
-            rec.end_rendering();
-            result
-        });
-        g.end_scope();
-        rest
     }
 }
