@@ -776,7 +776,6 @@ fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-
 /// `bench cpu-generate`: the CPU oracle's strands per second on one thread.
 fn bench_cpu_generate(mesh: &Path, strands: u32, verts_log2: u32, runs: u16) -> Result<()> {
     let vertices = strands as u64 * ((1u64 << verts_log2) + 1);

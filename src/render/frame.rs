@@ -2,6 +2,7 @@
 //! blocks, build the frame graph from the passes, run it, submit (the frames in flight are
 //! [`super::core::slots`]).
 
+use std::collections::VecDeque;
 use std::sync::Arc;
 
 use std::time::Instant;
@@ -9,31 +10,253 @@ use std::time::Instant;
 use super::RenderPath;
 use super::camera::View;
 use super::core::graph::FrameGraph;
+use super::core::graph::TransientPool;
+use super::core::shared::{FrameBinding, SET_FRAME, SET_TEXTURES};
 use super::core::shared::{FrameBlock, HairVertex, PropInstance};
+use super::core::slots::FrameReport;
 use super::core::slots::{
     FRAMES_IN_FLIGHT, FrameSlot, Pending, Retired, prop_instance_buffer, records_buffer,
 };
 use super::core::targets::{COLOR_FORMAT, DEPTH_FORMAT};
+use super::core::targets::{RenderTargets, ShadowMaps};
 use super::core::workspace::FrameBuffers;
+use super::core::workspace::Workspace;
+use super::crowd::Crowd;
 use super::features::temporal::{
     FrameMotion, PreviousFrame, Temporal, TemporalFeature, TemporalWork,
 };
 use super::host::{DepthMapping, HostFrame, HostImage};
+use super::passes::FramePasses;
 use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::host_targets::HostTargetPasses;
 use super::passes::output::FrameOutputs;
+use super::passes::output::Overlay;
 use super::passes::props::{PropDraw, PropList};
 use super::passes::write_address_table;
 use super::passes::{
     FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets, TargetFormats,
 };
-use super::renderer::{PresentTarget, Renderer};
 use super::schedule::{FramePlan, FrameUpdates, HostStart, add_frame};
+use super::settings::{DeviceCaps, RendererDesc, check_msaa};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
+use super::soft::SoftBudget;
 use super::soft::StrandRaster;
 use super::transparency::Transparency;
-use crate::vk::{Access, Buffer, CommandRecorder, Context, GpuError, GpuResult};
+use super::world::World;
+use crate::vk::{
+    Access, BindingDesc, Buffer, CommandRecorder, Context, DescriptorSetLayout, GpuError,
+    GpuResult, PipelineLayout, Semaphore, SwapchainImage,
+};
+
+/// Where a windowed frame goes: a swapchain image, the semaphore its acquisition signals and
+/// the one presentation waits for.
+pub struct PresentTarget<'a> {
+    /// The acquired image.
+    pub image: &'a SwapchainImage,
+    /// Signalled when the image may be written.
+    pub wait: &'a Semaphore,
+    /// Signalled when the frame is done (presentation waits for it).
+    pub signal: &'a Semaphore,
+    /// Drawn over the frame before it is presented (the control panel): called with the
+    /// colour target in colour-attachment use.
+    pub overlay: Option<&'a mut Overlay<'a>>,
+}
+
+/// The frames in flight and everything that draws them: the passes, the targets, the frame
+/// slots, the working buffers, the state temporal accumulation and the static and LHS paths
+/// keep between frames. What they draw is the [`World`].
+pub struct Frames {
+    pub(super) ctx: Arc<Context>,
+    pub(super) desc: RendererDesc,
+    pub(super) passes: FramePasses,
+    pub(super) slots: Vec<FrameSlot>,
+    pub(super) next: usize,
+    pub(super) frame_number: u64,
+    pub(super) targets: RenderTargets,
+    pub(super) shadow: ShadowMaps,
+    /// The frame graph's transient buffers and images, kept across frames.
+    pub(super) transients: TransientPool,
+    /// The software rasterizer's budgets.
+    pub(super) soft_budget: SoftBudget,
+    /// The crowd version whose strands the vertex pool holds (the last compute-path frame's),
+    /// which static-path frames draw again.
+    pub(super) static_version: Option<u64>,
+    /// The crowd structure whose strand layout the draw arguments describe (the last compute
+    /// frame's; a mesh frame clears them).
+    pub(super) args_structure: Option<u64>,
+    /// The LHS baseline's stored strands (`capture_lhs`), with the crowd version they are of.
+    pub(super) lhs: Option<(u64, super::passes::lhs_skin::LhsState)>,
+    pub(super) work: Workspace,
+    /// The previous frame's matrices and the temporal history.
+    pub(super) temporal: TemporalFeature,
+    pub(super) completed: VecDeque<FrameReport>,
+    /// The passes of host frames, made by the first one.
+    pub(super) host_passes: Option<HostTargetPasses>,
+}
+
+impl Frames {
+    /// Create pipelines, targets and frame slots for `crowd`'s textures; `soft_budget` as
+    /// checked against the device.
+    pub fn new(
+        ctx: &Arc<Context>,
+        desc: &RendererDesc,
+        crowd: &Crowd,
+        soft_budget: SoftBudget,
+    ) -> GpuResult<Self> {
+        let bindings: Vec<BindingDesc> = FrameBinding::ALL
+            .iter()
+            .map(|(b, _)| BindingDesc::single(*b as u32, b.kind()))
+            .collect();
+        let frame_layout = DescriptorSetLayout::new(ctx, &bindings)?;
+        let mut set_layouts = vec![frame_layout.clone(); 2];
+        set_layouts[SET_FRAME as usize] = frame_layout.clone();
+        set_layouts[SET_TEXTURES as usize] = crowd.texture_layout().clone();
+        let layout = PipelineLayout::new(ctx, &set_layouts)?;
+        check_msaa(ctx, desc.msaa)
+            .map_err(|why| GpuError::Unsupported(format!("{}x MSAA: {why}", desc.msaa)))?;
+        let passes = FramePasses::new(ctx, &layout, desc.task_bundles, desc.msaa)?;
+        let temporal = TemporalFeature::new(ctx, &layout)?;
+        if desc.path == Some(RenderPath::Mesh) && !passes.has_mesh_path() {
+            return Err(GpuError::Unsupported(format!(
+                "{}: no usable VK_EXT_mesh_shader for the mesh path",
+                ctx.info.name
+            )));
+        }
+        let slots = (0..FRAMES_IN_FLIGHT)
+            .map(|_| FrameSlot::new(ctx, &frame_layout))
+            .collect::<GpuResult<_>>()?;
+        Ok(Frames {
+            ctx: ctx.clone(),
+            desc: desc.clone(),
+            passes,
+            slots,
+            next: 0,
+            frame_number: 0,
+            targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
+            shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
+            transients: TransientPool::new(ctx),
+            soft_budget,
+            static_version: None,
+            args_structure: None,
+            lhs: None,
+            work: Workspace::new(ctx)?,
+            temporal,
+            completed: VecDeque::new(),
+            host_passes: None,
+        })
+    }
+
+    /// The path frames use unless told otherwise.
+    pub fn default_path(&self) -> RenderPath {
+        match self.desc.path {
+            Some(p) => p,
+            None if self.passes.has_mesh_path() => RenderPath::Mesh,
+            None => RenderPath::Compute,
+        }
+    }
+
+    /// What this device offers, for [`super::FrameSettings::validate`].
+    pub fn caps(&self) -> DeviceCaps {
+        DeviceCaps {
+            name: self.ctx.info.name.clone(),
+            mesh_path: self.passes.has_mesh_path(),
+            int64_atomics: self.passes.has_software_raster(),
+        }
+    }
+
+    /// The software rasterizer's budgets and the `RendererDesc` choices it draws with.
+    pub fn soft_tuning(&self) -> super::soft::SoftTuning {
+        super::soft::SoftTuning {
+            budget: self.soft_budget,
+            auto_split_pixels: self.desc.auto_split_pixels,
+        }
+    }
+
+    /// Vertex slots of the compute path's pool.
+    pub fn vertex_budget(&self) -> u32 {
+        (self.desc.vertex_pool_bytes / size_of::<HairVertex>() as u64).min(u32::MAX as u64) as u32
+    }
+
+    /// Recreate the targets at a new size (frames in flight keep the old ones until done).
+    pub fn resize(&mut self, crowd: &mut Crowd, width: u32, height: u32) -> GpuResult<()> {
+        super::settings::check_size(width, height)?;
+        if self.targets.size() == (width, height) {
+            return Ok(());
+        }
+        let old = std::mem::replace(
+            &mut self.targets,
+            RenderTargets::new(&self.ctx, width, height, self.desc.msaa)?,
+        );
+        self.retire(crowd, Retired::Resource(Box::new(old)));
+        Ok(())
+    }
+
+    /// The frame slot the newest submitted frame used.
+    pub(super) fn last_slot(&self) -> &FrameSlot {
+        &self.slots[(self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT]
+    }
+
+    /// Release `r` after the newest submitted frame completes (now if none is pending).
+    pub(super) fn retire(&mut self, crowd: &mut Crowd, r: Retired) {
+        let last = (self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT;
+        if self.slots[last].pending.is_some() {
+            self.slots[last].retired.push(r);
+        } else if let Retired::CharacterSlot(s) = r {
+            crowd.free_slot(s);
+        }
+    }
+
+    /// Wait for frame slot `i`, collect its report and release what was retired with it.
+    pub(super) fn retire_slot(&mut self, crowd: &mut Crowd, i: usize) -> GpuResult<()> {
+        let slot = &mut self.slots[i];
+        slot.fence.wait()?;
+        if let Some(p) = slot.pending.take() {
+            self.completed.push_back(slot.report(p)?);
+            while self.completed.len() > 2 * FRAMES_IN_FLIGHT {
+                self.completed.pop_front();
+            }
+        }
+        for r in std::mem::take(&mut self.slots[i].retired) {
+            if let Retired::CharacterSlot(s) = r {
+                crowd.free_slot(s);
+            }
+        }
+        Ok(())
+    }
+
+    /// Wait for a submitted frame and return its report.
+    pub fn wait(&mut self, crowd: &mut Crowd, ticket: FrameTicket) -> GpuResult<FrameReport> {
+        let pending_is = |slot: &FrameSlot, f: &dyn Fn(u64) -> bool| {
+            slot.pending.as_ref().is_some_and(|p| f(p.frame))
+        };
+        if let Some(i) =
+            (0..FRAMES_IN_FLIGHT).find(|&i| pending_is(&self.slots[i], &|f| f == ticket.0))
+        {
+            // Frames complete in order: retire the older pending frame first.
+            let other = (i + 1) % FRAMES_IN_FLIGHT;
+            if pending_is(&self.slots[other], &|f| f < ticket.0) {
+                self.retire_slot(crowd, other)?;
+            }
+            self.retire_slot(crowd, i)?;
+        }
+        self.completed
+            .iter()
+            .position(|r| r.frame == ticket.0)
+            .and_then(|k| self.completed.remove(k))
+            .ok_or_else(|| {
+                GpuError::Unsupported(format!("report of frame {} is no longer kept", ticket.0))
+            })
+    }
+
+    /// Wait for every frame in flight.
+    pub fn finish(&mut self, crowd: &mut Crowd) -> GpuResult<()> {
+        for k in 1..=FRAMES_IN_FLIGHT {
+            self.retire_slot(crowd, (self.next + k) % FRAMES_IN_FLIGHT)?;
+        }
+        Ok(())
+    }
+}
 
 /// The density volumes of a frame.
 struct DensityWork {
@@ -114,16 +337,19 @@ pub(super) struct HostTargets<'t> {
     pub mapping: DepthMapping,
 }
 
-impl Renderer {
-    /// [`Renderer::render_frame`], then blit the image onto `present.image` (scaled to its
+impl Frames {
+    /// [`super::Renderer::render_frame`], then blit the image onto `present.image` (scaled to its
     /// size) after `present.wait`, signalling `present.signal` for presentation.
-    pub fn render_frame_to(
+    pub(in crate::render) fn render_frame_to(
         &mut self,
+        world: &mut World,
+        background: [f32; 3],
         view: &View,
         opts: &FrameOptions,
         mut present: Option<PresentTarget>,
     ) -> GpuResult<FrameTicket> {
-        self.draw_frame(self.next, view, opts, FrameTarget::Own(present.as_mut()))
+        let target = FrameTarget::Own(present.as_mut());
+        self.draw_frame(world, background, self.next, view, opts, target)
     }
 
     /// Draw one frame in frame slot `i` (waited for first) into `target`: check the settings,
@@ -131,23 +357,26 @@ impl Renderer {
     /// own command buffer) or leave it to the host.
     pub(super) fn draw_frame(
         &mut self,
+        world: &mut World,
+        background: [f32; 3],
         i: usize,
         view: &View,
         opts: &FrameOptions,
         mut target: FrameTarget,
     ) -> GpuResult<FrameTicket> {
-        let (path, kbuffer_budget) = self.check_frame(view, opts)?;
+        let (path, kbuffer_budget) = self.check_frame(world, view, opts)?;
         let temporal = self.temporal_work(view, opts, path)?;
         // What draws the frame's bundles, decided once (`auto` with k-buffer OIT is all
         // software): the passes, buffers and frame blocks all follow it.
         let raster = super::settings::raster_under(opts.raster, view.transparency);
-        self.retire_slot(i)?;
+        self.retire_slot(&mut world.crowd, i)?;
         self.prepare_history(i, temporal)?;
-        self.prepare_workspace(i, path)?;
-        let updates = self.crowd.write_pending_poses(i)?;
+        self.prepare_workspace(world, i, path)?;
+        let updates = world.crowd.write_pending_poses(i)?;
         let simulated = self.write_sim_jobs(i, &updates.simulated)?;
         let pose_updates = updates.updated;
-        let (mut block, light_block) = self.frame_blocks(view, opts, (raster, kbuffer_budget));
+        let (mut block, light_block) =
+            self.frame_blocks(world, view, opts, (raster, kbuffer_budget));
         let motion = self
             .temporal
             .write_block(&mut block, temporal, self.targets.size());
@@ -162,16 +391,21 @@ impl Renderer {
         )?;
         // Motion matrices only where the frame's temporal pass reads them.
         let moving = temporal.map(|_| &motion);
-        let mut records = self.frame_records(&pose_updates, moving);
-        let density =
-            self.write_density_jobs(i, &mut records, (&view.volumes, &block), &pose_updates)?;
+        let mut records = self.frame_records(world, &pose_updates, moving);
+        let density = self.write_density_jobs(
+            world,
+            i,
+            &mut records,
+            (&view.volumes, &block),
+            &pose_updates,
+        )?;
         let work_draw = density.draw;
         let blocks = (&block, light_block.as_ref());
-        let (prop_draws, skin) = self.write_slot(i, blocks, &records, moving, opts)?;
+        let (prop_draws, skin) = self.write_slot(world, i, blocks, &records, moving, opts)?;
         let start = Instant::now();
         let work = FrameWork {
             path,
-            bundles: self.crowd.bundle_count(),
+            bundles: world.crowd.bundle_count(),
             props: &prop_draws,
             skin,
             shadows: light_block.map(|_| view.shadows),
@@ -185,10 +419,31 @@ impl Renderer {
             temporal,
             transients,
         };
-        let (frame_graph, unscoped_commands) = self.record(i, work, opts, &mut target)?;
+        let (frame_graph, unscoped_commands) =
+            self.record((world, background), i, work, opts, &mut target)?;
         let record_ms = start.elapsed().as_secs_f64() * 1e3;
+        let recorded = (frame_graph, unscoped_commands, record_ms);
+        let bundles = world.crowd.bundle_count();
+        let pending = self.pending((path, opts), recorded, (work_draw, bundles), &block);
+        self.hand_over(i, pending, target)?;
+        self.remember_frame(&records, &motion, temporal);
+        self.after_submit(world, path, raster);
+        self.next = (i + 1) % FRAMES_IN_FLIGHT;
+        Ok(FrameTicket(self.frame_number - 1))
+    }
+
+    /// What the report of this frame (drawn on `path` with `opts`) needs once it completes:
+    /// the graph's description, the commands outside every scope and the CPU ms it took to
+    /// record, the volume tier's draw and the bundles, the frame block.
+    fn pending(
+        &self,
+        (path, opts): (RenderPath, &FrameOptions),
+        (frame_graph, unscoped_commands, record_ms): (Option<String>, u32, f64),
+        (tier, bundles): (super::volume::TierDraw, u32),
+        block: &FrameBlock,
+    ) -> Pending {
         let (width, height) = self.targets.size();
-        let pending = Pending {
+        Pending {
             frame: self.frame_number,
             path,
             width,
@@ -197,16 +452,11 @@ impl Renderer {
             read_image: opts.read_image,
             read_motion: opts.read_motion,
             frame_graph,
-            volume_characters: (work_draw.alone, work_draw.blended),
-            probe_roots: opts.probe_roots.then_some(self.crowd.bundle_count()),
+            volume_characters: (tier.alone, tier.blended),
+            probe_roots: opts.probe_roots.then_some(bundles),
             unscoped_commands,
-            budgets: self.view_budgets(path, &block),
-        };
-        self.hand_over(i, pending, target)?;
-        self.remember_frame(&records, &motion, temporal);
-        self.after_submit(path, raster);
-        self.next = (i + 1) % FRAMES_IN_FLIGHT;
-        Ok(FrameTicket(self.frame_number - 1))
+            budgets: self.view_budgets(path, block),
+        }
     }
 
     /// This frame's temporal work (`None`: no motion vectors), or why this device cannot do
@@ -232,9 +482,7 @@ impl Renderer {
             .temporal
             .prepare(&self.ctx, temporal, self.targets.size())?
         {
-            self.frames[i]
-                .retired
-                .push(Retired::Resource(Box::new(old)));
+            self.slots[i].retired.push(Retired::Resource(Box::new(old)));
         }
         Ok(())
     }
@@ -266,7 +514,7 @@ impl Renderer {
         }
         let jobs: Vec<super::core::shared::SimJob> = steps.iter().map(|(_, j)| *j).collect();
         let bytes = bytemuck::cast_slice(&jobs);
-        let table = &mut self.frames[i].sim_jobs;
+        let table = &mut self.slots[i].sim_jobs;
         write_address_table(&self.ctx, table, "hair dynamics jobs", bytes)?;
         Ok(steps.iter().map(|(s, _)| *s).collect())
     }
@@ -277,6 +525,7 @@ impl Renderer {
     /// completed), and fill the volume fields of `records`.
     fn write_density_jobs(
         &mut self,
+        world: &mut World,
         i: usize,
         records: &mut [super::core::shared::CharacterRecord],
         (tier, block): (&super::volume::VolumeTier, &FrameBlock),
@@ -291,22 +540,20 @@ impl Renderer {
             })
             .collect();
         if tier.enabled() {
-            for id in self.crowd.ids() {
+            for id in world.crowd.ids() {
                 let slot = id.slot() as usize;
                 let visible = records[slot].flags & super::core::shared::CHARACTER_VISIBLE != 0;
                 let needed = tier.occlusion || weights[slot] > 0.0;
                 if visible
                     && needed
-                    && let Some(old) = self.volumes.ensure(&self.ctx, id, tier.sampling)?
+                    && let Some(old) = world.volumes.ensure(&self.ctx, id, tier.sampling)?
                 {
-                    self.frames[i]
-                        .retired
-                        .push(Retired::Resource(Box::new(old)));
+                    self.slots[i].retired.push(Retired::Resource(Box::new(old)));
                 }
             }
         }
         for &slot in pose_updates {
-            self.volumes.mark_stale(slot);
+            world.volumes.mark_stale(slot);
         }
         // Stale volumes are rebuilt for the tier; with it off only requests are built.
         let rebuilds = if tier.enabled() {
@@ -315,11 +562,13 @@ impl Renderer {
             0
         };
         let (jobs, built, most_bundles) =
-            self.volumes.take_jobs(records, rebuilds, self.frame_number);
-        let draw = self.volumes.fill_records(records, tier, &weights);
+            world
+                .volumes
+                .take_jobs(records, rebuilds, self.frame_number);
+        let draw = world.volumes.fill_records(records, tier, &weights);
         if !jobs.is_empty() {
             let bytes = bytemuck::cast_slice(&jobs);
-            let table = &mut self.frames[i].density_jobs;
+            let table = &mut self.slots[i].density_jobs;
             write_address_table(&self.ctx, table, "density volume jobs", bytes)?;
         }
         Ok(DensityWork {
@@ -333,10 +582,11 @@ impl Renderer {
     /// pose's textures, all with their motion where the frame has motion vectors.
     fn frame_records(
         &self,
+        world: &World,
         pose_updates: &[usize],
         motion: Option<&FrameMotion>,
     ) -> Vec<super::core::shared::CharacterRecord> {
-        let mut records = self.crowd.records(pose_updates);
+        let mut records = world.crowd.records(pose_updates);
         if let Some(motion) = motion {
             for (slot, r) in records.iter_mut().enumerate() {
                 let model = glam::Mat4::from_cols_array_2d(&r.model);
@@ -368,15 +618,20 @@ impl Renderer {
 
     /// Refuse a frame this renderer cannot draw (path state, 32-bit counters, settings);
     /// returns its path and k-buffer budget.
-    fn check_frame(&self, view: &View, opts: &FrameOptions) -> GpuResult<(RenderPath, u32)> {
+    fn check_frame(
+        &self,
+        world: &World,
+        view: &View,
+        opts: &FrameOptions,
+    ) -> GpuResult<(RenderPath, u32)> {
         view.validate().map_err(GpuError::Unsupported)?;
         let path = opts.path.unwrap_or(self.default_path());
-        if path == RenderPath::Static && self.static_version != Some(self.crowd.version()) {
+        if path == RenderPath::Static && self.static_version != Some(world.crowd.version()) {
             return Err(GpuError::Unsupported(
                 "the static path draws the strands of the last compute-path frame: render one first, and again after the characters change".into(),
             ));
         }
-        let structure = Some(self.crowd.structure_version());
+        let structure = Some(world.crowd.structure_version());
         if path == RenderPath::Lhs
             && (self.lhs.as_ref().map(|l| l.0) != structure || self.args_structure != structure)
         {
@@ -387,7 +642,7 @@ impl Renderer {
         // Statistics are 32-bit: refuse a frame without LoD whose crowd could wrap them (with
         // LoD a real head's strands follow its pixels; the buffers' sums are held to their
         // budgets by the LoD pressure either way).
-        let worst = self.crowd.max_triangles();
+        let worst = world.crowd.max_triangles();
         if !view.lod.enabled && worst > u32::MAX as u64 {
             return Err(GpuError::Unsupported(format!(
                 "the crowd has {worst} strand triangles at full detail, more than 32-bit frame counters hold; lower strands per bundle or vertex level"
@@ -444,13 +699,14 @@ impl Renderer {
     /// drawn with `raster` and a k-buffer of `kbuffer_budget` nodes.
     fn frame_blocks(
         &self,
+        world: &World,
         view: &View,
         opts: &FrameOptions,
         (raster, kbuffer_budget): (StrandRaster, u32),
     ) -> (FrameBlock, Option<FrameBlock>) {
         let (width, height) = self.targets.size();
-        let bundles = self.crowd.bundle_count();
-        let slots = self.crowd.slot_count();
+        let bundles = world.crowd.bundle_count();
+        let slots = world.crowd.slot_count();
         let mut block = view.frame_block(width, height, bundles, slots, self.vertex_budget());
         block.transparency = view.transparency.frame_fields(self.desc.msaa);
         if raster.uses_software() {
@@ -461,12 +717,12 @@ impl Renderer {
             };
             super::soft::frame_fields(&mut block, raster, opacity, self.soft_tuning());
         }
-        let light = self.light_view(view, &block);
+        let light = self.light_view(world, view, &block);
         if let Some(l) = &light {
             (block.light_view_proj, block.shadow, block.shadow_params) =
                 l.shadow_fields(view.shadows);
         }
-        if let Some(b) = self.body_light_view(view, &block) {
+        if let Some(b) = self.body_light_view(world, view, &block) {
             (block.body_view_proj, block.body_shadow) = b.body_fields();
         }
         let soft_light = (opts.light_raster == LightRaster::Software).then_some(self.soft_budget);
@@ -480,13 +736,14 @@ impl Renderer {
     /// and widest job.
     fn write_slot(
         &mut self,
+        world: &mut World,
         i: usize,
         (block, light_block): (&FrameBlock, Option<&FrameBlock>),
         records: &[super::core::shared::CharacterRecord],
         motion: Option<&FrameMotion>,
         opts: &FrameOptions,
     ) -> GpuResult<(PropDraws, (u32, u32))> {
-        let crowd = &self.crowd;
+        let crowd = &world.crowd;
         let still = glam::Mat4::IDENTITY;
         let moved = |id: super::crowd::CharacterId| {
             let model = crowd.drawn_model(id)?;
@@ -495,7 +752,7 @@ impl Renderer {
                 motion.map_or(still, |m| m.character(id.slot() as usize, model)),
             ))
         };
-        let world = motion.map_or(still, FrameMotion::camera);
+        let camera_motion = motion.map_or(still, FrameMotion::camera);
         let camera = super::prop_table::Projection {
             eye: glam::Vec3::from_slice(&block.camera_pos[..3]),
             height: block.camera_pos[3],
@@ -510,9 +767,10 @@ impl Renderer {
                 body_texel * super::shadow::LIGHT_FAR_TEXELS_PER_PIXEL,
             )
         });
-        let (mut prop_instances, mut prop_draws) = self.props.frame_lists(&moved, world, &camera);
+        let (mut prop_instances, mut prop_draws) =
+            world.props.frame_lists(&moved, camera_motion, &camera);
         let mut light_draws = prop_draws.clone();
-        let skin = self.skinned.frame_lists(
+        let skin = world.skinned.frame_lists(
             moved,
             (&camera, light.as_ref()),
             &mut prop_instances,
@@ -522,7 +780,7 @@ impl Renderer {
         // is then never shaded.
         prop_draws.sort_by_key(|d| !d.skinned);
         light_draws.sort_by_key(|d| !d.skinned);
-        let slot = &mut self.frames[i];
+        let slot = &mut self.slots[i];
         slot.frame_ubo.write(0, bytemuck::bytes_of(block))?;
         if let Some(lb) = light_block {
             slot.light_ubo.write(0, bytemuck::bytes_of(lb))?;
@@ -556,7 +814,7 @@ impl Renderer {
     fn size_readbacks(&mut self, i: usize, opts: &FrameOptions) -> GpuResult<()> {
         let (width, height) = self.targets.size();
         let pixels = width as u64 * height as u64;
-        let slot = &mut self.frames[i];
+        let slot = &mut self.slots[i];
         size_readback(
             &self.ctx,
             &mut slot.image_readback,
@@ -577,6 +835,7 @@ impl Renderer {
     /// timing scope.
     fn record(
         &mut self,
+        (world, background): (&World, [f32; 3]),
         i: usize,
         work: FrameWork,
         opts: &FrameOptions,
@@ -597,14 +856,14 @@ impl Renderer {
             skinned,
             root_probe,
             ..
-        } = &mut self.frames[i];
+        } = &mut self.slots[i];
         let mut rec = match target {
             FrameTarget::Host(h) => CommandRecorder::host(&self.ctx, h.cmd),
             FrameTarget::Own(_) => cmd.begin()?,
         };
         begin_timing(&mut rec, profiler, mesh_query.as_mut());
-        let jobs = self.crowd.update_jobs(i, &work.pose_updates);
-        let simulated = simulated_characters(&self.crowd, &work.simulated);
+        let jobs = world.crowd.update_jobs(i, &work.pose_updates);
+        let simulated = simulated_characters(&world.crowd, &work.simulated);
         let (mut host_color_use, mut host_depth_use) = target.host_uses();
         let mut g = new_graph(opts, &self.desc);
         let sources = FrameSources {
@@ -625,13 +884,13 @@ impl Renderer {
                 (RenderPath::Lhs, Some((_, lhs))) => Some((lhs, i)),
                 _ => None,
             },
-            volume_builds: volume_builds(density_jobs.as_ref(), &self.volumes, &work.density),
+            volume_builds: volume_builds(density_jobs.as_ref(), &world.volumes, &work.density),
         };
         let host_uses = (&mut host_color_use, &mut host_depth_use);
         let host = host_start(&*target, self.host_passes.as_ref(), host_uses, i);
-        let clear = (opts.clear && host.is_none()).then_some(opaque(self.background));
-        let sets = PassSets::camera_and_light((set, light_set), self.crowd.texture_set());
-        let props = prop_lists(work.props, self.skinned.indices.as_ref());
+        let clear = (opts.clear && host.is_none()).then_some(opaque(background));
+        let sets = PassSets::camera_and_light((set, light_set), world.crowd.texture_set());
+        let props = prop_lists(work.props, world.skinned.indices.as_ref());
         let query = (mesh_query.as_mut(), &self.temporal);
         let mut draw = frame_inputs(&work, (sets, props), clear, size, query);
         if opts.probe_roots {
@@ -661,7 +920,7 @@ impl Renderer {
         match target {
             FrameTarget::Own(present) => self.submit(i, pending, present.as_deref()),
             FrameTarget::Host(_) => {
-                self.frames[i].pending = Some(pending);
+                self.slots[i].pending = Some(pending);
                 self.frame_number += 1;
                 Ok(())
             }
@@ -675,7 +934,7 @@ impl Renderer {
         pending: Pending,
         present: Option<&PresentTarget>,
     ) -> GpuResult<()> {
-        let slot = &mut self.frames[i];
+        let slot = &mut self.slots[i];
         slot.fence.reset()?;
         let (wait, signal) = match present {
             Some(p) => (Some(p.wait), Some(p.signal)),
@@ -693,12 +952,12 @@ impl Renderer {
 
     /// The pool and draw arguments now hold this frame's strands (compute path), or the mesh
     /// path has overwritten the arguments.
-    fn after_submit(&mut self, path: RenderPath, raster: StrandRaster) {
+    fn after_submit(&mut self, world: &mut World, path: RenderPath, raster: StrandRaster) {
         match path {
             // Software bundles leave no strands in the pool.
             RenderPath::Compute if !raster.uses_software() => {
-                self.static_version = Some(self.crowd.version());
-                self.args_structure = Some(self.crowd.structure_version());
+                self.static_version = Some(world.crowd.version());
+                self.args_structure = Some(world.crowd.structure_version());
             }
             RenderPath::Compute | RenderPath::Mesh => {
                 self.static_version = None;
@@ -710,43 +969,42 @@ impl Renderer {
 
     /// Grow the working buffers for the crowd's bundles and allocate the vertex pool when the
     /// compute path first needs it. Replaced buffers are retired with frame slot `i`.
-    pub(super) fn prepare_workspace(&mut self, i: usize, path: RenderPath) -> GpuResult<()> {
-        if let Some(old) = self.crowd.update_bundle_table()? {
-            self.frames[i]
-                .retired
-                .push(Retired::Resource(Box::new(old)));
+    pub(super) fn prepare_workspace(
+        &mut self,
+        world: &mut World,
+        i: usize,
+        path: RenderPath,
+    ) -> GpuResult<()> {
+        if let Some(old) = world.crowd.update_bundle_table()? {
+            self.slots[i].retired.push(Retired::Resource(Box::new(old)));
         }
-        if let Some(old) = self.work.grow(self.crowd.bundle_count())? {
-            self.frames[i]
-                .retired
-                .push(Retired::Resource(Box::new(old)));
+        if let Some(old) = self.work.grow(world.crowd.bundle_count())? {
+            self.slots[i].retired.push(Retired::Resource(Box::new(old)));
         }
         if let Some(old) = self
             .work
-            .ensure_root_samples(self.crowd.most_in_a_bundle())?
+            .ensure_root_samples(world.crowd.most_in_a_bundle())?
         {
-            self.frames[i]
-                .retired
-                .push(Retired::Resource(Box::new(old)));
+            self.slots[i].retired.push(Retired::Resource(Box::new(old)));
         }
         if path.pulls_vertices() {
             self.work.ensure_pool(self.desc.vertex_pool_bytes)?;
         }
-        let slots = self.crowd.slot_count();
-        let slot = &mut self.frames[i];
+        let slots = world.crowd.slot_count();
+        let slot = &mut self.slots[i];
         if slot.records.size
             < slots as u64 * size_of::<super::core::shared::CharacterRecord>() as u64
         {
             slot.records = records_buffer(&self.ctx, slots.next_power_of_two())?;
         }
-        let skin = self.skinned.capacity();
+        let skin = world.skinned.capacity();
         let instances =
-            (self.props.instances.len() + self.props.attached.len()) as u32 + skin.instances;
+            (world.props.instances.len() + world.props.attached.len()) as u32 + skin.instances;
         if slot.prop_instances.size < instances as u64 * size_of::<PropInstance>() as u64 {
             slot.prop_instances = prop_instance_buffer(&self.ctx, instances.next_power_of_two())?;
         }
         grow_skin_buffers(&self.ctx, slot, skin)?;
-        let probe_bytes = self.crowd.bundle_count() as u64 * 16;
+        let probe_bytes = world.crowd.bundle_count() as u64 * 16;
         if slot.root_probe.size < probe_bytes {
             slot.root_probe = super::core::slots::host_table(
                 &self.ctx,
@@ -754,7 +1012,7 @@ impl Renderer {
                 probe_bytes.next_power_of_two(),
             )?;
         }
-        let slot = &self.frames[i];
+        let slot = &self.slots[i];
         for (set, ubo) in [
             (&slot.set, &slot.frame_ubo),
             (&slot.light_set, &slot.light_ubo),
@@ -765,10 +1023,10 @@ impl Renderer {
                     frame_ubo: ubo,
                     records: &slot.records,
                     prop_instances: &slot.prop_instances,
-                    bundle_table: self.crowd.bundle_table(),
-                    prop_vertices: self.props.vertices.as_ref(),
+                    bundle_table: world.crowd.bundle_table(),
+                    prop_vertices: world.props.vertices.as_ref(),
                     skin: [
-                        self.skinned.rest.as_ref(),
+                        world.skinned.rest.as_ref(),
                         Some(&slot.skin_matrices),
                         Some(&slot.skin_jobs),
                         Some(&slot.skinned),
@@ -786,13 +1044,14 @@ impl Renderer {
     /// camera's frustum. `None` when shadows are off or no hair is in view.
     fn light_view(
         &self,
+        world: &World,
         view: &View,
         block: &super::core::shared::FrameBlock,
     ) -> Option<LightView> {
         if view.shadows == ShadowMode::Off {
             return None;
         }
-        let bounds: Vec<_> = self
+        let bounds: Vec<_> = world
             .crowd
             .hair_bounds()
             .into_iter()
@@ -805,15 +1064,16 @@ impl Renderer {
     /// when shadows are off or no body is in view.
     fn body_light_view(
         &self,
+        world: &World,
         view: &View,
         block: &super::core::shared::FrameBlock,
     ) -> Option<LightView> {
         if view.shadows == ShadowMode::Off {
             return None;
         }
-        let model_of = |id| self.crowd.drawn_model(id);
-        let mut bodies = self.props.character_spheres(&model_of);
-        bodies.extend(self.skinned.character_spheres(&model_of));
+        let model_of = |id| world.crowd.drawn_model(id);
+        let mut bodies = world.props.character_spheres(&model_of);
+        bodies.extend(world.skinned.character_spheres(&model_of));
         let camera = (
             glam::Mat4::from_cols_array_2d(&block.unjittered_view_proj),
             glam::Vec3::from_slice(&block.camera_pos[..3]),
@@ -1026,18 +1286,20 @@ fn frame_inputs<'a>(
     }
 }
 
-impl Renderer {
+impl Frames {
     /// Record the hair of one frame into a host's command buffer: seen through the host's
     /// camera, hidden behind the host's depth, composited over the host's colour, with `look`
     /// for everything else (light, shading, shadows, LoD; its camera is replaced). The host
-    /// submits the buffer, and once that submission has completed, [`Renderer::wait`] with the
+    /// submits the buffer, and once that submission has completed, [`super::Renderer::wait`] with the
     /// ticket returns the frame's report without waiting (host frames complete when the host
     /// says so). The renderer's targets follow the host colour's size. `opts.clear` does not
     /// apply (the hair is drawn over a transparent layer, which `opts.read_image` reads back).
     /// Refused: temporal accumulation (the host's own anti-aliasing jitters its projection,
     /// which host frames follow), a slot out of range, images the host wants back unused.
-    pub fn record_host_frame(
+    pub(in crate::render) fn record_host_frame(
         &mut self,
+        world: &mut World,
+        background: [f32; 3],
         look: &View,
         opts: &FrameOptions,
         frame: HostFrame,
@@ -1066,7 +1328,7 @@ impl Renderer {
             return Err(refuse("an image cannot be handed back unused".into()));
         }
         let [width, height, _] = frame.color.image.desc.extent;
-        self.resize(width, height)?;
+        self.resize(&mut world.crowd, width, height)?;
         if self.host_passes.is_none() {
             let targets = TargetFormats {
                 color: COLOR_FORMAT,
@@ -1083,7 +1345,7 @@ impl Renderer {
         let size = (width, height);
         let mut host = frame
             .camera
-            .view(size, self.hair_far(frame.camera.eye()))
+            .view(size, self.hair_far(world, frame.camera.eye()))
             .map_err(refuse)?;
         host.depth.slack = frame.depth_slack;
         let view = View {
@@ -1096,12 +1358,12 @@ impl Renderer {
             depth: frame.depth.as_ref(),
             mapping: host.depth,
         });
-        self.draw_frame(frame.slot, &view, opts, target)
+        self.draw_frame(world, background, frame.slot, &view, opts, target)
     }
 
     /// A far plane beyond every character's hair seen from `eye` (with a tenth to spare).
-    fn hair_far(&self, eye: glam::Vec3) -> f32 {
-        let far = self
+    fn hair_far(&self, world: &World, eye: glam::Vec3) -> f32 {
+        let far = world
             .crowd
             .hair_bounds()
             .into_iter()

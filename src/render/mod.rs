@@ -20,6 +20,7 @@ pub mod schedule;
 pub mod settings;
 pub mod shadow;
 pub mod skinned_props;
+pub mod world;
 
 pub use self::core::shared::FrameStats;
 pub use self::core::slots::{Dropped, FRAMES_IN_FLIGHT, FrameReport, ViewBudgets};

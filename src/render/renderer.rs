@@ -1,25 +1,24 @@
-//! The renderer: one frame serves every character. It owns the pipelines, the render targets
-//! (recreated on resize only), the crowd's GPU tables and [`FRAMES_IN_FLIGHT`] frame slots.
-//! A frame is recorded with [`Renderer::render_frame`] and its [`FrameReport`] collected with
-//! [`Renderer::wait`]; headless tools and tests do both with [`Renderer::render_one`].
-//! How a frame is built and recorded is in [`super::frame`]; props in
-//! [`super::prop_table`]; inspection hooks in [`super::debug`].
+//! The renderer: one frame serves every character. Its whole `impl` is here, a thin face over
+//! two parts: the [`World`] it draws (characters, props, skinned bodies, density volumes) and
+//! the [`Frames`] that draw it (pipelines, targets recreated on resize only, and
+//! [`super::FRAMES_IN_FLIGHT`] frame slots). A frame is recorded with
+//! [`Renderer::render_frame`] and its [`FrameReport`] collected with [`Renderer::wait`];
+//! headless tools and tests do both with [`Renderer::render_one`]. What a frame runs is
+//! [`super::schedule`]; how it is recorded and submitted, [`super::frame`]; inspection hooks,
+//! [`super::debug`].
 
-use std::collections::VecDeque;
 use std::sync::Arc;
 
 use glam::Mat4;
 
 use super::camera::View;
-use super::core::graph::TransientPool;
-use super::core::shared::{
-    FrameBinding, GenerateArgs, HairVertex, PropInstance, SET_FRAME, SET_TEXTURES,
-};
-use super::core::slots::{FRAMES_IN_FLIGHT, FrameReport, FrameSlot, Retired};
-use super::core::targets::{RenderTargets, ShadowMaps};
-use super::core::workspace::Workspace;
+use super::core::shared::{HairVertex, PropInstance, SoftSegment, TextureBinding};
+use super::core::slots::{FrameReport, Retired};
 use super::crowd::{CharacterId, Crowd, StrandParams};
-use super::passes::FramePasses;
+use super::debug;
+use super::frame::Frames;
+pub use super::frame::PresentTarget;
+use super::host::HostFrame;
 pub use super::passes::output::Overlay;
 use super::prop_table::Props;
 pub use super::settings::{
@@ -27,61 +26,17 @@ pub use super::settings::{
     software_raster_conflict, supported_msaa,
 };
 use super::soft::SoftBudget;
+use super::world::World;
 use crate::bake::BakedHairMesh;
 use crate::model::style::HairStyle;
-use crate::vk::{
-    BindingDesc, Context, DescriptorSetLayout, GpuError, GpuResult, PipelineLayout, Semaphore,
-    SwapchainImage,
-};
+use crate::vk::{Context, GpuError, GpuResult};
 
-/// Where a windowed frame goes: a swapchain image, the semaphore its acquisition signals and
-/// the one presentation waits for.
-pub struct PresentTarget<'a> {
-    /// The acquired image.
-    pub image: &'a SwapchainImage,
-    /// Signalled when the image may be written.
-    pub wait: &'a Semaphore,
-    /// Signalled when the frame is done (presentation waits for it).
-    pub signal: &'a Semaphore,
-    /// Drawn over the frame before it is presented (the control panel): called with the
-    /// colour target in colour-attachment use.
-    pub overlay: Option<&'a mut Overlay<'a>>,
-}
-
-/// Renders every character of the crowd in one frame.
+/// Renders every character of the crowd in one frame: the public face over the [`World`] it
+/// draws and the [`Frames`] that draw it.
 pub struct Renderer {
-    pub(super) ctx: Arc<Context>,
-    pub(super) desc: RendererDesc,
-    pub(super) crowd: Crowd,
-    pub(super) passes: FramePasses,
-    pub(super) frames: Vec<FrameSlot>,
-    pub(super) props: Props,
-    /// Skinned bodies and clothes.
-    pub(super) skinned: super::skinned_props::SkinnedProps,
-    pub(super) next: usize,
-    pub(super) frame_number: u64,
-    pub(super) targets: RenderTargets,
-    pub(super) shadow: ShadowMaps,
-    /// The frame graph's transient buffers and images, kept across frames.
-    pub(super) transients: TransientPool,
-    /// The software rasterizer's budgets.
-    pub(super) soft_budget: SoftBudget,
-    /// The crowd version whose strands the vertex pool holds (the last compute-path frame's),
-    /// which static-path frames draw again.
-    pub(super) static_version: Option<u64>,
-    /// The crowd structure whose strand layout the draw arguments describe (the last compute
-    /// frame's; a mesh frame clears them).
-    pub(super) args_structure: Option<u64>,
-    /// The LHS baseline's stored strands (`capture_lhs`), with the crowd version they are of.
-    pub(super) lhs: Option<(u64, super::passes::lhs_skin::LhsState)>,
-    pub(super) work: Workspace,
-    /// The previous frame's matrices and the temporal history.
-    pub(super) temporal: super::features::temporal::TemporalFeature,
-    pub(super) completed: VecDeque<FrameReport>,
-    /// Requested strand density volumes.
-    pub(super) volumes: super::volume::DensityVolumes,
-    /// The passes of host frames, made by the first one.
-    pub(super) host_passes: Option<super::passes::host_targets::HostTargetPasses>,
+    ctx: Arc<Context>,
+    world: World,
+    frames: Frames,
     /// Background colour (linear RGB).
     pub background: [f32; 3],
 }
@@ -91,115 +46,69 @@ impl Renderer {
     pub fn new(ctx: &Arc<Context>, desc: &RendererDesc) -> GpuResult<Self> {
         let soft_budget = check_desc(ctx, desc)?;
         let crowd = Crowd::new(ctx, desc.max_characters)?;
-        let bindings: Vec<BindingDesc> = FrameBinding::ALL
-            .iter()
-            .map(|(b, _)| BindingDesc::single(*b as u32, b.kind()))
-            .collect();
-        let frame_layout = DescriptorSetLayout::new(ctx, &bindings)?;
-        let mut set_layouts = vec![frame_layout.clone(); 2];
-        set_layouts[SET_FRAME as usize] = frame_layout.clone();
-        set_layouts[SET_TEXTURES as usize] = crowd.texture_layout().clone();
-        let layout = PipelineLayout::new(ctx, &set_layouts)?;
-        check_msaa(ctx, desc.msaa)
-            .map_err(|why| GpuError::Unsupported(format!("{}x MSAA: {why}", desc.msaa)))?;
-        let passes = FramePasses::new(ctx, &layout, desc.task_bundles, desc.msaa)?;
-        let temporal = super::features::temporal::TemporalFeature::new(ctx, &layout)?;
-        if desc.path == Some(RenderPath::Mesh) && !passes.has_mesh_path() {
-            return Err(GpuError::Unsupported(format!(
-                "{}: no usable VK_EXT_mesh_shader for the mesh path",
-                ctx.info.name
-            )));
-        }
-        let frames = (0..FRAMES_IN_FLIGHT)
-            .map(|_| FrameSlot::new(ctx, &frame_layout))
-            .collect::<GpuResult<_>>()?;
-        let work = Workspace::new(ctx)?;
+        let frames = Frames::new(ctx, desc, &crowd, soft_budget)?;
         Ok(Renderer {
             ctx: ctx.clone(),
-            desc: desc.clone(),
-            crowd,
-            passes,
+            world: World {
+                crowd,
+                props: Props::default(),
+                skinned: Default::default(),
+                volumes: Default::default(),
+            },
             frames,
-            props: Props::default(),
-            skinned: Default::default(),
-            next: 0,
-            frame_number: 0,
-            targets: RenderTargets::new(ctx, desc.width, desc.height, desc.msaa)?,
-            shadow: ShadowMaps::new(ctx, desc.shadow_resolution)?,
-            transients: TransientPool::new(ctx),
-            soft_budget,
-            static_version: None,
-            args_structure: None,
-            lhs: None,
-            work,
-            temporal,
-            completed: VecDeque::new(),
-            volumes: Default::default(),
-            host_passes: None,
             background: [0.6, 0.65, 0.7],
         })
     }
 
     /// The path frames use unless told otherwise.
     pub fn default_path(&self) -> RenderPath {
-        match self.desc.path {
-            Some(p) => p,
-            None if self.passes.has_mesh_path() => RenderPath::Mesh,
-            None => RenderPath::Compute,
-        }
+        self.frames.default_path()
     }
 
     /// Whether the mesh path is available.
     pub fn has_mesh_path(&self) -> bool {
-        self.passes.has_mesh_path()
+        self.frames.passes.has_mesh_path()
     }
 
     /// Whether the software rasterizer is available (64-bit shared and buffer atomics).
     pub fn has_software_raster(&self) -> bool {
-        self.passes.has_software_raster()
+        self.frames.passes.has_software_raster()
     }
 
     /// What this renderer's device offers, for [`FrameSettings::validate`].
     pub fn caps(&self) -> DeviceCaps {
-        DeviceCaps {
-            name: self.ctx.info.name.clone(),
-            mesh_path: self.passes.has_mesh_path(),
-            int64_atomics: self.passes.has_software_raster(),
-        }
+        self.frames.caps()
     }
 
     /// Forget the previous frame and the temporal history (a camera cut): the next frame has
     /// no motion and starts accumulating afresh.
     pub fn reset_temporal(&mut self) {
-        self.temporal.reset();
+        self.frames.temporal.reset();
     }
 
     /// Samples per pixel of the targets.
     pub fn msaa(&self) -> u32 {
-        self.desc.msaa
+        self.frames.desc.msaa
     }
 
     /// The software rasterizer's budgets.
     pub fn soft_budget(&self) -> SoftBudget {
-        self.soft_budget
+        self.frames.soft_budget
     }
 
     /// The software rasterizer's budgets and the `RendererDesc` choices it draws with.
     pub fn soft_tuning(&self) -> super::soft::SoftTuning {
-        super::soft::SoftTuning {
-            budget: self.soft_budget,
-            auto_split_pixels: self.desc.auto_split_pixels,
-        }
+        self.frames.soft_tuning()
     }
 
     /// The characters.
     pub fn crowd(&self) -> &Crowd {
-        &self.crowd
+        &self.world.crowd
     }
 
     /// Vertex slots of the compute path's pool.
     pub fn vertex_budget(&self) -> u32 {
-        (self.desc.vertex_pool_bytes / size_of::<HairVertex>() as u64).min(u32::MAX as u64) as u32
+        self.frames.vertex_budget()
     }
 
     /// Add a character (uploads its textures; blocks until they are on the GPU).
@@ -210,15 +119,15 @@ impl Renderer {
         params: StrandParams,
         model: Mat4,
     ) -> GpuResult<CharacterId> {
-        self.crowd.add(baked, style, params, model)
+        self.world.crowd.add(baked, style, params, model)
     }
 
     /// Remove a character; its textures are released after the frames using them.
     pub fn remove_character(&mut self, id: CharacterId) -> GpuResult<()> {
-        let removed = self.crowd.remove(id)?;
-        self.props.attached.retain(|(c, ..)| *c != id);
-        self.skinned.remove(id);
-        if let Some(cells) = self.volumes.remove(id) {
+        let removed = self.world.crowd.remove(id)?;
+        self.world.props.attached.retain(|(c, ..)| *c != id);
+        self.world.skinned.remove(id);
+        if let Some(cells) = self.world.volumes.remove(id) {
             self.retire(Retired::Resource(Box::new(cells)));
         }
         self.retire(Retired::Resource(Box::new(removed.textures)));
@@ -228,17 +137,17 @@ impl Renderer {
 
     /// Move a character.
     pub fn set_model(&mut self, id: CharacterId, model: Mat4) -> GpuResult<()> {
-        self.crowd.set_model(id, model)
+        self.world.crowd.set_model(id, model)
     }
 
     /// Show or hide a character.
     pub fn set_visible(&mut self, id: CharacterId, visible: bool) -> GpuResult<()> {
-        self.crowd.set_visible(id, visible)
+        self.world.crowd.set_visible(id, visible)
     }
 
     /// Change a character's strand settings.
     pub fn set_params(&mut self, id: CharacterId, params: StrandParams) -> GpuResult<()> {
-        self.crowd.set_params(id, params)
+        self.world.crowd.set_params(id, params)
     }
 
     /// Let character `id`'s hair mesh move (`bake::deform`): `basis` from the mesh and bake it
@@ -248,8 +157,8 @@ impl Renderer {
         id: CharacterId,
         basis: crate::bake::deform::DeformBasis,
     ) -> GpuResult<()> {
-        let layout = self.passes.deform_set_layout().clone();
-        self.crowd.make_deformable(id, basis, &layout)
+        let layout = self.frames.passes.deform_set_layout().clone();
+        self.world.crowd.make_deformable(id, basis, &layout)
     }
 
     /// Set a deformable character's hair mesh pose (`layers x vertices` object-space positions,
@@ -260,7 +169,7 @@ impl Renderer {
         id: CharacterId,
         positions: &[glam::Vec3],
     ) -> GpuResult<()> {
-        self.crowd.set_pose(id, positions)
+        self.world.crowd.set_pose(id, positions)
     }
 
     /// Simulate character `id`'s hair mesh on the GPU (`glsl/hair_dynamics.comp`), continuing
@@ -273,8 +182,8 @@ impl Renderer {
         id: CharacterId,
         sim: &crate::dynamics::HairDynamics,
     ) -> GpuResult<()> {
-        let layout = self.passes.deform_set_layout().clone();
-        if let Some(old) = self.crowd.simulate(id, sim, &layout)? {
+        let layout = self.frames.passes.deform_set_layout().clone();
+        if let Some(old) = self.world.crowd.simulate(id, sim, &layout)? {
             self.retire(Retired::Resource(Box::new(old)));
         }
         Ok(())
@@ -292,7 +201,7 @@ impl Renderer {
         model: glam::Mat4,
         settings: &crate::dynamics::DynamicsSettings,
     ) -> GpuResult<()> {
-        self.crowd.step_simulation(id, dt, model, settings)
+        self.world.crowd.step_simulation(id, dt, model, settings)
     }
 
     /// Character `id`'s GPU hair dynamics state (world positions and velocities) and clock,
@@ -302,7 +211,7 @@ impl Renderer {
         id: CharacterId,
     ) -> GpuResult<(crate::dynamics::HairState, crate::dynamics::StepClock)> {
         self.finish()?;
-        let sim = self.crowd.simulation(id)?.sim();
+        let sim = self.world.crowd.simulation(id)?.sim();
         let bytes = super::core::readback::read_device_buffer(
             &self.ctx,
             sim.state_buffer(),
@@ -318,10 +227,10 @@ impl Renderer {
         id: CharacterId,
         sampling: crate::reference::volume::VolumeSampling,
     ) -> GpuResult<()> {
-        if !self.crowd.contains(id) {
+        if !self.world.crowd.contains(id) {
             return Err(GpuError::Unsupported("no such character".into()));
         }
-        if let Some(old) = self.volumes.request(&self.ctx, id, sampling)? {
+        if let Some(old) = self.world.volumes.request(&self.ctx, id, sampling)? {
             self.retire(Retired::Resource(Box::new(old)));
         }
         Ok(())
@@ -333,7 +242,7 @@ impl Renderer {
         id: CharacterId,
     ) -> GpuResult<crate::reference::volume::DensityVolume> {
         self.finish()?;
-        self.volumes.read(&self.ctx, id)
+        self.world.volumes.read(&self.ctx, id)
     }
 
     /// Character `id`'s density volume's occupancy mask as the GPU wrote it (its bricks with
@@ -341,14 +250,14 @@ impl Renderer {
     /// flight.
     pub fn read_density_occupancy(&mut self, id: CharacterId) -> GpuResult<Vec<u32>> {
         self.finish()?;
-        self.volumes.read_occupancy(&self.ctx, id)
+        self.world.volumes.read_occupancy(&self.ctx, id)
     }
 
     /// The pose character `id`'s GPU hair dynamics last wrote (`layers x vertices`,
     /// character frame), read back after the frames in flight.
     pub fn read_hair_pose(&mut self, id: CharacterId) -> GpuResult<Vec<glam::Vec3>> {
         self.finish()?;
-        let s = self.crowd.simulation(id)?;
+        let s = self.world.crowd.simulation(id)?;
         let bytes = super::core::readback::read_device_buffer(&self.ctx, s.pose(), s.pose().size)?;
         let poses: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
         let n = s.sim().vertex_count();
@@ -367,8 +276,7 @@ impl Renderer {
         vertices: usize,
     ) -> GpuResult<Vec<super::core::shared::SkinnedVertex>> {
         self.finish()?;
-        let last = (self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT;
-        let buffer = &self.frames[last].skinned;
+        let buffer = &self.frames.last_slot().skinned;
         let bytes = vertices as u64 * size_of::<super::core::shared::SkinnedVertex>() as u64;
         if bytes > buffer.size {
             return Err(GpuError::Unsupported(format!(
@@ -390,7 +298,7 @@ impl Renderer {
         verts_per_strand: usize,
         fraction: f32,
     ) -> GpuResult<&crate::reference::lhs::LhsModel> {
-        if self.static_version != Some(self.crowd.version()) {
+        if self.frames.static_version != Some(self.world.crowd.version()) {
             return Err(GpuError::Unsupported(
                 "capture_lhs needs the strands of a compute-path frame of the current characters"
                     .into(),
@@ -410,19 +318,21 @@ impl Renderer {
         let model = crate::reference::lhs::LhsModel::new(positions, verts_per_strand, fraction)
             .map_err(|e| GpuError::Unsupported(e.to_string()))?;
         let pool = self
+            .frames
             .work
             .pool
             .as_ref()
             .ok_or_else(|| GpuError::Unsupported("no vertex pool".into()))?;
-        let state = self.passes.lhs_skin().upload(model, &rest, pool)?;
-        let version = self.crowd.structure_version();
-        Ok(self.lhs.insert((version, state)).1.model())
+        let state = self.frames.passes.lhs_skin().upload(model, &rest, pool)?;
+        let version = self.world.crowd.structure_version();
+        Ok(self.frames.lhs.insert((version, state)).1.model())
     }
 
     /// Set the LHS guides' vertices for the next `RenderPath::Lhs` frame (guide-major, as
     /// `LhsModel::guide_rest`).
     pub fn set_lhs_guides(&mut self, now: &[glam::Vec3]) -> GpuResult<()> {
-        self.lhs
+        self.frames
+            .lhs
             .as_mut()
             .ok_or_else(|| GpuError::Unsupported("no LHS strands captured".into()))?
             .1
@@ -435,7 +345,7 @@ impl Renderer {
         &mut self,
         meshes: &[Vec<super::core::shared::PropVertex>],
     ) -> GpuResult<()> {
-        if let Some(old) = self.props.set_meshes(&self.ctx, meshes)? {
+        if let Some(old) = self.world.props.set_meshes(&self.ctx, meshes)? {
             self.retire(Retired::Resource(Box::new(old)));
         }
         Ok(())
@@ -446,12 +356,12 @@ impl Renderer {
     /// frame (camera, light, motion). Replaces earlier far versions; cleared by
     /// [`Self::set_prop_meshes`].
     pub fn set_prop_lods(&mut self, lods: &[super::prop_table::PropLod]) -> GpuResult<()> {
-        self.props.set_lods(lods)
+        self.world.props.set_lods(lods)
     }
 
     /// Place world props for the next frames: `(mesh index, instance)`.
     pub fn set_prop_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
-        self.props.set_instances(instances)
+        self.world.props.set_instances(instances)
     }
 
     /// Give character `id` props that move with it (its head and body): `(mesh index,
@@ -463,17 +373,17 @@ impl Renderer {
         id: CharacterId,
         instances: &[(usize, PropInstance)],
     ) -> GpuResult<()> {
-        if !self.crowd.contains(id) {
+        if !self.world.crowd.contains(id) {
             return Err(GpuError::Unsupported(format!("no character {id:?}")));
         }
-        self.props.set_attached(id, instances)
+        self.world.props.set_attached(id, instances)
     }
 
     /// Where character `id`'s props are drawn this frame (world transforms, in the order
     /// given to [`Self::set_character_props`]); empty while it is hidden.
     pub fn character_prop_models(&self, id: CharacterId) -> Vec<Mat4> {
-        match self.crowd.drawn_model(id) {
-            Some(model) => self.props.attached_models(id, model),
+        match self.world.crowd.drawn_model(id) {
+            Some(model) => self.world.props.attached_models(id, model),
             None => Vec::new(),
         }
     }
@@ -481,7 +391,7 @@ impl Renderer {
     /// Upload the skinned meshes (bodies, clothes); characters wear them by index
     /// ([`Self::set_character_skin`]). Replaces earlier ones and what characters wore.
     pub fn set_skinned_meshes(&mut self, meshes: &[crate::skin::SkinnedMesh]) -> GpuResult<()> {
-        for old in self.skinned.set_meshes(&self.ctx, meshes)? {
+        for old in self.world.skinned.set_meshes(&self.ctx, meshes)? {
             self.retire(Retired::Resource(Box::new(old)));
         }
         Ok(())
@@ -489,7 +399,7 @@ impl Renderer {
 
     /// Far versions of skinned meshes (as [`Self::set_prop_lods`]).
     pub fn set_skinned_lods(&mut self, lods: &[super::prop_table::PropLod]) -> GpuResult<()> {
-        self.skinned.set_lods(lods)
+        self.world.skinned.set_lods(lods)
     }
 
     /// Character `id` wears skinned meshes `parts` (`(mesh, linear colour)`, the colour
@@ -502,10 +412,10 @@ impl Renderer {
         parts: &[(usize, [f32; 4])],
         joints: usize,
     ) -> GpuResult<()> {
-        if !self.crowd.contains(id) {
+        if !self.world.crowd.contains(id) {
             return Err(GpuError::Unsupported(format!("no character {id:?}")));
         }
-        self.skinned.set_wearer(id, parts, joints)
+        self.world.skinned.set_wearer(id, parts, joints)
     }
 
     /// Character `id`'s body for the next frames: its placement (`body`, the skinned
@@ -517,108 +427,91 @@ impl Renderer {
         body: Mat4,
         matrices: &[Mat4],
     ) -> GpuResult<()> {
-        self.skinned.set_pose(id, body, matrices)
+        self.world.skinned.set_pose(id, body, matrices)
     }
 
     /// Character `id`'s body placement and skin matrices as last set.
     pub fn character_pose(&self, id: CharacterId) -> Option<(Mat4, &[Mat4])> {
-        self.skinned.pose(id)
+        self.world.skinned.pose(id)
     }
 
     /// Where character `id` is drawn this frame (`None`: hidden or removed).
     pub fn drawn_model(&self, id: CharacterId) -> Option<Mat4> {
-        self.crowd.drawn_model(id)
+        self.world.crowd.drawn_model(id)
     }
 
     /// Target size.
     pub fn size(&self) -> (u32, u32) {
-        self.targets.size()
+        self.frames.targets.size()
     }
 
     /// Recreate the targets at a new size (frames in flight keep the old ones until done).
     pub fn resize(&mut self, width: u32, height: u32) -> GpuResult<()> {
-        super::settings::check_size(width, height)?;
-        if self.targets.size() == (width, height) {
-            return Ok(());
-        }
-        let old = std::mem::replace(
-            &mut self.targets,
-            RenderTargets::new(&self.ctx, width, height, self.desc.msaa)?,
-        );
-        self.retire(Retired::Resource(Box::new(old)));
-        Ok(())
+        self.frames.resize(&mut self.world.crowd, width, height)
     }
 
     /// Release `r` after the newest submitted frame completes (now if none is pending).
-    pub(super) fn retire(&mut self, r: Retired) {
-        let last = (self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT;
-        if self.frames[last].pending.is_some() {
-            self.frames[last].retired.push(r);
-        } else if let Retired::CharacterSlot(s) = r {
-            self.crowd.free_slot(s);
-        }
+    fn retire(&mut self, r: Retired) {
+        self.frames.retire(&mut self.world.crowd, r);
     }
 
-    /// Wait for frame slot `i`, collect its report and release what was retired with it.
-    pub(super) fn retire_slot(&mut self, i: usize) -> GpuResult<()> {
-        let slot = &mut self.frames[i];
-        slot.fence.wait()?;
-        if let Some(p) = slot.pending.take() {
-            let args: GenerateArgs = bytemuck::pod_read_unaligned(&slot.stats_readback.read()?);
-            let rgba = match (&mut slot.image_readback, p.read_image) {
-                (Some(b), true) => Some(b.read_range(0, (p.width * p.height * 4) as usize)?),
-                _ => None,
-            };
-            let motion = match (&mut slot.motion_readback, p.read_motion) {
-                (Some(b), true) => {
-                    let bytes = b.read_range(0, (p.width * p.height * 16) as usize)?;
-                    let words: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
-                    let decode = super::core::slots::PixelMotion::from_words;
-                    Some(words.iter().copied().map(decode).collect())
-                }
-                _ => None,
-            };
-            let roots = match p.probe_roots {
-                Some(n) => {
-                    let bytes = slot.root_probe.read_range(0, n as usize * 16)?;
-                    Some(bytemuck::pod_collect_to_vec(&bytes))
-                }
-                None => None,
-            };
-            let mesh_primitives = match (&slot.mesh_query, p.path) {
-                (Some(q), RenderPath::Mesh) => q.result()?,
-                _ => None,
-            };
-            let times = slot.profiler.results()?;
-            self.completed.push_back(FrameReport {
-                frame: p.frame,
-                path: p.path,
-                width: p.width,
-                height: p.height,
-                stats: args.stats,
-                light_stats: args.light_stats,
-                budgets: p.budgets,
-                pass_ms: times.scopes,
-                frame_ms: times.frame_ms,
-                unscoped_commands: p.unscoped_commands,
-                mesh_primitives,
-                record_ms: p.record_ms,
-                rgba,
-                motion,
-                frame_graph: p.frame_graph,
-                volume_characters: p.volume_characters,
-                roots,
-            });
-            while self.completed.len() > 2 * FRAMES_IN_FLIGHT {
-                self.completed.pop_front();
-            }
-        }
-        for r in std::mem::take(&mut self.frames[i].retired) {
-            if let Retired::CharacterSlot(s) = r {
-                self.crowd.free_slot(s);
-            }
-        }
-        Ok(())
+    /// [`Renderer::render_frame`], then blit the image onto `present.image` (scaled to its
+    /// size) after `present.wait`, signalling `present.signal` for presentation.
+    pub fn render_frame_to(
+        &mut self,
+        view: &View,
+        opts: &FrameOptions,
+        present: Option<PresentTarget>,
+    ) -> GpuResult<FrameTicket> {
+        let world = &mut self.world;
+        self.frames
+            .render_frame_to(world, self.background, view, opts, present)
+    }
+
+    /// Record the hair of one frame into a host's command buffer: seen through the host's
+    /// camera, hidden behind the host's depth, composited over the host's colour, with `look`
+    /// for everything else (light, shading, shadows, LoD; its camera is replaced). The host
+    /// submits the buffer, and once that submission has completed, [`Renderer::wait`] with the
+    /// ticket returns the frame's report without waiting (host frames complete when the host
+    /// says so). The renderer's targets follow the host colour's size. `opts.clear` does not
+    /// apply (the hair is drawn over a transparent layer, which `opts.read_image` reads back).
+    /// Refused: temporal accumulation (the host's own anti-aliasing jitters its projection,
+    /// which host frames follow), a slot out of range, images the host wants back unused.
+    pub fn record_host_frame(
+        &mut self,
+        look: &View,
+        opts: &FrameOptions,
+        frame: HostFrame,
+    ) -> GpuResult<FrameTicket> {
+        let world = &mut self.world;
+        self.frames
+            .record_host_frame(world, self.background, look, opts, frame)
+    }
+
+    /// Draw `segments` (screen space and shaded, as generation appends them) with the
+    /// software rasterizer alone, over a black image with nothing in front, keeping `k`
+    /// fragments per pixel sorted, each with opacity `opacity` times its coverage; returns
+    /// the image (RGBA8, sRGB). Waits for the frames in flight. For tests and tools that
+    /// check the rasterizer apart from generation (single-sample targets only).
+    pub fn rasterize_segments(
+        &mut self,
+        segments: &[SoftSegment],
+        k: u32,
+        opacity: f32,
+    ) -> GpuResult<Vec<u8>> {
+        debug::rasterize_segments(&mut self.frames, &mut self.world, segments, k, opacity)
+    }
+
+    /// The first `count` vertices of the compute path's pool, as the last frame wrote them
+    /// (waits for every frame in flight).
+    pub fn read_vertices(&mut self, count: u32) -> GpuResult<Vec<HairVertex>> {
+        debug::read_vertices(&mut self.frames, &mut self.world, count)
+    }
+
+    /// Read back character `id`'s texture `binding` (tightly packed texels, as in the bake).
+    /// Waits for every frame in flight; for tests and tools.
+    pub fn read_texture(&mut self, id: CharacterId, binding: TextureBinding) -> GpuResult<Vec<u8>> {
+        debug::read_texture(&mut self.frames, &mut self.world, id, binding)
     }
 
     /// Record and submit one frame of every visible character seen from `view`. Waits only
@@ -631,43 +524,18 @@ impl Renderer {
     /// completed); a window loop calls this before acquiring a swapchain image, so the
     /// semaphores it passes are no longer in use.
     pub fn wait_for_free_slot(&mut self) -> GpuResult<()> {
-        self.retire_slot(self.next)
+        self.frames
+            .retire_slot(&mut self.world.crowd, self.frames.next)
     }
 
     /// Wait for a submitted frame and return its report.
     pub fn wait(&mut self, ticket: FrameTicket) -> GpuResult<FrameReport> {
-        if let Some(i) = (0..FRAMES_IN_FLIGHT).find(|&i| {
-            self.frames[i]
-                .pending
-                .as_ref()
-                .is_some_and(|p| p.frame == ticket.0)
-        }) {
-            // Frames complete in order: retire the older pending frame first.
-            let other = (i + 1) % FRAMES_IN_FLIGHT;
-            if self.frames[other]
-                .pending
-                .as_ref()
-                .is_some_and(|p| p.frame < ticket.0)
-            {
-                self.retire_slot(other)?;
-            }
-            self.retire_slot(i)?;
-        }
-        self.completed
-            .iter()
-            .position(|r| r.frame == ticket.0)
-            .and_then(|k| self.completed.remove(k))
-            .ok_or_else(|| {
-                GpuError::Unsupported(format!("report of frame {} is no longer kept", ticket.0))
-            })
+        self.frames.wait(&mut self.world.crowd, ticket)
     }
 
     /// Wait for every frame in flight.
     pub fn finish(&mut self) -> GpuResult<()> {
-        for k in 1..=FRAMES_IN_FLIGHT {
-            self.retire_slot((self.next + k) % FRAMES_IN_FLIGHT)?;
-        }
-        Ok(())
+        self.frames.finish(&mut self.world.crowd)
     }
 
     /// Render one frame and wait for it (headless tools and tests).

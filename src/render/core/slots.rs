@@ -283,6 +283,55 @@ impl FrameSlot {
             density_jobs: None,
         })
     }
+
+    /// The report of this slot's completed frame `p`: its statistics, timings and what it
+    /// read back.
+    pub fn report(&mut self, p: Pending) -> GpuResult<FrameReport> {
+        let args: GenerateArgs = bytemuck::pod_read_unaligned(&self.stats_readback.read()?);
+        let rgba = match (&mut self.image_readback, p.read_image) {
+            (Some(b), true) => Some(b.read_range(0, (p.width * p.height * 4) as usize)?),
+            _ => None,
+        };
+        let motion = match (&mut self.motion_readback, p.read_motion) {
+            (Some(b), true) => {
+                let bytes = b.read_range(0, (p.width * p.height * 16) as usize)?;
+                let words: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
+                Some(words.iter().copied().map(PixelMotion::from_words).collect())
+            }
+            _ => None,
+        };
+        let roots = match p.probe_roots {
+            Some(n) => {
+                let bytes = self.root_probe.read_range(0, n as usize * 16)?;
+                Some(bytemuck::pod_collect_to_vec(&bytes))
+            }
+            None => None,
+        };
+        let mesh_primitives = match (&self.mesh_query, p.path) {
+            (Some(q), RenderPath::Mesh) => q.result()?,
+            _ => None,
+        };
+        let times = self.profiler.results()?;
+        Ok(FrameReport {
+            frame: p.frame,
+            path: p.path,
+            width: p.width,
+            height: p.height,
+            stats: args.stats,
+            light_stats: args.light_stats,
+            budgets: p.budgets,
+            pass_ms: times.scopes,
+            frame_ms: times.frame_ms,
+            unscoped_commands: p.unscoped_commands,
+            mesh_primitives,
+            record_ms: p.record_ms,
+            rgba,
+            motion,
+            frame_graph: p.frame_graph,
+            volume_characters: p.volume_characters,
+            roots,
+        })
+    }
 }
 
 /// A host-visible uniform buffer for one `FrameBlock`.
