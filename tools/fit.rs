@@ -13,6 +13,7 @@ use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::Vec3;
 use hairmesh::budget::{self, MemoryBudget, VEC_HEADER};
+use hairmesh::cli::DeviceFlags;
 use hairmesh::fit::metric::compare;
 use hairmesh::fit::picture::{StrandLook, draw_strands};
 use hairmesh::fit::{FitOptions, Fitted, fit};
@@ -20,7 +21,7 @@ use hairmesh::fsutil::RunFiles;
 use hairmesh::model::strands::StrandModel;
 use hairmesh::reference::generate::strands_per_bundle_for;
 use hairmesh::render::{Camera, Renderer, RendererDesc};
-use hairmesh::vk::{Context, ContextDesc};
+use hairmesh::vk::Context;
 use hairmesh::{BakeOptions, BakedHairMesh, CpuGenerator, bake, outln};
 
 /// Fit a hair mesh to a strand model.
@@ -48,12 +49,9 @@ struct Args {
     /// With --report: write the input (left) and the fitted hair mesh (right) here.
     #[arg(long)]
     picture: Option<PathBuf>,
-    /// Enable Vulkan validation layers (--report).
-    #[arg(long)]
-    validation: bool,
-    /// Choose the GPU by name substring (--report).
-    #[arg(long)]
-    device: Option<String>,
+    /// The device of --report.
+    #[command(flatten)]
+    gpu: DeviceFlags,
     /// Host memory the fit may use, MiB: larger work is refused before it starts.
     #[arg(long, value_name = "MIB", default_value = "4096", value_parser = budget::parse_budget_flag)]
     memory_budget_mib: MemoryBudget,
@@ -172,11 +170,7 @@ fn report(
         model.diagonal(),
         fitted.bundle_size
     )?;
-    let ctx = Arc::new(Context::new(
-        &ContextDesc::default()
-            .validation(args.validation)
-            .device(args.device.clone()),
-    )?);
+    let ctx = Arc::new(Context::new(&args.gpu.context_desc())?);
     let size = 384;
     let mut r = Renderer::new(&ctx, &RendererDesc::default().size(size, size))?;
     let (lo, hi) = model.bounds();

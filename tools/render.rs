@@ -15,7 +15,7 @@ use anyhow::{Context as _, Result, bail};
 use clap::Parser;
 use glam::{Mat4, Vec3};
 use hairmesh::budget::{self, Estimate, MemoryBudget};
-use hairmesh::cli::Parsed;
+use hairmesh::cli::{DeviceFlags, LodFlags, LookFlags, Parsed};
 use hairmesh::fsutil::RunFiles;
 use hairmesh::outln;
 use hairmesh::render::FrameSettings;
@@ -24,7 +24,7 @@ use hairmesh::render::{
     Camera, FrameOptions, FrameReport, LodSettings, RenderPath, Renderer, RendererDesc,
     StrandParams, View,
 };
-use hairmesh::vk::{Context, ContextDesc};
+use hairmesh::vk::Context;
 
 /// Render hair generated on the GPU from hair-mesh textures.
 #[derive(Parser)]
@@ -60,9 +60,6 @@ struct Args {
     /// Vertices per strand are 2^e + 1 (e in 0..=6).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=6))]
     verts_log2: u32,
-    /// Choose the GPU by name substring (default: discrete, else integrated, else lavapipe).
-    #[arg(long)]
-    device: Option<String>,
     /// Generation path: mesh (task + mesh shaders), compute (compute + vertex pulling),
     /// static (a compute frame generates the strands, then a second frame draws them again
     /// with no generation: the raster limit), or lhs (the same strands stored with 1% guides
@@ -70,71 +67,6 @@ struct Args {
     /// second frame's. Default: mesh where the device supports it.
     #[arg(long)]
     path: Option<RenderPath>,
-    /// Level of detail (paper sec. 3.6).
-    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
-    lod: bool,
-    /// Alpha of eq. 7 for strand LoD.
-    #[arg(long, default_value_t = 0.1)]
-    lod_alpha_strands: f32,
-    /// Strands of bundles spanning fewer than this many pixels fall with their area, thickened
-    /// to keep the coverage (0: off, the paper's eq. 7; `crowd` uses 8).
-    #[arg(long, default_value_t = 0.0)]
-    lod_area_below: f32,
-    /// At most this many strands per square pixel of a bundle's extent, thickened to keep the
-    /// coverage (0: off; `crowd` uses 0.5).
-    #[arg(long, default_value_t = 0.0)]
-    lod_strands_per_pixel: f32,
-    /// Alpha of eq. 7 for vertex LoD.
-    #[arg(long, default_value_t = 0.1)]
-    lod_alpha_verts: f32,
-    /// Geomorph window lambda of eq. 10-12, in (0, 1].
-    #[arg(long, default_value_t = 0.5)]
-    lod_lambda: f32,
-    /// Samples per pixel (MSAA): 1, 2, 4, 8 where the device supports it (lavapipe: 1 or 4);
-    /// default: the scene's `[look] msaa`, else 1.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
-    msaa: Option<u32>,
-    /// Shadows: off, deep-opacity (deep opacity maps) or approximate (approximate deep
-    /// shadow maps); default: the scene's `[look] shadows`, else off.
-    #[arg(long)]
-    shadows: Option<hairmesh::render::ShadowMode>,
-    /// Strand shading: placeholder, kajiya-kay or marschner; default: the scene's
-    /// `[look] shading`, else marschner.
-    #[arg(long)]
-    shading: Option<hairmesh::shade::ShadingModel>,
-    /// Strand compositing: opaque, oit or oit:K (K-buffer OIT with K fragments per pixel,
-    /// default 8), peel or peel:N (depth peeling of N layers, default 32: the slow
-    /// reference); default: the scene's `[look] transparency`, else opaque.
-    #[arg(long)]
-    transparency: Option<hairmesh::render::Transparency>,
-    /// Temporal accumulation: off, or taa (jittered frames blended along exact motion
-    /// vectors; with --frames N the last of N accumulated frames is written); default: the
-    /// scene's `[look] temporal`, else off.
-    #[arg(long)]
-    temporal: Option<hairmesh::render::Temporal>,
-    /// Seed 000's thick-strand appearance term under LoD (true/false); default: the scene's
-    /// `[look] lod_appearance`, else true.
-    #[arg(long)]
-    lod_appearance: Option<bool>,
-    /// Multiple scattering between strands under marschner (dual scattering: light hair
-    /// glows through itself) (true/false); default: the scene's `[look]
-    /// multiple_scattering`, else false.
-    #[arg(long)]
-    multiple_scattering: Option<bool>,
-    /// Strand rasterization: hw (camera-facing strips through the hardware rasterizer),
-    /// soft or soft:K (the compute software rasterizer keeping K fragments per pixel sorted,
-    /// default 8), auto or auto:K (per bundle: strands drawn at most 4 pixels wide to
-    /// software, thicker ones to hardware; the static and LHS paths' stored strands all go
-    /// to software). Default: auto where the device and the other settings allow it, else
-    /// hw.
-    #[arg(long)]
-    draw: Option<hairmesh::render::StrandRaster>,
-    /// How the light's passes draw the hair with shadows on: hw (hardware strips) or soft
-    /// (the compute software rasterizer: nearest depth by atomic min, deep opacity layers by
-    /// fixed-point sums). soft needs the mesh or compute path. Default: soft where the device
-    /// and the other settings allow it, else hw.
-    #[arg(long)]
-    shadow_draw: Option<hairmesh::render::LightRaster>,
     /// Render this many identical frames and report (and write) the last: later frames give
     /// steady-state timings (lavapipe compiles shaders during the first). With the mesh or
     /// compute path.
@@ -144,13 +76,16 @@ struct Args {
     /// up to it and report the overflow).
     #[arg(long, default_value_t = 96, value_parser = clap::value_parser!(u64).range(1..=4096))]
     vertex_pool_mib: u64,
-    /// Enable Vulkan validation layers.
-    #[arg(long)]
-    validation: bool,
     /// Print the frame graph of the (last) frame: every pass in order with the resources it
     /// reads and writes and the barriers the graph derived.
     #[arg(long)]
     print_frame: bool,
+    #[command(flatten)]
+    lod: LodFlags,
+    #[command(flatten)]
+    look: LookFlags,
+    #[command(flatten)]
+    gpu: DeviceFlags,
     /// Output PNG.
     #[arg(short, long)]
     output: PathBuf,
@@ -203,20 +138,9 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
 
 /// Settings from the flags, checked.
 fn lod_settings(args: &Args) -> Result<LodSettings> {
-    let lod = LodSettings {
-        enabled: args.lod,
-        alpha_strands: args.lod_alpha_strands,
-        area_below: args.lod_area_below,
-        strands_per_pixel: args.lod_strands_per_pixel,
-        alpha_verts: args.lod_alpha_verts,
-        lambda: args.lod_lambda,
-    };
-    lod.validate().map_err(|e| {
-        anyhow::anyhow!(
-            "--lod-alpha-strands/--lod-area-below/--lod-strands-per-pixel/--lod-alpha-verts/--lod-lambda: {e}"
-        )
-    })?;
-    Ok(lod)
+    args.lod
+        .settings(LodSettings::default())
+        .map_err(anyhow::Error::msg)
 }
 
 /// One character to render.
@@ -396,19 +320,30 @@ struct Look {
 impl Look {
     fn resolve(args: &Args, look: &hairmesh::render::scene::LookDesc) -> Self {
         Look {
-            msaa: args.msaa.or(look.msaa).unwrap_or(1),
+            msaa: args.look.msaa.or(look.msaa).unwrap_or(1),
             transparency: args
+                .look
                 .transparency
                 .or(look.transparency_mode())
                 .unwrap_or_default(),
             shading: args
+                .look
                 .shading
                 .or(look.shading_model())
                 .unwrap_or(hairmesh::shade::ShadingModel::Marschner),
-            shadows: args.shadows.or(look.shadow_mode()).unwrap_or_default(),
-            temporal: args.temporal.or(look.temporal_mode()).unwrap_or_default(),
-            lod_appearance: args.lod_appearance.or(look.lod_appearance).unwrap_or(true),
+            shadows: args.look.shadows.or(look.shadow_mode()).unwrap_or_default(),
+            temporal: args
+                .look
+                .temporal
+                .or(look.temporal_mode())
+                .unwrap_or_default(),
+            lod_appearance: args
+                .look
+                .lod_appearance
+                .or(look.lod_appearance)
+                .unwrap_or(true),
             multiple_scattering: args
+                .look
                 .multiple_scattering
                 .or(look.multiple_scattering)
                 .unwrap_or(false),
@@ -431,15 +366,8 @@ fn check_unused(p: &Parsed<Args>, inputs: &Inputs, look: &Look) -> Result<(), St
         a.camera.is_some() || inputs.scene_camera.is_none(),
         "the scene's camera has its own field of view (give --camera to use --fov)",
     )?;
-    for id in [
-        "lod_alpha_strands",
-        "lod_area_below",
-        "lod_strands_per_pixel",
-        "lod_alpha_verts",
-        "lod_lambda",
-        "lod_appearance",
-    ] {
-        p.unused_unless(id, a.lod, "--lod is off")?;
+    for id in LodFlags::TUNING_IDS {
+        p.unused_unless(id, a.lod.lod, "--lod is off")?;
     }
     p.unused_unless(
         "multiple_scattering",
@@ -465,7 +393,7 @@ fn print_report(
     outln!(
         "{:?} path, LoD {}, {} character(s), {} strands (up to {} vertices each), {} strand triangles, {}x{}",
         out.path,
-        args.lod,
+        args.lod.lod,
         characters,
         out.stats.strands_drawn,
         (1u32 << args.verts_log2) + 1,
@@ -529,10 +457,10 @@ fn check_before_work(
     check_unused(parsed, inputs, look).map_err(anyhow::Error::msg)?;
     let settings = FrameSettings {
         path: args.path.unwrap_or(RenderPath::Compute),
-        raster: args.draw.unwrap_or_default(),
+        raster: args.look.draw.unwrap_or_default(),
         transparency: look.transparency,
         msaa: look.msaa,
-        light_raster: args.shadow_draw.unwrap_or_default(),
+        light_raster: args.look.shadow_draw.unwrap_or_default(),
     };
     if let Err(why) = settings.check_combination() {
         bail!(
@@ -547,14 +475,10 @@ fn check_before_work(
     let output = RunFiles::new()
         .inputs(inputs.files.iter().map(PathBuf::as_path))
         .output(&args.output, "-o")?;
-    let ctx = Arc::new(Context::new(
-        &ContextDesc::default()
-            .validation(args.validation)
-            .device(args.device.clone()),
-    )?);
+    let ctx = Arc::new(Context::new(&args.gpu.context_desc())?);
     let msaa = look.msaa;
     hairmesh::render::check_msaa(&ctx, msaa).map_err(|why| {
-        let flag = if args.msaa.is_some() {
+        let flag = if args.look.msaa.is_some() {
             "--msaa"
         } else {
             "the scene's [look] msaa"
@@ -575,7 +499,7 @@ fn check_before_work(
         inputs.size,
         look.transparency,
         look.temporal != hairmesh::render::Temporal::Off,
-        settings.raster.uses_software() || args.draw.is_none(),
+        settings.raster.uses_software() || args.look.draw.is_none(),
     )
     .map_err(|why| anyhow::anyhow!("--size {w}x{h}: {why}"))?;
     Ok((ctx, output, settings))
@@ -609,7 +533,7 @@ fn run(parsed: Parsed<Args>) -> Result<()> {
     for c in &inputs.characters {
         renderer.add_character(&c.baked, &c.style, c.params, c.model)?;
     }
-    let settings = settings.with_fastest((args.draw, args.shadow_draw), &renderer.caps());
+    let settings = settings.with_fastest((args.look.draw, args.look.shadow_draw), &renderer.caps());
     let view = View {
         light_dir: match &args.light {
             Some(l) => parse_vec3("--light", l)?,

@@ -21,6 +21,7 @@ use hairmesh::animate::{CharacterMotion, CrowdAnimation, Wind};
 use hairmesh::bake::deform::DeformBasis;
 use hairmesh::characters::own::OwnCharacter;
 use hairmesh::characters::preset::{self, Preset, SPACING, StrandDensity};
+use hairmesh::cli::{DeviceFlags, LodFlags, LookFlags};
 use hairmesh::fsutil::{RunFiles, StagedFolder};
 use hairmesh::render::{
     Camera, FrameOptions, LodSettings, RenderPath, Renderer, RendererDesc, StrandParams, View,
@@ -102,44 +103,6 @@ pub struct Args {
     /// Vertices per strand are 2^e + 1 (e in 0..=6).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=6))]
     verts_log2: u32,
-    /// Samples per pixel (MSAA): 1, 2, 4, 8 where the device supports it (lavapipe: 1 or 4).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
-    msaa: u32,
-    /// Strand shading: placeholder, kajiya-kay or marschner.
-    #[arg(long, default_value = "marschner")]
-    shading: hairmesh::shade::ShadingModel,
-    /// Shadows: off, deep-opacity (deep opacity maps) or approximate (approximate deep
-    /// shadow maps).
-    #[arg(long, default_value = "deep-opacity")]
-    shadows: hairmesh::render::ShadowMode,
-    /// Strand compositing: opaque, oit or oit:K (K-buffer OIT, K fragments per pixel, default
-    /// 8) or peel or peel:N (depth peeling, N layers: the slow reference).
-    #[arg(long, default_value = "opaque")]
-    transparency: hairmesh::render::Transparency,
-    /// Temporal accumulation: off, or taa (jittered frames blended along exact motion
-    /// vectors: steadier sub-pixel strands).
-    #[arg(long, default_value = "off")]
-    temporal: hairmesh::render::Temporal,
-    /// Strand rasterization: hw (hardware strips), soft or soft:K (the compute software
-    /// rasterizer, K fragments per pixel kept sorted), auto or auto:K (per bundle: thin
-    /// strands to software, thick ones to hardware). Software needs --msaa 1 and opaque or
-    /// oit transparency. Default: auto where the device and the other settings allow it,
-    /// else hw.
-    #[arg(long)]
-    draw: Option<hairmesh::render::StrandRaster>,
-    /// How the light's passes draw the hair with shadows on: hw (hardware strips) or soft
-    /// (the compute software rasterizer: nearest depth by atomic min, deep opacity layers by
-    /// fixed-point sums). soft needs the mesh or compute path. Default: soft where the device
-    /// and the other settings allow it, else hw.
-    #[arg(long)]
-    shadow_draw: Option<hairmesh::render::LightRaster>,
-    /// Seed 000's thick-strand appearance term under LoD.
-    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
-    lod_appearance: bool,
-    /// Multiple scattering between strands under marschner (dual scattering, seed 000): light
-    /// hair glows through itself instead of going flat and grey.
-    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
-    multiple_scattering: bool,
     /// The volume tier (seed 002): far characters' hair ray-marched through strand density
     /// volumes, and volumetric ambient occlusion of every character's hair; off: strands
     /// only, no occlusion.
@@ -149,26 +112,6 @@ pub struct Args {
     /// volumes alone, above NEAR as strands alone, blended between.
     #[arg(long, default_value = "40,64")]
     volume_band: String,
-    /// Level of detail.
-    #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
-    lod: bool,
-    /// Alpha of eq. 7 for strand LoD (the crowd's default is half `render`'s: measured FLIP
-    /// 0.008 against 0.1 on the people crowd, 1.4x faster).
-    #[arg(long, default_value_t = hairmesh::render::CROWD_ALPHA_STRANDS)]
-    lod_alpha_strands: f32,
-    /// Strands of bundles spanning fewer than this many pixels fall with their area, thickened
-    /// to keep the coverage (0: off, the paper's eq. 7): 1000 people draw half the strands,
-    /// FLIP 0.011 against off.
-    #[arg(long, default_value_t = hairmesh::render::CROWD_AREA_BELOW)]
-    lod_area_below: f32,
-    /// At most this many strands per square pixel of a bundle's extent (0: off): at crowd
-    /// distance a bundle draws the strands the pixels it covers need, whatever the density,
-    /// thickened to keep its coverage.
-    #[arg(long, default_value_t = hairmesh::render::CROWD_STRANDS_PER_PIXEL)]
-    lod_strands_per_pixel: f32,
-    /// Alpha of eq. 7 for vertex LoD.
-    #[arg(long, default_value_t = 0.1)]
-    lod_alpha_verts: f32,
     /// Characters walk, turn and sway, and their hair meshes are simulated (people and furry
     /// balls; teapots move without hair dynamics).
     #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
@@ -191,15 +134,15 @@ pub struct Args {
     /// Headless: the camera orbits the crowd (off: it stays at frame 0's place).
     #[arg(long, default_value = "on", value_parser = hairmesh::render::parse_switch, action = clap::ArgAction::Set)]
     orbit: bool,
+    #[command(flatten)]
+    lod: LodFlags,
+    #[command(flatten)]
+    look: LookFlags,
+    #[command(flatten)]
+    gpu: DeviceFlags,
     /// Generation path (default: mesh where supported).
     #[arg(long, value_parser = parse_generated_path)]
     path: Option<RenderPath>,
-    /// Choose the GPU by name substring.
-    #[arg(long)]
-    device: Option<String>,
-    /// Enable Vulkan validation layers (any error fails the run).
-    #[arg(long)]
-    validation: bool,
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32)> {
@@ -277,14 +220,14 @@ impl Scene {
         height: u32,
     ) -> Result<Renderer> {
         let path = args.path;
-        hairmesh::render::check_msaa(ctx, args.msaa)
-            .map_err(|why| anyhow::anyhow!("--msaa {}: {why}", args.msaa))?;
+        hairmesh::render::check_msaa(ctx, args.msaa())
+            .map_err(|why| anyhow::anyhow!("--msaa {}: {why}", args.msaa()))?;
         let mut renderer = Renderer::new(
             ctx,
             &RendererDesc::default()
                 .size(width, height)
                 .path(path)
-                .msaa(args.msaa)
+                .msaa(args.msaa())
                 .max_characters(args.count),
         )?;
         let density = args.density();
@@ -495,19 +438,50 @@ impl Args {
         }
     }
 
-    /// Level of detail as the flags ask (checked by `check_args`).
-    fn lod_settings(&self) -> LodSettings {
-        if self.lod {
-            LodSettings {
-                alpha_strands: self.lod_alpha_strands,
-                area_below: self.lod_area_below,
-                strands_per_pixel: self.lod_strands_per_pixel,
-                alpha_verts: self.lod_alpha_verts,
-                ..LodSettings::crowd()
-            }
-        } else {
-            LodSettings::off()
-        }
+    /// The LoD flags over the crowd's preset ([`LodSettings::crowd`]), checked.
+    fn lod_settings(&self) -> Result<LodSettings> {
+        self.lod
+            .settings(LodSettings::crowd())
+            .map_err(anyhow::Error::msg)
+    }
+
+    /// Samples per pixel (default 1).
+    fn msaa(&self) -> u32 {
+        self.look.msaa.unwrap_or(1)
+    }
+
+    /// Strand shading (default marschner, the crowd's look).
+    fn shading(&self) -> hairmesh::shade::ShadingModel {
+        self.look
+            .shading
+            .unwrap_or(hairmesh::shade::ShadingModel::Marschner)
+    }
+
+    /// Shadows (default deep opacity, the crowd's look).
+    fn shadows(&self) -> hairmesh::render::ShadowMode {
+        self.look
+            .shadows
+            .unwrap_or(hairmesh::render::ShadowMode::DeepOpacity)
+    }
+
+    /// Strand compositing (default opaque).
+    fn transparency(&self) -> hairmesh::render::Transparency {
+        self.look.transparency.unwrap_or_default()
+    }
+
+    /// Temporal accumulation (default off).
+    fn temporal(&self) -> hairmesh::render::Temporal {
+        self.look.temporal.unwrap_or_default()
+    }
+
+    /// The thick-strand appearance term (default on).
+    fn lod_appearance(&self) -> bool {
+        self.look.lod_appearance.unwrap_or(true)
+    }
+
+    /// Multiple scattering (default on, the crowd's look).
+    fn multiple_scattering(&self) -> bool {
+        self.look.multiple_scattering.unwrap_or(true)
     }
 
     /// The frame settings the flags ask for (the path and rasterizers the device picks are
@@ -515,10 +489,10 @@ impl Args {
     fn frame_settings(&self) -> hairmesh::render::FrameSettings {
         hairmesh::render::FrameSettings {
             path: self.path.unwrap_or(RenderPath::Compute),
-            raster: self.draw.unwrap_or_default(),
-            transparency: self.transparency,
-            msaa: self.msaa,
-            light_raster: self.shadow_draw.unwrap_or_default(),
+            raster: self.look.draw.unwrap_or_default(),
+            transparency: self.transparency(),
+            msaa: self.msaa(),
+            light_raster: self.look.shadow_draw.unwrap_or_default(),
         }
     }
 
@@ -586,21 +560,15 @@ fn check_unused(p: &hairmesh::cli::Parsed<Args>) -> Result<(), String> {
     )?;
     p.unused_unless(
         "multiple_scattering",
-        a.shading == hairmesh::shade::ShadingModel::Marschner,
+        a.shading() == hairmesh::shade::ShadingModel::Marschner,
         "it is part of --shading marschner",
     )?;
-    for id in [
-        "lod_appearance",
-        "lod_alpha_strands",
-        "lod_area_below",
-        "lod_strands_per_pixel",
-        "lod_alpha_verts",
-    ] {
-        p.unused_unless(id, a.lod, "--lod is off")?;
+    for id in LodFlags::TUNING_IDS.into_iter().chain(["lod_appearance"]) {
+        p.unused_unless(id, a.lod.lod, "--lod is off")?;
     }
     p.unused_unless(
         "shadow_draw",
-        a.shadows != hairmesh::render::ShadowMode::Off,
+        a.shadows() != hairmesh::render::ShadowMode::Off,
         "--shadows is off",
     )?;
     Ok(())
@@ -638,14 +606,11 @@ fn check_args(p: &hairmesh::cli::Parsed<Args>) -> Result<Checked> {
             args.strands_per_cm2
         );
     }
-    args.lod_settings().validate().map_err(|e| {
-        anyhow::anyhow!(
-            "--lod-alpha-strands / --lod-area-below / --lod-strands-per-pixel / --lod-alpha-verts: {e}"
-        )
-    })?;
+    args.lod_settings()?;
+
     let settings = args.frame_settings();
     if let Err(why) = settings.check_combination() {
-        bail!("--draw / --msaa {} / --transparency: {why}", args.msaa);
+        bail!("--draw / --msaa {} / --transparency: {why}", args.msaa());
     }
     // Every output of the run is checked before the first frame, and they appear only when
     // the whole run succeeded.
@@ -667,14 +632,14 @@ fn check_args(p: &hairmesh::cli::Parsed<Args>) -> Result<Checked> {
 /// The flags against the device: MSAA it offers, and per-pixel storage its largest buffer
 /// holds at `--size` (named as flags, never as buffers).
 fn check_device_limits(ctx: &Context, args: &Args, (w, h): (u32, u32)) -> Result<()> {
-    hairmesh::render::check_msaa(ctx, args.msaa)
-        .map_err(|why| anyhow::anyhow!("--msaa {}: {why}", args.msaa))?;
+    hairmesh::render::check_msaa(ctx, args.msaa())
+        .map_err(|why| anyhow::anyhow!("--msaa {}: {why}", args.msaa()))?;
     hairmesh::render::passes::check_frame_storage(
         ctx.info.max_storage_buffer_range,
         (w, h),
-        args.transparency,
-        args.temporal != hairmesh::render::Temporal::Off,
-        args.draw.is_none_or(|d| d.uses_software()),
+        args.transparency(),
+        args.temporal() != hairmesh::render::Temporal::Off,
+        args.look.draw.is_none_or(|d| d.uses_software()),
     )
     .map_err(|why| anyhow::anyhow!("--size {w}x{h}: {why}"))
 }
@@ -690,7 +655,7 @@ const STATS_HEADER: &str = "frame,gpu_ms,unscoped_ms,unscoped_commands,record_ms
 /// The interactive window. It makes its own device once it exists; the flags are checked
 /// against the device before the crowd is built all the same.
 fn run_window(args: Args, size: (u32, u32)) -> Result<()> {
-    let probe = Context::new(&ContextDesc::default().device(args.device.clone()))?;
+    let probe = Context::new(&ContextDesc::default().device(args.gpu.device.clone()))?;
     check_device_limits(&probe, &args, size)?;
     drop(probe);
     let scene = Scene::build(&args)?;
@@ -723,11 +688,7 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
         return run_window(args, (width, height));
     };
     // The device's limits are checked before the crowd is built.
-    let ctx = Arc::new(Context::new(
-        &ContextDesc::default()
-            .validation(args.validation)
-            .device(args.device.clone()),
-    )?);
+    let ctx = Arc::new(Context::new(&args.gpu.context_desc())?);
     check_device_limits(&ctx, &args, (width, height))?;
     let scene = Scene::build(&args)?;
     let settings = args.frame_settings();
@@ -737,12 +698,12 @@ fn run(parsed: hairmesh::cli::Parsed<Args>) -> Result<()> {
         path: renderer.default_path(),
         ..settings
     }
-    .with_fastest((args.draw, args.shadow_draw), &renderer.caps());
+    .with_fastest((args.look.draw, args.look.shadow_draw), &renderer.caps());
     let mut animation = scene.animation(&mut renderer, &args)?;
     let csv_path = args.out.join("stats.csv");
     let mut csv = String::from(STATS_HEADER);
     print_run_line(&ctx, &scene, &args, &renderer)?;
-    let lod = args.lod_settings();
+    let lod = args.lod_settings()?;
     let full = scene.full_strands(args.density(), args.verts_log2)?;
     for f in 0..args.frames {
         let camera = frame_camera(&args, f, &animation, characters)?;
@@ -851,12 +812,12 @@ fn frame_view(
             hairmesh::render::camera::CROWD_LIGHT_DIR
         },
         lod,
-        shading: args.shading,
-        shadows: args.shadows,
-        transparency: args.transparency,
-        temporal: args.temporal,
-        lod_appearance: args.lod_appearance,
-        multiple_scattering: args.multiple_scattering,
+        shading: args.shading(),
+        shadows: args.shadows(),
+        transparency: args.transparency(),
+        temporal: args.temporal(),
+        lod_appearance: args.lod_appearance(),
+        multiple_scattering: args.multiple_scattering(),
         volumes,
         ..View::new(camera)
     }

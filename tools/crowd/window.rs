@@ -25,7 +25,7 @@ use hairmesh::render::{
 };
 use hairmesh::shade::ShadingModel;
 use hairmesh::vk::{
-    Acquired, Context, ContextDesc, PresentMode, Semaphore, Swapchain, UiRenderer, WindowHandles,
+    Acquired, Context, PresentMode, Semaphore, Swapchain, UiRenderer, WindowHandles,
 };
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::application::ApplicationHandler;
@@ -462,15 +462,18 @@ impl App {
         let acquire = (0..hairmesh::render::FRAMES_IN_FLIGHT)
             .map(|_| Semaphore::new(&ctx))
             .collect::<Result<_, _>>()?;
-        let soft_ok = renderer.has_software_raster() && self.args.msaa == 1;
+        let soft_ok = renderer.has_software_raster() && self.args.msaa() == 1;
         let chosen = hairmesh::render::FrameSettings {
             path,
-            raster: self.args.draw.unwrap_or_default(),
-            transparency: self.args.transparency,
+            raster: self.args.look.draw.unwrap_or_default(),
+            transparency: self.args.transparency(),
             msaa: renderer.msaa(),
-            light_raster: self.args.shadow_draw.unwrap_or_default(),
+            light_raster: self.args.look.shadow_draw.unwrap_or_default(),
         }
-        .with_fastest((self.args.draw, self.args.shadow_draw), &renderer.caps());
+        .with_fastest(
+            (self.args.look.draw, self.args.look.shadow_draw),
+            &renderer.caps(),
+        );
         self.running = Some(Running {
             soft_ok,
             panel,
@@ -489,14 +492,14 @@ impl App {
             },
             scene: Arc::clone(&self.scene),
             path,
-            shading: self.args.shading,
-            shadows: self.args.shadows,
+            shading: self.args.shading(),
+            shadows: self.args.shadows(),
             light_raster: chosen.light_raster,
-            transparency: self.args.transparency,
-            temporal: self.args.temporal,
+            transparency: self.args.transparency(),
+            temporal: self.args.temporal(),
             raster: chosen.raster,
-            lod_appearance: self.args.lod_appearance,
-            multiple_scattering: self.args.multiple_scattering,
+            lod_appearance: self.args.lod_appearance(),
+            multiple_scattering: self.args.multiple_scattering(),
             volumes: self.args.volume_tier()?,
             animation,
             last_draw: Instant::now(),
@@ -539,10 +542,7 @@ impl App {
             window: window.window_handle()?.as_raw(),
         };
         Ok(Arc::new(Context::new(
-            &ContextDesc::default()
-                .validation(self.args.validation)
-                .device(self.args.device.clone())
-                .window(handles),
+            &self.args.gpu.context_desc().window(handles),
         )?))
     }
 
@@ -567,7 +567,7 @@ impl App {
             egui_state,
             pending_free: Vec::new(),
             visible: self.scene.character_count(),
-            lod: self.args.lod_settings(),
+            lod: self.args.lod_settings()?,
         })
     }
 

@@ -8,6 +8,9 @@
 //! hairmesh::cli::clean_up_on_signals("crowd");
 //! ```
 
+pub mod flags;
+pub use flags::{DeviceFlags, LodFlags, LookFlags};
+
 use clap::error::{ContextKind, ContextValue, ErrorKind};
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Command, Parser};
