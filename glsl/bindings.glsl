@@ -88,7 +88,7 @@ float lod_strand_fade(uvec4 lod, uint strand) {
 // empty one for g below the total; generate.comp, pool_segments.comp).
 uint group_bundle(uint g) {
     uint lo = 0u;
-    uint hi = frame.counts.x - 1u;
+    uint hi = frame.counts.bundles - 1u;
     while (lo < hi) {
         uint mid = (lo + hi + 1u) / 2u;
         if (bundle_offsets[mid].w <= g) {

@@ -20,21 +20,21 @@ uvec4 encode_lod(BundleLod r) {
     return uvec4(r.strands, r.e | (r.soft ? LOD_SOFT : 0u) | fade, floatBitsToUint(r.gamma), floatBitsToUint(r.thickness));
 }
 
-// Software or hardware raster (frame.soft.x: RASTER_HARDWARE, RASTER_SOFTWARE, RASTER_AUTO, or
+// Software or hardware raster (frame.soft.mode: RASTER_HARDWARE, RASTER_SOFTWARE, RASTER_AUTO, or
 // RASTER_LIGHT: the light's software shadow passes, every bundle). Auto: software
-// when the bundle's strands are drawn at most frame.soft_params.x pixels wide at its nearest
+// when the bundle's strands are drawn at most frame.soft.auto_split_pixels pixels wide at its nearest
 // point `d` (the LoD-thickened width, or the cluster footprint of lod_appearance.glsl).
 bool soft_raster(float d, float width, float thickness, float cap) {
-    if (frame.soft.x != RASTER_AUTO) {
-        return frame.soft.x != RASTER_HARDWARE;
+    if (frame.soft.mode != RASTER_AUTO) {
+        return frame.soft.mode != RASTER_HARDWARE;
     }
-    float pixel = frame.light_dir.w > 0.0 ? 2.0 * max(d, 1e-6) / (frame.camera_pos.w * frame.light_dir.w)
-                                          : frame.lod_ortho.x / frame.camera_pos.w;
+    float pixel = frame.cot_half_fov > 0.0 ? 2.0 * max(d, 1e-6) / (frame.pixels_high * frame.cot_half_fov)
+                                          : frame.lod.ortho_height / frame.pixels_high;
     float drawn = width * thickness;
-    if (frame.shading.y != 0u && thickness > 1.0) {
+    if (frame.shading.lod_appearance != 0u && thickness > 1.0) {
         drawn = max(drawn, min(sqrt(thickness) * min(pixel, width), cap));
     }
-    return drawn <= frame.soft_params.x * pixel;
+    return drawn <= frame.soft.auto_split_pixels * pixel;
 }
 
 // Eq. 8's strand count for `wanted` strands (its level times N + delta), clamped to
@@ -57,36 +57,36 @@ bool box_visible(vec3 lo, vec3 hi) {
     return true;
 }
 
-// Eq. 7's d tan theta at distance d (orthographic, lod.w == 0: the view height).
+// Eq. 7's d tan theta at distance d (orthographic, frame.lod.tan_fov == 0: the view height).
 float eq7_denominator(float d) {
-    return frame.lod.w > 0.0 ? max(d, 1e-6) * frame.lod.w : max(frame.lod_ortho.x, 1e-6);
+    return frame.lod.tan_fov > 0.0 ? max(d, 1e-6) * frame.lod.tan_fov : max(frame.lod.ortho_height, 1e-6);
 }
 
 // Eq. 7's measure h R / (d tan theta) before alpha and the clamp.
 float detail_level_unclamped(float h, float d) {
-    return h * frame.camera_pos.w / eq7_denominator(d);
+    return h * frame.pixels_high / eq7_denominator(d);
 }
 
-// Eq. 7 (perspective, or orthographic when lod.w == 0).
+// Eq. 7 (perspective, or orthographic when frame.lod.tan_fov == 0).
 float detail_level(float h, float d, float alpha) {
-    return clamp(h * frame.camera_pos.w * alpha / eq7_denominator(d), 0.0, 1.0);
+    return clamp(h * frame.pixels_high * alpha / eq7_denominator(d), 0.0, 1.0);
 }
 
-// Eq. 7's strand level times the crowd's area term (frame.lod_ortho.y: 0 off): below that
+// Eq. 7's strand level times the crowd's area term (frame.lod.area_below: 0 off): below that
 // extent (h R / (d tan theta), about pixels) a bundle's strands fall with its area, and eq. 8's
-// thickness widens the rest; then the pixel cap (frame.lod_ortho.z strands per square pixel of
+// thickness widens the rest; then the pixel cap (frame.lod.strands_per_pixel strands per square pixel of
 // the extent, 0 off) for a bundle of `count` strands: at crowd distance a bundle draws as many
 // strands as the pixels it covers need, whatever its count at full detail (seed 000's thick
 // strands in place of a cluster). CPU twin: reference::lod::{bundle_extent, area_factor,
 // pixel_cap_level}.
 float strand_level(float h, float d, uint count) {
-    float level = detail_level(h, d, frame.lod.x);
+    float level = detail_level(h, d, frame.lod.alpha_strands);
     float extent = detail_level_unclamped(h, d);
-    float below = frame.lod_ortho.y;
+    float below = frame.lod.area_below;
     if (below > 0.0) {
         level *= clamp(extent / below, 0.0, 1.0);
     }
-    float per_pixel = frame.lod_ortho.z;
+    float per_pixel = frame.lod.strands_per_pixel;
     if (per_pixel > 0.0) {
         level = min(level, per_pixel * extent * extent / float(count));
     }
@@ -168,12 +168,12 @@ BundleLod bundle_lod(uint g, float pressure) {
         r.strands = 0u;
         return r;
     }
-    vec3 eye = frame.camera_pos.xyz;
+    vec3 eye = frame.eye;
     float d = length(eye - clamp(eye, lo, hi));
     float h = scale * desc.rest_size;
     float delta = hash_f32(hash_u32(desc.local_index ^ 0x2545f491u) ^ style.seed);
     float size_over_width = bundle_size_over_width(desc);
-    if (frame.counts.z == 0u) {
+    if (frame.counts.lod_on == 0u) {
         r.soft = soft_raster(d, scale * style.strand_width, 1.0, h);
         if (ch_strand_share < 1.0 || pressure < 1.0) {
             set_strands(r, ch_strand_share * pressure * (float(count) + delta), count);
@@ -191,10 +191,10 @@ BundleLod bundle_lod(uint g, float pressure) {
     set_strands(r, ls * ch_strand_share * (float(count) + delta), count);
     r.thickness = eq8_thickness(ls, count, r.strands, size_over_width);
     // Vertex LoD: eq. 9, 10, 12.
-    float lv = detail_level(h, d, frame.lod.y);
+    float lv = detail_level(h, d, frame.lod.alpha_verts);
     float x = log2(max(lv * float(1u << emax), 1e-30));
     r.e = uint(clamp(ceil(x), 0.0, float(emax)));
-    float lambda = clamp(frame.lod.z, 1e-6, 1.0);
+    float lambda = clamp(frame.lod.lambda, 1e-6, 1.0);
     float e_next = max(ceil(x - lambda), 0.0);
     if (float(r.e) > e_next && r.e > 0u) {
         r.gamma = clamp(1.0 - (x - e_next) / lambda, 0.0, 1.0);

@@ -21,7 +21,7 @@ void main() {
         s_demand[gl_LocalInvocationIndex] = 0u;
     }
     barrier();
-    if (g < frame.counts.x) {
+    if (g < frame.counts.bundles) {
         bind_character(bundles[g].character);
         BundleLod r = bundle_lod(g, 1.0);
         bundle_lods[g] = encode_lod(r);

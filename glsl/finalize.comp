@@ -1,6 +1,6 @@
 #version 460
 // Compute path, pass 3 (one invocation): totals, the vertex-pool budget and the indirect
-// arguments. When the frame needs more vertex slots than the pool holds (frame.counts.w),
+// arguments. When the frame needs more vertex slots than the pool holds (frame.counts.vertex_budget),
 // whole strands are kept in crowd order up to the budget: they are a prefix of every prefix
 // sum, so generate.comp and strands.vert need no other change; the rest is reported.
 // push.params.x: offset of the grand total in scan_scratch.
@@ -10,8 +10,8 @@ layout(local_size_x = 1) in;
 #include "bundle_sizes.glsl"
 
 void main() {
-    uint bundles = frame.counts.x;
-    uint budget = frame.counts.w;
+    uint bundles = frame.counts.bundles;
+    uint budget = frame.counts.vertex_budget;
     uvec4 total = scan_scratch[push.params.x];
     uvec4 kept = total;
     if (total.y > budget) {

@@ -52,7 +52,7 @@ void main() {
             hair_vertices[out_index].pos_width = vec4(sp[idx], width_scale * fade * strand_width_at(s));
             hair_vertices[out_index].tangent_s = vec4(st[idx], s);
 #ifdef VISIBILITY
-            if (frame.temporal.w != 0u) {
+            if (frame.temporal.residuals != 0u) {
                 vertex_motion[out_index] = packHalf2x16(entry_residual(idx, bundles[bundle].character));
             }
 #endif

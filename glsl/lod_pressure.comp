@@ -1,7 +1,7 @@
 #version 460
 // Both paths, every view, after cull.comp: when the bundles' LoD asks for more software
-// segments than the segment budget (frame.soft.z), or on the compute path (push.params.x != 0)
-// more vertex slots than the pool holds (frame.counts.w), every bundle of that kind keeps the
+// segments than the segment budget (frame.soft.segment_budget), or on the compute path (push.params.x != 0)
+// more vertex slots than the pool holds (frame.counts.vertex_budget), every bundle of that kind keeps the
 // same share of its strands (eq. 7's strand level times the share, eq. 8's thickness widened
 // to keep its coverage: bundle_lod's pressure), so the frame fits and no character loses its hair to the order in which its
 // strands were appended. CPU twin: reference::lod::{lod_pressure, strand_lod}.
@@ -14,7 +14,7 @@ layout(local_size_x = CULL_GROUP_SIZE) in;
 
 void main() {
     uint g = gl_WorkGroupID.y * (DISPATCH_ROW * uint(CULL_GROUP_SIZE)) + gl_GlobalInvocationID.x;
-    if (g >= frame.counts.x) {
+    if (g >= frame.counts.bundles) {
         return;
     }
     uvec4 lod = bundle_lods[g];
@@ -23,9 +23,9 @@ void main() {
     }
     float p = 1.0;
     if (lod_is_soft(lod.y)) {
-        p = lod_pressure(args.stats.soft_demand, args.stats.soft_slack, frame.soft.z);
+        p = lod_pressure(args.stats.soft_demand, args.stats.soft_slack, frame.soft.segment_budget);
     } else if (push.params.x != 0u) {
-        p = lod_pressure(args.stats.pool_demand, args.stats.pool_slack, frame.counts.w);
+        p = lod_pressure(args.stats.pool_demand, args.stats.pool_slack, frame.counts.vertex_budget);
     }
     if (p < 1.0) {
         // The decision again with the lower level; the bundle stays with the rasterizer

@@ -15,13 +15,13 @@ layout(early_fragment_tests) in;
 void main() {
     // With MSAA a fragment runs for a pixel when the strip covers any of its samples: weigh
     // it by the samples it covers, so a strip adds the same opacity whatever the sample count.
-    float a = strand_alpha() * float(bitCount(gl_SampleMaskIn[0])) / float(frame.transparency.z);
+    float a = strand_alpha() * float(bitCount(gl_SampleMaskIn[0])) / float(frame.transparency.samples);
     if (a < 0.5 / 255.0) {
         return;
     }
     note_fragment(in_character, in_residual);
     uint pixel = oit_pixel();
-    uint k = frame.transparency.y;
+    uint k = frame.transparency.kbuffer_nodes;
     uint64_t v = (uint64_t(floatBitsToUint(gl_FragCoord.z)) << 32) | uint64_t(pack_fragment(shade_strand(), a));
     for (uint i = 0u; i < k; i++) {
         uint64_t old = atomicMin(oit_nodes[pixel * k + i], v);

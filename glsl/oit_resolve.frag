@@ -1,6 +1,6 @@
 #version 460
 // Composite the transparent strands over the opaque image: the K-buffer's sorted nodes front
-// to back, then its tail as one layer behind them (frame.transparency.x == 1), or the depth
+// to back, then its tail as one layer behind them (frame.transparency.mode == 1), or the depth
 // peeling accumulation (== 2, PEEL_RESOLVE). Output premultiplied (C, A), blended over:
 // dst = C + dst (1 - A), coverage A + a_dst (1 - A) (an opaque image stays opaque; a host
 // frame's transparent layer gains the strands' coverage).
@@ -26,7 +26,7 @@ void main() {
 #else
     {
         uint p = oit_pixel();
-        uint k = frame.transparency.y;
+        uint k = frame.transparency.kbuffer_nodes;
         for (uint i = 0u; i < k; i++) {
             uint64_t node = oit_nodes[p * k + i];
             if (node == OIT_EMPTY) {

@@ -22,8 +22,8 @@ layout(location = 0) out vec4 out_color;
 void main() {
     note_fragment(VISIBILITY_PROP | in_instance, vec2(0.0));
     vec3 n = normalize(in_normal);
-    vec3 l = normalize(frame.light_dir.xyz);
-    vec3 v = normalize(frame.camera_pos.xyz - in_pos);
+    vec3 l = normalize(frame.to_light);
+    vec3 v = normalize(frame.eye - in_pos);
     vec3 h = normalize(l + v);
     float nl = max(dot(n, l), 0.0);
     float nv = max(dot(n, v), 1e-4);

@@ -15,6 +15,6 @@ void main() {
     note_fragment(VISIBILITY_SOLID | in_character, vec2(0.0));
     vec3 n = normalize(in_normal);
     // Two-sided: the scalp winding is arbitrary.
-    float d = abs(dot(n, normalize(frame.light_dir.xyz)));
+    float d = abs(dot(n, normalize(frame.to_light)));
     out_color = vec4(in_color * (0.3 + 0.7 * d), 1.0);
 }

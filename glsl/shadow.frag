@@ -2,7 +2,7 @@
 // Deep opacity maps, second light pass (Yuksel and Keyser 2008): each strand fragment adds its
 // opacity (one strand's opacity times the fraction of the texel it covers, strip.glsl) to the
 // layer its depth falls in, counted from the hair depth of the first light pass in steps of
-// frame.shadow_params.x. Additive blending sums the layers; the last one keeps everything
+// frame.shadow.layer_thickness. Additive blending sums the layers; the last one keeps everything
 // further back. Lookups: shadow_lookup.glsl.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
@@ -17,9 +17,9 @@ layout(location = 0) out vec4 out_layers;
 
 void main() {
     float d0 = texelFetch(shadow_hair_depth, ivec2(gl_FragCoord.xy), 0).r;
-    float dz = max(gl_FragCoord.z - d0, 0.0) * frame.shadow_params.y;
-    int layer = min(int(dz / frame.shadow_params.x), 3);
+    float dz = max(gl_FragCoord.z - d0, 0.0) * frame.shadow.depth_range;
+    int layer = min(int(dz / frame.shadow.layer_thickness), 3);
     vec4 add = vec4(0.0);
-    add[layer] = cluster_opacity(frame.shadow_params.z * in_coverage, in_thickness);
+    add[layer] = cluster_opacity(frame.shadow.strand_opacity * in_coverage, in_thickness);
     out_layers = add;
 }

@@ -14,7 +14,7 @@ layout(set = SET_FRAME, binding = BINDING_SHADOW_LAYERS) uniform sampler2D shado
 // Hair opacity (sum of strand opacities) between the first hair and depth dz behind it,
 // interpolated within the layer dz falls in (the cumulative layer sums of the DOM paper).
 float deep_opacity(vec4 layers, float dz) {
-    float x = dz / frame.shadow_params.x;
+    float x = dz / frame.shadow.layer_thickness;
     return layers.x * clamp(x, 0.0, 1.0) + layers.y * clamp(x - 1.0, 0.0, 1.0)
         + layers.z * clamp(x - 2.0, 0.0, 1.0) + layers.w * clamp(x - 3.0, 0.0, 1.0);
 }
@@ -33,7 +33,7 @@ float box_weight(int i, float f) {
 // count as lit. Unfiltered (strands: a strand is thinner than a texel, and its many fragments
 // or vertices average the edge anyway), one comparison at the nearest texel.
 float body_visibility(vec3 p, bool filtered) {
-    float res = frame.body_shadow.x;
+    float res = frame.body_shadow.resolution;
     if (res <= 0.0) {
         return 1.0;
     }
@@ -44,12 +44,12 @@ float body_visibility(vec3 p, bool filtered) {
     vec2 st = (c.xy * 0.5 + 0.5) * res - 0.5;
     vec2 base = floor(st);
     vec2 f = st - base;
-    float z = c.z * frame.body_shadow.y - frame.body_shadow.z;
+    float z = c.z * frame.body_shadow.depth_range - frame.body_shadow.bias;
     int side = int(res);
     if (!filtered) {
         ivec2 t = ivec2(floor(st + 0.5));
         bool off = any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, ivec2(side)));
-        return off || z <= texelFetch(shadow_prop_depth, t, 0).r * frame.body_shadow.y ? 1.0 : 0.0;
+        return off || z <= texelFetch(shadow_prop_depth, t, 0).r * frame.body_shadow.depth_range ? 1.0 : 0.0;
     }
     float lit = 0.0;
     for (int j = -1; j <= 2; j++) {
@@ -58,7 +58,7 @@ float body_visibility(vec3 p, bool filtered) {
             float wx = box_weight(i, f.x);
             ivec2 t = ivec2(base) + ivec2(i, j);
             bool open = any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, ivec2(side)))
-                || z <= texelFetch(shadow_prop_depth, t, 0).r * frame.body_shadow.y;
+                || z <= texelFetch(shadow_prop_depth, t, 0).r * frame.body_shadow.depth_range;
             lit += open ? wx * wy : 0.0;
         }
     }
@@ -73,7 +73,7 @@ float body_visibility(vec3 p, bool filtered) {
 // surfaces, where a hair shadow's edge would show the texels); else the 3x3 texels around
 // the nearest (strands: 9 taps, not 16).
 vec3 light_arrival_with(vec3 p, float offset, float body, bool slide) {
-    uint mode = frame.shadow.x;
+    uint mode = frame.shadow.mode;
     if (mode == SHADOW_OFF) {
         return vec3(1.0, 1.0, 0.0);
     }
@@ -87,13 +87,13 @@ vec3 light_arrival_with(vec3 p, float offset, float body, bool slide) {
     if (body <= 0.0) {
         return vec3(0.0);
     }
-    int res = int(frame.shadow.y);
+    int res = int(frame.shadow.resolution);
     vec2 st = uv * float(res) - (slide ? 0.5 : 0.0);
     ivec2 base = ivec2(floor(st));
     vec2 f = slide ? st - floor(st) : vec2(0.5);
     int last = slide ? 2 : 1;
-    float range = frame.shadow_params.y;
-    float alpha = frame.shadow_params.z;
+    float range = frame.shadow.depth_range;
+    float alpha = frame.shadow.strand_opacity;
     float z = c.z * range - offset;
     // Per-strand transmittance 1 - alpha written as exp(-k alpha): opacity sums then give the
     // product of strand transmittances, and k * opacity is the expected hits.
@@ -117,7 +117,7 @@ vec3 light_arrival_with(vec3 p, float offset, float body, bool slide) {
             } else {
                 // One strand per layer thickness in front of the point (calibrated against
                 // deep opacity maps on the sample heads, tests/shadows.rs).
-                opacity = alpha * (dz / frame.shadow_params.x);
+                opacity = alpha * (dz / frame.shadow.layer_thickness);
             }
             sum += w * exp(-k * opacity);
             hits += w * k * opacity;
@@ -136,8 +136,8 @@ vec3 light_arrival(vec3 p, float offset) {
 // acne on slopes without the light leaking under contacts), the hair maps two biases toward
 // the light.
 vec3 light_arrival_surface(vec3 p, vec3 n) {
-    float body = body_visibility(p + n * (1.5 * frame.body_shadow.w), true);
-    return light_arrival_with(p, 2.0 * frame.shadow_params.w, body, true);
+    float body = body_visibility(p + n * (1.5 * frame.body_shadow.texel), true);
+    return light_arrival_with(p, 2.0 * frame.shadow.bias, body, true);
 }
 
 

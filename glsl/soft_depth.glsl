@@ -1,7 +1,7 @@
 // The camera's opaque depth as the software rasterizer keeps it: one float (0..1) per pixel,
 // row by row, copied from the depth target (passes::soft_raster::add_depth_copy) after the
 // opaque pass, for the far hair's march, and again before the software raster. Bound when the
-// camera's strands go through the software rasterizer (frame.soft.x != RASTER_HARDWARE).
+// camera's strands go through the software rasterizer (frame.soft.mode != RASTER_HARDWARE).
 // Requires bindings.glsl.
 #ifndef SOFT_DEPTH_GLSL
 #define SOFT_DEPTH_GLSL

@@ -121,13 +121,13 @@ void shade_pixel(SegmentRaster s, ivec2 pixel, ivec2 origin, uint k) {
         return;
     }
     vec4 c = mix(s.ca, s.cb, u);
-    float alpha = cluster_opacity(frame.soft_params.y * cov * c.a, s.thickness);
+    float alpha = cluster_opacity(frame.soft.strand_opacity * cov * c.a, s.thickness);
     if (alpha < 0.5 / 255.0) {
         return;
     }
     uint64_t v = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(pack_fragment(c.rgb, alpha));
 #ifdef VISIBILITY
-    if (frame.temporal.x != 0u) {
+    if (frame.temporal.motion != 0u) {
         atomicMin(s_visible[lp], visibility_word(depth, s.id, s.residual));
     }
 #endif
@@ -174,7 +174,7 @@ void raster_segment(Segment s, vec2 residual, ivec2 origin, ivec2 extent, uint k
 // Deformation residual of segment si (temporal.glsl), in frames with motion vectors.
 vec2 segment_residual(uint si) {
 #ifdef VISIBILITY
-    if (frame.temporal.x != 0u) {
+    if (frame.temporal.motion != 0u) {
         return unpackHalf2x16(segment_motion[si]);
     }
 #endif
@@ -189,7 +189,7 @@ void main() {
         return;
     }
     uint lp = gl_LocalInvocationIndex;
-    uint k = frame.soft.y;
+    uint k = frame.soft.k;
     ivec2 size = ivec2(frame.viewport.xy);
     ivec2 origin = ivec2(gl_WorkGroupID.xy) * int(SOFT_TILE);
     ivec2 extent = min(ivec2(SOFT_TILE), size - origin);
@@ -239,9 +239,9 @@ void main() {
     }
 #endif
     // Insert the tile's fragments into the k-buffer's sorted list (the pixel is this
-    // thread's alone now): the nearest frame.transparency.y stay nodes, the others join the
+    // thread's alone now): the nearest frame.transparency.kbuffer_nodes stay nodes, the others join the
     // tail.
-    uint kg = frame.transparency.y;
+    uint kg = frame.transparency.kbuffer_nodes;
     uint64_t rg = s_tail[lp * 2u];
     uint64_t ba = s_tail[lp * 2u + 1u];
     uvec4 tail = uvec4(uint(rg), uint(rg >> 32), uint(ba), uint(ba >> 32));

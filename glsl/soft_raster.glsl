@@ -40,11 +40,11 @@ Segment load_segment(uint i) {
 }
 
 uint tiles_per_row() {
-    return frame.soft_grid.x;
+    return frame.soft.tiles_x;
 }
 
 uint tile_rows() {
-    return frame.soft_grid.y;
+    return frame.soft.tiles_y;
 }
 
 // The range of the parameter t in [0, 1] where the centre line a + t (b - a) has its

@@ -5,8 +5,8 @@
 // same models as the fragment shaders, evaluated at the vertices and interpolated along the
 // segment) and projected; every segment with both ends in the depth range and its footprint
 // on screen is appended to soft_segments[]. The workgroup reserves its segments with one
-// atomic add; those past the budget (frame.soft.z) are counted, not written. In the light's
-// view (frame.soft.x == RASTER_LIGHT) nothing is shaded: the shadow passes need depth and
+// atomic add; those past the budget (frame.soft.segment_budget) are counted, not written. In the light's
+// view (frame.soft.mode == RASTER_LIGHT) nothing is shaded: the shadow passes need depth and
 // coverage only.
 #ifndef SOFT_SEGMENTS_GLSL
 #define SOFT_SEGMENTS_GLSL
@@ -59,7 +59,7 @@ float soft_vertex_width(uint idx, uint strand, float s) {
 // sqrt(k) times the smaller of a pixel and one strand's width, capped by the bundle). Unlike
 // hardware strips it is not widened to a pixel: coverage is computed exactly.
 float soft_drawn_width(float width, float pixel, float thickness, float cap) {
-    if (frame.shading.y == 0u || thickness <= 1.0) {
+    if (frame.shading.lod_appearance == 0u || thickness <= 1.0) {
         return width;
     }
     return max(width, min(sqrt(thickness) * min(pixel, width / thickness), cap));
@@ -102,7 +102,7 @@ void emit_soft_segments(uint count, uint segments, vec3 color, uint character, u
         vec3 ndc = c.xyz / max(c.w, 1e-6);
         vec2 screen = (ndc.xy * 0.5 + 0.5) * frame.viewport.xy;
         sv_screen[idx] = vec4(screen, ndc.z, in_range ? drawn / pixel : -1.0);
-        vec3 radiance = frame.soft.x == RASTER_LIGHT ? vec3(0.0) : strand_radiance(st[idx], s, p, color, character, thickness);
+        vec3 radiance = frame.soft.mode == RASTER_LIGHT ? vec3(0.0) : strand_radiance(st[idx], s, p, color, character, thickness);
         sv_color[idx] = pack_fragment(radiance, width / max(drawn, 1e-20));
 #if defined(VISIBILITY) && !defined(SOFT_POOL)
         sv_residual[idx] = entry_residual(idx, character);
@@ -125,7 +125,7 @@ void emit_soft_segments(uint count, uint segments, vec3 color, uint character, u
         s_soft_base = s_soft_count > 0u ? atomicAdd(args.stats.segments_demanded, s_soft_count) : 0u;
     }
     barrier();
-    uint budget = frame.soft.z;
+    uint budget = frame.soft.segment_budget;
     uint out_index = s_soft_base + local;
     for (uint idx = t, i = 0u; idx < entries; idx += S, i++) {
         if ((kept & (1u << i)) != 0u) {
@@ -142,7 +142,7 @@ void emit_soft_segments(uint count, uint segments, vec3 color, uint character, u
                 soft_segments[out_index].b = uvec4(packHalf2x16(b.xy - a.xy), sv_color[idx], sv_color[idx + 1u],
                                                    packHalf2x16(vec2(0.5 * (a.w + b.w), thickness)));
 #ifdef VISIBILITY
-                if (frame.temporal.x != 0u) {
+                if (frame.temporal.motion != 0u) {
                     // The segment's deformation residual: its ends' mean (the stored strands
                     // of the static and LHS paths have none).
 #ifdef SOFT_POOL

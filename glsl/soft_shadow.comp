@@ -11,10 +11,10 @@
 //   nearest centre line point; the minimum over segments by atomicMin on the float bits
 //   (non-negative floats order as their bits).
 // - deep opacity (OPACITY_PASS, Yuksel and Keyser 2008, as shadow.frag): each texel a segment
-//   covers adds one strand's opacity (frame.shadow_params.z) times the exact covered area
+//   covers adds one strand's opacity (frame.shadow.strand_opacity) times the exact covered area
 //   (soft_raster.glsl's pixel_coverage) times the drawn width's share, with seed 000's cluster
 //   opacity for thick LoD strands, into the layer its depth falls in behind the hair depth
-//   (steps of frame.shadow_params.x). Sums are fixed point (SHADOW_OPACITY_FIXED) so the
+//   (steps of frame.shadow.layer_thickness). Sums are fixed point (SHADOW_OPACITY_FIXED) so the
 //   result does not depend on the order segments arrive in; the four layers are written as the
 //   RGBA16F texel of the layers map.
 //
@@ -72,9 +72,9 @@ void draw_segment(Segment s, ivec2 origin, ivec2 extent, float h) {
             if (cov <= 0.0) {
                 continue;
             }
-            float dz = max(z - s_hair_depth[lp], 0.0) * frame.shadow_params.y;
-            uint layer = uint(min(int(dz / frame.shadow_params.x), 3));
-            float o = cluster_opacity(frame.shadow_params.z * cov * share, s.thickness);
+            float dz = max(z - s_hair_depth[lp], 0.0) * frame.shadow.depth_range;
+            uint layer = uint(min(int(dz / frame.shadow.layer_thickness), 3));
+            float o = cluster_opacity(frame.shadow.strand_opacity * cov * share, s.thickness);
             atomicAdd(s_layers[lp * 4u + layer], uint(round(o * SHADOW_OPACITY_FIXED)));
 #else
             if (near.y <= h * h) {

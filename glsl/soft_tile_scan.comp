@@ -1,7 +1,7 @@
 #version 460
 // Software rasterizer: exclusive prefix sum of the per-tile segment counts into each tile's
 // first entry (one workgroup; each thread owns a run of consecutive tiles). Entries past the
-// budget (frame.soft.w) are dropped from the tiles at the end of the order and counted.
+// budget (frame.soft.tile_entry_budget) are dropped from the tiles at the end of the order and counted.
 #extension GL_GOOGLE_include_directive : require
 #include "bindings.glsl"
 // One workgroup, dispatched alone: its width has no Rust twin.
@@ -30,7 +30,7 @@ void main() {
         s_sum[t] += add;
         barrier();
     }
-    uint budget = frame.soft.w;
+    uint budget = frame.soft.tile_entry_budget;
     uint offset = s_sum[t] - mine;
     for (uint i = first; i < last; i++) {
         uint count = soft_tiles[i].x;

@@ -1,6 +1,6 @@
 // The radiance of a strand point toward the eye, shared by every strand fragment shader
 // (strand_fragment.glsl) and the software rasterizer's vertex shading (soft_segments.glsl).
-// The model is chosen per frame by frame.shading.x (src/shade/mod.rs ShadingModel):
+// The model is chosen per frame by frame.shading.model (src/shade/mod.rs ShadingModel):
 // 0 placeholder (Kajiya-Kay diffuse with a half-vector highlight and darker roots),
 // 1 Kajiya-Kay diffuse + specular, 2 Marschner R / TT / TRT. Requires bindings.glsl.
 #ifndef STRAND_RADIANCE_GLSL
@@ -11,7 +11,7 @@
 #include "lod_appearance.glsl"
 
 // LIGHT_IRRADIANCE (the directional light) and AMBIENT, SKY_TINT, GROUND_TINT (the sky and
-// ground) come from shared.glsl (Rust twins in src/shade/mod.rs). With frame.shading.z on,
+// ground) come from shared.glsl (Rust twins in src/shade/mod.rs). With frame.shading.multiple_scattering on,
 // Marschner adds dual scattering (hair_shading.glsl) from the light; the ambient term is the
 // sky and ground in every model.
 
@@ -35,17 +35,17 @@ vec3 strand_radiance_lit(vec3 tangent, float s_param, vec3 pos, vec3 base, uint 
                          float ambient) {
     float lit = arrival.x;
     vec3 t = normalize(tangent);
-    vec3 l = normalize(frame.light_dir.xyz);
-    vec3 e = normalize(frame.camera_pos.xyz - pos);
+    vec3 l = normalize(frame.to_light);
+    vec3 e = normalize(frame.eye - pos);
     float root_shadow = mix(0.55, 1.0, smoothstep(0.0, 0.3, s_param));
     vec3 c;
-    if (frame.shading.x == SHADING_KAJIYA_KAY) {
+    if (frame.shading.model == SHADING_KAJIYA_KAY) {
         vec2 kk = kajiya_kay(t, l, e);
         c = (base * (hair_ambient(character, pos) * ambient + kk.x * lit) + vec3(0.3) * (kk.y * lit)) * root_shadow;
-    } else if (frame.shading.x == SHADING_MARSCHNER) {
+    } else if (frame.shading.model == SHADING_MARSCHNER) {
         HairStyle s = characters[character].style;
         vec3 sc = dual_scattering(t, l, e, base, s.roughness, radians(s.cuticle_tilt_degrees), arrival,
-                                  frame.shading.z != 0u, cluster_crossings(thickness));
+                                  frame.shading.multiple_scattering != 0u, cluster_crossings(thickness));
         c = (sc * LIGHT_IRRADIANCE + base * (hair_ambient(character, pos) * ambient)) * root_shadow;
     } else {
         float tl = dot(t, l);

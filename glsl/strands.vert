@@ -19,7 +19,7 @@ void main() {
     uint idx = uint(gl_VertexIndex);
     // Bundle owning this draw vertex: last bundle whose first draw vertex is <= idx.
     uint lo = 0u;
-    uint hi = frame.counts.x - 1u;
+    uint hi = frame.counts.bundles - 1u;
     while (lo < hi) {
         uint mid = (lo + hi + 1u) / 2u;
         if (bundle_offsets[mid].z <= idx) {
@@ -53,7 +53,7 @@ void main() {
     out_residual = vec2(0.0);
 #ifdef VISIBILITY
     // Frames with motion on the compute path: generate.comp wrote every vertex's residual.
-    if (frame.temporal.x != 0u && frame.temporal.w != 0u) {
+    if (frame.temporal.motion != 0u && frame.temporal.residuals != 0u) {
         out_residual = unpackHalf2x16(vertex_motion[slot]);
     }
 #endif

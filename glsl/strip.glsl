@@ -1,6 +1,6 @@
 // Camera-facing strip expansion shared by strands.vert (compute path) and strands.mesh, for
-// perspective views (the camera) and orthographic ones (the light: frame.light_dir.w == 0,
-// facing frame.light_dir). A strand thinner than one pixel is drawn one pixel wide so it does
+// perspective views (the camera) and orthographic ones (the light: frame.cot_half_fov == 0,
+// facing frame.to_light). A strand thinner than one pixel is drawn one pixel wide so it does
 // not break into dots; strip_coverage says which fraction of the drawn strip the strand really
 // covers (coverage to alpha, seed 002), for passes that accumulate opacity.
 #ifndef STRIP_GLSL
@@ -9,10 +9,10 @@
 
 // World size of one pixel at `pos`.
 float pixel_size(vec3 pos) {
-    if (frame.light_dir.w > 0.0) {
-        return 2.0 * length(frame.camera_pos.xyz - pos) / (frame.camera_pos.w * frame.light_dir.w);
+    if (frame.cot_half_fov > 0.0) {
+        return 2.0 * length(frame.eye - pos) / (frame.pixels_high * frame.cot_half_fov);
     }
-    return frame.lod_ortho.x / frame.camera_pos.w;
+    return frame.lod.ortho_height / frame.pixels_high;
 }
 
 // Width the strip is drawn with: the strand's (LoD-thickened) width, at least one pixel; with
@@ -27,7 +27,7 @@ float drawn_width(vec3 pos, float width, float thickness, float cap) {
 }
 
 vec3 strip_offset(vec3 pos, vec3 tangent, float drawn, float side) {
-    vec3 to_eye = frame.light_dir.w > 0.0 ? normalize(frame.camera_pos.xyz - pos) : frame.light_dir.xyz;
+    vec3 to_eye = frame.cot_half_fov > 0.0 ? normalize(frame.eye - pos) : frame.to_light;
     vec3 across = cross(tangent, to_eye);
     across = length(across) > 1e-6 ? normalize(across) : normalize(cross(tangent, vec3(0.0, 0.0, 1.0)) + 1e-6);
     return pos + across * (side * 0.5 * drawn);

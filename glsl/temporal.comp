@@ -1,7 +1,7 @@
 #version 460
 // Temporal pass (src/render/temporal.rs), one thread per pixel. With push.params.x, the
 // pixel's motion from its nearest surface (visibility word: depth, id, deformation residual;
-// the id's clip_to_prev matrix) is written to the motion target. With accumulation (frame.temporal.y) the history
+// the id's clip_to_prev matrix) is written to the motion target. With accumulation (frame.temporal.accumulate) the history
 // is reprojected (Catmull-Rom), checked against what the pixel is (visibility id and depth of
 // the nearest surface in the 3x3 neighbourhood, both frames), clipped to the neighbourhood's
 // colour box (wider on hair) and blended; the result goes to the history and, as sRGB bytes,
@@ -173,7 +173,7 @@ vec3 clip_to_box(vec3 h, vec3 mean, vec3 extent) {
 // The accumulated colour of pixel p, whose own visibility word is `own`.
 vec3 accumulate(ivec2 p, uint64_t own) {
     vec3 current = current_color(p);
-    if (frame.temporal.z == 0u) {
+    if (frame.temporal.history_valid == 0u) {
         return current;
     }
     // The nearest surface of the 3x3 neighbourhood moves the pixel: a strand crossing it
@@ -215,10 +215,10 @@ vec3 accumulate(ivec2 p, uint64_t own) {
     vec3 mean = m1 / 9.0;
     vec3 sigma = sqrt(max(m2 / 9.0 - mean * mean, vec3(0.0)));
     // Hair keeps a wide clamp (a tight one erases single strands).
-    float gamma = is_hair(near.x) ? frame.temporal_params.w : 1.0;
+    float gamma = is_hair(near.x) ? frame.temporal.hair_clamp : 1.0;
     vec3 h = clip_to_box(to_ycocg(history_at(q)), mean, gamma * sigma + 1e-4);
     // Moving solid surfaces keep a shorter history (less blur and lag on their edges).
-    float weight = frame.temporal_params.z;
+    float weight = frame.temporal.history_weight;
     if (!is_hair(near.x)) {
         float moving = clamp(distance(q, centre) / TEMPORAL_SOLID_MOTION, 0.0, 1.0);
         weight = mix(weight, max(weight, TEMPORAL_SOLID_MOVING_WEIGHT), moving);
@@ -238,7 +238,7 @@ void main() {
         vec2 m = motion_at(own.x, vec2(p) + 0.5, uintBitsToFloat(own.y), visibility_residual(word));
         motion_out[i] = uvec4(floatBitsToUint(m), own);
     }
-    if (frame.temporal.y != 0u) {
+    if (frame.temporal.accumulate != 0u) {
         vec3 c = accumulate(p, word);
         history_out[i] = uvec2(packHalf2x16(c.rg), packHalf2x16(vec2(c.b, 1.0)));
         history_out[pixel_count() + i] = own;

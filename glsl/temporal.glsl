@@ -2,7 +2,7 @@
 // every camera pass that draws a surface notes a visibility word (depth, visibility id,
 // deformation residual) with a 64-bit atomicMin, so the nearest wins whatever the order (ties:
 // the smaller id). Compiled in with VISIBILITY (devices with 64-bit buffer atomics);
-// frame.temporal.x says whether this frame wants it (never in the light's views).
+// frame.temporal.motion says whether this frame wants it (never in the light's views).
 #ifndef TEMPORAL_GLSL
 #define TEMPORAL_GLSL
 
@@ -58,7 +58,7 @@ vec2 visibility_residual(uint64_t w) {
 
 void note_visible(uvec2 pixel, float depth, uint id, vec2 residual) {
 #ifdef VISIBILITY
-    if (frame.temporal.x == 0u) {
+    if (frame.temporal.motion == 0u) {
         return;
     }
     uint p = pixel.y * uint(frame.viewport.x) + pixel.x;
@@ -80,7 +80,7 @@ void note_visible_word(uvec2 pixel, uint64_t word) {
 // Whether this frame's strands of the bound character need their previous pose evaluated:
 // motion vectors are wanted and the pose changed this frame (its previous texture set differs).
 bool deform_motion() {
-    return frame.temporal.x != 0u && ch_prev_slot != tex_slot;
+    return frame.temporal.motion != 0u && ch_prev_slot != tex_slot;
 }
 
 // Where a strand point at `world` (this pose) was in the previous frame's pixels, relative to

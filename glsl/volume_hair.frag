@@ -27,7 +27,7 @@ void main() {
     if (weight <= 0.0) {
         discard;
     }
-    vec3 eye = frame.camera_pos.xyz;
+    vec3 eye = frame.eye;
     vec3 dir = normalize(in_world - eye);
     mat4 to_grid = characters[c].world_to_volume;
     vec3 g0 = (to_grid * vec4(eye, 1.0)).xyz;
@@ -46,7 +46,7 @@ void main() {
     // at once (the depth test would reject whatever it found). The band's depth stays the
     // box's exit (below).
     float t_box_exit = t_exit;
-    if (frame.soft.x != RASTER_HARDWARE) {
+    if (frame.soft.mode != RASTER_HARDWARE) {
         t_exit = min(t_exit, ray_length_to_depth(eye, dir, opaque_depth_at(uvec2(gl_FragCoord.xy))));
         if (t_exit <= max(t_enter, 0.0)) {
             discard;
@@ -55,7 +55,7 @@ void main() {
     float scale = characters[c].model_scale;
     float step = MARCH_STEP_CELLS * characters[c].volume_shading.y * scale;
     // The frame's opacity of one strand: opaque frames draw whole strands.
-    float alpha = frame.transparency.x == TRANSPARENCY_OPAQUE ? 1.0 : STRAND_OPACITY;
+    float alpha = frame.transparency.mode == TRANSPARENCY_OPAQUE ? 1.0 : STRAND_OPACITY;
     float t0 = max(t_enter, 0.0);
     uint steps = min(uint(ceil((t_exit - t0) / step)), MAX_MARCH_STEPS);
     float transmittance = 1.0;
@@ -98,7 +98,7 @@ void main() {
     if (dot(tangent, tangent) < 1e-20) {
         tangent = vec3(0.0, -1.0, 0.0);
     }
-    vec3 l = normalize(frame.light_dir.xyz);
+    vec3 l = normalize(frame.to_light);
     vec3 arrival = light_arrival(point, 0.0);
     if ((characters[c].flags & CHARACTER_VOLUME_ONLY) != 0u) {
         // Through its own hair too: hits add, transmittances multiply.

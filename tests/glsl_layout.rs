@@ -2,7 +2,7 @@
 //! same std430 layout as its Rust `#[repr(C)]` twin, field by field, and the copy of the
 //! generated header in `glsl/generated/` is current.
 
-use hairmesh::render::shared::{glsl_header, shared_structs, std430_layout, std430_type};
+use hairmesh::render::shared::{glsl_header, shared_structs, std140_layout, std430_layout};
 
 /// Every way the structs' Rust layouts disagree with std430 (field offsets, struct sizes),
 /// one line each, the structs laid out in order (a struct's layout depends on those before).
@@ -38,17 +38,62 @@ fn every_shared_struct_has_the_rust_layout() {
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }
 
+/// Every way `block` (a uniform block) laid out in std140 disagrees with its Rust twin, the
+/// structs before it in `structs` laid out in std140 too.
+fn std140_mismatches(
+    structs: &[hairmesh::render::shared::StructInfo],
+    block: &hairmesh::render::shared::StructInfo,
+) -> Vec<String> {
+    let mut known: Vec<(String, usize, usize)> = Vec::new();
+    for s in structs.iter().take_while(|s| s.name != block.name) {
+        let (_, size, align) = std140_layout(s, &known);
+        known.push((s.name.to_string(), size, align));
+    }
+    let (offsets, size, _) = std140_layout(block, &known);
+    let mut out: Vec<String> = block
+        .fields
+        .iter()
+        .zip(&offsets)
+        .filter(|(f, off)| f.offset != **off)
+        .map(|(f, off)| {
+            format!(
+                "{}.{}: Rust offset {} but std140 offset {off}",
+                block.name, f.name, f.offset
+            )
+        })
+        .collect();
+    if size != block.rust_size {
+        out.push(format!(
+            "{}: std140 size {size}, Rust {}",
+            block.name, block.rust_size
+        ));
+    }
+    out
+}
+
 #[test]
 fn the_frame_block_is_the_same_in_std140() {
-    // Uniform blocks use std140; with only 16-byte-aligned vec4/uvec4/mat4 fields (and arrays
-    // of vec4) std140 and std430 agree.
-    let s = shared_structs()
-        .into_iter()
-        .find(|s| s.name == "FrameBlock")
+    // The frame block is a uniform block (std140): its named scalars, vec3s and field groups
+    // must land where the Rust struct has them.
+    let structs = shared_structs();
+    let block = structs.iter().find(|s| s.name == "FrameBlock").unwrap();
+    let wrong = std140_mismatches(&structs, block);
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    // Negative control: an array of scalars (stride 16 in std140, 4 in Rust) moves the field
+    // after it.
+    let mut planted = hairmesh::render::shared::StructInfo {
+        name: "FrameBlock",
+        fields: block.fields.clone(),
+        rust_size: block.rust_size,
+    };
+    let k = planted
+        .fields
+        .iter()
+        .position(|f| f.name == "pixels_high")
         .unwrap();
-    for f in &s.fields {
-        assert_eq!(std430_type(f.glsl).unwrap().1, 16, "FrameBlock.{}", f.name);
-    }
+    planted.fields[k].glsl = "float";
+    planted.fields[k].array = 2;
+    assert!(!std140_mismatches(&structs, &planted).is_empty());
 }
 
 /// The check above fails on each kind of drift it guards against, run through the same

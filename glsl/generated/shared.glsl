@@ -205,29 +205,98 @@ struct BundleDesc {
     uint _pad[3];
 };
 
+struct LodFields {
+    float alpha_strands;
+    float alpha_verts;
+    float lambda;
+    float tan_fov;
+    float ortho_height;
+    float area_below;
+    float strands_per_pixel;
+    float _pad;
+};
+
+struct CountFields {
+    uint bundles;
+    uint slots;
+    uint lod_on;
+    uint vertex_budget;
+};
+
+struct ShadingFields {
+    uint model;
+    uint lod_appearance;
+    uint multiple_scattering;
+    uint _pad;
+};
+
+struct ShadowFields {
+    uint mode;
+    uint resolution;
+    uvec2 _pad;
+    float layer_thickness;
+    float depth_range;
+    float strand_opacity;
+    float bias;
+};
+
+struct TransparencyFields {
+    uint mode;
+    uint kbuffer_nodes;
+    uint samples;
+    uint _pad;
+};
+
+struct SoftFields {
+    uint mode;
+    uint k;
+    uint segment_budget;
+    uint tile_entry_budget;
+    float auto_split_pixels;
+    float strand_opacity;
+    uvec2 _pad;
+    uint tiles_x;
+    uint tiles_y;
+    uvec2 _pad2;
+};
+
+struct TemporalFields {
+    uint motion;
+    uint accumulate;
+    uint history_valid;
+    uint residuals;
+    vec2 jitter;
+    float history_weight;
+    float hair_clamp;
+};
+
+struct BodyShadowFields {
+    float resolution;
+    float depth_range;
+    float bias;
+    float texel;
+};
+
 struct FrameBlock {
     mat4 view_proj;
-    vec4 camera_pos;
-    vec4 light_dir;
+    vec3 eye;
+    float pixels_high;
+    vec3 to_light;
+    float cot_half_fov;
     vec4 viewport;
     vec4 planes[6];
-    vec4 lod;
-    vec4 lod_ortho;
-    uvec4 counts;
-    uvec4 shading;
+    LodFields lod;
+    CountFields counts;
+    ShadingFields shading;
     mat4 light_view_proj;
-    uvec4 shadow;
-    vec4 shadow_params;
-    uvec4 transparency;
-    uvec4 soft;
-    vec4 soft_params;
-    uvec4 soft_grid;
-    uvec4 temporal;
-    vec4 temporal_params;
+    ShadowFields shadow;
+    TransparencyFields transparency;
+    SoftFields soft;
+    TemporalFields temporal;
     mat4 clip_to_prev;
     mat4 unjittered_view_proj;
     mat4 body_view_proj;
-    vec4 body_shadow;
+    BodyShadowFields body_shadow;
 };
 
 struct CharacterRecord {

@@ -2,7 +2,7 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use super::core::shared::FrameBlock;
+use super::core::shared::{CountFields, FrameBlock, LodFields, ShadingFields};
 
 /// Default viewing direction (target toward eye) of `render`, `bench` and the tests: a 3/4 view
 /// from behind and above, where the sample heads show their hair.
@@ -381,12 +381,10 @@ impl View {
         let vp = camera.view_proj(width as f32 / height as f32);
         FrameBlock {
             view_proj: vp.to_cols_array_2d(),
-            camera_pos: camera.eye.extend(height as f32).to_array(),
-            light_dir: self
-                .light_dir
-                .normalize_or(Vec3::Y)
-                .extend(1.0 / (camera.fov_y * 0.5).tan())
-                .to_array(),
+            eye: camera.eye.to_array(),
+            pixels_high: height as f32,
+            to_light: self.light_dir.normalize_or(Vec3::Y).to_array(),
+            cot_half_fov: 1.0 / (camera.fov_y * 0.5).tan(),
             viewport: [
                 width as f32,
                 height as f32,
@@ -394,38 +392,42 @@ impl View {
                 1.0 / height as f32,
             ],
             planes: frustum_planes(vp),
-            lod: [
-                self.lod.alpha_strands,
-                self.lod.alpha_verts,
-                self.lod.lambda,
-                camera.fov_y.tan(),
-            ],
-            lod_ortho: [0.0, self.lod.area_below, self.lod.strands_per_pixel, 0.0],
-            counts: [bundles, characters, self.lod.enabled as u32, vertex_budget],
-            shading: [
-                self.shading as u32,
-                self.lod_appearance as u32,
-                self.multiple_scattering as u32,
-                0,
-            ],
+            lod: LodFields {
+                alpha_strands: self.lod.alpha_strands,
+                alpha_verts: self.lod.alpha_verts,
+                lambda: self.lod.lambda,
+                tan_fov: camera.fov_y.tan(),
+                ortho_height: 0.0,
+                area_below: self.lod.area_below,
+                strands_per_pixel: self.lod.strands_per_pixel,
+                _pad: 0.0,
+            },
+            counts: CountFields {
+                bundles,
+                slots: characters,
+                lod_on: self.lod.enabled as u32,
+                vertex_budget,
+            },
+            shading: ShadingFields {
+                model: self.shading as u32,
+                lod_appearance: self.lod_appearance as u32,
+                multiple_scattering: self.multiple_scattering as u32,
+                _pad: 0,
+            },
             // Filled in by the renderer once the light view is fitted.
             light_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
-            shadow: [0; 4],
-            shadow_params: [0.0; 4],
+            shadow: Default::default(),
             // Samples filled in by the renderer.
             transparency: self.transparency.frame_fields(1),
             // Filled in by the renderer for frames with motion vectors.
-            temporal: [0; 4],
-            temporal_params: [0.0; 4],
+            temporal: Default::default(),
             clip_to_prev: Mat4::IDENTITY.to_cols_array_2d(),
             unjittered_view_proj: vp.to_cols_array_2d(),
             // Filled in by the renderer for frames that use the software rasterizer.
-            soft: [0; 4],
-            soft_params: [0.0; 4],
-            soft_grid: [0; 4],
+            soft: Default::default(),
             // Filled in by the renderer once the bodies' light view is fitted.
             body_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
-            body_shadow: [0.0; 4],
+            body_shadow: Default::default(),
         }
     }
 }
@@ -579,8 +581,8 @@ mod tests {
             let dir = (cam.eye - centre).normalize();
             assert!(dir.dot(DEFAULT_VIEW_DIR.normalize()) > 0.99999);
             let mut block: crate::render::core::shared::FrameBlock = bytemuck::Zeroable::zeroed();
-            block.camera_pos = cam.eye.extend(height as f32).to_array();
-            block.light_dir[3] = 1.0 / (cam.fov_y * 0.5).tan();
+            (block.eye, block.pixels_high) = (cam.eye.to_array(), height as f32);
+            block.cot_half_fov = 1.0 / (cam.fov_y * 0.5).tan();
             let spans = crate::render::volume::hair_pixels(&r, &block);
             assert!((spans / pixels - 1.0).abs() < 1e-4, "{pixels}: {spans}");
         }

@@ -496,7 +496,7 @@ impl Frames {
         super::core::slots::ViewBudgets {
             segments: self.soft_budget.segments,
             pool: match path {
-                RenderPath::Compute => block.counts[3],
+                RenderPath::Compute => block.counts.vertex_budget,
                 _ => 0,
             },
         }
@@ -710,7 +710,7 @@ impl Frames {
         let mut block = view.frame_block(width, height, bundles, slots, self.vertex_budget());
         block.transparency = view.transparency.frame_fields(self.desc.msaa);
         if raster.uses_software() {
-            block.transparency[1] = kbuffer_budget;
+            block.transparency.kbuffer_nodes = kbuffer_budget;
             let opacity = match view.transparency {
                 Transparency::Opaque => 1.0,
                 _ => super::transparency::STRAND_OPACITY,
@@ -719,8 +719,7 @@ impl Frames {
         }
         let light = self.light_view(world, view, &block);
         if let Some(l) = &light {
-            (block.light_view_proj, block.shadow, block.shadow_params) =
-                l.shadow_fields(view.shadows);
+            (block.light_view_proj, block.shadow) = l.shadow_fields(view.shadows);
         }
         if let Some(b) = self.body_light_view(world, view, &block) {
             (block.body_view_proj, block.body_shadow) = b.body_fields();
@@ -754,14 +753,14 @@ impl Frames {
         };
         let camera_motion = motion.map_or(still, FrameMotion::camera);
         let camera = super::prop_table::Projection {
-            eye: glam::Vec3::from_slice(&block.camera_pos[..3]),
-            height: block.camera_pos[3],
-            cot_half_fov: block.light_dir[3],
+            eye: glam::Vec3::from_array(block.eye),
+            height: block.pixels_high,
+            cot_half_fov: block.cot_half_fov,
             texel: 0.0,
         };
         // The bodies' light map sees far bodies at its own texel size, a pixel being as many
         // texels as its filter blurs together.
-        let body_texel = block.body_shadow[3];
+        let body_texel = block.body_shadow.texel;
         let light = (body_texel > 0.0).then(|| {
             super::prop_table::Projection::orthographic(
                 body_texel * super::shadow::LIGHT_FAR_TEXELS_PER_PIXEL,
@@ -1076,7 +1075,7 @@ impl Frames {
         bodies.extend(world.skinned.character_spheres(&model_of));
         let camera = (
             glam::Mat4::from_cols_array_2d(&block.unjittered_view_proj),
-            glam::Vec3::from_slice(&block.camera_pos[..3]),
+            glam::Vec3::from_array(block.eye),
         );
         LightView::fit_bodies(
             &bodies,

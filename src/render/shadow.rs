@@ -16,7 +16,10 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use super::camera::{LodSettings, box_corners, frustum_planes};
-use super::core::shared::{FrameBlock, STRAND_SHADOW_OPACITY};
+use super::core::shared::{
+    BodyShadowFields, FrameBlock, LodFields, STRAND_SHADOW_OPACITY, ShadowFields, SoftFields,
+    TemporalFields,
+};
 
 /// Deep opacity layers (the 4 channels of one RGBA16F map).
 pub const SHADOW_LAYERS: u32 = 4;
@@ -155,15 +158,15 @@ impl LightView {
     }
 
     /// The bodies' map fields of a camera frame block: `(body_view_proj, body_shadow)`.
-    pub fn body_fields(&self) -> ([[f32; 4]; 4], [f32; 4]) {
+    pub fn body_fields(&self) -> ([[f32; 4]; 4], BodyShadowFields) {
         (
             self.view_proj.to_cols_array_2d(),
-            [
-                self.resolution as f32,
-                self.depth_range,
-                self.bias(),
-                self.texel(),
-            ],
+            BodyShadowFields {
+                resolution: self.resolution as f32,
+                depth_range: self.depth_range,
+                bias: self.bias(),
+                texel: self.texel(),
+            },
         )
     }
 
@@ -177,7 +180,7 @@ impl LightView {
         2.0 * self.texel()
     }
 
-    /// The light's own frame block: orthographic (`lod.w = 0`, `light_dir.w = 0`), LoD from the
+    /// The light's own frame block: orthographic (`lod.tan_fov = 0`, `cot_half_fov = 0`), LoD from the
     /// view size, culling against the light's box; otherwise as `camera` (counts, shading,
     /// shadow settings). With `soft` (the software shadow passes' budgets) every bundle goes to
     /// the software rasterizer as depth and coverage (`RASTER_LIGHT`), binned into the map's
@@ -189,60 +192,59 @@ impl LightView {
         soft: Option<super::soft::SoftBudget>,
     ) -> FrameBlock {
         let res = self.resolution as f32;
-        let (tx, ty) = super::soft::tile_grid(self.resolution, self.resolution);
-        let (soft, soft_grid) = match soft {
-            Some(b) => (
-                [
-                    super::core::shared::RASTER_LIGHT,
-                    0,
-                    b.segments,
-                    b.tile_entries,
-                ],
-                [tx, ty, 0, 0],
-            ),
-            None => ([0; 4], [0; 4]),
+        let (tiles_x, tiles_y) = super::soft::tile_grid(self.resolution, self.resolution);
+        let soft = match soft {
+            Some(b) => SoftFields {
+                mode: super::core::shared::RASTER_LIGHT,
+                segment_budget: b.segments,
+                tile_entry_budget: b.tile_entries,
+                tiles_x,
+                tiles_y,
+                ..Default::default()
+            },
+            None => SoftFields::default(),
         };
         FrameBlock {
             view_proj: self.view_proj.to_cols_array_2d(),
-            camera_pos: self.eye.extend(res).to_array(),
-            light_dir: self.dir.extend(0.0).to_array(),
+            eye: self.eye.to_array(),
+            pixels_high: res,
+            to_light: self.dir.to_array(),
+            cot_half_fov: 0.0,
             viewport: [res, res, 1.0 / res, 1.0 / res],
             planes: frustum_planes(self.view_proj),
-            lod: [
-                lod.alpha_strands * LIGHT_LOD_SCALE,
-                lod.alpha_verts * LIGHT_LOD_SCALE,
-                lod.lambda,
-                0.0,
-            ],
-            // The pixel cap counts texels of the map at LIGHT_LOD_SCALE of its resolution,
-            // as eq. 7's alphas do: a quarter of the camera's strands per texel².
-            lod_ortho: [
-                self.size,
-                lod.area_below,
-                lod.strands_per_pixel * LIGHT_LOD_SCALE * LIGHT_LOD_SCALE,
-                0.0,
-            ],
+            lod: LodFields {
+                alpha_strands: lod.alpha_strands * LIGHT_LOD_SCALE,
+                alpha_verts: lod.alpha_verts * LIGHT_LOD_SCALE,
+                lambda: lod.lambda,
+                tan_fov: 0.0,
+                ortho_height: self.size,
+                area_below: lod.area_below,
+                // The pixel cap counts texels of the map at LIGHT_LOD_SCALE of its
+                // resolution, as eq. 7's alphas do: a quarter of the camera's strands per
+                // texel².
+                strands_per_pixel: lod.strands_per_pixel * LIGHT_LOD_SCALE * LIGHT_LOD_SCALE,
+                _pad: 0.0,
+            },
             soft,
-            soft_params: [0.0; 4],
-            soft_grid,
             // The light's views note no visibility and accumulate nothing.
-            temporal: [0; 4],
-            temporal_params: [0.0; 4],
+            temporal: TemporalFields::default(),
             ..*camera
         }
     }
 
-    /// The shadow fields of a frame block in `mode`.
-    pub fn shadow_fields(&self, mode: ShadowMode) -> ([[f32; 4]; 4], [u32; 4], [f32; 4]) {
+    /// The shadow fields of a frame block in `mode`: the light's view and its maps.
+    pub fn shadow_fields(&self, mode: ShadowMode) -> ([[f32; 4]; 4], ShadowFields) {
         (
             self.view_proj.to_cols_array_2d(),
-            [mode as u32, self.resolution, 0, 0],
-            [
-                self.layer_spacing,
-                self.depth_range,
-                STRAND_SHADOW_OPACITY,
-                self.bias(),
-            ],
+            ShadowFields {
+                mode: mode as u32,
+                resolution: self.resolution,
+                _pad: [0; 2],
+                layer_thickness: self.layer_spacing,
+                depth_range: self.depth_range,
+                strand_opacity: STRAND_SHADOW_OPACITY,
+                bias: self.bias(),
+            },
         )
     }
 }

@@ -107,13 +107,13 @@ pub const COLLIDER_HEAD: u32 = 2;
 pub const MAX_OIT_BUDGET: u32 = 16;
 /// Opacity of one full-detail strand over the part of a pixel it covers.
 pub const STRAND_OPACITY: f32 = 0.7;
-/// `FrameBlock::soft.x`: hardware strips.
+/// `SoftFields::mode`: hardware strips.
 pub const RASTER_HARDWARE: u32 = 0;
-/// `FrameBlock::soft.x`: the software rasterizer.
+/// `SoftFields::mode`: the software rasterizer.
 pub const RASTER_SOFTWARE: u32 = 1;
-/// `FrameBlock::soft.x`: software or hardware per bundle.
+/// `SoftFields::mode`: software or hardware per bundle.
 pub const RASTER_AUTO: u32 = 2;
-/// `FrameBlock::soft.x` of the light's view: every bundle to the software rasterizer, as
+/// `SoftFields::mode` of the light's view: every bundle to the software rasterizer, as
 /// depth and coverage only (no shading).
 pub const RASTER_LIGHT: u32 = 3;
 /// Fixed-point scale of the software shadow pass's opacity sums (`soft_shadow.comp`): opacity
@@ -145,17 +145,17 @@ pub const TEMPORAL_SOLID_MOVING_WEIGHT: f32 = 0.5;
 pub const TEMPORAL_SOLID_MOTION: f32 = 0.25;
 /// Temporal: threads per side of the temporal passes' square workgroups.
 pub const TEMPORAL_GROUP: u32 = 16;
-/// `FrameBlock::transparency.x`: opaque strands.
+/// `TransparencyFields::mode`: opaque strands.
 pub const TRANSPARENCY_OPAQUE: u32 = 0;
-/// `FrameBlock::transparency.x`: k-buffer OIT.
+/// `TransparencyFields::mode`: k-buffer OIT.
 pub const TRANSPARENCY_KBUFFER: u32 = 1;
-/// `FrameBlock::transparency.x`: depth peeling.
+/// `TransparencyFields::mode`: depth peeling.
 pub const TRANSPARENCY_PEELING: u32 = 2;
-/// `FrameBlock::shadow.x`: no shadows.
+/// `ShadowFields::mode`: no shadows.
 pub const SHADOW_OFF: u32 = 0;
-/// `FrameBlock::shadow.x`: deep opacity maps.
+/// `ShadowFields::mode`: deep opacity maps.
 pub const SHADOW_DEEP_OPACITY: u32 = 1;
-/// `FrameBlock::shadow.x`: approximate deep shadow maps.
+/// `ShadowFields::mode`: approximate deep shadow maps.
 pub const SHADOW_APPROXIMATE: u32 = 2;
 /// `GpuBundleLod::y` (`bundle_lods[].y`): the vertex level `e` is the low byte.
 pub const LOD_LEVEL_MASK: u32 = 255;
@@ -213,13 +213,13 @@ pub enum FrameBinding {
     /// The Marschner lookup texture (`shade::lut`, sampled bilinearly).
     ShadingLut = 18,
     /// Software rasterizer: `SoftSegment[]` projected, shaded strand segments (bounded by
-    /// `FrameBlock::soft.z`).
+    /// `SoftFields::segment_budget`).
     SoftSegments = 19,
     /// Software rasterizer: per screen tile `uvec4` (segments touching it, first entry,
     /// scatter cursor, entries kept).
     SoftTiles = 20,
     /// Software rasterizer: `uint[]` segment indices, tile by tile (bounded by
-    /// `FrameBlock::soft.w`).
+    /// `SoftFields::tile_entry_budget`).
     SoftEntries = 21,
     /// Software rasterizer: per pixel, the opaque depth (`float`) the strands are tested
     /// against.
@@ -492,58 +492,42 @@ gpu_struct!(BundleDesc as "BundleDesc" {
     origin: "uvec2", flags: "uint", rest_size: "float", density: "float", _pad: "uint"[3],
 });
 
-/// Per-view data of one frame (uniform block, identical in std140 and std430 because every
-/// field is a vec4, uvec4 or mat4).
+/// Per-view data of one frame (uniform block). Every field group is 16 bytes (or a multiple)
+/// and 16-byte aligned, so std140 and std430 lay it out alike; shaders read every value by
+/// name (`frame.lod.area_below`), never by a swizzle's position.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct FrameBlock {
     /// World to clip.
     pub view_proj: [[f32; 4]; 4],
-    /// xyz eye, w vertical resolution in pixels.
-    pub camera_pos: [f32; 4],
-    /// xyz direction toward the light, w `1 / tan(fov_y / 2)` (0: orthographic).
-    pub light_dir: [f32; 4],
+    /// The eye (world).
+    pub eye: [f32; 3],
+    /// Vertical resolution in pixels.
+    pub pixels_high: f32,
+    /// Unit direction toward the light.
+    pub to_light: [f32; 3],
+    /// `1 / tan(fov_y / 2)` of the view (0: orthographic).
+    pub cot_half_fov: f32,
     /// width, height, 1/width, 1/height.
     pub viewport: [f32; 4],
     /// Frustum planes (inside where `dot(n, p) + d >= 0`).
     pub planes: [[f32; 4]; 6],
-    /// x alpha strands, y alpha vertices, z lambda, w `tan(fov_y)` of eq. 7 (0: orthographic).
-    pub lod: [f32; 4],
-    /// x view height of orthographic views, y the strand level's area term below this extent
-    /// (`LodSettings::area_below`; 0 off), z strands per square pixel of a bundle's extent
-    /// (`LodSettings::strands_per_pixel`; 0 off); w unused.
-    pub lod_ortho: [f32; 4],
-    /// x bundles of all characters, y character slots, z LoD on, w vertex pool budget
-    /// (compute path, in `HairVertex` slots).
-    pub counts: [u32; 4],
-    /// x shading model (`shade::ShadingModel`), y thick-strand appearance term on (seed 000,
-    /// `lod_appearance.glsl`), z multiple scattering on (`shade::scattering`); w reserved.
-    pub shading: [u32; 4],
+    /// Level of detail (eq. 7 and the strand caps).
+    pub lod: LodFields,
+    /// Sizes of the frame's tables.
+    pub counts: CountFields,
+    /// How strands are shaded.
+    pub shading: ShadingFields,
     /// World to the light's clip space (the shadow maps; camera views only).
     pub light_view_proj: [[f32; 4]; 4],
-    /// x shadow mode (`render::ShadowMode`: 0 off, 1 deep opacity, 2 approximate deep), y
-    /// shadow map resolution; zw reserved.
-    pub shadow: [u32; 4],
-    /// x deep-opacity layer thickness (world units), y light depth range (far - near, world),
-    /// z opacity of one strand, w depth bias (world units).
-    pub shadow_params: [f32; 4],
-    /// x transparency mode (`render::Transparency`: 0 opaque, 1 k-buffer OIT, 2 depth
-    /// peeling), y k-buffer nodes per pixel, z samples per pixel of the targets; w reserved.
-    pub transparency: [u32; 4],
-    /// Software rasterizer (`render::StrandRaster`): x mode (0 hardware, 1 software, 2 auto:
-    /// per bundle), y fragments kept sorted per pixel, z segment budget, w tile entry budget.
-    pub soft: [u32; 4],
-    /// Software rasterizer: x auto split (bundles whose strands are drawn at most this many
-    /// pixels wide go to software), y opacity of one strand; zw reserved.
-    pub soft_params: [f32; 4],
-    /// Software rasterizer: x tiles per row, y tile rows; zw reserved.
-    pub soft_grid: [u32; 4],
-    /// Temporal (`render::Temporal`): x passes note the nearest surface per pixel (motion
-    /// vectors), y accumulation on, z history valid; w reserved.
-    pub temporal: [u32; 4],
-    /// Temporal: xy this frame's sub-pixel jitter (pixels, in `view_proj`), z history
-    /// weight of a fully trusted pixel, w colour clamp width for hair (standard deviations).
-    pub temporal_params: [f32; 4],
+    /// The hair's shadow maps.
+    pub shadow: ShadowFields,
+    /// How strands are composited.
+    pub transparency: TransparencyFields,
+    /// The software rasterizer (`render::StrandRaster`).
+    pub soft: SoftFields,
+    /// Motion vectors and temporal accumulation (`render::Temporal`).
+    pub temporal: TemporalFields,
     /// Temporal: unjittered clip space of this frame to the previous frame's, for surfaces
     /// that did not move (the background; `CharacterRecord::clip_to_prev` for hair).
     pub clip_to_prev: [[f32; 4]; 4],
@@ -552,18 +536,194 @@ pub struct FrameBlock {
     /// World to the light's clip space of the bodies' map (`render::shadow::LightView::fit_bodies`:
     /// fitted to the bodies the camera sees; the light's prop pass draws with it).
     pub body_view_proj: [[f32; 4]; 4],
-    /// Bodies' map: x resolution (0: no map this frame), y depth range (world units), z depth
-    /// bias (world units), w texel size (world units).
-    pub body_shadow: [f32; 4],
+    /// The bodies' shadow map.
+    pub body_shadow: BodyShadowFields,
 }
 
+/// [`FrameBlock::lod`]: eq. 7's terms and the strand caps (`render::LodSettings`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct LodFields {
+    /// Alpha of eq. 7 for strands.
+    pub alpha_strands: f32,
+    /// Alpha of eq. 7 for vertices.
+    pub alpha_verts: f32,
+    /// Lambda of eq. 7.
+    pub lambda: f32,
+    /// `tan(fov_y)` of eq. 7 (0: orthographic).
+    pub tan_fov: f32,
+    /// View height of orthographic views (world units).
+    pub ortho_height: f32,
+    /// The strand level's area term below this extent in pixels (`LodSettings::area_below`;
+    /// 0 off).
+    pub area_below: f32,
+    /// Strands per square pixel of a bundle's extent (`LodSettings::strands_per_pixel`; 0
+    /// off).
+    pub strands_per_pixel: f32,
+    /// Padding.
+    pub _pad: f32,
+}
+
+/// [`FrameBlock::counts`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct CountFields {
+    /// Bundles of all characters.
+    pub bundles: u32,
+    /// Character slots.
+    pub slots: u32,
+    /// LoD on (1) or off (0).
+    pub lod_on: u32,
+    /// Vertex pool budget (compute path, in `HairVertex` slots).
+    pub vertex_budget: u32,
+}
+
+/// [`FrameBlock::shading`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct ShadingFields {
+    /// Shading model (`shade::ShadingModel`).
+    pub model: u32,
+    /// Thick-strand appearance term on (seed 000, `lod_appearance.glsl`).
+    pub lod_appearance: u32,
+    /// Multiple scattering on (`shade::scattering`).
+    pub multiple_scattering: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// [`FrameBlock::shadow`]: the hair's shadow maps.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct ShadowFields {
+    /// Shadow mode (`render::ShadowMode`: [`SHADOW_OFF`], [`SHADOW_DEEP_OPACITY`],
+    /// [`SHADOW_APPROXIMATE`]).
+    pub mode: u32,
+    /// Shadow map resolution.
+    pub resolution: u32,
+    /// Padding.
+    pub _pad: [u32; 2],
+    /// Deep-opacity layer thickness (world units).
+    pub layer_thickness: f32,
+    /// Light depth range (far - near, world units).
+    pub depth_range: f32,
+    /// Opacity of one strand.
+    pub strand_opacity: f32,
+    /// Depth bias (world units).
+    pub bias: f32,
+}
+
+/// [`FrameBlock::transparency`] (`render::Transparency`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct TransparencyFields {
+    /// Mode: [`TRANSPARENCY_OPAQUE`], [`TRANSPARENCY_KBUFFER`], [`TRANSPARENCY_PEEL`].
+    pub mode: u32,
+    /// k-buffer nodes per pixel.
+    pub kbuffer_nodes: u32,
+    /// Samples per pixel of the targets.
+    pub samples: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// [`FrameBlock::soft`]: the software rasterizer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct SoftFields {
+    /// Mode: [`RASTER_HARDWARE`], [`RASTER_SOFTWARE`], [`RASTER_AUTO`], [`RASTER_LIGHT`].
+    pub mode: u32,
+    /// Fragments kept sorted per pixel.
+    pub k: u32,
+    /// Segment budget.
+    pub segment_budget: u32,
+    /// Tile entry budget.
+    pub tile_entry_budget: u32,
+    /// Auto split: bundles whose strands are drawn at most this many pixels wide go to
+    /// software.
+    pub auto_split_pixels: f32,
+    /// Opacity of one strand.
+    pub strand_opacity: f32,
+    /// Padding.
+    pub _pad: [u32; 2],
+    /// Tiles per row.
+    pub tiles_x: u32,
+    /// Tile rows.
+    pub tiles_y: u32,
+    /// Padding.
+    pub _pad2: [u32; 2],
+}
+
+/// [`FrameBlock::temporal`] (`render::Temporal`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct TemporalFields {
+    /// Passes note the nearest surface per pixel (motion vectors).
+    pub motion: u32,
+    /// Accumulation on.
+    pub accumulate: u32,
+    /// History valid.
+    pub history_valid: u32,
+    /// The compute path's vertices carry deformation residuals.
+    pub residuals: u32,
+    /// This frame's sub-pixel jitter (pixels, in `view_proj`).
+    pub jitter: [f32; 2],
+    /// History weight of a fully trusted pixel.
+    pub history_weight: f32,
+    /// Colour clamp width for hair (standard deviations).
+    pub hair_clamp: f32,
+}
+
+/// [`FrameBlock::body_shadow`]: the bodies' map.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BodyShadowFields {
+    /// Resolution (0: no map this frame).
+    pub resolution: f32,
+    /// Depth range (world units).
+    pub depth_range: f32,
+    /// Depth bias (world units).
+    pub bias: f32,
+    /// Texel size (world units).
+    pub texel: f32,
+}
+
+gpu_struct!(LodFields as "LodFields" {
+    alpha_strands: "float", alpha_verts: "float", lambda: "float", tan_fov: "float",
+    ortho_height: "float", area_below: "float", strands_per_pixel: "float", _pad: "float",
+});
+gpu_struct!(CountFields as "CountFields" {
+    bundles: "uint", slots: "uint", lod_on: "uint", vertex_budget: "uint",
+});
+gpu_struct!(ShadingFields as "ShadingFields" {
+    model: "uint", lod_appearance: "uint", multiple_scattering: "uint", _pad: "uint",
+});
+gpu_struct!(ShadowFields as "ShadowFields" {
+    mode: "uint", resolution: "uint", _pad: "uvec2", layer_thickness: "float",
+    depth_range: "float", strand_opacity: "float", bias: "float",
+});
+gpu_struct!(TransparencyFields as "TransparencyFields" {
+    mode: "uint", kbuffer_nodes: "uint", samples: "uint", _pad: "uint",
+});
+gpu_struct!(SoftFields as "SoftFields" {
+    mode: "uint", k: "uint", segment_budget: "uint", tile_entry_budget: "uint",
+    auto_split_pixels: "float", strand_opacity: "float", _pad: "uvec2", tiles_x: "uint",
+    tiles_y: "uint", _pad2: "uvec2",
+});
+gpu_struct!(TemporalFields as "TemporalFields" {
+    motion: "uint", accumulate: "uint", history_valid: "uint", residuals: "uint",
+    jitter: "vec2", history_weight: "float", hair_clamp: "float",
+});
+gpu_struct!(BodyShadowFields as "BodyShadowFields" {
+    resolution: "float", depth_range: "float", bias: "float", texel: "float",
+});
 gpu_struct!(FrameBlock as "FrameBlock" {
-    view_proj: "mat4", camera_pos: "vec4", light_dir: "vec4", viewport: "vec4",
-    planes: "vec4"[6], lod: "vec4", lod_ortho: "vec4", counts: "uvec4", shading: "uvec4",
-    light_view_proj: "mat4", shadow: "uvec4", shadow_params: "vec4", transparency: "uvec4",
-    soft: "uvec4", soft_params: "vec4", soft_grid: "uvec4", temporal: "uvec4",
-    temporal_params: "vec4", clip_to_prev: "mat4", unjittered_view_proj: "mat4",
-    body_view_proj: "mat4", body_shadow: "vec4",
+    view_proj: "mat4", eye: "vec3", pixels_high: "float", to_light: "vec3",
+    cot_half_fov: "float", viewport: "vec4", planes: "vec4"[6], lod: "LodFields",
+    counts: "CountFields", shading: "ShadingFields", light_view_proj: "mat4",
+    shadow: "ShadowFields", transparency: "TransparencyFields", soft: "SoftFields",
+    temporal: "TemporalFields", clip_to_prev: "mat4", unjittered_view_proj: "mat4",
+    body_view_proj: "mat4", body_shadow: "BodyShadowFields",
 });
 
 /// One character: where its bundles and textures are, how it is placed and styled.
@@ -1087,6 +1247,14 @@ pub fn shared_structs() -> Vec<StructInfo> {
         info::<MeshInfo>(),
         info::<HairStyle>(),
         info::<BundleDesc>(),
+        info::<LodFields>(),
+        info::<CountFields>(),
+        info::<ShadingFields>(),
+        info::<ShadowFields>(),
+        info::<TransparencyFields>(),
+        info::<SoftFields>(),
+        info::<TemporalFields>(),
+        info::<BodyShadowFields>(),
         info::<FrameBlock>(),
         info::<CharacterRecord>(),
         info::<GpuBundle>(),
@@ -1134,6 +1302,36 @@ pub fn std430_layout(
         // std430 arrays: stride is the element size rounded up to its alignment.
         offset += if f.array > 0 {
             size.next_multiple_of(align) * f.array
+        } else {
+            size
+        };
+        align_max = align_max.max(align);
+    }
+    (offsets, offset.next_multiple_of(align_max), align_max)
+}
+
+/// std140 layout of `s` (uniform blocks): `(field offsets, size, alignment)`, using the
+/// std140 layouts of the structs before it in `known`. As std430, but a struct's alignment and
+/// every array's stride round up to 16 bytes.
+pub fn std140_layout(
+    s: &StructInfo,
+    known: &[(String, usize, usize)],
+) -> (Vec<usize>, usize, usize) {
+    let (mut offset, mut align_max, mut offsets) = (0usize, 16usize, Vec::new());
+    for f in &s.fields {
+        let (size, align) = std430_type(f.glsl)
+            .or_else(|| {
+                known
+                    .iter()
+                    .find(|(n, ..)| n == f.glsl)
+                    .map(|(_, s, a)| (*s, *a))
+            })
+            .unwrap_or_else(|| panic!("{}: unknown GLSL type {}", s.name, f.glsl));
+        let align = if f.array > 0 { align.max(16) } else { align };
+        offset = offset.next_multiple_of(align);
+        offsets.push(offset);
+        offset += if f.array > 0 {
+            size.next_multiple_of(16) * f.array
         } else {
             size
         };

@@ -65,7 +65,7 @@ pub enum StrandRaster {
 }
 
 impl StrandRaster {
-    /// Mode number in `FrameBlock::soft.x`.
+    /// Mode number in `SoftFields::mode`.
     pub fn mode(self) -> u32 {
         match self {
             StrandRaster::Hardware => crate::render::core::shared::RASTER_HARDWARE,
@@ -202,15 +202,18 @@ pub fn frame_fields(
     tuning: SoftTuning,
 ) {
     let (w, h) = (block.viewport[0] as u32, block.viewport[1] as u32);
-    let (tx, ty) = tile_grid(w, h);
-    block.soft = [
-        raster.mode(),
-        raster.k(),
-        tuning.budget.segments,
-        tuning.budget.tile_entries,
-    ];
-    block.soft_params = [tuning.auto_split_pixels, opacity, 0.0, 0.0];
-    block.soft_grid = [tx, ty, 0, 0];
+    let (tiles_x, tiles_y) = tile_grid(w, h);
+    block.soft = crate::render::core::shared::SoftFields {
+        mode: raster.mode(),
+        k: raster.k(),
+        segment_budget: tuning.budget.segments,
+        tile_entry_budget: tuning.budget.tile_entries,
+        auto_split_pixels: tuning.auto_split_pixels,
+        strand_opacity: opacity,
+        tiles_x,
+        tiles_y,
+        ..Default::default()
+    };
 }
 
 impl SoftBudget {
@@ -280,7 +283,7 @@ pub fn shadow_buffers(light: Option<(u32, bool)>) -> [TransientBuffer; 2] {
 mod tests {
     use super::*;
 
-    /// Each raster reaches the shaders as its own mode number (`FrameBlock::soft.x`).
+    /// Each raster reaches the shaders as its own mode number (`SoftFields::mode`).
     #[test]
     fn each_raster_has_its_shader_mode() {
         use crate::render::core::shared::{RASTER_AUTO, RASTER_HARDWARE, RASTER_SOFTWARE};

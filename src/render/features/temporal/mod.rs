@@ -86,7 +86,7 @@ impl std::fmt::Display for Temporal {
     }
 }
 
-/// The accumulation's constants (`FrameBlock::temporal_params`).
+/// The accumulation's constants (`TemporalFields::history_weight`, `TemporalFields::hair_clamp`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TemporalTuning {
     /// Weight of the current frame in a pixel whose history is trusted (the rest is history):
@@ -324,8 +324,15 @@ impl TemporalFeature {
         let tuning = TemporalTuning::default();
         block.view_proj = jittered(view_proj, jitter, size).to_cols_array_2d();
         let residuals = work.vertex_slots > 0;
-        block.temporal = [1, work.accumulate as u32, valid as u32, residuals as u32];
-        block.temporal_params = [jitter.x, jitter.y, tuning.current_weight, tuning.hair_clamp];
+        block.temporal = crate::render::core::shared::TemporalFields {
+            motion: 1,
+            accumulate: work.accumulate as u32,
+            history_valid: valid as u32,
+            residuals: residuals as u32,
+            jitter: jitter.to_array(),
+            history_weight: tuning.current_weight,
+            hair_clamp: tuning.hair_clamp,
+        };
         block.clip_to_prev = motion.camera().to_cols_array_2d();
         motion
     }

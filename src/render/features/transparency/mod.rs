@@ -47,7 +47,7 @@ pub enum Transparency {
 }
 
 impl Transparency {
-    /// Mode number in `FrameBlock::transparency.x`.
+    /// Mode number in `TransparencyFields::mode`.
     pub fn mode(self) -> u32 {
         match self {
             Transparency::Opaque => crate::render::core::shared::TRANSPARENCY_OPAQUE,
@@ -57,12 +57,17 @@ impl Transparency {
     }
 
     /// `FrameBlock::transparency` for targets of `samples` samples per pixel.
-    pub fn frame_fields(self, samples: u32) -> [u32; 4] {
-        let budget = match self {
+    pub fn frame_fields(self, samples: u32) -> crate::render::core::shared::TransparencyFields {
+        let kbuffer_nodes = match self {
             Transparency::KBuffer { budget } => budget,
             _ => 0,
         };
-        [self.mode(), budget, samples, 0]
+        crate::render::core::shared::TransparencyFields {
+            mode: self.mode(),
+            kbuffer_nodes,
+            samples,
+            _pad: 0,
+        }
     }
 
     /// Check the budget or layer count.

@@ -134,12 +134,12 @@ pub fn hair_pixels(r: &CharacterRecord, block: &FrameBlock) -> f32 {
     let model = Mat4::from_cols_array_2d(&r.model);
     let centre = model.transform_point3(lo + 0.5 * extent);
     let radius = 0.5 * extent.length() * r.model_scale;
-    let height = block.camera_pos[3];
-    let inv_tan = block.light_dir[3];
+    let height = block.pixels_high;
+    let inv_tan = block.cot_half_fov;
     if inv_tan <= 0.0 {
-        return 2.0 * radius / block.lod_ortho[0].max(1e-12) * height;
+        return 2.0 * radius / block.lod.ortho_height.max(1e-12) * height;
     }
-    let distance = centre.distance(Vec3::from_slice(&block.camera_pos[..3]));
+    let distance = centre.distance(Vec3::from_array(block.eye));
     if distance <= radius {
         return f32::INFINITY;
     }
@@ -496,14 +496,14 @@ mod tests {
         r.model_scale = 1.0;
         let mut block: FrameBlock = bytemuck::Zeroable::zeroed();
         // Sphere at (2, 0, 0), radius 2, eye 10 away, 720 px high, inv_tan 1.
-        block.camera_pos = [2.0, 0.0, 10.0, 720.0];
-        block.light_dir[3] = 1.0;
+        (block.eye, block.pixels_high) = ([2.0, 0.0, 10.0], 720.0);
+        block.cot_half_fov = 1.0;
         assert!((hair_pixels(&r, &block) - 144.0).abs() < 1e-3);
-        block.camera_pos = [2.0, 0.0, 1.5, 720.0];
+        (block.eye, block.pixels_high) = ([2.0, 0.0, 1.5], 720.0);
         assert_eq!(hair_pixels(&r, &block), f32::INFINITY);
         // Orthographic (inv_tan 0): a 4-unit-high view.
-        block.light_dir[3] = 0.0;
-        block.lod_ortho[0] = 4.0;
+        block.cot_half_fov = 0.0;
+        block.lod.ortho_height = 4.0;
         assert!((hair_pixels(&r, &block) - 720.0).abs() < 1e-3);
     }
 
