@@ -1281,6 +1281,18 @@ pub fn shared_structs() -> Vec<StructInfo> {
     ]
 }
 
+/// `(size, alignment)` of field `f` of `s`: a GLSL type, or a struct laid out in `known`.
+fn field_type(s: &StructInfo, f: &GpuField, known: &[(String, usize, usize)]) -> (usize, usize) {
+    std430_type(f.glsl)
+        .or_else(|| {
+            known
+                .iter()
+                .find(|(n, ..)| n == f.glsl)
+                .map(|(_, s, a)| (*s, *a))
+        })
+        .unwrap_or_else(|| panic!("{}: unknown GLSL type {}", s.name, f.glsl))
+}
+
 /// std430 layout of `s`: `(field offsets, size, alignment)`, using the layouts of the structs
 /// before it in `known`.
 pub fn std430_layout(
@@ -1289,14 +1301,7 @@ pub fn std430_layout(
 ) -> (Vec<usize>, usize, usize) {
     let (mut offset, mut align_max, mut offsets) = (0usize, 4usize, Vec::new());
     for f in &s.fields {
-        let (size, align) = std430_type(f.glsl)
-            .or_else(|| {
-                known
-                    .iter()
-                    .find(|(n, ..)| n == f.glsl)
-                    .map(|(_, s, a)| (*s, *a))
-            })
-            .unwrap_or_else(|| panic!("{}: unknown GLSL type {}", s.name, f.glsl));
+        let (size, align) = field_type(s, f, known);
         offset = offset.next_multiple_of(align);
         offsets.push(offset);
         // std430 arrays: stride is the element size rounded up to its alignment.
@@ -1319,14 +1324,7 @@ pub fn std140_layout(
 ) -> (Vec<usize>, usize, usize) {
     let (mut offset, mut align_max, mut offsets) = (0usize, 16usize, Vec::new());
     for f in &s.fields {
-        let (size, align) = std430_type(f.glsl)
-            .or_else(|| {
-                known
-                    .iter()
-                    .find(|(n, ..)| n == f.glsl)
-                    .map(|(_, s, a)| (*s, *a))
-            })
-            .unwrap_or_else(|| panic!("{}: unknown GLSL type {}", s.name, f.glsl));
+        let (size, align) = field_type(s, f, known);
         let align = if f.array > 0 { align.max(16) } else { align };
         offset = offset.next_multiple_of(align);
         offsets.push(offset);
