@@ -688,7 +688,7 @@ impl Frames {
         }
         let soft = raster.uses_software().then_some(self.soft_budget);
         let light = soft_light.map(|mode| (self.soft_budget, self.shadow.resolution(), mode));
-        let t = FrameTransients::new(buffers_for, (soft, light), size, temporal);
+        let t = super::passes::frame_transients(buffers_for, (soft, light), size, temporal);
         for b in t.buffers() {
             self.transients.check(b)?;
         }

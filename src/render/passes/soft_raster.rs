@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets, TemporalRes, device_shader_options, dispatch_2d};
+use super::{FrameRes, PassSets, TemporalRes, add_depth_copy, device_shader_options, dispatch_2d};
 use crate::render::core::graph::FrameGraph;
 use crate::render::core::shared::GenerateArgs;
 use crate::render::soft::tile_grid;
@@ -208,19 +208,4 @@ impl SoftRasterPass {
             });
         bin(g, "soft bin scatter", &self.scatter, true);
     }
-}
-
-/// Add a pass named `name` copying the camera's depth target into the soft depth buffer
-/// (`glsl/soft_depth.glsl`: a float per pixel, row by row), which exists when the camera's
-/// strands go through the software rasterizer. Single-sampled targets only: MSAA frames draw
-/// no software strands.
-pub fn add_depth_copy<'a>(g: &mut FrameGraph<'a>, r: &FrameRes<'a>, name: &'static str) {
-    let (depth, soft_depth) = (r.images.depth, r.soft_depth);
-    g.pass(name)
-        .read(r.depth, Access::TransferRead)
-        .discard(r.soft_depth, Access::TransferWrite)
-        .record(move |rec, res| {
-            rec.copy_image_to_buffer_at(depth, res.buffer(soft_depth)?, 0);
-            Ok(())
-        });
 }

@@ -8,71 +8,11 @@ use std::sync::Arc;
 
 use super::TemporalWork;
 use crate::render::core::binding::{PassSets, device_shader_options};
-use crate::render::core::graph::{FrameGraph, Res, TransientBuffer};
+pub use crate::render::core::frame_res::TemporalRes;
+use crate::render::core::graph::{FrameGraph, Res};
 use crate::render::core::shared::TEMPORAL_GROUP;
 use crate::vk::shader::compile;
 use crate::vk::{Access, Buffer, Context, GpuResult, Image, Pipeline, PipelineLayout};
-
-/// The temporal passes' resources besides the visibility words (graph handles).
-#[derive(Clone, Copy)]
-pub struct TemporalRes {
-    /// Motion vectors.
-    pub motion: Res,
-    /// The frame's colour as a buffer (accumulation).
-    pub frame_color: Res,
-    /// Deformation residuals of the compute path's vertices.
-    pub vertex_motion: Res,
-    /// Deformation residuals of the software rasterizer's segments.
-    pub segment_motion: Res,
-    /// The history read and the one written (placeholders without accumulation).
-    pub history: (Res, Res),
-}
-
-impl TemporalRes {
-    /// The vertex residuals of `t`, if the frame has motion vectors.
-    pub fn vertex_motion(t: Option<Self>) -> Option<Res> {
-        t.map(|t| t.vertex_motion)
-    }
-
-    /// The segment residuals of `t`, if the frame has motion vectors.
-    pub fn segment_motion(t: Option<Self>) -> Option<Res> {
-        t.map(|t| t.segment_motion)
-    }
-
-    /// Create the temporal transients (`buffers`, from [`super::transient_buffers`]:
-    /// visibility, motion, frame colour, residuals) and import the history buffers: the
-    /// visibility words and the rest, in frames with motion vectors (`motion`).
-    pub fn create<'a>(
-        g: &mut FrameGraph<'a>,
-        buffers: &[TransientBuffer; 5],
-        motion: bool,
-        history: Option<(&'a Buffer, &'a Buffer)>,
-    ) -> Option<(Res, Self)> {
-        let [
-            visibility,
-            motion_vectors,
-            frame_color,
-            vertex_motion,
-            segment_motion,
-        ] = buffers.map(|d| g.create_buffer(d));
-        let history = history.map(|(read, write)| {
-            (
-                g.import_buffer("temporal history read", read),
-                g.import_buffer("temporal history written", write),
-            )
-        });
-        motion.then_some((
-            visibility,
-            TemporalRes {
-                motion: motion_vectors,
-                frame_color,
-                vertex_motion,
-                segment_motion,
-                history: history.unwrap_or((frame_color, frame_color)),
-            },
-        ))
-    }
-}
 
 /// What the temporal passes take from the frame.
 pub struct TemporalInputs<'a> {

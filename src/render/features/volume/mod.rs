@@ -1,6 +1,6 @@
-//! Strand density volumes on the GPU (`passes::density_volume`, the twin of
+//! Strand density volumes on the GPU (`density_volume`, the twin of
 //! `reference::volume`) and the volume tier that uses them (seed 002): far characters' hair
-//! ray-marched through their volume (`passes::volume_hair`), and volumetric ambient occlusion
+//! ray-marched through their volume (`volume_hair`), and volumetric ambient occlusion
 //! of near hair (`glsl/volume_shading.glsl`).
 //!
 //! A volume is built in the frame after it is requested (after that frame's texture
@@ -8,6 +8,9 @@
 //! hair mesh changed pose since their build a few a frame, the longest stale first
 //! ([`VolumeTier::rebuilds_per_frame`]): a far character's volume may lag its hair's motion by
 //! a few frames, which nobody sees at its size.
+
+pub mod density_volume;
+pub mod volume_hair;
 
 use std::sync::Arc;
 

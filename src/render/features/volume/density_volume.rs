@@ -8,7 +8,8 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets};
+use crate::render::core::binding::{PassSets, shader_options};
+use crate::render::core::frame_res::FrameRes;
 use crate::render::core::graph::FrameGraph;
 use crate::render::core::shared::DENSITY_PASS_OCCUPANCY;
 use crate::vk::shader::compile;
@@ -22,7 +23,7 @@ pub struct DensityVolumePass {
 impl DensityVolumePass {
     /// Compile the pass.
     pub fn new(ctx: &Arc<Context>, layout: &Arc<PipelineLayout>) -> GpuResult<Self> {
-        let spirv = compile("density_volume.comp", &super::shader_options(1))?;
+        let spirv = compile("density_volume.comp", &shader_options(1))?;
         Ok(DensityVolumePass {
             pipeline: Pipeline::compute(ctx, "density volume", layout, &spirv)?,
         })

@@ -9,8 +9,10 @@
 
 use std::sync::Arc;
 
-use super::{DrawTarget, FrameRes, PassSets, TargetFormats, device_shader_options};
+use crate::render::core::binding::{PassSets, device_shader_options};
+use crate::render::core::frame_res::{FrameRes, add_depth_copy};
 use crate::render::core::graph::FrameGraph;
+use crate::render::core::pipelines::{DrawTarget, TargetFormats};
 use crate::vk::shader::compile;
 use crate::vk::{
     Access, Attachment, BlendMode, Context, CullMode, GpuResult, Pipeline, PipelineLayout,
@@ -60,7 +62,7 @@ impl VolumeHairDraw {
     ) {
         g.begin_scope("volume hair");
         if soft {
-            super::soft_raster::add_depth_copy(g, r, "volume depth copy");
+            add_depth_copy(g, r, "volume depth copy");
         }
         let mut p = g
             .pass("volume hair")
