@@ -36,7 +36,7 @@ use super::passes::write_address_table;
 use super::passes::{
     FrameInputs, FrameRes, FrameSources, FrameTransients, PassSets, TargetFormats,
 };
-use super::schedule::{FramePlan, FrameUpdates, HostStart, add_frame};
+use super::schedule::{Changes, HostStart, ScheduleInputs, add_frame};
 use super::settings::{DeviceCaps, RendererDesc, check_msaa};
 use super::settings::{FrameOptions, FrameTicket, LightRaster};
 use super::shadow::{LightView, ShadowMode};
@@ -876,7 +876,7 @@ impl Frames {
         let r = FrameRes::new(&mut g, sources, &work.transients);
         g.bind_transients(set);
         g.bind_transients(light_set);
-        let updates = FrameUpdates {
+        let changes = Changes {
             jobs: &jobs,
             dynamics: sim_jobs.as_ref().map(|t| (t, simulated.as_slice())),
             lhs: match (work.path, self.lhs.as_mut()) {
@@ -897,8 +897,8 @@ impl Frames {
         }
         draw.motion_readback = motion_readback.as_ref().filter(|_| opts.read_motion);
         let image_readback = image_readback.as_ref().filter(|_| opts.read_image);
-        let plan = FramePlan {
-            updates,
+        let plan = ScheduleInputs {
+            changes,
             host,
             draw,
             outputs: outputs(target, stats_readback, image_readback),

@@ -40,7 +40,7 @@ use crate::render::core::graph::ImageState::Tracked;
 use crate::vk::{Access, Buffer, GpuResult};
 
 /// What changed since the last frame, rebuilt before anything draws.
-pub struct FrameUpdates<'a> {
+pub struct Changes<'a> {
     /// Hair mesh texture rebuilds (new poses).
     pub jobs: &'a [UpdateJob<'a>],
     /// GPU hair dynamics: the slot's step table and the simulated characters.
@@ -69,9 +69,9 @@ pub struct HostStart<'a> {
 }
 
 /// Everything one frame adds to its graph.
-pub struct FramePlan<'a, 'o> {
+pub struct ScheduleInputs<'a, 'o> {
     /// What changed since the last frame.
-    pub updates: FrameUpdates<'a>,
+    pub changes: Changes<'a>,
     /// A host frame's start (`None`: the renderer's own frame).
     pub host: Option<HostStart<'a>>,
     /// What the views draw.
@@ -85,16 +85,16 @@ pub fn add_frame<'a>(
     g: &mut FrameGraph<'a>,
     passes: &'a FramePasses,
     r: &FrameRes<'a>,
-    plan: FramePlan<'a, '_>,
+    plan: ScheduleInputs<'a, '_>,
 ) -> GpuResult<()> {
-    let FramePlan {
-        updates,
+    let ScheduleInputs {
+        changes,
         host,
         draw: mut inp,
         outputs,
     } = plan;
     // 1. What changed.
-    add_updates(g, passes, r, updates, inp.sets)?;
+    add_changes(g, passes, r, changes, inp.sets)?;
     // 2. A host frame's depth.
     let host = host.map(|h| add_host_start(g, r, h));
     // 3-5. Statistics, skinning, the probe, the light's view, the camera's culling and
@@ -161,22 +161,22 @@ impl StrandWork {
 
 /// Step 1: hair dynamics, then the hair mesh rebuilds they and new poses need; the LHS
 /// baseline's skinning; the requested density volumes.
-fn add_updates<'a>(
+fn add_changes<'a>(
     g: &mut FrameGraph<'a>,
     passes: &'a FramePasses,
     r: &FrameRes<'a>,
-    updates: FrameUpdates<'a>,
+    changes: Changes<'a>,
     sets: PassSets<'a>,
 ) -> GpuResult<()> {
-    let poses = match updates.dynamics {
+    let poses = match changes.dynamics {
         Some((table, simulated)) => passes.hair_dynamics.add(g, table, simulated),
         None => Vec::new(),
     };
-    passes.hair_mesh_update.add(g, r, updates.jobs, &poses);
-    if let Some((lhs, slot)) = updates.lhs {
+    passes.hair_mesh_update.add(g, r, changes.jobs, &poses);
+    if let Some((lhs, slot)) = changes.lhs {
         passes.lhs_skin.add(g, r, lhs, slot)?;
     }
-    if let Some((table, volumes, most_bundles)) = updates.volume_builds {
+    if let Some((table, volumes, most_bundles)) = changes.volume_builds {
         passes
             .density_volume
             .add(g, r, sets, table, &volumes, most_bundles);
