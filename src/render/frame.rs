@@ -25,10 +25,10 @@ use super::crowd::Crowd;
 use super::features::temporal::{
     FrameMotion, PreviousFrame, Temporal, TemporalFeature, TemporalWork,
 };
+use super::host::targets::HostTargetPasses;
 use super::host::{DepthMapping, HostFrame, HostImage};
 use super::passes::FramePasses;
 use super::passes::hair_dynamics::SimulatedCharacter;
-use super::passes::host_targets::HostTargetPasses;
 use super::passes::output::FrameOutputs;
 use super::passes::output::Overlay;
 use super::passes::props::{PropDraw, PropList};

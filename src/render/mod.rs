@@ -11,7 +11,6 @@ pub mod deform;
 pub mod dynamics;
 pub mod features;
 pub mod frame;
-pub mod host;
 pub mod passes;
 pub mod prop_table;
 pub mod renderer;
@@ -31,7 +30,7 @@ pub use camera::{
 };
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use features::soft_raster::{payload, pixel as soft_pixel};
-pub use features::{soft_raster as soft, temporal, transparency, volume};
+pub use features::{host, soft_raster as soft, temporal, transparency, volume};
 pub use host::{HostCamera, HostFrame, HostImage};
 pub use renderer::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,

@@ -1,5 +1,5 @@
 //! The renderer's core, which every feature builds on and which imports nothing above it: the
-//! frame graph and its pool of transient resources ([`graph`]), the CPU/GPU contract
+//! camera ([`camera`]), the frame graph and its pool of transient resources ([`graph`]), the CPU/GPU contract
 //! ([`shared`], a leaf), the camera's targets and shadow maps ([`targets`]), the frames in
 //! flight and what a finished frame reports ([`slots`]), the working buffers that outlive a
 //! frame ([`workspace`]), the generation path every feature reads ([`path`]), what every pass
@@ -7,6 +7,7 @@
 //! the frame's resources in its graph ([`frame_res`]).
 
 pub mod binding;
+pub mod camera;
 pub mod frame_res;
 pub mod graph;
 pub mod ids;

@@ -5,7 +5,6 @@ pub mod bundle_lod;
 pub mod compute_generate;
 pub mod hair_dynamics;
 pub mod hair_mesh_update;
-pub mod host_targets;
 pub mod lhs_skin;
 pub mod opaque;
 pub mod output;

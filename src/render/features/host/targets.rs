@@ -1,4 +1,4 @@
-//! A host frame's passes around the renderer's own ([`crate::render::host`]): first the
+//! A host frame's passes around the renderer's own ([`super`]): first the
 //! host's depth into the renderer's (`glsl/host_depth.frag`, or a clear when the host gives no
 //! depth) with the colour cleared to transparent, then, after the frame, its hair composited
 //! premultiplied over the host's colour (`glsl/host_composite.frag`), and the host's images
@@ -12,10 +12,12 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{FrameRes, TargetFormats};
+use super::DepthMapping;
+use crate::render::core::binding::device_shader_options;
+use crate::render::core::frame_res::FrameRes;
 use crate::render::core::graph::{FrameGraph, Res};
+use crate::render::core::pipelines::TargetFormats;
 use crate::render::core::slots::FRAMES_IN_FLIGHT;
-use crate::render::host::DepthMapping;
 use crate::vk::shader::compile;
 use crate::vk::{
     Access, Attachment, BindingDesc, BlendMode, Context, DepthMode, DescriptorKind, DescriptorSet,
@@ -66,7 +68,7 @@ impl HostTargetPasses {
             (set_layout(HOST_DEPTH_BINDING)?, set_layout(HAIR_BINDING)?);
         let depth_layout = PipelineLayout::new(ctx, std::slice::from_ref(&depth_set_layout))?;
         let layout = PipelineLayout::new(ctx, std::slice::from_ref(&set_layout))?;
-        let opts = super::device_shader_options(ctx, 1);
+        let opts = device_shader_options(ctx, 1);
         let v = compile("fullscreen.vert", &opts)?;
         let f = compile("host_depth.frag", &opts)?;
         let desc = targets
@@ -123,7 +125,7 @@ impl HostTargetPasses {
         }
         let key = (c.format, c.samples);
         if let std::collections::hash_map::Entry::Vacant(e) = self.composite.entry(key) {
-            let opts = super::device_shader_options(&self.ctx, 1);
+            let opts = device_shader_options(&self.ctx, 1);
             let v = compile("fullscreen.vert", &opts)?;
             let f = compile("host_composite.frag", &opts)?;
             let desc = GraphicsDesc::new("host composite", c.format, vk::Format::UNDEFINED)

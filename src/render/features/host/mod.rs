@@ -13,7 +13,9 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use super::camera::Camera;
+pub mod targets;
+
+use crate::render::core::camera::Camera;
 use crate::vk::{Access, Image};
 
 /// A host's camera: its world-to-view and view-to-clip matrices, in Vulkan's clip space (x to
