@@ -22,13 +22,13 @@ use super::core::targets::{RenderTargets, ShadowMaps};
 use super::core::workspace::FrameBuffers;
 use super::core::workspace::Workspace;
 use super::crowd::Crowd;
+use super::dynamics::pass::SimulatedCharacter;
 use super::features::temporal::{
     FrameMotion, PreviousFrame, Temporal, TemporalFeature, TemporalWork,
 };
 use super::host::targets::HostTargetPasses;
 use super::host::{DepthMapping, HostFrame, HostImage};
 use super::passes::FramePasses;
-use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::output::FrameOutputs;
 use super::passes::output::Overlay;
 use super::passes::props::{PropDraw, PropList};

@@ -8,7 +8,6 @@ pub mod core;
 pub mod crowd;
 pub mod debug;
 pub mod deform;
-pub mod dynamics;
 pub mod features;
 pub mod frame;
 pub mod passes;
@@ -30,7 +29,7 @@ pub use camera::{
 };
 pub use crowd::{CharacterId, Crowd, StrandParams};
 pub use features::soft_raster::{payload, pixel as soft_pixel};
-pub use features::{host, soft_raster as soft, temporal, transparency, volume};
+pub use features::{dynamics, host, soft_raster as soft, temporal, transparency, volume};
 pub use host::{HostCamera, HostFrame, HostImage};
 pub use renderer::{
     DeviceCaps, FrameOptions, FrameSettings, FrameTicket, PresentTarget, RenderPath, Renderer,

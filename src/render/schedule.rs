@@ -20,11 +20,11 @@
 use super::RenderPath;
 use super::core::binding::PassSets;
 use super::core::graph::FrameGraph;
+use super::dynamics::pass::SimulatedCharacter;
 use super::features::temporal::{TemporalFeature, TemporalInputs};
 use super::host::targets::{HostTargetPasses, HostTargetRes};
 use super::host::{DepthMapping, HostImage};
 use super::passes::compute_generate::GenerateView;
-use super::passes::hair_dynamics::SimulatedCharacter;
 use super::passes::hair_mesh_update::UpdateJob;
 use super::passes::lhs_skin::LhsState;
 use super::passes::output::{FrameOutputs, add_outputs};

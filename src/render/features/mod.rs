@@ -3,6 +3,7 @@
 //! a frame's graph, returning what it made. Features take from [`super::core`] and their own
 //! folder only, never from each other or the renderer (`tests/module_house.rs` checks).
 
+pub mod dynamics;
 pub mod host;
 pub mod soft_raster;
 pub mod temporal;

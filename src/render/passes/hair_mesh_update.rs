@@ -1,7 +1,7 @@
 //! Animated hair meshes: rebuild the hair mesh texture and the u/v textures of every character
 //! whose pose changed (`glsl/hair_mesh_update.comp`, the GPU twin of `bake::deform`), then copy
 //! the packed texels into its textures. Reads: the pose (uploaded, or written by
-//! `passes::hair_dynamics`) and static basis buffers. Writes: the
+//! `features::dynamics::pass`) and static basis buffers. Writes: the
 //! characters' position, u and v textures (left sampled). Runs before anything reads them.
 
 use std::sync::Arc;

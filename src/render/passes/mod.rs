@@ -3,7 +3,6 @@
 
 pub mod bundle_lod;
 pub mod compute_generate;
-pub mod hair_dynamics;
 pub mod hair_mesh_update;
 pub mod lhs_skin;
 pub mod opaque;
@@ -39,7 +38,6 @@ use super::targets::{COLOR_FORMAT, DEPTH_FORMAT};
 use super::transparency::Transparency;
 use crate::vk::{
     Access, Attachment, Buffer, Context, GpuResult, MeshPrimitivesQuery, PipelineLayout,
-    shader::compile,
 };
 use compute_generate::ComputeGenerate;
 use props::PropList;
@@ -175,7 +173,7 @@ pub struct FramePasses {
     /// Hair mesh textures rebuilt from new poses.
     pub(in crate::render) hair_mesh_update: hair_mesh_update::HairMeshUpdate,
     /// GPU hair dynamics.
-    pub(in crate::render) hair_dynamics: hair_dynamics::HairDynamicsPass,
+    pub(in crate::render) hair_dynamics: crate::render::features::dynamics::pass::HairDynamicsPass,
     /// The LHS baseline's skinning.
     pub(in crate::render) lhs_skin: lhs_skin::LhsSkin,
     /// Density volume builds.
@@ -254,7 +252,7 @@ impl FramePasses {
                 false => None,
             },
             hair_mesh_update: hair_mesh_update::HairMeshUpdate::new(ctx)?,
-            hair_dynamics: hair_dynamics::HairDynamicsPass::new(ctx)?,
+            hair_dynamics: crate::render::features::dynamics::pass::HairDynamicsPass::new(ctx)?,
             lhs_skin: lhs_skin::LhsSkin::new(ctx)?,
             density_volume:
                 crate::render::features::volume::density_volume::DensityVolumePass::new(

@@ -5,7 +5,10 @@
 
 use std::sync::Arc;
 
+use crate::render::core::binding::shader_options;
 use crate::render::core::graph::{FrameGraph, Res};
+use crate::render::core::pipelines::dispatch_2d;
+use crate::vk::shader::compile;
 use crate::vk::{Access, Buffer, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One simulated character's buffers this frame.
@@ -26,10 +29,10 @@ impl HairDynamicsPass {
     pub fn new(ctx: &Arc<Context>) -> GpuResult<Self> {
         let layout = PipelineLayout::new(ctx, &[])?;
         let options = match ctx.info.cpu_device {
-            true => super::shader_options(1).define("CPU_DEVICE", 1),
-            false => super::shader_options(1),
+            true => shader_options(1).define("CPU_DEVICE", 1),
+            false => shader_options(1),
         };
-        let spirv = super::compile("hair_dynamics.comp", &options)?;
+        let spirv = compile("hair_dynamics.comp", &options)?;
         Ok(HairDynamicsPass {
             pipeline: Pipeline::compute(ctx, "hair dynamics", &layout, &spirv)?,
         })
@@ -67,7 +70,7 @@ impl HairDynamicsPass {
         p.record(move |rec, _| {
             rec.bind(&self.pipeline, &[]);
             rec.push_constants(&self.pipeline, &[address[0], address[1], count, 0]);
-            let (x, y) = super::dispatch_2d(count);
+            let (x, y) = dispatch_2d(count);
             rec.dispatch(x, y, 1);
             Ok(())
         });

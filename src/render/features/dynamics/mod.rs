@@ -10,12 +10,14 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, Vec3};
 
-use super::core::shared::{
-    COLLIDER_CAPSULE, COLLIDER_ELLIPSOID, COLLIDER_HEAD, MAX_SIM_COLLIDERS, SimCollider,
-    SimConstraint, SimJob, SimState, SimVertex,
-};
+pub mod pass;
+
 use crate::dynamics::{
     Collider, DynamicsSettings, HairDynamics, HairState, RadialMap, StepClock, StepPlan,
+};
+use crate::render::core::shared::{
+    COLLIDER_CAPSULE, COLLIDER_ELLIPSOID, COLLIDER_HEAD, MAX_SIM_COLLIDERS, SimCollider,
+    SimConstraint, SimJob, SimState, SimVertex,
 };
 use crate::vk::{Buffer, BufferDesc, Context, GpuError, GpuResult};
 
