@@ -11,13 +11,11 @@ pub mod deform;
 pub mod features;
 pub mod frame;
 pub mod passes;
-pub mod prop_table;
 pub mod renderer;
 pub mod scene;
 pub mod schedule;
 pub mod settings;
 pub mod shadow;
-pub mod skinned_props;
 pub mod world;
 
 pub use self::core::shared::FrameStats;
@@ -28,6 +26,7 @@ pub use camera::{
     LodSettings, View,
 };
 pub use crowd::{CharacterId, Crowd, StrandParams};
+pub use features::props::{self as prop_table, skinned as skinned_props};
 pub use features::soft_raster::{payload, pixel as soft_pixel};
 pub use features::{dynamics, host, soft_raster as soft, temporal, transparency, volume};
 pub use host::{HostCamera, HostFrame, HostImage};

@@ -5,6 +5,7 @@
 
 pub mod dynamics;
 pub mod host;
+pub mod props;
 pub mod soft_raster;
 pub mod temporal;
 pub mod transparency;

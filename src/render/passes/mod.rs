@@ -8,11 +8,9 @@ pub mod lhs_skin;
 pub mod opaque;
 pub mod output;
 pub mod pool_segments;
-pub mod props;
 pub mod root_probe;
 pub mod scalp;
 pub mod shadow;
-pub mod skin;
 pub mod soft_raster;
 pub mod soft_shadow;
 pub mod strands;
@@ -29,6 +27,7 @@ pub use super::core::frame_res::{
 pub use super::core::pipelines::{
     DrawTarget, TargetFormats, dispatch_2d, own_set_compute, vertex_pipeline,
 };
+pub use super::features::props::{draw as props, skin};
 use super::features::temporal::{TemporalFeature, TemporalRes, TemporalWork};
 use super::graph::FrameGraph;
 use super::settings::{LightRaster, ShadowMode};

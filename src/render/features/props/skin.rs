@@ -6,7 +6,8 @@
 
 use std::sync::Arc;
 
-use super::{FrameRes, PassSets, device_shader_options};
+use crate::render::core::binding::{PassSets, device_shader_options};
+use crate::render::core::frame_res::FrameRes;
 use crate::render::core::graph::FrameGraph;
 use crate::render::core::shared::SKIN_GROUP_SIZE;
 use crate::vk::shader::compile;

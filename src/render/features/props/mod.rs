@@ -6,10 +6,14 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, Vec3};
 
-use super::core::shared::{PropInstance, PropVertex};
-use super::crowd::CharacterId;
-use super::passes::props::PropDraw;
+pub mod draw;
+pub mod skin;
+pub mod skinned;
+
+use crate::render::core::ids::CharacterId;
+use crate::render::core::shared::{PropInstance, PropVertex};
 use crate::vk::{Buffer, Context, GpuError, GpuResult};
+use draw::PropDraw;
 
 /// A far version of a prop mesh: instances whose bounding sphere spans fewer than
 /// `below_pixels` pixels of the camera's image are drawn with `far_mesh` instead (in every
@@ -29,17 +33,17 @@ pub struct PropLod {
 /// orthographic view's texel size (`texel`; 0 for perspective views). An orthographic view
 /// without a texel size picks no far meshes.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Projection {
-    pub(super) eye: Vec3,
-    pub(super) height: f32,
-    pub(super) cot_half_fov: f32,
+pub(in crate::render) struct Projection {
+    pub(in crate::render) eye: Vec3,
+    pub(in crate::render) height: f32,
+    pub(in crate::render) cot_half_fov: f32,
     /// World size of one texel of an orthographic view (the light's maps); 0: perspective.
-    pub(super) texel: f32,
+    pub(in crate::render) texel: f32,
 }
 
 impl Projection {
     /// An orthographic view (a light's map) whose texels are `texel` world units wide.
-    pub(super) fn orthographic(texel: f32) -> Self {
+    pub(in crate::render) fn orthographic(texel: f32) -> Self {
         Projection {
             eye: Vec3::ZERO,
             height: 0.0,
@@ -50,7 +54,7 @@ impl Projection {
 
     /// Diameter in pixels of a sphere of `radius` at `centre` (infinite at the eye, and in
     /// orthographic views without a texel size).
-    pub(super) fn pixels(&self, centre: Vec3, radius: f32) -> f32 {
+    pub(in crate::render) fn pixels(&self, centre: Vec3, radius: f32) -> f32 {
         if self.texel > 0.0 {
             return 2.0 * radius / self.texel;
         }
@@ -64,16 +68,16 @@ impl Projection {
 
 /// Prop meshes on the GPU and the instances placed for the next frames.
 #[derive(Default)]
-pub(super) struct Props {
-    pub(super) vertices: Option<Buffer>,
-    pub(super) meshes: Vec<(u32, u32)>,
+pub(in crate::render) struct Props {
+    pub(in crate::render) vertices: Option<Buffer>,
+    pub(in crate::render) meshes: Vec<(u32, u32)>,
     /// Bounding sphere (centre, radius) of each mesh in its own frame.
     bounds: Vec<(Vec3, f32)>,
     /// Far version of each mesh, if any: `(far mesh, below pixels)`.
     far: Vec<Option<(usize, f32)>>,
-    pub(super) instances: Vec<(usize, PropInstance)>,
+    pub(in crate::render) instances: Vec<(usize, PropInstance)>,
     /// Props that move with a character: `(character, mesh, instance in its frame)`.
-    pub(super) attached: Vec<(CharacterId, usize, PropInstance)>,
+    pub(in crate::render) attached: Vec<(CharacterId, usize, PropInstance)>,
 }
 
 impl Props {
@@ -87,7 +91,7 @@ impl Props {
     /// (their motion: `world_clip_to_prev`, the camera's) and, placed by `model_of` (model
     /// and clip_to_prev; `None`: not drawn), the characters' own; far versions where `camera`
     /// sees a prop small.
-    pub(super) fn frame_lists(
+    pub(in crate::render) fn frame_lists(
         &self,
         model_of: &impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
         world_clip_to_prev: Mat4,
@@ -136,7 +140,7 @@ impl Props {
 impl Props {
     /// World bounding spheres of the props that move with characters, placed by `model_of`
     /// (`None`: not drawn): what the bodies' shadow map is fitted to.
-    pub(super) fn character_spheres(
+    pub(in crate::render) fn character_spheres(
         &self,
         model_of: &impl Fn(CharacterId) -> Option<Mat4>,
     ) -> Vec<(Vec3, f32)> {
@@ -151,7 +155,7 @@ impl Props {
 
     /// Replace the prop meshes (triangle lists) and clear the instances; returns the old
     /// vertex buffer (frames in flight may still read it).
-    pub(super) fn set_meshes(
+    pub(in crate::render) fn set_meshes(
         &mut self,
         ctx: &Arc<Context>,
         meshes: &[Vec<PropVertex>],
@@ -207,20 +211,23 @@ impl Props {
 
     /// Give meshes far versions (replacing earlier ones; chains allowed), checked by
     /// [`far_table`].
-    pub(super) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
+    pub(in crate::render) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
         self.far = far_table(lods, self.meshes.len())?;
         Ok(())
     }
 
     /// Place the world props: `(mesh index, instance)`.
-    pub(super) fn set_instances(&mut self, instances: &[(usize, PropInstance)]) -> GpuResult<()> {
+    pub(in crate::render) fn set_instances(
+        &mut self,
+        instances: &[(usize, PropInstance)],
+    ) -> GpuResult<()> {
         self.check(instances)?;
         self.instances = instances.to_vec();
         Ok(())
     }
 
     /// Replace character `id`'s props (instances in its frame).
-    pub(super) fn set_attached(
+    pub(in crate::render) fn set_attached(
         &mut self,
         id: CharacterId,
         instances: &[(usize, PropInstance)],
@@ -233,7 +240,7 @@ impl Props {
     }
 
     /// Character `id`'s props placed at `model` (world transforms, in the order given).
-    pub(super) fn attached_models(&self, id: CharacterId, model: Mat4) -> Vec<Mat4> {
+    pub(in crate::render) fn attached_models(&self, id: CharacterId, model: Mat4) -> Vec<Mat4> {
         self.attached
             .iter()
             .filter(|(c, ..)| *c == id)
@@ -246,7 +253,10 @@ impl Props {
 /// its own far version, a mesh with two far versions, chains of far versions that loop or
 /// whose thresholds grow, and thresholds that are not finite and non-negative. A far version
 /// may have a far version of its own (a chain of coarser and coarser levels).
-pub(super) fn far_table(lods: &[PropLod], n: usize) -> GpuResult<Vec<Option<(usize, f32)>>> {
+pub(in crate::render) fn far_table(
+    lods: &[PropLod],
+    n: usize,
+) -> GpuResult<Vec<Option<(usize, f32)>>> {
     let mut far = vec![None; n];
     for l in lods {
         let bad = if l.mesh >= n || l.far_mesh >= n {
@@ -292,7 +302,7 @@ pub(super) fn far_table(lods: &[PropLod], n: usize) -> GpuResult<Vec<Option<(usi
 /// The mesh an instance of `mesh` (bounding sphere `(centre, radius)` in its own frame) at
 /// `model` is drawn with: down `far`'s chain of far versions while `camera` sees the sphere,
 /// scaled by the model's largest axis, smaller than the next version's pixel threshold.
-pub(super) fn far_choice(
+pub(in crate::render) fn far_choice(
     mesh: usize,
     far: &[Option<(usize, f32)>],
     (centre, radius): (Vec3, f32),
@@ -317,7 +327,7 @@ pub(super) fn far_choice(
 
 /// Order instances by mesh, each mesh's nearest `eye` first, so the depth test spares the
 /// shading of what nearer ones hide (`props.frag` tests depth before shading).
-pub(super) fn sort_nearest_first(instances: &mut [(usize, PropInstance)], eye: Vec3) {
+pub(in crate::render) fn sort_nearest_first(instances: &mut [(usize, PropInstance)], eye: Vec3) {
     let distance = |i: &PropInstance| eye.distance_squared(Vec3::from_slice(&i.model[3][..3]));
     instances.sort_by(|a, b| {
         a.0.cmp(&b.0)
@@ -327,7 +337,7 @@ pub(super) fn sort_nearest_first(instances: &mut [(usize, PropInstance)], eye: V
 
 /// A bounding sphere (centre, radius) of a mesh placed at `model`, in world space (the
 /// radius scaled by the model's largest axis scale).
-pub(super) fn world_sphere(model: &Mat4, (centre, radius): (Vec3, f32)) -> (Vec3, f32) {
+pub(in crate::render) fn world_sphere(model: &Mat4, (centre, radius): (Vec3, f32)) -> (Vec3, f32) {
     let scale = model
         .x_axis
         .truncate()

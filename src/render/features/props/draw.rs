@@ -5,7 +5,8 @@
 
 use std::sync::Arc;
 
-use super::{DrawTarget, PassSets, vertex_pipeline};
+use crate::render::core::binding::PassSets;
+use crate::render::core::pipelines::{DrawTarget, vertex_pipeline};
 use crate::vk::{CommandRecorder, Context, GpuResult, Pipeline, PipelineLayout};
 
 /// One instanced draw: a mesh's vertex range and a run of instances.

@@ -9,10 +9,10 @@ use std::sync::Arc;
 use ash::vk;
 use glam::{Mat4, Vec3};
 
-use super::core::shared::{PropInstance, SKIN_GROUP_SIZE, SkinJob, SkinRestVertex};
-use super::crowd::CharacterId;
-use super::passes::props::PropDraw;
-use super::prop_table::{Projection, PropLod};
+use super::draw::PropDraw;
+use super::{Projection, PropLod};
+use crate::render::core::ids::CharacterId;
+use crate::render::core::shared::{PropInstance, SKIN_GROUP_SIZE, SkinJob, SkinRestVertex};
 use crate::skin::SkinnedMesh;
 use crate::vk::{Buffer, Context, GpuError, GpuResult};
 
@@ -41,7 +41,7 @@ struct Wearer {
 
 /// This frame's skinning: jobs, matrices, posed vertices, and the instances and draws.
 #[derive(Default)]
-pub(super) struct SkinWork {
+pub(in crate::render) struct SkinWork {
     pub jobs: Vec<SkinJob>,
     pub matrices: Vec<[[f32; 4]; 4]>,
     pub vertices: u32,
@@ -51,7 +51,7 @@ pub(super) struct SkinWork {
 
 /// Upper bounds of a frame's skinning ([`SkinnedProps::capacity`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(super) struct SkinCapacity {
+pub(in crate::render) struct SkinCapacity {
     pub instances: u32,
     pub jobs: u32,
     pub matrices: u32,
@@ -79,9 +79,9 @@ fn push_jobs(work: &mut SkinWork, r: &MeshRange, matrix_first: u32) {
 
 /// Skinned meshes and the characters wearing them.
 #[derive(Default)]
-pub(super) struct SkinnedProps {
-    pub(super) rest: Option<Buffer>,
-    pub(super) indices: Option<Buffer>,
+pub(in crate::render) struct SkinnedProps {
+    pub(in crate::render) rest: Option<Buffer>,
+    pub(in crate::render) indices: Option<Buffer>,
     meshes: Vec<MeshRange>,
     far: Vec<Option<(usize, f32)>>,
     wearers: HashMap<CharacterId, Wearer>,
@@ -121,7 +121,7 @@ fn rest_vertex(v: &crate::skin::SkinVertex) -> SkinRestVertex {
 
 impl SkinnedProps {
     /// Replace the skinned meshes (forgetting what characters wear); returns the old buffers.
-    pub(super) fn set_meshes(
+    pub(in crate::render) fn set_meshes(
         &mut self,
         ctx: &Arc<Context>,
         meshes: &[SkinnedMesh],
@@ -177,14 +177,14 @@ impl SkinnedProps {
     }
 
     /// Give skinned meshes far versions (checked as the static props' are).
-    pub(super) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
-        self.far = super::prop_table::far_table(lods, self.meshes.len())?;
+    pub(in crate::render) fn set_lods(&mut self, lods: &[PropLod]) -> GpuResult<()> {
+        self.far = super::far_table(lods, self.meshes.len())?;
         Ok(())
     }
 
     /// Character `id` wears `parts` (`(mesh, linear colour)`) over a skeleton of `joints`
     /// (posed at rest until [`Self::set_pose`]); no parts: it wears nothing skinned.
-    pub(super) fn set_wearer(
+    pub(in crate::render) fn set_wearer(
         &mut self,
         id: CharacterId,
         parts: &[(usize, [f32; 4])],
@@ -216,7 +216,7 @@ impl SkinnedProps {
 
     /// Character `id`'s body placement and skin matrices for the next frame (one per joint,
     /// all finite).
-    pub(super) fn set_pose(
+    pub(in crate::render) fn set_pose(
         &mut self,
         id: CharacterId,
         body: Mat4,
@@ -242,19 +242,19 @@ impl SkinnedProps {
     }
 
     /// Forget character `id`.
-    pub(super) fn remove(&mut self, id: CharacterId) {
+    pub(in crate::render) fn remove(&mut self, id: CharacterId) {
         self.wearers.remove(&id);
     }
 
     /// Character `id`'s body placement and skin matrices as last set.
-    pub(super) fn pose(&self, id: CharacterId) -> Option<(Mat4, &[Mat4])> {
+    pub(in crate::render) fn pose(&self, id: CharacterId) -> Option<(Mat4, &[Mat4])> {
         self.wearers
             .get(&id)
             .map(|w| (w.body, w.matrices.as_slice()))
     }
 
     /// Upper bounds of a frame's instances, skinning jobs, matrices and posed vertices.
-    pub(super) fn capacity(&self) -> SkinCapacity {
+    pub(in crate::render) fn capacity(&self) -> SkinCapacity {
         let mut out = SkinCapacity::default();
         for w in self.wearers.values() {
             // Each part twice: the camera's instance and the light's.
@@ -280,7 +280,7 @@ impl SkinnedProps {
     /// (`light_draws`; coarser far versions where `light`'s map sees a body smaller than the
     /// camera does, posed alongside). Characters are taken in slot order, so frames are
     /// repeatable.
-    pub(super) fn frame_lists(
+    pub(in crate::render) fn frame_lists(
         &self,
         model_of: impl Fn(CharacterId) -> Option<(Mat4, Mat4)>,
         (camera, light): (&Projection, Option<&Projection>),
@@ -325,7 +325,7 @@ impl SkinnedProps {
                 });
             }
         }
-        super::prop_table::sort_nearest_first(&mut placed, camera.eye);
+        super::sort_nearest_first(&mut placed, camera.eye);
         self.push_draws(&placed, records, draws);
         if light.is_some() {
             cast.sort_by_key(|(mesh, _)| *mesh);
@@ -339,7 +339,7 @@ impl SkinnedProps {
     /// World bounding spheres of the drawn characters' (`model_of`: `None` hidden) skinned
     /// meshes, each part at its body placement (bind-pose spheres, widened by a fifth for the
     /// pose).
-    pub(super) fn character_spheres(
+    pub(in crate::render) fn character_spheres(
         &self,
         model_of: &impl Fn(CharacterId) -> Option<Mat4>,
     ) -> Vec<(Vec3, f32)> {
@@ -350,10 +350,7 @@ impl SkinnedProps {
             }
             for &(mesh, _) in &w.parts {
                 let r = &self.meshes[mesh];
-                out.push(super::prop_table::world_sphere(
-                    &w.body,
-                    (r.centre, r.radius),
-                ));
+                out.push(super::world_sphere(&w.body, (r.centre, r.radius)));
             }
         }
         out
@@ -393,7 +390,7 @@ impl SkinnedProps {
     /// one of its far versions): `drawn` or a coarser one down its chain.
     fn coarser_for(&self, mesh: usize, drawn: usize, model: &Mat4, view: &Projection) -> usize {
         let r = self.meshes[mesh];
-        super::prop_table::far_choice(drawn, &self.far, (r.centre, r.radius), model, view)
+        super::far_choice(drawn, &self.far, (r.centre, r.radius), model, view)
     }
 }
 
