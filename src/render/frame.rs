@@ -192,14 +192,19 @@ impl Frames {
         Ok(())
     }
 
+    /// The index of the frame slot the newest submitted frame used.
+    fn last_index(&self) -> usize {
+        (self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT
+    }
+
     /// The frame slot the newest submitted frame used.
     pub(super) fn last_slot(&self) -> &FrameSlot {
-        &self.slots[(self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT]
+        &self.slots[self.last_index()]
     }
 
     /// Release `r` after the newest submitted frame completes (now if none is pending).
     pub(super) fn retire(&mut self, crowd: &mut Crowd, r: Retired) {
-        let last = (self.next + FRAMES_IN_FLIGHT - 1) % FRAMES_IN_FLIGHT;
+        let last = self.last_index();
         if self.slots[last].pending.is_some() {
             self.slots[last].retired.push(r);
         } else if let Retired::CharacterSlot(s) = r {
@@ -227,15 +232,13 @@ impl Frames {
 
     /// Wait for a submitted frame and return its report.
     pub fn wait(&mut self, crowd: &mut Crowd, ticket: FrameTicket) -> GpuResult<FrameReport> {
-        let pending_is = |slot: &FrameSlot, f: &dyn Fn(u64) -> bool| {
-            slot.pending.as_ref().is_some_and(|p| f(p.frame))
-        };
-        if let Some(i) =
-            (0..FRAMES_IN_FLIGHT).find(|&i| pending_is(&self.slots[i], &|f| f == ticket.0))
+        // The frame pending in slot `i`, if any.
+        let pending = |slots: &[FrameSlot], i: usize| slots[i].pending.as_ref().map(|p| p.frame);
+        if let Some(i) = (0..FRAMES_IN_FLIGHT).find(|&i| pending(&self.slots, i) == Some(ticket.0))
         {
             // Frames complete in order: retire the older pending frame first.
             let other = (i + 1) % FRAMES_IN_FLIGHT;
-            if pending_is(&self.slots[other], &|f| f < ticket.0) {
+            if pending(&self.slots, other).is_some_and(|f| f < ticket.0) {
                 self.retire_slot(crowd, other)?;
             }
             self.retire_slot(crowd, i)?;
